@@ -1,0 +1,160 @@
+//! Counting layers: by the slicer's markers when the file has them, else by Z.
+//!
+//! Both counts are kept during the single pass (a file's markers may start late), and the
+//! marker count wins if there is one. Without markers a new layer starts when extrusion happens
+//! at a new Z on a flat move after Z changed on a travel, as planar slicers print. On
+//! continuous-Z moves (spiral vase, FullControl designs, non-planar paths) every point has its
+//! own Z, so a layer is one turn of the path instead: a new layer starts each time the printing
+//! direction has turned through a full 360°. A helix is then as many layers as it has turns,
+//! not one layer per point.
+
+use super::report::{LayerSource, LayerSummary};
+use crate::gcode::LayerMarkerKind;
+use crate::machine::{axis, Move};
+use std::f64::consts::{PI, TAU};
+
+/// Smallest Z difference that counts as a new layer on flat moves, mm.
+const Z_EPS: f64 = 1e-4;
+
+#[derive(Debug, Default)]
+struct Count {
+    layers: Vec<LayerSummary>,
+}
+
+impl Count {
+    fn start(&mut self, line: u32, z: Option<f64>) {
+        let index = self.layers.len() as u64;
+        self.layers.push(LayerSummary {
+            index,
+            z,
+            line,
+            moves: 0,
+            extrude_distance_mm: 0.0,
+            travel_distance_mm: 0.0,
+            filament_mm: 0.0,
+            time_s: 0.0,
+        });
+    }
+
+    fn add(&mut self, m: &Move, time_s: f64) {
+        if let Some(l) = self.layers.last_mut() {
+            l.moves += 1;
+            if m.is_extruding() {
+                l.extrude_distance_mm += m.length_mm;
+                if l.z.is_none() {
+                    l.z = Some(m.to[axis::Z]);
+                }
+            } else {
+                l.travel_distance_mm += m.length_mm;
+            }
+            l.filament_mm += m.extrusion();
+            l.time_s += time_s;
+        }
+    }
+}
+
+/// Tracks layers from markers and from Z at once.
+#[derive(Debug)]
+pub struct LayerTracker {
+    marker_kind: Option<LayerMarkerKind>,
+    by_marker: Count,
+    by_z: Count,
+    z_layer: Option<f64>,
+    z_last: Option<f64>,
+    /// Heading of the last printing move, radians (None after a travel).
+    heading: Option<f64>,
+    /// Signed turning of the printing direction since the layer started, radians.
+    turned: f64,
+}
+
+impl LayerTracker {
+    /// An empty tracker.
+    pub fn new() -> Self {
+        Self {
+            marker_kind: None,
+            by_marker: Count::default(),
+            by_z: Count::default(),
+            z_layer: None,
+            z_last: None,
+            heading: None,
+            turned: 0.0,
+        }
+    }
+
+    /// A layer marker at `line`. Markers of a family other than the file's first are ignored.
+    pub fn marker(&mut self, kind: LayerMarkerKind, z: Option<f64>, line: u32) {
+        match self.marker_kind {
+            None => self.marker_kind = Some(kind),
+            Some(k) if k != kind => return,
+            _ => {}
+        }
+        self.by_marker.start(line, z);
+    }
+
+    /// A move with its time.
+    pub fn motion(&mut self, m: &Move, time_s: f64) {
+        if m.is_extruding() {
+            let z = m.to[axis::Z];
+            let z_start = m.from[axis::Z];
+            let dx = m.to[axis::X] - m.from[axis::X];
+            let dy = m.to[axis::Y] - m.from[axis::Y];
+            let heading = (dx.hypot(dy) > 1e-9).then(|| dy.atan2(dx));
+            let new_layer = match (self.z_layer, self.z_last) {
+                (Some(zl), Some(last)) => {
+                    if (z - z_start).abs() <= Z_EPS {
+                        // Flat move: a new layer if Z changed off the print (on a travel) to a
+                        // new height, as planar slicers do between layers.
+                        (z_start - last).abs() > Z_EPS && (z - zl).abs() > Z_EPS
+                    } else {
+                        // Continuous Z: a new layer after each full turn of the path.
+                        if let (Some(prev), Some(h)) = (self.heading, heading) {
+                            self.turned += wrap_angle(h - prev);
+                        }
+                        self.turned.abs() >= TAU
+                    }
+                }
+                _ => true,
+            };
+            if heading.is_some() {
+                self.heading = heading;
+            }
+            self.z_last = Some(z);
+            if new_layer {
+                self.turned = 0.0;
+                self.z_layer = Some(z);
+                self.by_z.start(m.line, Some(z));
+            }
+        } else if m.length_mm > 1e-9 {
+            self.heading = None;
+        }
+        self.by_marker.add(m, time_s);
+        self.by_z.add(m, time_s);
+    }
+
+    /// Time spent outside moves (dwell) goes to the current layer.
+    pub fn dwell(&mut self, secs: f64) {
+        for c in [&mut self.by_marker, &mut self.by_z] {
+            if let Some(l) = c.layers.last_mut() {
+                l.time_s += secs;
+            }
+        }
+    }
+
+    /// The layer list and how it was counted.
+    pub fn finish(self) -> (Vec<LayerSummary>, LayerSource) {
+        match self.marker_kind {
+            Some(kind) => (self.by_marker.layers, LayerSource::Markers(kind)),
+            None => (self.by_z.layers, LayerSource::ZChanges),
+        }
+    }
+}
+
+/// Wraps an angle difference into (-π, π].
+fn wrap_angle(a: f64) -> f64 {
+    let w = (a + PI).rem_euclid(TAU) - PI;
+    if w <= -PI {
+        w + TAU
+    } else {
+        w
+    }
+}

@@ -1,0 +1,183 @@
+//! The analysis report: the JSON contract shared by the CLI (`analyze --json`), the JS API and
+//! the playground. Field names are stable; new fields are added, never renamed.
+
+use serde::Serialize;
+
+use crate::error::Warning;
+use crate::gcode::{FeatureKind, LayerMarkerKind};
+use crate::machine::{ExtrusionMode, Heater, ModeSource};
+
+/// Everything `analyze` says about a file.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Report {
+    /// quietpath version that made the report.
+    pub version: String,
+    /// Facts about the file itself.
+    pub file: FileInfo,
+    /// Estimated print time, s (nominal: path length over feed rate, plus dwells).
+    pub time_s: f64,
+    /// How `time_s` was computed.
+    pub time_model: String,
+    /// Motion commands that moved something (XYZ, rotary axes or the extruder).
+    pub moves: u64,
+    /// Of those, moves that laid down material.
+    pub extruding_moves: u64,
+    /// Layers printed.
+    pub layers: u64,
+    /// How layers were counted.
+    pub layer_source: LayerSource,
+    /// Tool-tip path length, mm (printing and travel).
+    pub distance_mm: f64,
+    /// Path length while extruding, mm.
+    pub extrude_distance_mm: f64,
+    /// Path length without extruding, mm.
+    pub travel_distance_mm: f64,
+    /// Net filament pushed into the nozzle, mm (retractions cancel their recoveries).
+    pub filament_mm: f64,
+    /// Filament volume, mm³.
+    pub filament_volume_mm3: f64,
+    /// Filament mass, g.
+    pub material_g: f64,
+    /// Retraction moves (E going back), including firmware retraction.
+    pub retractions: u64,
+    /// Extrusion settings used.
+    pub extrusion: ExtrusionInfo,
+    /// Bounding box of the printed (extruded) path, or `null` if nothing was extruded.
+    pub bounds: Option<Bounds>,
+    /// Per-feature totals, in order of first appearance; travel last.
+    pub features: Vec<FeatureSummary>,
+    /// Per-layer totals.
+    pub layer_list: Vec<LayerSummary>,
+    /// Heater targets over time.
+    pub temperatures: Vec<TemperatureEvent>,
+    /// Part-cooling fan speeds over time.
+    pub fans: Vec<FanEvent>,
+    /// Energy models (filled by the energy module).
+    pub energy: Energy,
+    /// Toolpath metrics (filled by the VTG module).
+    pub toolpath: Toolpath,
+    /// Problems found, with their line numbers (at most 1000; see `warnings_dropped`).
+    pub warnings: Vec<Warning>,
+    /// Warnings counted beyond the ones listed.
+    pub warnings_dropped: u64,
+}
+
+/// Facts about the input file.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FileInfo {
+    /// Size, bytes.
+    pub bytes: u64,
+    /// Number of lines.
+    pub lines: u64,
+    /// Slicer that wrote it, from its header.
+    pub slicer: Option<String>,
+    /// Firmware flavour declared in the file.
+    pub flavor: Option<String>,
+}
+
+/// Extrusion settings used for filament and mass.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ExtrusionInfo {
+    /// Mode the file starts in.
+    pub mode: ExtrusionMode,
+    /// Where that mode came from.
+    pub source: ModeSource,
+    /// Filament diameter, mm.
+    pub filament_diameter_mm: f64,
+    /// Filament density, g/cm³.
+    pub density_g_cm3: f64,
+}
+
+/// How the layer count was obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "method", content = "marker")]
+pub enum LayerSource {
+    /// From the slicer's own layer-change comments.
+    Markers(LayerMarkerKind),
+    /// From changes of Z while extruding (no markers in the file).
+    ZChanges,
+}
+
+/// Axis-aligned bounding box.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Bounds {
+    /// Minimum X, Y, Z, mm.
+    pub min: [f64; 3],
+    /// Maximum X, Y, Z, mm.
+    pub max: [f64; 3],
+}
+
+/// Totals for one printed feature (as named by the slicer), or for travel.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FeatureSummary {
+    /// Name as the slicer wrote it (`travel` for non-printing moves, `unmarked` when the file
+    /// names no features).
+    pub name: String,
+    /// Canonical kind (`null` for travel).
+    pub kind: Option<FeatureKind>,
+    /// Moves.
+    pub moves: u64,
+    /// Path length, mm.
+    pub distance_mm: f64,
+    /// Net filament, mm.
+    pub filament_mm: f64,
+    /// Time, s (same model as `time_s`).
+    pub time_s: f64,
+}
+
+/// Totals for one layer.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LayerSummary {
+    /// 0-based layer index.
+    pub index: u64,
+    /// Z of the layer, mm (the marker's, else the first extrusion's).
+    pub z: Option<f64>,
+    /// 1-based line where the layer starts.
+    pub line: u32,
+    /// Moves in the layer.
+    pub moves: u64,
+    /// Path length while extruding, mm.
+    pub extrude_distance_mm: f64,
+    /// Path length of travel, mm.
+    pub travel_distance_mm: f64,
+    /// Net filament, mm.
+    pub filament_mm: f64,
+    /// Time, s.
+    pub time_s: f64,
+}
+
+/// A heater target set at some point of the print.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TemperatureEvent {
+    /// 1-based line.
+    pub line: u32,
+    /// Print time at that line, s.
+    pub time_s: f64,
+    /// Which heater.
+    pub heater: Heater,
+    /// Target, °C.
+    pub target_c: f64,
+    /// Whether the printer waits for it.
+    pub wait: bool,
+}
+
+/// A fan speed set at some point of the print.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FanEvent {
+    /// 1-based line.
+    pub line: u32,
+    /// Print time at that line, s.
+    pub time_s: f64,
+    /// Fan index.
+    pub index: u16,
+    /// Speed, 0..=1.
+    pub speed: f64,
+}
+
+/// Energy figures; filled in by the energy models.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Energy {}
+
+/// Toolpath metrics; filled in by the VTG module.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Toolpath {}

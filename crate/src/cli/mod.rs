@@ -1,0 +1,172 @@
+//! The `quietpath` command-line tool: a thin shell over the library. Every subcommand's
+//! `--json` output is the serde form of the same type the JS API returns.
+
+mod bench;
+mod output;
+mod table;
+
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+
+use quietpath::analyze::{analyze_with_progress, AnalyzeOptions, ExtrusionModeOption};
+use quietpath::error::Warnings;
+use quietpath::gcode::{self, Strictness};
+
+/// Quieter, cheaper 3D-printer toolpaths.
+#[derive(Debug, Parser)]
+#[command(name = "quietpath", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Cmd,
+}
+
+#[derive(Debug, Subcommand)]
+enum Cmd {
+    /// Time, distance, filament, layers and features of a G-code file.
+    Analyze {
+        /// G-code file to read.
+        file: PathBuf,
+        /// Print the report as JSON (the same object the JS API returns).
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        opts: AnalyzeArgs,
+    },
+    /// Parse and re-emit a file: byte-identical when nothing is changed.
+    Rewrite {
+        /// G-code file to read.
+        file: PathBuf,
+        /// Where to write (atomically: a temporary file, then a rename).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Stop at the first malformed line instead of passing it through with a warning.
+        #[arg(long)]
+        strict: bool,
+        /// Allow the output to replace the input file.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Measure parsing and analysis throughput on a file.
+    Bench {
+        /// G-code file to read.
+        file: PathBuf,
+        /// Repetitions (the best is reported).
+        #[arg(long, default_value_t = 5)]
+        runs: u32,
+        /// Print the figures as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Debug, clap::Args)]
+struct AnalyzeArgs {
+    /// Stop at the first malformed line instead of warning.
+    #[arg(long)]
+    strict: bool,
+    /// Filament diameter, mm (default: from the file, else 1.75).
+    #[arg(long, value_name = "MM")]
+    filament_diameter: Option<f64>,
+    /// Filament density, g/cm³ (default: from the file, else 1.24 for PLA).
+    #[arg(long, value_name = "G_CM3")]
+    density: Option<f64>,
+    /// Starting extrusion mode (default: from M82/M83, else inferred from the E values).
+    #[arg(long, value_enum)]
+    extrusion: Option<ExtrusionArg>,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum ExtrusionArg {
+    Absolute,
+    Relative,
+}
+
+impl AnalyzeArgs {
+    fn options(&self) -> AnalyzeOptions {
+        AnalyzeOptions {
+            strict: self.strict,
+            filament_diameter_mm: self.filament_diameter,
+            density_g_cm3: self.density,
+            extrusion_mode: self.extrusion.map(|e| match e {
+                ExtrusionArg::Absolute => ExtrusionModeOption::Absolute,
+                ExtrusionArg::Relative => ExtrusionModeOption::Relative,
+            }),
+        }
+    }
+}
+
+/// Files at least this big get a progress bar (when stderr is a terminal).
+const PROGRESS_MIN_BYTES: usize = 4 << 20;
+
+/// Runs the CLI.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(msg) => {
+            eprintln!("error: {msg}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn read(path: &Path) -> Result<Vec<u8>, String> {
+    std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+fn run(cli: Cli) -> Result<(), String> {
+    match cli.command {
+        Cmd::Analyze { file, json, opts } => {
+            let input = read(&file)?;
+            let mut bar = output::ProgressBar::new(
+                input.len() >= PROGRESS_MIN_BYTES && std::io::stderr().is_terminal(),
+            );
+            let report = analyze_with_progress(&input, &opts.options(), &mut |f| bar.update(f))
+                .map_err(|e| format!("{}:{}", file.display(), e))?;
+            bar.finish();
+            let mut stdout = std::io::stdout().lock();
+            if json {
+                output::write_json(&mut stdout, &report)?;
+            } else {
+                table::write_report(&mut stdout, &file, &report).map_err(|e| e.to_string())?;
+            }
+            stdout.flush().map_err(|e| e.to_string())
+        }
+        Cmd::Rewrite {
+            file,
+            output,
+            strict,
+            force,
+        } => {
+            let input = read(&file)?;
+            let strictness = if strict {
+                Strictness::Strict
+            } else {
+                Strictness::Lenient
+            };
+            let mut warnings = Warnings::default();
+            gcode::for_each_line(&input, strictness, &mut warnings, |_, _, _| Ok(()))
+                .map_err(|e| format!("{}:{}", file.display(), e))?;
+            for w in warnings.list() {
+                eprintln!("warning: {}:{}: {}", file.display(), w.line, w.message);
+            }
+            output::write_atomically(&file, &output, force, |out| {
+                gcode::write_with_edits(&input, &[], out)
+            })
+        }
+        Cmd::Bench { file, runs, json } => {
+            let input = read(&file)?;
+            let figures = bench::run(&input, runs.max(1)).map_err(|e| e.to_string())?;
+            let mut stdout = std::io::stdout().lock();
+            if json {
+                output::write_json(&mut stdout, &figures)?;
+            } else {
+                bench::print(&mut stdout, &file, &figures).map_err(|e| e.to_string())?;
+            }
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,170 @@
+//! Typed errors and warnings.
+//!
+//! Every problem found in a G-code file is tied to a 1-based line and column so that a user
+//! can jump to it in an editor. In lenient mode (the default) problems become [`Warning`]s and
+//! the offending line is passed through untouched; in strict mode the first one is returned as
+//! an [`Error`].
+
+use serde::Serialize;
+
+/// What went wrong, independent of where.
+#[derive(Debug, Clone, PartialEq, thiserror::Error, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum ErrorKind {
+    /// A word letter was followed by something that is not a number (`X1.2.3`, `Yabc`).
+    #[error("invalid number after '{letter}'")]
+    InvalidNumber {
+        /// The word letter, upper case.
+        letter: char,
+    },
+    /// A number that overflows to infinity or is spelled `nan`/`inf`.
+    #[error("non-finite number after '{letter}'")]
+    NonFiniteNumber {
+        /// The word letter, upper case.
+        letter: char,
+    },
+    /// A byte that has no meaning in G-code outside a comment.
+    #[error("unexpected character {found:?}")]
+    UnexpectedCharacter {
+        /// The offending character (bytes above 0x7f are shown as U+FFFD).
+        found: char,
+    },
+    /// A `( ...` comment that is never closed on its line.
+    #[error("unclosed '(' comment")]
+    UnclosedComment,
+    /// `*nn` does not match the XOR of the bytes before it.
+    #[error("checksum mismatch: line says {found}, computed {computed}")]
+    ChecksumMismatch {
+        /// The checksum written in the line.
+        found: u32,
+        /// The checksum computed from the line.
+        computed: u8,
+    },
+    /// More words on one line than the parser keeps (a hostile or corrupted line).
+    #[error("too many words on one line (more than {max})")]
+    TooManyWords {
+        /// The limit.
+        max: usize,
+    },
+    /// The same word given twice (`G1 X1 X2`); the last one wins in lenient mode.
+    #[error("word '{letter}' given twice")]
+    DuplicateWord {
+        /// The repeated letter.
+        letter: char,
+    },
+    /// An arc whose geometry is impossible (zero radius, an `R` arc shorter than its chord...).
+    #[error("invalid arc: {reason}")]
+    InvalidArc {
+        /// Why.
+        reason: &'static str,
+    },
+    /// The file is UTF-16 encoded (G-code is ASCII / UTF-8).
+    #[error("file is UTF-16 encoded; G-code must be ASCII or UTF-8 (re-save it as UTF-8)")]
+    Utf16,
+    /// The input is not text (NUL bytes in the middle of a line).
+    #[error("binary data (NUL byte) in a G-code line")]
+    Binary,
+    /// A line longer than the parser accepts for a command (comments may be any length).
+    #[error("command line longer than {max} bytes")]
+    LineTooLong {
+        /// The limit.
+        max: usize,
+    },
+    /// An option value is out of range.
+    #[error("invalid option: {reason}")]
+    InvalidOption {
+        /// Why.
+        reason: &'static str,
+    },
+    /// The job was cancelled by the caller.
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// An error tied to its position in the input.
+#[derive(Debug, Clone, PartialEq, thiserror::Error, Serialize)]
+#[error("line {line}, column {column}: {kind}")]
+pub struct Error {
+    /// 1-based line number in the file (0 when not tied to a line).
+    pub line: u32,
+    /// 1-based column (byte offset in the line + 1; 0 when not tied to a column).
+    pub column: u32,
+    /// What went wrong.
+    pub kind: ErrorKind,
+}
+
+impl Error {
+    /// An error at `line`/`column`.
+    pub fn new(line: u32, column: u32, kind: ErrorKind) -> Self {
+        Self { line, column, kind }
+    }
+}
+
+/// A non-fatal problem, reported with its line so the user can look at it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(not(target_arch = "wasm32"), derive(serde::Deserialize))]
+pub struct Warning {
+    /// 1-based line number (0 for file-level remarks).
+    pub line: u32,
+    /// Human-readable message.
+    pub message: String,
+}
+
+impl From<&Error> for Warning {
+    fn from(e: &Error) -> Self {
+        Warning {
+            line: e.line,
+            message: format!("column {}: {}", e.column, e.kind),
+        }
+    }
+}
+
+/// Collects warnings with a cap, so that a hostile file with millions of bad lines produces a
+/// bounded report (the count of dropped warnings is kept).
+#[derive(Debug, Default, Clone)]
+pub struct Warnings {
+    list: Vec<Warning>,
+    dropped: u64,
+}
+
+impl Warnings {
+    /// Most warnings kept in a report; the rest are only counted.
+    pub const MAX_KEPT: usize = 1000;
+
+    /// Adds a warning (or counts it once the cap is reached).
+    pub fn push(&mut self, line: u32, message: impl Into<String>) {
+        if self.list.len() < Self::MAX_KEPT {
+            self.list.push(Warning {
+                line,
+                message: message.into(),
+            });
+        } else {
+            self.dropped += 1;
+        }
+    }
+
+    /// Adds a positioned error as a warning.
+    pub fn push_error(&mut self, e: &Error) {
+        if self.list.len() < Self::MAX_KEPT {
+            self.list.push(Warning::from(e));
+        } else {
+            self.dropped += 1;
+        }
+    }
+
+    /// The kept warnings, in file order.
+    pub fn list(&self) -> &[Warning] {
+        &self.list
+    }
+
+    /// How many warnings were counted but not kept.
+    pub fn dropped(&self) -> u64 {
+        self.dropped
+    }
+
+    /// Splits into the kept list and the dropped count.
+    pub fn into_parts(self) -> (Vec<Warning>, u64) {
+        (self.list, self.dropped)
+    }
+}

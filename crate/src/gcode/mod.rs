@@ -1,0 +1,68 @@
+//! The G-code engine's text layer: lines, words, slicer dialects and lossless writing.
+//!
+//! Everything here borrows from the input buffer; a parsed line costs no allocation.
+
+pub mod dialect;
+pub mod line;
+pub mod lines;
+pub mod writer;
+
+pub use dialect::{
+    classify_comment, feature_kind, FeatureKind, LayerMarkerKind, Marker, SlicerInfo,
+};
+pub use line::{parse_line, parse_line_into, Code, Command, Line, LineError, Params};
+pub use lines::{looks_like_utf16, Lines, RawLine};
+pub use writer::{apply_edits, write_with_edits, Edit};
+
+use crate::error::{Error, ErrorKind, Warnings};
+
+/// How to treat malformed lines.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Strictness {
+    /// A malformed line becomes a warning with its line number and is passed through.
+    #[default]
+    Lenient,
+    /// The first malformed line is an error.
+    Strict,
+}
+
+/// Parses every line of `input`, calling `each` with the raw line and its parse (`None` for a
+/// malformed line in lenient mode, after recording a warning) and the warning list.
+///
+/// This is the streaming entry point shared by analysis, rewriting and the optimisers.
+pub fn for_each_line<'a, F>(
+    input: &'a [u8],
+    strictness: Strictness,
+    warnings: &mut Warnings,
+    mut each: F,
+) -> Result<(), Error>
+where
+    F: FnMut(&RawLine<'a>, Option<&Line<'a>>, &mut Warnings) -> Result<(), Error>,
+{
+    check_encoding(input)?;
+    let mut line = Line::default();
+    for raw in Lines::new(input) {
+        match parse_line_into(raw.text, &mut line) {
+            Ok(()) => each(&raw, Some(&line), warnings)?,
+            Err(e) => {
+                let err = Error::new(raw.number, e.column, e.kind);
+                if strictness == Strictness::Strict {
+                    return Err(err);
+                }
+                warnings.push_error(&err);
+                each(&raw, None, warnings)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Rejects inputs that are not G-code text at all (UTF-16). Binary noise is left to the line
+/// parser, which reports it line by line.
+pub fn check_encoding(input: &[u8]) -> Result<(), Error> {
+    if looks_like_utf16(input) {
+        return Err(Error::new(1, 1, ErrorKind::Utf16));
+    }
+    Ok(())
+}

@@ -1,0 +1,36 @@
+//! # quietpath
+//!
+//! Quieter, cheaper 3D-printer toolpaths. quietpath reads real G-code from every common slicer,
+//! models how the machine moves and how much energy it spends, and rewrites the toolpath to
+//! suppress vibration and save energy.
+//!
+//! The crate is one core with thin front ends: the `quietpath` command-line tool (native) and a
+//! WebAssembly binding (`wasm` module, compiled only for `wasm32`). Both return the same
+//! serde types, so a report is the same JSON wherever it comes from.
+//!
+//! ```
+//! let gcode = b"G21\nG90\nM83\nG1 X10 Y0 E0.5 F1200\nG1 X10 Y10 E0.5\n";
+//! let report = quietpath::analyze::analyze(gcode, &Default::default()).unwrap();
+//! assert_eq!(report.moves, 2);
+//! assert!((report.filament_mm - 1.0).abs() < 1e-12);
+//! assert!((report.distance_mm - 20.0).abs() < 1e-12);
+//! ```
+//!
+//! Modules:
+//! - [`gcode`]: zero-copy lines and words, slicer dialects, lossless writing.
+//! - [`machine`]: modal printer state, arcs, extrusion modes; turns lines into motion events.
+//! - [`analyze`]: one streaming pass giving the report.
+
+pub mod analyze;
+pub mod error;
+pub mod gcode;
+pub mod machine;
+
+#[cfg(target_arch = "wasm32")]
+pub mod wasm;
+
+pub use analyze::{analyze, AnalyzeOptions, Report};
+pub use error::{Error, ErrorKind, Warning};
+
+/// The crate version, reported in every report.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -1,0 +1,806 @@
+//! The printer's modal state, driven line by line: positions, modes, feed rate, overrides,
+//! temperatures and fans. Each command that does something physical becomes an [`Event`].
+//!
+//! Semantics follow Marlin and Klipper where they agree, and are documented where they do not:
+//! - `G90`/`G91` switch X, Y, Z and the extra axes; `G91` also makes E relative, and `G90`
+//!   returns E to the `M82`/`M83` mode (Klipper's rule; Marlin's differs only if `G90` comes
+//!   after `M83`, which slicers do not write).
+//! - `G0` moves at the modal feed rate like `G1` (both firmwares, by default).
+//! - `G28` sets the homed axes (all, if none named) to 0; homing time is not modelled.
+//! - `G10`/`G11` without `P`/`L` are firmware retraction with the `M207`/`M208` lengths.
+//! - `M220` scales feed rates, `M221` scales extrusion.
+
+pub mod arc;
+pub mod extrusion;
+
+use serde::Serialize;
+
+use crate::error::Warnings;
+use crate::gcode::{Code, Command, Line};
+pub use arc::{Arc, ArcSpec, Plane};
+pub use extrusion::{infer_extrusion_mode, ExtrusionInference, ExtrusionMode, ModeSource};
+
+/// Number of tracked axes: X, Y, Z, E, A, B, C, U, V, W.
+pub const AXES: usize = 10;
+/// Index of each axis in a [`Pos`].
+pub mod axis {
+    /// X.
+    pub const X: usize = 0;
+    /// Y.
+    pub const Y: usize = 1;
+    /// Z.
+    pub const Z: usize = 2;
+    /// Extruder (filament mm).
+    pub const E: usize = 3;
+    /// A (rotary, degrees).
+    pub const A: usize = 4;
+    /// B (rotary, degrees).
+    pub const B: usize = 5;
+    /// C (rotary, degrees).
+    pub const C: usize = 6;
+}
+/// Word letter of each axis index.
+pub const AXIS_LETTERS: [u8; AXES] = *b"XYZEABCUVW";
+const LINEAR: [bool; AXES] = [
+    true, true, true, true, false, false, false, true, true, true,
+];
+
+/// A position over all axes: mm for linear axes and E, degrees for A, B, C.
+pub type Pos = [f64; AXES];
+
+/// Default feed rate before any `F`, mm/s (Marlin's and Klipper's 1500 mm/min).
+pub const DEFAULT_FEED_MM_S: f64 = 25.0;
+/// Default firmware retraction length, mm (Marlin's `RETRACT_LENGTH`).
+pub const DEFAULT_RETRACT_MM: f64 = 3.0;
+/// Default firmware retraction speed, mm/s (Marlin's `RETRACT_FEEDRATE`).
+pub const DEFAULT_RETRACT_FEED_MM_S: f64 = 45.0;
+
+/// The kind of a motion.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "type")]
+pub enum MoveKind {
+    /// `G0`.
+    Rapid,
+    /// `G1`.
+    Linear,
+    /// `G2`/`G3`.
+    Arc(Arc),
+    /// `G10`/`G11` firmware retraction or recovery (E only).
+    FirmwareRetract,
+}
+
+/// One motion, in machine coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Move {
+    /// 1-based line of the command.
+    pub line: u32,
+    /// Kind of motion.
+    pub kind: MoveKind,
+    /// Start position (E: net filament pushed so far, after flow override).
+    pub from: Pos,
+    /// End position.
+    pub to: Pos,
+    /// Requested feed rate after the `M220` override, mm/s.
+    pub feed_mm_s: f64,
+    /// Tool-tip path length in X, Y, Z (helix length for arcs), mm.
+    pub length_mm: f64,
+}
+
+impl Move {
+    /// Filament pushed (negative for retraction), mm.
+    #[inline]
+    pub fn extrusion(&self) -> f64 {
+        self.to[axis::E] - self.from[axis::E]
+    }
+
+    /// Whether the move lays down material: it moves the tool and pushes filament.
+    #[inline]
+    pub fn is_extruding(&self) -> bool {
+        self.length_mm > 1e-9 && self.extrusion() > 1e-12
+    }
+
+    /// The distance the feed rate applies to: the XYZ path, else the rotary axes (degrees),
+    /// else the extruder (the rule of Marlin's planner).
+    pub fn feed_length(&self) -> f64 {
+        if self.length_mm > 1e-9 {
+            return self.length_mm;
+        }
+        let rot = (axis::A..=axis::C)
+            .map(|i| (self.to[i] - self.from[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        if rot > 1e-9 {
+            rot
+        } else {
+            self.extrusion().abs()
+        }
+    }
+
+    /// Time at the requested feed rate, ignoring acceleration, s.
+    pub fn nominal_time(&self) -> f64 {
+        let f = self.feed_mm_s;
+        if f > 0.0 {
+            self.feed_length() / f
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Which heater a temperature command addresses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Heater {
+    /// A hotend (`M104`/`M109`), with its tool index.
+    Hotend(u16),
+    /// The bed (`M140`/`M190`).
+    Bed,
+    /// The chamber (`M141`/`M191`).
+    Chamber,
+}
+
+/// Something physical a line does.
+///
+/// Events are short-lived values returned per line; boxing the large `Move` variant would cost
+/// an allocation per move for no gain.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Event {
+    /// A motion.
+    Move(Move),
+    /// `G4`: wait, s.
+    Dwell(f64),
+    /// A heater target; `wait` for `M109`/`M190`/`M191`.
+    Temperature {
+        /// Which heater.
+        heater: Heater,
+        /// Target, °C.
+        target_c: f64,
+        /// Whether the printer waits for it.
+        wait: bool,
+    },
+    /// A part-cooling fan speed, 0..=1.
+    Fan {
+        /// Fan index (`P`).
+        index: u16,
+        /// Speed fraction.
+        speed: f64,
+    },
+    /// `G28`: the named axes (bit `i` for axis index `i`) were homed.
+    Home(u16),
+}
+
+/// Settings of the state machine.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MachineConfig {
+    /// Extrusion mode at the start of the file.
+    pub extrusion: ExtrusionMode,
+    /// Firmware retraction length before any `M207`, mm.
+    pub retract_mm: f64,
+    /// Firmware retraction speed before any `M207`, mm/s.
+    pub retract_feed_mm_s: f64,
+}
+
+impl Default for MachineConfig {
+    fn default() -> Self {
+        Self {
+            extrusion: ExtrusionMode::Absolute,
+            retract_mm: DEFAULT_RETRACT_MM,
+            retract_feed_mm_s: DEFAULT_RETRACT_FEED_MM_S,
+        }
+    }
+}
+
+/// The modal state of the printer.
+#[derive(Debug, Clone)]
+pub struct Machine {
+    /// Logical position (what G-code coordinates refer to, after `G92`).
+    logical: Pos,
+    /// Machine position (continuous across `G92`; E accumulates net filament after flow).
+    physical: Pos,
+    relative_axes: bool,
+    e_mode: ExtrusionMode,
+    inches: bool,
+    plane: Plane,
+    feed_mm_s: f64,
+    speed_factor: f64,
+    flow_factor: f64,
+    retracted: bool,
+    retract_mm: f64,
+    retract_feed_mm_s: f64,
+    unretract_extra_mm: f64,
+    unretract_feed_mm_s: f64,
+    tool: u16,
+}
+
+impl Default for Machine {
+    fn default() -> Self {
+        Self::new(MachineConfig::default())
+    }
+}
+
+impl Machine {
+    /// A machine at the origin in the configured modes.
+    pub fn new(config: MachineConfig) -> Self {
+        Self {
+            logical: [0.0; AXES],
+            physical: [0.0; AXES],
+            relative_axes: false,
+            e_mode: config.extrusion,
+            inches: false,
+            plane: Plane::Xy,
+            feed_mm_s: DEFAULT_FEED_MM_S,
+            speed_factor: 1.0,
+            flow_factor: 1.0,
+            retracted: false,
+            retract_mm: config.retract_mm,
+            retract_feed_mm_s: config.retract_feed_mm_s,
+            unretract_extra_mm: 0.0,
+            unretract_feed_mm_s: config.retract_feed_mm_s,
+            tool: 0,
+        }
+    }
+
+    /// Current machine position.
+    pub fn position(&self) -> &Pos {
+        &self.physical
+    }
+
+    /// Current logical (G-code) position.
+    pub fn logical_position(&self) -> &Pos {
+        &self.logical
+    }
+
+    /// Extrusion mode in force for E words.
+    pub fn extrusion_mode(&self) -> ExtrusionMode {
+        if self.relative_axes {
+            ExtrusionMode::Relative
+        } else {
+            self.e_mode
+        }
+    }
+
+    /// Modal feed rate, mm/s, before the `M220` override.
+    pub fn feed_mm_s(&self) -> f64 {
+        self.feed_mm_s
+    }
+
+    /// Active tool.
+    pub fn tool(&self) -> u16 {
+        self.tool
+    }
+
+    fn unit(&self) -> f64 {
+        if self.inches {
+            25.4
+        } else {
+            1.0
+        }
+    }
+
+    /// Applies one parsed line; `line_no` is used in warnings and events.
+    pub fn apply(
+        &mut self,
+        line_no: u32,
+        line: &Line<'_>,
+        warnings: &mut Warnings,
+    ) -> Option<Event> {
+        match line.command {
+            Command::Code(code) => self.apply_code(line_no, code, line, warnings),
+            Command::Extended(name) => {
+                self.apply_extended(name, line);
+                None
+            }
+            Command::None | Command::Bare => None,
+        }
+    }
+
+    fn apply_extended(&mut self, name: &[u8], line: &Line<'_>) {
+        // Klipper's M220/M221 equivalents are macros; the one core command that changes
+        // motion state here is SET_GCODE_OFFSET, which only shifts coordinates.
+        let _ = (name, line);
+    }
+
+    fn apply_code(
+        &mut self,
+        line_no: u32,
+        code: Code,
+        line: &Line<'_>,
+        warnings: &mut Warnings,
+    ) -> Option<Event> {
+        let p = &line.params;
+        match (code.letter, code.number, code.sub) {
+            (b'G', 0..=3, None) => self.motion(line_no, code.number, line, warnings),
+            (b'G', 4, None) => {
+                let secs = match (p.get(b'S'), p.get(b'P')) {
+                    (Some(s), _) => s,
+                    (None, Some(ms)) => ms / 1000.0,
+                    _ => 0.0,
+                };
+                if secs < 0.0 {
+                    warnings.push(line_no, "negative dwell ignored");
+                    return None;
+                }
+                (secs > 0.0).then_some(Event::Dwell(secs))
+            }
+            (b'G', 10, None) if !p.has(b'P') && !p.has(b'L') => {
+                self.firmware_retract(line_no, true)
+            }
+            (b'G', 11, None) => self.firmware_retract(line_no, false),
+            (b'G', 17, None) => {
+                self.plane = Plane::Xy;
+                None
+            }
+            (b'G', 18, None) => {
+                self.plane = Plane::Zx;
+                None
+            }
+            (b'G', 19, None) => {
+                self.plane = Plane::Yz;
+                None
+            }
+            (b'G', 20, None) => {
+                self.inches = true;
+                None
+            }
+            (b'G', 21, None) => {
+                self.inches = false;
+                None
+            }
+            (b'G', 28, None) => Some(self.home(line)),
+            (b'G', 90, None) => {
+                self.relative_axes = false;
+                None
+            }
+            (b'G', 91, None) => {
+                self.relative_axes = true;
+                None
+            }
+            (b'G', 92, None) => {
+                self.set_position(line);
+                None
+            }
+            (b'G', 5, _) => {
+                warnings.push(
+                    line_no,
+                    "G5 Bézier moves are not modelled; the move is skipped",
+                );
+                None
+            }
+            (b'M', 82, _) => {
+                self.e_mode = ExtrusionMode::Absolute;
+                None
+            }
+            (b'M', 83, _) => {
+                self.e_mode = ExtrusionMode::Relative;
+                None
+            }
+            (b'M', 104 | 109, _) => {
+                let tool = p.get(b'T').map_or(self.tool, to_u16);
+                let target = p.get(b'S').or_else(|| p.get(b'R'))?;
+                Some(Event::Temperature {
+                    heater: Heater::Hotend(tool),
+                    target_c: target,
+                    wait: code.number == 109,
+                })
+            }
+            (b'M', 140 | 190, _) => {
+                let target = p.get(b'S').or_else(|| p.get(b'R'))?;
+                Some(Event::Temperature {
+                    heater: Heater::Bed,
+                    target_c: target,
+                    wait: code.number == 190,
+                })
+            }
+            (b'M', 141 | 191, _) => {
+                let target = p.get(b'S').or_else(|| p.get(b'R'))?;
+                Some(Event::Temperature {
+                    heater: Heater::Chamber,
+                    target_c: target,
+                    wait: code.number == 191,
+                })
+            }
+            (b'M', 106, _) => {
+                let s = p.get(b'S').unwrap_or(255.0);
+                // RepRapFirmware accepts 0..1 fractions; Marlin and Klipper take 0..255.
+                let speed = if s < 1.0 || (s <= 1.0 && s.fract() != 0.0) {
+                    s
+                } else {
+                    s / 255.0
+                };
+                Some(Event::Fan {
+                    index: p.get(b'P').map_or(0, to_u16),
+                    speed: speed.clamp(0.0, 1.0),
+                })
+            }
+            (b'M', 107, _) => Some(Event::Fan {
+                index: p.get(b'P').map_or(0, to_u16),
+                speed: 0.0,
+            }),
+            (b'M', 207, _) => {
+                if let Some(s) = p.get(b'S') {
+                    self.retract_mm = s.max(0.0) * self.unit();
+                }
+                if let Some(f) = p.get(b'F').filter(|f| *f > 0.0) {
+                    self.retract_feed_mm_s = f * self.unit() / 60.0;
+                }
+                None
+            }
+            (b'M', 208, _) => {
+                if let Some(s) = p.get(b'S') {
+                    self.unretract_extra_mm = s * self.unit();
+                }
+                if let Some(f) = p.get(b'F').filter(|f| *f > 0.0) {
+                    self.unretract_feed_mm_s = f * self.unit() / 60.0;
+                }
+                None
+            }
+            (b'M', 220, _) => {
+                if let Some(s) = p.get(b'S') {
+                    if s > 0.0 {
+                        self.speed_factor = s / 100.0;
+                    } else {
+                        warnings.push(line_no, "M220 with a non-positive factor ignored");
+                    }
+                }
+                None
+            }
+            (b'M', 221, _) => {
+                if let Some(s) = p.get(b'S') {
+                    if s >= 0.0 {
+                        self.flow_factor = s / 100.0;
+                    } else {
+                        warnings.push(line_no, "M221 with a negative factor ignored");
+                    }
+                }
+                None
+            }
+            (b'T', n, _) => {
+                self.tool = n;
+                None
+            }
+            _ => None,
+        }
+    }
+
+    fn set_feed(&mut self, line_no: u32, line: &Line<'_>, warnings: &mut Warnings) {
+        if let Some(f) = line.params.get(b'F') {
+            if f > 0.0 {
+                self.feed_mm_s = f * self.unit() / 60.0;
+            } else {
+                warnings.push(
+                    line_no,
+                    format!("feed rate F{f} is not positive; previous feed rate kept"),
+                );
+            }
+        }
+    }
+
+    /// Target logical position of a motion command.
+    fn target(&self, line: &Line<'_>) -> Pos {
+        let mut target = self.logical;
+        for (i, letter) in AXIS_LETTERS.iter().enumerate() {
+            if let Some(v) = line.params.get(*letter) {
+                let v = if LINEAR[i] { v * self.unit() } else { v };
+                let relative = if i == axis::E {
+                    self.extrusion_mode() == ExtrusionMode::Relative
+                } else {
+                    self.relative_axes
+                };
+                target[i] = if relative { self.logical[i] + v } else { v };
+            }
+        }
+        target
+    }
+
+    /// Moves the state to `target` (logical) and returns the physical start and end.
+    fn go_to(&mut self, target: Pos) -> (Pos, Pos) {
+        let from = self.physical;
+        let flow = self.flow_factor;
+        for (i, ((phys, logical), t)) in self
+            .physical
+            .iter_mut()
+            .zip(&self.logical)
+            .zip(&target)
+            .enumerate()
+        {
+            let delta = t - logical;
+            *phys += if i == axis::E { delta * flow } else { delta };
+        }
+        self.logical = target;
+        (from, self.physical)
+    }
+
+    fn motion(
+        &mut self,
+        line_no: u32,
+        g: u16,
+        line: &Line<'_>,
+        warnings: &mut Warnings,
+    ) -> Option<Event> {
+        self.set_feed(line_no, line, warnings);
+        let target = self.target(line);
+        let mut kind = match g {
+            0 => MoveKind::Rapid,
+            1 => MoveKind::Linear,
+            _ => match self.arc(line_no, g == 2, &target, line, warnings) {
+                Some(arc) => MoveKind::Arc(arc),
+                None => MoveKind::Linear,
+            },
+        };
+        let (from, to) = self.go_to(target);
+        let d = |i: usize| to[i] - from[i];
+        let straight = (d(0).powi(2) + d(1).powi(2) + d(2).powi(2)).sqrt();
+        let length_mm = match &kind {
+            MoveKind::Arc(a) => {
+                let (_, _, h) = a.plane.axes();
+                a.length(d(h))
+            }
+            _ => straight,
+        };
+        if !length_mm.is_finite() {
+            warnings.push(line_no, "move length is not finite; move skipped");
+            return None;
+        }
+        if from == to && !matches!(kind, MoveKind::Arc(_)) {
+            return None;
+        }
+        if let MoveKind::Arc(a) = &kind {
+            if a.planar_length() <= 1e-12 {
+                kind = MoveKind::Linear;
+            }
+        }
+        Some(Event::Move(Move {
+            line: line_no,
+            kind,
+            from,
+            to,
+            feed_mm_s: self.feed_mm_s * self.speed_factor,
+            length_mm,
+        }))
+    }
+
+    fn arc(
+        &self,
+        line_no: u32,
+        clockwise: bool,
+        target: &Pos,
+        line: &Line<'_>,
+        warnings: &mut Warnings,
+    ) -> Option<Arc> {
+        let (a0, a1, _) = self.plane.axes();
+        let (l0, l1) = self.plane.offset_letters();
+        let u = self.unit();
+        let p = &line.params;
+        let spec = if let Some(r) = p.get(b'R') {
+            ArcSpec::Radius(r * u)
+        } else if p.has(l0) || p.has(l1) {
+            ArcSpec::Offsets(p.get(l0).unwrap_or(0.0) * u, p.get(l1).unwrap_or(0.0) * u)
+        } else {
+            warnings.push(
+                line_no,
+                "arc without I/J/K or R; treated as a straight move",
+            );
+            return None;
+        };
+        let turns = p.get(b'P').map_or(1, |t| t.clamp(1.0, 1000.0) as u32);
+        let start = [self.logical[a0], self.logical[a1]];
+        let end = [target[a0], target[a1]];
+        match Arc::new(self.plane, start, end, spec, clockwise, turns) {
+            Ok((arc, mismatch)) => {
+                if mismatch {
+                    warnings.push(line_no, "arc end point is not on the circle through its start; radius from the start point used");
+                }
+                Some(arc)
+            }
+            Err(reason) => {
+                warnings.push(
+                    line_no,
+                    format!("invalid arc ({reason}); treated as a straight move"),
+                );
+                None
+            }
+        }
+    }
+
+    fn firmware_retract(&mut self, line_no: u32, retract: bool) -> Option<Event> {
+        if retract == self.retracted {
+            return None;
+        }
+        self.retracted = retract;
+        let (amount, feed) = if retract {
+            (-self.retract_mm, self.retract_feed_mm_s)
+        } else {
+            (
+                self.retract_mm + self.unretract_extra_mm,
+                self.unretract_feed_mm_s,
+            )
+        };
+        let from = self.physical;
+        self.physical[axis::E] += amount;
+        Some(Event::Move(Move {
+            line: line_no,
+            kind: MoveKind::FirmwareRetract,
+            from,
+            to: self.physical,
+            feed_mm_s: feed,
+            length_mm: 0.0,
+        }))
+    }
+
+    fn home(&mut self, line: &Line<'_>) -> Event {
+        let named: Vec<usize> = [axis::X, axis::Y, axis::Z]
+            .into_iter()
+            .filter(|&i| line.params.has(AXIS_LETTERS[i]))
+            .collect();
+        let axes = if named.is_empty() {
+            vec![axis::X, axis::Y, axis::Z]
+        } else {
+            named
+        };
+        let mut mask = 0u16;
+        for i in axes {
+            self.logical[i] = 0.0;
+            self.physical[i] = 0.0;
+            mask |= 1 << i;
+        }
+        Event::Home(mask)
+    }
+
+    fn set_position(&mut self, line: &Line<'_>) {
+        let mut any = false;
+        for (i, letter) in AXIS_LETTERS.iter().enumerate() {
+            if let Some(v) = line.params.get(*letter) {
+                self.logical[i] = if LINEAR[i] { v * self.unit() } else { v };
+                any = true;
+            }
+        }
+        if !any {
+            // Bare G92 zeroes every axis (Marlin, RepRapFirmware).
+            self.logical = [0.0; AXES];
+        }
+    }
+}
+
+fn to_u16(v: f64) -> u16 {
+    v.clamp(0.0, f64::from(u16::MAX)) as u16
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gcode::parse_line;
+
+    fn run(src: &str, config: MachineConfig) -> (Machine, Vec<Event>, Warnings) {
+        let mut m = Machine::new(config);
+        let mut w = Warnings::default();
+        let mut events = Vec::new();
+        for (i, l) in src.lines().enumerate() {
+            let line = parse_line(l.as_bytes()).expect(l);
+            if let Some(e) = m.apply(i as u32 + 1, &line, &mut w) {
+                events.push(e);
+            }
+        }
+        (m, events, w)
+    }
+
+    fn moves(events: &[Event]) -> Vec<Move> {
+        events
+            .iter()
+            .filter_map(|e| {
+                if let Event::Move(m) = e {
+                    Some(*m)
+                } else {
+                    None
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn absolute_and_relative_positioning() {
+        let (m, ev, _) = run(
+            "G1 X10 Y0 F600\nG91\nG1 X5 Y5\nG90\nG1 X0 Y0",
+            MachineConfig::default(),
+        );
+        let mv = moves(&ev);
+        assert_eq!(mv.len(), 3);
+        assert_eq!(mv[1].to[axis::X], 15.0);
+        assert_eq!(mv[1].feed_mm_s, 10.0);
+        assert!((mv[1].length_mm - 50f64.sqrt()).abs() < 1e-12);
+        assert_eq!(m.position()[axis::X], 0.0);
+    }
+
+    #[test]
+    fn extrusion_modes_g92_and_flow() {
+        let src = "M83\nG1 X1 E1\nG1 X2 E1\nM82\nG92 E0\nG1 X3 E2\nM221 S50\nG1 X4 E4\nG91\nG1 X1 E1\nG90\nG1 X6 E5";
+        let (m, ev, _) = run(src, MachineConfig::default());
+        let e: Vec<f64> = moves(&ev).iter().map(Move::extrusion).collect();
+        assert_eq!(e, vec![1.0, 1.0, 2.0, 1.0, 0.5, 0.0]);
+        assert_eq!(m.position()[axis::E], 5.5);
+    }
+
+    #[test]
+    fn inches_and_feed_override() {
+        let (_, ev, _) = run("G20\nM220 S200\nG1 X1 F60", MachineConfig::default());
+        let mv = moves(&ev);
+        assert_eq!(mv[0].to[axis::X], 25.4);
+        assert!((mv[0].feed_mm_s - 2.0 * 25.4).abs() < 1e-12);
+    }
+
+    #[test]
+    fn arcs_lengths_helix_and_turns() {
+        let (_, ev, w) = run(
+            "G1 X10 Y0 F600\nG3 X0 Y10 I-10 J0 Z2\nG2 X0 Y10 I0 J-10 P2",
+            MachineConfig::default(),
+        );
+        assert!(w.list().is_empty(), "{:?}", w.list());
+        let mv = moves(&ev);
+        let quarter = 10.0 * std::f64::consts::FRAC_PI_2;
+        assert!((mv[1].length_mm - quarter.hypot(2.0)).abs() < 1e-9);
+        assert!((mv[2].length_mm - 2.0 * std::f64::consts::TAU * 10.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn invalid_arc_becomes_a_warned_straight_move() {
+        let (_, ev, w) = run("G2 X10 Y0 R1", MachineConfig::default());
+        assert_eq!(w.list().len(), 1);
+        assert_eq!(w.list()[0].line, 1);
+        assert!(matches!(moves(&ev)[0].kind, MoveKind::Linear));
+    }
+
+    #[test]
+    fn firmware_retraction_is_net_zero() {
+        let (m, ev, _) = run("M207 S2 F1200\nG10\nG10\nG11", MachineConfig::default());
+        let e: Vec<f64> = moves(&ev).iter().map(Move::extrusion).collect();
+        assert_eq!(e, vec![-2.0, 2.0]);
+        assert_eq!(m.position()[axis::E], 0.0);
+        assert!((moves(&ev)[0].feed_mm_s - 20.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn homing_temperatures_fans_dwell() {
+        let (_, ev, _) = run(
+            "G1 X5 Y5 Z5\nG28 X\nM109 S210\nM140 S60\nM106 S127.5\nM106 S0.5\nM107\nG4 P500\nG4 S2",
+            MachineConfig::default(),
+        );
+        assert!(matches!(ev[1], Event::Home(1)));
+        assert!(matches!(
+            ev[2],
+            Event::Temperature {
+                heater: Heater::Hotend(0),
+                wait: true,
+                ..
+            }
+        ));
+        assert!(matches!(
+            ev[3],
+            Event::Temperature {
+                heater: Heater::Bed,
+                wait: false,
+                ..
+            }
+        ));
+        assert!(matches!(ev[4], Event::Fan { speed, .. } if (speed - 0.5).abs() < 1e-12));
+        assert!(matches!(ev[5], Event::Fan { speed, .. } if (speed - 0.5).abs() < 1e-12));
+        assert!(matches!(ev[6], Event::Fan { speed, .. } if speed == 0.0));
+        assert!(matches!(ev[7], Event::Dwell(s) if s == 0.5));
+        assert!(matches!(ev[8], Event::Dwell(s) if s == 2.0));
+    }
+
+    #[test]
+    fn extra_axes_are_tracked() {
+        let (m, ev, _) = run("G1 X1 B30 C-720 U2", MachineConfig::default());
+        assert_eq!(m.position()[axis::B], 30.0);
+        assert_eq!(m.position()[axis::C], -720.0);
+        assert_eq!(m.position()[7], 2.0);
+        assert_eq!(moves(&ev).len(), 1);
+    }
+
+    #[test]
+    fn bad_feed_is_warned_and_ignored() {
+        let (m, _, w) = run("G1 X1 F0\nG1 X2 F-5", MachineConfig::default());
+        assert_eq!(w.list().len(), 2);
+        assert_eq!(m.feed_mm_s(), DEFAULT_FEED_MM_S);
+    }
+}

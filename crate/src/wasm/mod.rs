@@ -1,0 +1,96 @@
+//! WebAssembly bindings: type conversion and error mapping only, no logic.
+//!
+//! Results cross the boundary as the same JSON the CLI prints (serialised by `serde_json`, then
+//! parsed by the JS engine), so a report from the browser, Node and the CLI is identical.
+//! Errors become JS `Error` objects carrying `line`, `column` and `kind` properties.
+
+use js_sys::{Function, Reflect, Uint8Array};
+use wasm_bindgen::prelude::*;
+
+use crate::analyze::{analyze_with_progress, AnalyzeOptions};
+use crate::error::Error;
+
+/// Installs the panic hook so that a bug shows its message in the console instead of an
+/// anonymous `unreachable`.
+#[wasm_bindgen(start)]
+pub fn start() {
+    console_error_panic_hook::set_once();
+}
+
+/// The library version.
+#[wasm_bindgen]
+pub fn version() -> String {
+    crate::VERSION.to_string()
+}
+
+/// Turns a core error into a JS `Error` with position properties. The one error helper.
+fn js_error(e: &Error) -> JsValue {
+    let err = js_sys::Error::new(&e.to_string());
+    let set = |k: &str, v: JsValue| {
+        let _ = Reflect::set(&err, &JsValue::from_str(k), &v);
+    };
+    set("line", JsValue::from(e.line));
+    set("column", JsValue::from(e.column));
+    if let Ok(kind) = serde_json::to_string(&e.kind) {
+        if let Ok(v) = js_sys::JSON::parse(&kind) {
+            set("kind", v);
+        }
+    }
+    err.into()
+}
+
+fn message_error(msg: &str) -> JsValue {
+    js_sys::Error::new(msg).into()
+}
+
+/// Input bytes from a `Uint8Array`, an `ArrayBuffer` or a string.
+fn input_bytes(input: &JsValue) -> Result<Vec<u8>, JsValue> {
+    if let Some(s) = input.as_string() {
+        return Ok(s.into_bytes());
+    }
+    if input.is_instance_of::<Uint8Array>() || input.is_instance_of::<js_sys::ArrayBuffer>() {
+        return Ok(Uint8Array::new(input).to_vec());
+    }
+    Err(message_error(
+        "input must be a string, a Uint8Array or an ArrayBuffer",
+    ))
+}
+
+fn options<T: serde::de::DeserializeOwned + Default>(value: &JsValue) -> Result<T, JsValue> {
+    if value.is_undefined() || value.is_null() {
+        return Ok(T::default());
+    }
+    serde_wasm_bindgen::from_value(value.clone())
+        .map_err(|e| message_error(&format!("invalid options: {e}")))
+}
+
+fn to_js<T: serde::Serialize>(value: &T) -> Result<JsValue, JsValue> {
+    let json = serde_json::to_string(value).map_err(|e| message_error(&e.to_string()))?;
+    js_sys::JSON::parse(&json)
+}
+
+/// Progress adapter: calls `f(fraction)`; a callback returning `false` cancels the job.
+fn progress_fn(f: Option<Function>) -> impl FnMut(f64) -> bool {
+    move |fraction| match &f {
+        Some(f) => match f.call1(&JsValue::NULL, &JsValue::from_f64(fraction)) {
+            Ok(v) => v.as_bool() != Some(false),
+            Err(_) => true,
+        },
+        None => true,
+    }
+}
+
+/// Analyzes G-code (`string`, `Uint8Array` or `ArrayBuffer`); same report as
+/// `quietpath analyze --json`.
+#[wasm_bindgen(js_name = analyze)]
+pub fn analyze_js(
+    input: JsValue,
+    options_value: JsValue,
+    on_progress: Option<Function>,
+) -> Result<JsValue, JsValue> {
+    let bytes = input_bytes(&input)?;
+    let opts: AnalyzeOptions = options(&options_value)?;
+    let mut progress = progress_fn(on_progress);
+    let report = analyze_with_progress(&bytes, &opts, &mut progress).map_err(|e| js_error(&e))?;
+    to_js(&report)
+}

@@ -1,0 +1,331 @@
+//! Every real file in the shared corpus parses, analyzes and round-trips, and the analysis
+//! agrees with what the slicers themselves wrote (layer markers, filament summaries).
+#![allow(clippy::unwrap_used)]
+
+use quietpath::analyze::{analyze, AnalyzeOptions, ExtrusionModeOption, LayerSource};
+use quietpath::error::Warnings;
+use quietpath::gcode::{apply_edits, for_each_line, Edit, Lines, Strictness};
+use quietpath::machine::{ExtrusionMode, ModeSource};
+use quietpath_conformance::{corpus, CorpusFile};
+
+fn file(name_prefix: &str) -> CorpusFile {
+    corpus()
+        .into_iter()
+        .find(|f| f.name.starts_with(name_prefix))
+        .unwrap_or_else(|| panic!("no corpus file starting with {name_prefix}"))
+}
+
+#[test]
+fn corpus_is_complete_and_matches_its_provenance() {
+    let files = corpus();
+    assert_eq!(files.len(), 19, "SOURCES.md lists 19 files");
+    for f in &files {
+        let bytes = f.read();
+        assert_eq!(
+            bytes.len() as u64,
+            f.bytes,
+            "{}: size differs from SOURCES.md",
+            f.name
+        );
+        let lines = Lines::new(&bytes).count() as u64;
+        assert!(
+            lines.abs_diff(f.lines) <= 1,
+            "{}: {lines} lines, SOURCES.md says {}",
+            f.name,
+            f.lines
+        );
+    }
+}
+
+#[test]
+fn every_file_parses_strictly_without_warnings() {
+    for f in corpus() {
+        let bytes = f.read();
+        let mut warnings = Warnings::default();
+        let mut parsed = 0u64;
+        for_each_line(&bytes, Strictness::Strict, &mut warnings, |_, line, _| {
+            parsed += u64::from(line.is_some());
+            Ok(())
+        })
+        .unwrap_or_else(|e| panic!("{}: {e}", f.name));
+        assert!(
+            warnings.list().is_empty(),
+            "{}: {:?}",
+            f.name,
+            warnings.list()
+        );
+        assert!(parsed.abs_diff(f.lines) <= 1, "{}", f.name);
+        let strict = AnalyzeOptions {
+            strict: true,
+            ..AnalyzeOptions::default()
+        };
+        analyze(&bytes, &strict).unwrap_or_else(|e| panic!("{}: {e}", f.name));
+    }
+}
+
+#[test]
+fn every_file_round_trips_byte_identically() {
+    for f in corpus() {
+        let bytes = f.read();
+        assert!(
+            apply_edits(&bytes, &[]) == bytes,
+            "{}: rewrite without edits differs",
+            f.name
+        );
+    }
+}
+
+#[test]
+fn edits_replace_whole_lines_and_leave_the_rest_untouched() {
+    for f in corpus().iter().filter(|f| f.bytes < 4_000_000) {
+        let bytes = f.read();
+        let lines: Vec<_> = Lines::new(&bytes).collect();
+        // Replace every 97th line that starts with G1 by a canonical re-spelling.
+        let edits: Vec<Edit> = lines
+            .iter()
+            .filter(|l| l.text.starts_with(b"G1 ") && l.number % 97 == 0)
+            .map(|l| Edit {
+                line: l.number,
+                replacement: [b"G1 ; was: ".as_slice(), l.text].concat(),
+            })
+            .collect();
+        assert!(
+            !edits.is_empty() || f.name.starts_with("multiaxis"),
+            "{}: nothing to edit",
+            f.name
+        );
+        let out = apply_edits(&bytes, &edits);
+        let out_lines: Vec<_> = Lines::new(&out).collect();
+        assert_eq!(out_lines.len(), lines.len(), "{}", f.name);
+        let mut edit = edits.iter().peekable();
+        for (a, b) in lines.iter().zip(&out_lines) {
+            assert_eq!(a.terminator, b.terminator, "{}:{}", f.name, a.number);
+            if edit.peek().is_some_and(|e| e.line == a.number) {
+                assert_eq!(b.text, edit.next().unwrap().replacement.as_slice());
+            } else {
+                assert_eq!(a.text, b.text, "{}:{} changed", f.name, a.number);
+            }
+        }
+    }
+}
+
+#[test]
+fn layer_counts_match_the_slicers_own_markers() {
+    for f in corpus() {
+        let report = analyze(&f.read(), &AnalyzeOptions::default()).unwrap();
+        match f.marker_layers {
+            Some(expected) => {
+                assert!(
+                    matches!(report.layer_source, LayerSource::Markers(_)),
+                    "{}",
+                    f.name
+                );
+                assert!(
+                    report.layers.abs_diff(expected) <= 1,
+                    "{}: {} layers, the slicer marked {expected}",
+                    f.name,
+                    report.layers
+                );
+            }
+            None => {
+                assert_eq!(report.layer_source, LayerSource::ZChanges, "{}", f.name);
+                if f.z_extruding < 1000 {
+                    // Planar files: one layer per distinct printing height.
+                    assert!(
+                        report.layers.abs_diff(f.z_extruding) <= 1,
+                        "{}: {} layers vs {} heights",
+                        f.name,
+                        report.layers,
+                        f.z_extruding
+                    );
+                } else {
+                    // Continuous-Z files must not explode into one layer per Z value. (The 5-axis file is
+                    // counted in machine coordinates, where the rotary table adds turns.)
+                    assert!(
+                        report.layers >= 10 && report.layers * 10 < f.z_extruding,
+                        "{}: {} layers from {} distinct heights",
+                        f.name,
+                        report.layers,
+                        f.z_extruding
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn continuous_z_vases_count_revolutions_not_points() {
+    // Independent count: the winding of the printed path around the part's centre.
+    let bytes = file("fullcontrol").read();
+    let r = analyze(&bytes, &AnalyzeOptions::default()).unwrap();
+    let b = r.bounds.unwrap();
+    let centre = [(b.min[0] + b.max[0]) / 2.0, (b.min[1] + b.max[1]) / 2.0];
+    let (mut x, mut y, mut winding) = (0.0f64, 0.0f64, 0.0f64);
+    let mut prev_angle: Option<f64> = None;
+    for raw in Lines::new(&bytes) {
+        let line = quietpath::gcode::parse_line(raw.text).unwrap();
+        let p = &line.params;
+        if !matches!(line.code(), Some(c) if c.is(b'G', 1)) {
+            continue;
+        }
+        x = p.get(b'X').unwrap_or(x);
+        y = p.get(b'Y').unwrap_or(y);
+        if p.get(b'E').is_some_and(|e| e > 0.0) {
+            let a = (y - centre[1]).atan2(x - centre[0]);
+            if let Some(pa) = prev_angle {
+                let d = (a - pa + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                    - std::f64::consts::PI;
+                winding += d;
+            }
+            prev_angle = Some(a);
+        } else {
+            prev_angle = None;
+        }
+    }
+    let revolutions = winding.abs() / std::f64::consts::TAU;
+    assert!(revolutions > 50.0, "{revolutions}");
+    assert!(
+        (r.layers as f64 - revolutions).abs() <= 0.05 * revolutions,
+        "{} layers for {revolutions:.1} revolutions",
+        r.layers
+    );
+}
+
+/// Filament totals the slicers wrote in their summaries, with the flow override (`M221`) the
+/// file applies, which the slicers' own count leaves out.
+#[test]
+fn filament_matches_the_slicers_summaries() {
+    let cases: [(&str, f64, f64); 9] = [
+        ("superslicer-2.3.56", 264.59, 1.0),
+        ("prusaslicer-2.7.4_screw", 1706.22, 1.0),
+        ("prusaslicer-2.7.4_spiral", 2996.07, 1.0),
+        ("prusaslicer-2.6.1_benchy", 4282.06, 0.95),
+        ("slic3r-pe-1.33.3", 4913.4, 1.0),
+        ("simplify3d-5.1.2", 291.4, 1.0),
+        ("kisslicer-2.0.6", 305.09, 1.0),
+        ("crealityprint-4.3.8", 2007.59, 1.0),
+        ("crealityprint-5", 3775.18, 1.0),
+    ];
+    for (name, slicer_mm, flow) in cases {
+        let r = analyze(&file(name).read(), &AnalyzeOptions::default()).unwrap();
+        let expected = slicer_mm * flow;
+        assert!(
+            (r.filament_mm - expected).abs() <= 0.01 * expected,
+            "{name}: {} mm of filament, the slicer says {expected}",
+            r.filament_mm
+        );
+    }
+}
+
+#[test]
+fn absolute_extrusion_is_detected_when_the_file_never_says() {
+    let legacy = file("cura-legacy-15.x").read();
+    let r = analyze(&legacy, &AnalyzeOptions::default()).unwrap();
+    assert_eq!(
+        (r.extrusion.mode, r.extrusion.source),
+        (ExtrusionMode::Absolute, ModeSource::Inferred)
+    );
+    assert!(
+        r.filament_mm > 1_000.0 && r.filament_mm < 100_000.0,
+        "{} mm",
+        r.filament_mm
+    );
+    assert!(r.warnings.iter().any(|w| w.message.contains("M82/M83")));
+    // Read the wrong way, the same file claims kilometres of filament.
+    let wrong = AnalyzeOptions {
+        extrusion_mode: Some(ExtrusionModeOption::Relative),
+        ..AnalyzeOptions::default()
+    };
+    let bad = analyze(&legacy, &wrong).unwrap();
+    assert!(
+        bad.filament_mm > 100.0 * r.filament_mm,
+        "{} mm",
+        bad.filament_mm
+    );
+
+    // Kiri:Moto relies on its start macro for relative E; its own summary says 225.03 mm.
+    let kiri = analyze(&file("kirimoto").read(), &AnalyzeOptions::default()).unwrap();
+    assert_eq!(
+        (kiri.extrusion.mode, kiri.extrusion.source),
+        (ExtrusionMode::Relative, ModeSource::Inferred)
+    );
+    assert!(
+        (kiri.filament_mm - 225.03).abs() < 0.05 * 225.03,
+        "{} mm",
+        kiri.filament_mm
+    );
+}
+
+#[test]
+fn every_report_is_sane_and_serialises() {
+    for f in corpus() {
+        let r = analyze(&f.read(), &AnalyzeOptions::default()).unwrap();
+        let json = serde_json::to_value(&r).unwrap_or_else(|e| panic!("{}: {e}", f.name));
+        for key in [
+            "time_s",
+            "moves",
+            "layers",
+            "distance_mm",
+            "filament_mm",
+            "material_g",
+            "energy",
+            "toolpath",
+            "warnings",
+        ] {
+            assert!(json.get(key).is_some(), "{}: report lacks {key}", f.name);
+        }
+        assert!(r.time_s > 0.0 && r.time_s.is_finite(), "{}", f.name);
+        assert!(r.moves > 1000, "{}: {} moves", f.name, r.moves);
+        assert!(
+            r.distance_mm > r.extrude_distance_mm && r.extrude_distance_mm > 0.0,
+            "{}",
+            f.name
+        );
+        assert!(
+            (r.extrude_distance_mm + r.travel_distance_mm - r.distance_mm).abs()
+                < 1e-6 * r.distance_mm
+        );
+        let feature_sum: f64 = r.features.iter().map(|x| x.distance_mm).sum();
+        assert!(
+            (feature_sum - r.distance_mm).abs() < 1e-6 * r.distance_mm,
+            "{}",
+            f.name
+        );
+        let b = r.bounds.unwrap();
+        assert!((0..3).all(|i| b.min[i] <= b.max[i]), "{}", f.name);
+        assert!(
+            r.material_g > 0.1 && r.material_g < 2000.0,
+            "{}: {} g",
+            f.name,
+            r.material_g
+        );
+        assert!(
+            !r.temperatures.is_empty()
+                || f.name.starts_with("multiaxis")
+                || f.name.starts_with("fullcontrol")
+                || f.name.starts_with("kiri"),
+            "{}: no temperatures",
+            f.name
+        );
+    }
+}
+
+#[test]
+fn the_slicer_is_recognised() {
+    for (name, slicer) in [
+        ("prusaslicer-2.6.1", "PrusaSlicer 2.6.1"),
+        ("superslicer", "SuperSlicer 2.3.56"),
+        ("cura-4.10", "Cura_SteamEngine 4.10.0"),
+        ("simplify3d", "Simplify3D(R) Version 5.1.2"),
+        ("kirimoto", "Kiri:Moto 3.0"),
+        ("kisslicer", "KISSlicer"),
+        ("ideamaker", "ideaMaker 4.2.0"),
+        ("crealityprint-4.3.4", "Creality Print 4.3.4"),
+        ("slic3r-pe", "Slic3r 1.33.3-prusa3d"),
+    ] {
+        let r = analyze(&file(name).read(), &AnalyzeOptions::default()).unwrap();
+        let got = r.file.slicer.unwrap_or_default();
+        assert!(got.starts_with(slicer), "{name}: slicer {got:?}");
+    }
+}
