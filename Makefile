@@ -1,0 +1,63 @@
+# quietpath: the two commands that matter are `make serve` and `make test`.
+# Both install what they need first (scripts/setup.sh).
+
+PORT ?= 8080
+SHELL := /bin/bash
+# npm's binaryen wasm-opt first: Debian's wasm-opt 108 produces broken modules with current wasm-bindgen.
+export PATH := $(CURDIR)/node_modules/.bin:$(HOME)/.cargo/bin:$(PATH)
+CORPUS ?= $(CURDIR)/../shared/corpus
+LARGE := $(CORPUS)/curaengine-4.13.0_extruder-idler-x2.5_large.gcode
+
+.PHONY: all setup setup-test pkg serve test test-rust test-wasm test-js lint cli bench fuzz clean
+
+all: pkg cli
+
+setup:
+	@scripts/setup.sh wasm
+
+setup-test:
+	@scripts/setup.sh test
+
+## Build the wasm package (pkg/, --target web) and link it into the playground.
+pkg: setup
+	wasm-pack build crate --release --target web --out-dir ../pkg --out-name quietpath
+	ln -sfn ../pkg www/pkg
+
+## Build the wasm and serve the playground on http://127.0.0.1:$(PORT)
+serve: pkg
+	PORT=$(PORT) node scripts/serve.mjs www
+
+## The native command-line tool: target/release/quietpath
+cli:
+	cargo build --release
+
+## Everything: formatting, lints, Rust tests, wasm tests in Node, JS API and browser tests.
+test: setup-test lint test-rust test-wasm test-js
+
+lint:
+	cargo fmt --all -- --check
+	cargo clippy --workspace --all-targets -- -D warnings
+	RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
+
+test-rust:
+	cargo test --workspace
+
+test-wasm: setup
+	wasm-pack test --node crate
+
+test-js: pkg cli
+	npm test
+
+## Throughput on the 34 MB corpus file (parse and analyze), plus sha256sum for scale.
+bench: cli
+	@echo "sha256sum:"; time -p sha256sum "$(LARGE)" > /dev/null
+	target/release/quietpath bench "$(LARGE)"
+	cargo bench -p quietpath --bench parse
+
+## Long fuzzing run of the parser (nightly + cargo-fuzz).
+fuzz:
+	cargo +nightly fuzz run parse_line -- -max_total_time=600
+
+clean:
+	cargo clean
+	rm -rf pkg www/pkg node_modules
