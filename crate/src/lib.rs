@@ -20,11 +20,13 @@
 //! - [`gcode`]: zero-copy lines and words, slicer dialects, lossless writing.
 //! - [`machine`]: modal printer state, arcs, extrusion modes; turns lines into motion events.
 //! - [`analyze`]: one streaming pass giving the report.
+//! - [`math`]: portable transcendental functions (identical results native and wasm).
 
 pub mod analyze;
 pub mod error;
 pub mod gcode;
 pub mod machine;
+pub mod math;
 
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;

@@ -98,7 +98,7 @@ impl LayerTracker {
             let z_start = m.from[axis::Z];
             let dx = m.to[axis::X] - m.from[axis::X];
             let dy = m.to[axis::Y] - m.from[axis::Y];
-            let heading = (dx.hypot(dy) > 1e-9).then(|| dy.atan2(dx));
+            let heading = (dx * dx + dy * dy > 1e-18).then(|| crate::math::atan2(dy, dx));
             let new_layer = match (self.z_layer, self.z_last) {
                 (Some(zl), Some(last)) => {
                     if (z - z_start).abs() <= Z_EPS {

@@ -311,7 +311,9 @@ fn parse_number(s: &[u8], upper_letter: bool) -> (usize, Option<f64>) {
     let mut mantissa: u64 = 0;
     let mut digits = 0usize;
     while i < s.len() && s[i].is_ascii_digit() {
-        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(s[i] - b'0'));
+        mantissa = mantissa
+            .wrapping_mul(10)
+            .wrapping_add(u64::from(s[i] - b'0'));
         digits += 1;
         i += 1;
     }
@@ -319,7 +321,9 @@ fn parse_number(s: &[u8], upper_letter: bool) -> (usize, Option<f64>) {
     if i < s.len() && s[i] == b'.' {
         i += 1;
         while i < s.len() && s[i].is_ascii_digit() {
-            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(s[i] - b'0'));
+            mantissa = mantissa
+                .wrapping_mul(10)
+                .wrapping_add(u64::from(s[i] - b'0'));
             frac_digits += 1;
             i += 1;
         }
@@ -574,9 +578,12 @@ pub fn parse_line_into<'a>(text: &'a [u8], line: &mut Line<'a>) -> Result<(), Li
         };
         // What follows a word must be a separator, another word or a comment.
         let next = text.get(pos).copied().filter(|_| pos < end);
+        // In a G-code, a letter glued to a word that has no number (`Xabc`) is a typo, not two
+        // words; bare words must be separated (`G28 X Y`).
         let clean_end = match next {
             None => true,
-            Some(n) => is_space(n) || n.is_ascii_alphabetic() || n == b'(',
+            Some(n) if n.is_ascii_alphabetic() => value.is_some() || !is_g,
+            Some(n) => is_space(n) || n == b'(',
         };
         if !clean_end {
             if is_g {
@@ -675,6 +682,9 @@ mod tests {
         assert!(parse_line(b"G1 X1.2.3").is_err());
         assert!(parse_line(b"G1 X- Y1").is_err());
         assert!(parse_line(b"G1 X1 X2").is_err());
+        assert!(parse_line(b"G1 Xabc Y10").is_err());
+        assert!(parse_line(b"G1 X10 Yabc").is_err());
+        assert!(parse_line(b"G28 X Y").is_ok());
     }
 
     #[test]

@@ -6,6 +6,8 @@
 
 use serde::Serialize;
 
+use crate::math::{atan2, cos, hypot, sin};
+
 /// The plane arcs are drawn in (`G17`, `G18`, `G19`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -88,19 +90,19 @@ impl Arc {
             ArcSpec::Radius(r) => radius_to_offsets(start, end, r, clockwise)?,
         };
         let center = [start[0] + di, start[1] + dj];
-        let radius = di.hypot(dj);
+        let radius = hypot(di, dj);
         if radius.is_nan() || radius <= 1e-9 || !radius.is_finite() {
             return Err("zero radius");
         }
-        let end_radius = (end[0] - center[0]).hypot(end[1] - center[1]);
+        let end_radius = hypot(end[0] - center[0], end[1] - center[1]);
         let mismatch = (end_radius - radius).abs() > RADIUS_MISMATCH_TOLERANCE * radius.max(1.0);
-        let a0 = (start[1] - center[1]).atan2(start[0] - center[0]);
-        let a1 = (end[1] - center[1]).atan2(end[0] - center[0]);
+        let a0 = atan2(start[1] - center[1], start[0] - center[0]);
+        let a1 = atan2(end[1] - center[1], end[0] - center[0]);
         let tau = std::f64::consts::TAU;
         let mut sweep = if clockwise { a0 - a1 } else { a1 - a0 };
         sweep = sweep.rem_euclid(tau);
         // A closed arc is a full turn (the chord is zero to within rounding).
-        let closed = (end[0] - start[0]).hypot(end[1] - start[1]) <= 1e-9 * radius.max(1.0);
+        let closed = hypot(end[0] - start[0], end[1] - start[1]) <= 1e-9 * radius.max(1.0);
         if closed || sweep < 1e-12 {
             sweep = tau;
         }
@@ -124,15 +126,15 @@ impl Arc {
 
     /// Length of the helix with `rise` along the helix axis.
     pub fn length(&self, rise: f64) -> f64 {
-        self.planar_length().hypot(rise)
+        hypot(self.planar_length(), rise)
     }
 
     /// Point in the plane at fraction `t` (0..=1) of the sweep.
     pub fn point_at(&self, start_angle: f64, t: f64) -> [f64; 2] {
         let a = start_angle + self.sweep * t;
         [
-            self.center[0] + self.radius * a.cos(),
-            self.center[1] + self.radius * a.sin(),
+            self.center[0] + self.radius * cos(a),
+            self.center[1] + self.radius * sin(a),
         ]
     }
 }
@@ -146,7 +148,7 @@ fn radius_to_offsets(
 ) -> Result<(f64, f64), ArcError> {
     let x = end[0] - start[0];
     let y = end[1] - start[1];
-    let d = x.hypot(y);
+    let d = hypot(x, y);
     if d <= 1e-12 {
         return Err("R form cannot describe a full circle");
     }

@@ -519,6 +519,12 @@ impl Machine {
         warnings: &mut Warnings,
     ) -> Option<Event> {
         self.set_feed(line_no, line, warnings);
+        if AXIS_LETTERS
+            .iter()
+            .any(|&l| line.params.has(l) && line.params.get(l).is_none())
+        {
+            warnings.push(line_no, "axis word without a value ignored");
+        }
         let target = self.target(line);
         let mut kind = match g {
             0 => MoveKind::Rapid,
