@@ -9,7 +9,9 @@ fn bin() -> Command {
 }
 
 fn corpus(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/corpus").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/corpus")
+        .join(name)
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -26,13 +28,30 @@ fn run(cmd: &mut Command) -> Output {
 fn analyze_json_is_the_library_report() {
     let path = corpus("prusaslicer-2.7.4_screw_arcfit.gcode");
     let out = run(bin().arg("analyze").arg(&path).arg("--json"));
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let bytes = std::fs::read(&path).expect("read");
     let lib = quietpath::analyze(&bytes, &Default::default()).expect("analyze");
     let expected = serde_json::to_string_pretty(&lib).expect("to json") + "\n";
-    assert!(out.stdout == expected.as_bytes(), "CLI JSON differs from the library's report");
+    assert!(
+        out.stdout == expected.as_bytes(),
+        "CLI JSON differs from the library's report"
+    );
     let cli: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
-    for key in ["time_s", "moves", "layers", "distance_mm", "filament_mm", "material_g", "energy", "toolpath", "warnings"] {
+    for key in [
+        "time_s",
+        "moves",
+        "layers",
+        "distance_mm",
+        "filament_mm",
+        "material_g",
+        "energy",
+        "toolpath",
+        "warnings",
+    ] {
         assert!(cli.get(key).is_some(), "missing {key}");
     }
     assert_eq!(cli["layers"], 139);
@@ -40,7 +59,9 @@ fn analyze_json_is_the_library_report() {
 
 #[test]
 fn analyze_table_is_human_readable() {
-    let out = run(bin().arg("analyze").arg(corpus("superslicer-2.3.56_klipper_arcwelder.gcode")));
+    let out = run(bin()
+        .arg("analyze")
+        .arg(corpus("superslicer-2.3.56_klipper_arcwelder.gcode")));
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).expect("utf8");
     assert!(text.contains("SuperSlicer 2.3.56"), "{text}");
@@ -53,12 +74,19 @@ fn rewrite_is_byte_identical_and_atomic() {
     let input = corpus("crealityprint-4.3.4_k1_benchy_m83_arcs.gcode");
     let output = scratch("benchy.gcode");
     let out = run(bin().arg("rewrite").arg(&input).arg("-o").arg(&output));
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(std::fs::read(&input).expect("in") == std::fs::read(&output).expect("out"));
     // No temporary file is left behind.
     let leftovers = std::fs::read_dir(output.parent().expect("dir"))
         .expect("list")
-        .filter(|e| e.as_ref().is_ok_and(|e| e.file_name().to_string_lossy().ends_with(".tmp")))
+        .filter(|e| {
+            e.as_ref()
+                .is_ok_and(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        })
         .count();
     assert_eq!(leftovers, 0);
 }
@@ -70,7 +98,12 @@ fn rewrite_refuses_to_overwrite_its_input_unless_forced() {
     let out = run(bin().arg("rewrite").arg(&file).arg("-o").arg(&file));
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--force"));
-    let out = run(bin().arg("rewrite").arg(&file).arg("-o").arg(&file).arg("--force"));
+    let out = run(bin()
+        .arg("rewrite")
+        .arg(&file)
+        .arg("-o")
+        .arg(&file)
+        .arg("--force"));
     assert!(out.status.success());
     assert_eq!(std::fs::read(&file).expect("read"), b"G1 X1\r\nG1 X2");
 }
@@ -103,7 +136,10 @@ fn missing_file_and_bad_usage_fail_cleanly() {
 #[test]
 fn utf16_input_is_a_clear_error() {
     let file = scratch("utf16.gcode");
-    let bytes: Vec<u8> = "\u{feff}G1 X1\n".encode_utf16().flat_map(u16::to_le_bytes).collect();
+    let bytes: Vec<u8> = "\u{feff}G1 X1\n"
+        .encode_utf16()
+        .flat_map(u16::to_le_bytes)
+        .collect();
     std::fs::write(&file, bytes).expect("write");
     let out = run(bin().arg("analyze").arg(&file));
     assert_eq!(out.status.code(), Some(1));

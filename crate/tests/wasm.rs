@@ -9,7 +9,8 @@ use quietpath::analyze::{analyze, AnalyzeOptions, LayerSource};
 use quietpath::gcode::{apply_edits, parse_line};
 
 /// A real SuperSlicer + ArcWelder file from the shared corpus (read at compile time).
-const SUPERSLICER: &[u8] = include_bytes!("../../../shared/corpus/superslicer-2.3.56_klipper_arcwelder.gcode");
+const SUPERSLICER: &[u8] =
+    include_bytes!("../../../shared/corpus/superslicer-2.3.56_klipper_arcwelder.gcode");
 /// A real Kiri:Moto file that never says M82/M83.
 const KIRIMOTO: &[u8] = include_bytes!("../../../shared/corpus/kirimoto-3.0_voron.gcode");
 
@@ -19,7 +20,11 @@ fn analyzes_a_real_file_like_native() {
     assert_eq!(r.layers, 25);
     assert!(matches!(r.layer_source, LayerSource::Markers(_)));
     // SuperSlicer's own summary: filament used [mm] = 264.59
-    assert!((r.filament_mm - 264.59).abs() < 0.01 * 264.59, "{}", r.filament_mm);
+    assert!(
+        (r.filament_mm - 264.59).abs() < 0.01 * 264.59,
+        "{}",
+        r.filament_mm
+    );
     assert!(r.time_s > 0.0);
 }
 
@@ -27,7 +32,11 @@ fn analyzes_a_real_file_like_native() {
 fn infers_relative_extrusion() {
     let r = analyze(KIRIMOTO, &AnalyzeOptions::default()).expect("analyze");
     assert_eq!(r.layers, 25);
-    assert!((r.filament_mm - 225.03).abs() < 0.05 * 225.03, "{}", r.filament_mm);
+    assert!(
+        (r.filament_mm - 225.03).abs() < 0.05 * 225.03,
+        "{}",
+        r.filament_mm
+    );
 }
 
 #[wasm_bindgen_test]
@@ -46,12 +55,17 @@ fn parser_rejects_non_finite_numbers() {
 
 #[wasm_bindgen_test]
 fn binding_returns_plain_objects_and_js_errors() {
-    let report = quietpath::wasm::analyze_js(JsValue::from_str("M83\nG1 X10 E1 F600\n"), JsValue::UNDEFINED, None)
-        .expect("report");
+    let report = quietpath::wasm::analyze_js(
+        JsValue::from_str("M83\nG1 X10 E1 F600\n"),
+        JsValue::UNDEFINED,
+        None,
+    )
+    .expect("report");
     let moves = Reflect::get(&report, &JsValue::from_str("moves")).expect("moves");
     assert_eq!(moves.as_f64(), Some(1.0));
     let strict = js_sys::JSON::parse(r#"{"strict": true}"#).expect("json");
-    let err = quietpath::wasm::analyze_js(JsValue::from_str("G1 X1\nG1 X1e999\n"), strict, None).expect_err("strict");
+    let err = quietpath::wasm::analyze_js(JsValue::from_str("G1 X1\nG1 X1e999\n"), strict, None)
+        .expect_err("strict");
     assert!(err.is_instance_of::<js_sys::Error>());
     let line = Reflect::get(&err, &JsValue::from_str("line")).expect("line");
     assert_eq!(line.as_f64(), Some(2.0));
