@@ -54,9 +54,11 @@ bench: cli
 	target/release/quietpath bench "$(LARGE)"
 	cargo bench -p quietpath --bench parse
 
-## Long fuzzing run of the parser (nightly + cargo-fuzz).
+## Long fuzzing run of every target (parse_line, analyze, rewrite), 10 minutes each.
+## Installs nightly and cargo-fuzz if missing. FUZZ_SECONDS=… to change.
+FUZZ_SECONDS ?= 600
 fuzz:
-	cargo +nightly fuzz run parse_line -- -max_total_time=600
+	crate/fuzz/smoke.sh $(FUZZ_SECONDS)
 
 clean:
 	cargo clean

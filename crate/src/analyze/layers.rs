@@ -11,7 +11,7 @@
 use super::report::{LayerSource, LayerSummary};
 use crate::gcode::LayerMarkerKind;
 use crate::machine::{axis, Move};
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 /// Smallest Z difference that counts as a new layer on flat moves, mm.
 const Z_EPS: f64 = 1e-4;
@@ -61,8 +61,8 @@ pub struct LayerTracker {
     by_z: Count,
     z_layer: Option<f64>,
     z_last: Option<f64>,
-    /// Heading of the last printing move, radians (None after a travel).
-    heading: Option<f64>,
+    /// XY direction of the last printing move (None after a travel).
+    direction: Option<[f64; 2]>,
     /// Signed turning of the printing direction since the layer started, radians.
     turned: f64,
 }
@@ -76,7 +76,7 @@ impl LayerTracker {
             by_z: Count::default(),
             z_layer: None,
             z_last: None,
-            heading: None,
+            direction: None,
             turned: 0.0,
         }
     }
@@ -98,7 +98,7 @@ impl LayerTracker {
             let z_start = m.from[axis::Z];
             let dx = m.to[axis::X] - m.from[axis::X];
             let dy = m.to[axis::Y] - m.from[axis::Y];
-            let heading = (dx * dx + dy * dy > 1e-18).then(|| crate::math::atan2(dy, dx));
+            let direction = (dx * dx + dy * dy > 1e-18).then_some([dx, dy]);
             let new_layer = match (self.z_layer, self.z_last) {
                 (Some(zl), Some(last)) => {
                     if (z - z_start).abs() <= Z_EPS {
@@ -107,16 +107,20 @@ impl LayerTracker {
                         (z_start - last).abs() > Z_EPS && (z - zl).abs() > Z_EPS
                     } else {
                         // Continuous Z: a new layer after each full turn of the path.
-                        if let (Some(prev), Some(h)) = (self.heading, heading) {
-                            self.turned += wrap_angle(h - prev);
+                        if let (Some(p), Some(d)) = (self.direction, direction) {
+                            // Signed angle between the two directions, in (-π, π].
+                            self.turned += crate::math::atan2(
+                                p[0] * d[1] - p[1] * d[0],
+                                p[0] * d[0] + p[1] * d[1],
+                            );
                         }
                         self.turned.abs() >= TAU
                     }
                 }
                 _ => true,
             };
-            if heading.is_some() {
-                self.heading = heading;
+            if direction.is_some() {
+                self.direction = direction;
             }
             self.z_last = Some(z);
             if new_layer {
@@ -125,7 +129,7 @@ impl LayerTracker {
                 self.by_z.start(m.line, Some(z));
             }
         } else if m.length_mm > 1e-9 {
-            self.heading = None;
+            self.direction = None;
         }
         self.by_marker.add(m, time_s);
         self.by_z.add(m, time_s);
@@ -146,15 +150,5 @@ impl LayerTracker {
             Some(kind) => (self.by_marker.layers, LayerSource::Markers(kind)),
             None => (self.by_z.layers, LayerSource::ZChanges),
         }
-    }
-}
-
-/// Wraps an angle difference into (-π, π].
-fn wrap_angle(a: f64) -> f64 {
-    let w = (a + PI).rem_euclid(TAU) - PI;
-    if w <= -PI {
-        w + TAU
-    } else {
-        w
     }
 }

@@ -4,6 +4,8 @@
 mod layers;
 pub mod report;
 
+use std::collections::HashMap;
+
 use serde::Deserialize;
 
 use crate::error::{Error, ErrorKind, Warnings};
@@ -109,6 +111,7 @@ pub fn analyze_with_progress(
     let mut totals = Totals::default();
     let mut layer_tracker = LayerTracker::new();
     let mut features: Vec<FeatureSummary> = Vec::new();
+    let mut feature_names: HashMap<String, usize> = HashMap::new();
     let mut current_feature: Option<usize> = None;
     let mut travel = FeatureSummary {
         name: "travel".into(),
@@ -137,7 +140,7 @@ pub fn analyze_with_progress(
                     layer_tracker.marker(kind, z, raw.number);
                 }
                 Some(Marker::Feature(name)) => {
-                    current_feature = Some(feature_index(&mut features, name));
+                    current_feature = Some(feature_index(&mut features, &mut feature_names, name));
                 }
                 None => info.observe(comment),
             }
@@ -153,7 +156,7 @@ pub fn analyze_with_progress(
                     let i = match current_feature {
                         Some(i) => i,
                         None => {
-                            let i = feature_index(&mut features, "unmarked");
+                            let i = feature_index(&mut features, &mut feature_names, "unmarked");
                             current_feature = Some(i);
                             i
                         }
@@ -263,10 +266,15 @@ fn validate_options(o: &AnalyzeOptions) -> Result<(), Error> {
     Ok(())
 }
 
-fn feature_index(features: &mut Vec<FeatureSummary>, name: &str) -> usize {
-    if let Some(i) = features.iter().position(|f| f.name == name) {
+fn feature_index(
+    features: &mut Vec<FeatureSummary>,
+    index: &mut HashMap<String, usize>,
+    name: &str,
+) -> usize {
+    if let Some(&i) = index.get(name) {
         return i;
     }
+    index.insert(name.to_string(), features.len());
     features.push(FeatureSummary {
         name: name.to_string(),
         kind: Some(feature_kind(name)),

@@ -231,10 +231,11 @@ fn trim(mut s: &[u8]) -> &[u8] {
 /// Scans the numeric token at the start of `s`: `[+-] digits [. digits] [exponent]`, returning
 /// its length (0 if there is no number).
 ///
-/// Exponents: Marlin stops a number at `E` (so `G1X10E5` is X=10, E=5) and we keep that reading
-/// for a bare `E`/`e` followed by a digit when the word letter is upper case. An exponent is taken
-/// when it is written with a sign (`1E-5`, `2e+3`), or as a lower-case `e` after an upper-case
-/// word letter (`X1e3`), which no firmware would read as an extrusion word.
+/// Exponents: Marlin never reads `E` as an exponent (`G1X10E-2` is X=10 and a 2 mm retraction),
+/// and neither do we for an upper-case `E`. A lower-case `e` after an upper-case word letter
+/// (`X1e3`, `Y2e-5`) can only be an exponent, since no all-caps dialect writes a lower-case
+/// extrusion word, so that one is read as an exponent; in all-lower-case lines (`g1x10e-2`) `e`
+/// is the extrusion word again.
 #[inline]
 fn scan_number(s: &[u8], upper_letter: bool) -> usize {
     let mut i = 0;
@@ -257,17 +258,17 @@ fn scan_number(s: &[u8], upper_letter: bool) -> usize {
     if digits == 0 {
         return 0;
     }
-    if i + 1 < s.len() && (s[i] == b'e' || s[i] == b'E') {
+    if upper_letter && i + 1 < s.len() && s[i] == b'e' {
         let next = s[i + 1];
         let signed = (next == b'+' || next == b'-') && s.get(i + 2).is_some_and(u8::is_ascii_digit);
-        let lower = s[i] == b'e' && upper_letter && next.is_ascii_digit();
-        if signed || lower {
+        if signed || next.is_ascii_digit() {
             i += if signed { 2 } else { 1 };
             while i < s.len() && s[i].is_ascii_digit() {
                 i += 1;
             }
         }
     }
+
     i
 }
 
@@ -331,7 +332,7 @@ fn parse_number(s: &[u8], upper_letter: bool) -> (usize, Option<f64>) {
     if digits + frac_digits == 0 {
         return (0, None);
     }
-    let has_exponent = i + 1 < s.len() && (s[i] == b'e' || s[i] == b'E');
+    let has_exponent = upper_letter && i + 1 < s.len() && s[i] == b'e';
     if !has_exponent && digits + frac_digits <= 15 && frac_digits < POW10.len() {
         let v = mantissa as f64 / POW10[frac_digits];
         return (i, Some(if negative { -v } else { v }));
@@ -413,7 +414,10 @@ pub fn parse_line_into<'a>(text: &'a [u8], line: &mut Line<'a>) -> Result<(), Li
     // Checksum: `*nn` at the end of the command part. The host protocol puts checksums only
     // on numbered lines (`N123 ... *nn`), so only those are searched for one.
     let numbered = matches!(text[pos], b'N' | b'n');
-    if let Some(star) = memchr::memrchr(b'*', &text[..end]).filter(|_| numbered) {
+    if let Some(star) = numbered
+        .then(|| memchr::memrchr(b'*', &text[..end]))
+        .flatten()
+    {
         let digits = trim(&text[star + 1..end]);
         if !digits.is_empty() && digits.iter().all(u8::is_ascii_digit) && digits.len() <= 9 {
             let found = digits
@@ -666,10 +670,16 @@ mod tests {
         let l = ok("G1 X1E5");
         assert_eq!(l.params.get(b'X'), Some(1.0));
         assert_eq!(l.params.get(b'E'), Some(5.0));
-        let l = ok("G1 X1e3 Y2E-2 Z+3");
+        let l = ok("G1 X1e3 Y2e-2 Z+3");
         assert_eq!(l.params.get(b'X'), Some(1000.0));
         assert_eq!(l.params.get(b'Y'), Some(0.02));
         assert_eq!(l.params.get(b'Z'), Some(3.0));
+        // Marlin's reading: an upper-case E after a number is always the extrusion word.
+        let l = ok("G1X10E-2");
+        assert_eq!(l.params.get(b'X'), Some(10.0));
+        assert_eq!(l.params.get(b'E'), Some(-2.0));
+        let l = ok("g1x10e-2");
+        assert_eq!(l.params.get(b'E'), Some(-2.0));
     }
 
     #[test]

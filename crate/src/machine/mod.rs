@@ -50,6 +50,17 @@ pub type Pos = [f64; AXES];
 
 /// Default feed rate before any `F`, mm/s (Marlin's and Klipper's 1500 mm/min).
 pub const DEFAULT_FEED_MM_S: f64 = 25.0;
+/// Largest coordinate accepted, mm (or degrees): a thousand kilometres. Beyond it a value is
+/// corruption, not geometry; the line is ignored with a warning so that no report or rewritten
+/// file ever carries absurd coordinates, and every sum over a file stays finite.
+pub const MAX_COORDINATE: f64 = 1e9;
+/// Slowest feed rate used for timing, mm/s: a smaller (or vanishing) feed would make times
+/// infinite. Marlin's planner never goes below its `MINIMUM_PLANNER_SPEED` (0.05 mm/s) either.
+pub const MIN_FEED_MM_S: f64 = 1e-3;
+/// Longest dwell accepted, s (about four months).
+pub const MAX_DWELL_S: f64 = 1e7;
+/// Range of `M220`/`M221` factors accepted, percent.
+pub const OVERRIDE_RANGE_PERCENT: std::ops::RangeInclusive<f64> = 1.0..=1000.0;
 /// Default firmware retraction length, mm (Marlin's `RETRACT_LENGTH`).
 pub const DEFAULT_RETRACT_MM: f64 = 3.0;
 /// Default firmware retraction speed, mm/s (Marlin's `RETRACT_FEEDRATE`).
@@ -118,12 +129,7 @@ impl Move {
 
     /// Time at the requested feed rate, ignoring acceleration, s.
     pub fn nominal_time(&self) -> f64 {
-        let f = self.feed_mm_s;
-        if f > 0.0 {
-            self.feed_length() / f
-        } else {
-            0.0
-        }
+        self.feed_length() / self.feed_mm_s.max(MIN_FEED_MM_S)
     }
 }
 
@@ -317,8 +323,11 @@ impl Machine {
                     (None, Some(ms)) => ms / 1000.0,
                     _ => 0.0,
                 };
-                if secs < 0.0 {
-                    warnings.push(line_no, "negative dwell ignored");
+                if !(0.0..=MAX_DWELL_S).contains(&secs) {
+                    warnings.push(
+                        line_no,
+                        format!("dwell of {secs} s ignored (accepted: 0 to {MAX_DWELL_S} s)"),
+                    );
                     return None;
                 }
                 (secs > 0.0).then_some(Event::Dwell(secs))
@@ -357,7 +366,7 @@ impl Machine {
                 None
             }
             (b'G', 92, None) => {
-                self.set_position(line);
+                self.set_position(line_no, line, warnings);
                 None
             }
             (b'G', 5, _) => {
@@ -418,8 +427,8 @@ impl Machine {
                 speed: 0.0,
             }),
             (b'M', 207, _) => {
-                if let Some(s) = p.get(b'S') {
-                    self.retract_mm = s.max(0.0) * self.unit();
+                if let Some(s) = p.get(b'S').filter(|s| (0.0..=1000.0).contains(s)) {
+                    self.retract_mm = s * self.unit();
                 }
                 if let Some(f) = p.get(b'F').filter(|f| *f > 0.0) {
                     self.retract_feed_mm_s = f * self.unit() / 60.0;
@@ -427,7 +436,7 @@ impl Machine {
                 None
             }
             (b'M', 208, _) => {
-                if let Some(s) = p.get(b'S') {
+                if let Some(s) = p.get(b'S').filter(|s| (-1000.0..=1000.0).contains(s)) {
                     self.unretract_extra_mm = s * self.unit();
                 }
                 if let Some(f) = p.get(b'F').filter(|f| *f > 0.0) {
@@ -437,20 +446,26 @@ impl Machine {
             }
             (b'M', 220, _) => {
                 if let Some(s) = p.get(b'S') {
-                    if s > 0.0 {
+                    if OVERRIDE_RANGE_PERCENT.contains(&s) {
                         self.speed_factor = s / 100.0;
                     } else {
-                        warnings.push(line_no, "M220 with a non-positive factor ignored");
+                        warnings.push(
+                            line_no,
+                            format!("M220 S{s} ignored (accepted: 1 to 1000 %)"),
+                        );
                     }
                 }
                 None
             }
             (b'M', 221, _) => {
                 if let Some(s) = p.get(b'S') {
-                    if s >= 0.0 {
+                    if s == 0.0 || OVERRIDE_RANGE_PERCENT.contains(&s) {
                         self.flow_factor = s / 100.0;
                     } else {
-                        warnings.push(line_no, "M221 with a negative factor ignored");
+                        warnings.push(
+                            line_no,
+                            format!("M221 S{s} ignored (accepted: 0 or 1 to 1000 %)"),
+                        );
                     }
                 }
                 None
@@ -526,6 +541,13 @@ impl Machine {
             warnings.push(line_no, "axis word without a value ignored");
         }
         let target = self.target(line);
+        if let Some(bad) = target.iter().find(|v| v.abs() > MAX_COORDINATE) {
+            warnings.push(
+                line_no,
+                format!("coordinate {bad:e} out of range (|v| > {MAX_COORDINATE:e}); line ignored"),
+            );
+            return None;
+        }
         let mut kind = match g {
             0 => MoveKind::Rapid,
             1 => MoveKind::Linear,
@@ -653,12 +675,20 @@ impl Machine {
         Event::Home(mask)
     }
 
-    fn set_position(&mut self, line: &Line<'_>) {
+    fn set_position(&mut self, line_no: u32, line: &Line<'_>, warnings: &mut Warnings) {
         let mut any = false;
         for (i, letter) in AXIS_LETTERS.iter().enumerate() {
             if let Some(v) = line.params.get(*letter) {
-                self.logical[i] = if LINEAR[i] { v * self.unit() } else { v };
+                let v = if LINEAR[i] { v * self.unit() } else { v };
                 any = true;
+                if v.abs() > MAX_COORDINATE {
+                    warnings.push(
+                        line_no,
+                        format!("G92 {}{v} out of range; ignored", *letter as char),
+                    );
+                    continue;
+                }
+                self.logical[i] = v;
             }
         }
         if !any {

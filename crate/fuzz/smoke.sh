@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Runs every cargo-fuzz target for N seconds each (default 20) and exits non-zero if any of them
+# finds a crash, a timeout or an out-of-memory input.
+#
+#   crate/fuzz/smoke.sh [SECONDS] [TARGET...]      (default: all targets)
+#
+# Needs the nightly toolchain; installs cargo-fuzz if it is missing. New corpus entries go to
+# fuzz/corpus/<target>/ (git-ignored); fuzz/seeds/<target>/ is only read. Crashing inputs are
+# written to fuzz/artifacts/<target>/ (git-ignored): copy them into fuzz/regressions/ so that
+# `cargo test` (tests/fuzz_regressions.rs) replays them for ever.
+set -uo pipefail
+
+secs=${1:-20}
+shift || true
+targets=("$@")
+[ ${#targets[@]} -gt 0 ] || targets=(parse_line analyze rewrite)
+
+case $secs in ''|*[!0-9]*) echo "smoke.sh: SECONDS must be a whole number, got '$secs'" >&2; exit 2 ;; esac
+
+fuzz_dir=$(cd "$(dirname "$0")" && pwd)
+cd "$fuzz_dir/.." || exit 2 # the crate: cargo fuzz looks for ./fuzz
+
+export PATH="$HOME/.cargo/bin:$PATH"
+if ! rustup toolchain list 2>/dev/null | grep -q '^nightly'; then
+    echo "smoke.sh: installing the nightly toolchain (cargo-fuzz needs it)" >&2
+    rustup toolchain install nightly --profile minimal || exit 2
+fi
+if ! cargo fuzz --version >/dev/null 2>&1; then
+    echo "smoke.sh: installing cargo-fuzz" >&2
+    cargo install cargo-fuzz --locked || exit 2
+fi
+
+failed=()
+for t in "${targets[@]}"; do
+    mkdir -p "fuzz/corpus/$t" "fuzz/artifacts/$t"
+    echo "== fuzz $t for ${secs}s"
+    # -timeout: one input taking longer than 10 s is a bug (quadratic paths on hostile input).
+    # -rss_limit_mb: the parser streams; 2 GB means a leak or an unbounded structure.
+    if ! cargo +nightly fuzz run "$t" "fuzz/corpus/$t" "fuzz/seeds/$t" -- \
+        -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 -dict=fuzz/gcode.dict \
+        -print_final_stats=1; then
+        echo "!! fuzz target $t failed; reproducer in crate/fuzz/artifacts/$t/" >&2
+        failed+=("$t")
+    fi
+done
+
+if [ ${#failed[@]} -gt 0 ]; then
+    echo "smoke.sh: crashes in: ${failed[*]}" >&2
+    exit 1
+fi
+echo "smoke.sh: no crashes in ${targets[*]} (${secs}s each)"
