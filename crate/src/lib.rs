@@ -19,7 +19,7 @@
 //! Modules:
 //! - [`gcode`]: zero-copy lines and words, slicer dialects, lossless writing.
 //! - [`machine`]: modal printer state, arcs, extrusion modes; turns lines into motion events.
-//! - [`analyze`]: one streaming pass giving the report.
+//! - [`analyze`](mod@analyze): one streaming pass giving the report.
 //! - [`math`]: portable transcendental functions (identical results native and wasm).
 
 pub mod analyze;
