@@ -27,6 +27,7 @@ pub mod error;
 pub mod gcode;
 pub mod machine;
 pub mod math;
+pub mod plan;
 
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;

@@ -29,3 +29,9 @@ pub fn cos(x: f64) -> f64 {
 pub fn hypot(x: f64, y: f64) -> f64 {
     libm::hypot(x, y)
 }
+
+/// Arccosine, radians.
+#[inline]
+pub fn acos(x: f64) -> f64 {
+    libm::acos(x)
+}

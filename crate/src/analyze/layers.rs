@@ -13,6 +13,9 @@ use crate::gcode::LayerMarkerKind;
 use crate::machine::{axis, Move};
 use std::f64::consts::TAU;
 
+/// Layer index meaning "before the first layer".
+pub const NO_LAYER: u32 = u32::MAX;
+
 /// Smallest Z difference that counts as a new layer on flat moves, mm.
 const Z_EPS: f64 = 1e-4;
 
@@ -36,7 +39,7 @@ impl Count {
         });
     }
 
-    fn add(&mut self, m: &Move, time_s: f64) {
+    fn add(&mut self, m: &Move) {
         if let Some(l) = self.layers.last_mut() {
             l.moves += 1;
             if m.is_extruding() {
@@ -48,7 +51,16 @@ impl Count {
                 l.travel_distance_mm += m.length_mm;
             }
             l.filament_mm += m.extrusion();
-            l.time_s += time_s;
+        }
+    }
+
+    fn current(&self) -> u32 {
+        u32::try_from(self.layers.len()).map_or(NO_LAYER, |n| n.wrapping_sub(1))
+    }
+
+    fn add_time(&mut self, index: u32, secs: f64) {
+        if let Some(l) = self.layers.get_mut(index as usize) {
+            l.time_s += secs;
         }
     }
 }
@@ -91,8 +103,8 @@ impl LayerTracker {
         self.by_marker.start(line, z);
     }
 
-    /// A move with its time.
-    pub fn motion(&mut self, m: &Move, time_s: f64) {
+    /// A move (its time comes later, from the planner, through [`LayerTracker::add_time`]).
+    pub fn motion(&mut self, m: &Move) {
         if m.is_extruding() {
             let z = m.to[axis::Z];
             let z_start = m.from[axis::Z];
@@ -131,17 +143,19 @@ impl LayerTracker {
         } else if m.length_mm > 1e-9 {
             self.direction = None;
         }
-        self.by_marker.add(m, time_s);
-        self.by_z.add(m, time_s);
+        self.by_marker.add(m);
+        self.by_z.add(m);
     }
 
-    /// Time spent outside moves (dwell) goes to the current layer.
-    pub fn dwell(&mut self, secs: f64) {
-        for c in [&mut self.by_marker, &mut self.by_z] {
-            if let Some(l) = c.layers.last_mut() {
-                l.time_s += secs;
-            }
-        }
+    /// The current layer in each count ([`NO_LAYER`] before the first).
+    pub fn current(&self) -> (u32, u32) {
+        (self.by_marker.current(), self.by_z.current())
+    }
+
+    /// Adds time to a layer of each count, as given by [`LayerTracker::current`].
+    pub fn add_time(&mut self, (by_marker, by_z): (u32, u32), secs: f64) {
+        self.by_marker.add_time(by_marker, secs);
+        self.by_z.add_time(by_z, secs);
     }
 
     /// The layer list and how it was counted.

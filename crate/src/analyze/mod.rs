@@ -1,17 +1,18 @@
-//! `analyze`: one streaming pass over a file giving time, distances, filament, layers,
-//! features, temperatures and fans.
+//! `analyze`: one streaming pass over a file giving time (from the motion planner), distances,
+//! filament, layers, features, temperatures and fans.
 
+mod accounting;
 mod layers;
+pub mod prescan;
 pub mod report;
-
-use std::collections::HashMap;
 
 use serde::Deserialize;
 
 use crate::error::{Error, ErrorKind, Warnings};
-use crate::gcode::{self, classify_comment, feature_kind, Marker, SlicerInfo, Strictness};
-use crate::machine::{self, axis, Event, ExtrusionMode, Machine, MachineConfig, Move};
-use layers::LayerTracker;
+use crate::gcode::{self, classify_comment, Marker, SlicerInfo, Strictness};
+use crate::machine::{self, axis, Event, ExtrusionMode, Machine, MachineConfig};
+use crate::plan::{FeedUnits, JunctionModel, Limit, LimitSource, MachineProfile, Planner};
+use accounting::Accounts;
 pub use report::*;
 
 /// Default filament diameter when the file does not declare one, mm.
@@ -31,6 +32,15 @@ pub struct AnalyzeOptions {
     pub density_g_cm3: Option<f64>,
     /// Force the starting extrusion mode instead of inferring it.
     pub extrusion_mode: Option<ExtrusionModeOption>,
+    /// Built-in machine preset (see `plan::profiles::PRESETS`); default: chosen from the file's
+    /// flavour.
+    pub machine: Option<String>,
+    /// A whole machine profile (wins over `machine`).
+    pub machine_profile: Option<MachineProfile>,
+    /// Junction model; default: the profile's, or Klipper's for files that drive Klipper.
+    pub junction_model: Option<JunctionModel>,
+    /// Length of the segments arcs are split into, mm (default: the profile's, 1 mm).
+    pub arc_segment_mm: Option<f64>,
 }
 
 /// Starting extrusion mode, as an option.
@@ -54,17 +64,44 @@ pub fn analyze(input: &[u8], options: &AnalyzeOptions) -> Result<Report, Error> 
     analyze_with_progress(input, options, &mut |_| true)
 }
 
-#[derive(Debug, Default)]
-struct Totals {
-    time_s: f64,
-    moves: u64,
-    extruding_moves: u64,
-    distance_mm: f64,
-    extrude_distance_mm: f64,
-    travel_distance_mm: f64,
-    retractions: u64,
-    lines: u64,
-    bounds: Option<Bounds>,
+/// The machine, junction model and limits a file is planned with, and why.
+fn choose_machine(
+    options: &AnalyzeOptions,
+    pre: &prescan::Prescan,
+) -> Result<(MachineProfile, JunctionModel, String), Error> {
+    let klipper = pre.klipper_commands
+        || pre
+            .flavor
+            .as_deref()
+            .is_some_and(|f| f.contains("klipper") || f.contains("creality os"));
+    let invalid = |reason| Error::new(0, 0, ErrorKind::InvalidOption { reason });
+    let (profile, why) = if let Some(p) = &options.machine_profile {
+        (
+            p.clone(),
+            format!("profile '{}' given in the options", p.name),
+        )
+    } else if let Some(name) = &options.machine {
+        let p = MachineProfile::preset(name)
+            .ok_or_else(|| invalid("unknown machine preset (see plan::profiles::PRESETS)"))?;
+        (p, format!("preset '{name}' given in the options"))
+    } else if klipper {
+        (
+            MachineProfile::preset("voron-klipper").ok_or_else(|| invalid("preset missing"))?,
+            "the file drives Klipper".to_string(),
+        )
+    } else {
+        (
+            MachineProfile::preset("prusa-mk3s").ok_or_else(|| invalid("preset missing"))?,
+            "default for Marlin-style files (classic jerk, as slicer estimators assume)"
+                .to_string(),
+        )
+    };
+    let (model, why) = match options.junction_model {
+        Some(m) => (m, format!("{why}; junction model given in the options")),
+        None if klipper => (JunctionModel::Klipper, why),
+        None => (profile.junction, why),
+    };
+    Ok((profile, model, why))
 }
 
 /// [`analyze`] with progress reports and cancellation.
@@ -103,30 +140,36 @@ pub fn analyze_with_progress(
         );
     }
 
+    let pre = prescan::prescan(input);
+    let (profile, model, model_reason) = choose_machine(options, &pre)?;
+    let mut limits = profile.limits.clone();
+    for (key, value) in &pre.limit_settings {
+        limits.apply_setting(key, value);
+    }
+    if let Some(seg) = options.arc_segment_mm {
+        limits.arc_segment_mm = Limit {
+            value: seg,
+            source: LimitSource::Option,
+        };
+    }
+    let units = if pre.flavor.as_deref() == Some("reprapfirmware") {
+        FeedUnits::PerMinute
+    } else {
+        FeedUnits::PerSecond
+    };
+    let mut planner = Planner::new(limits, model);
+    let mut print_limits = None;
+
     let mut machine = Machine::new(MachineConfig {
         extrusion: mode,
         ..MachineConfig::default()
     });
     let mut info = SlicerInfo::default();
-    let mut totals = Totals::default();
-    let mut layer_tracker = LayerTracker::new();
-    let mut features: Vec<FeatureSummary> = Vec::new();
-    let mut feature_names: HashMap<String, usize> = HashMap::new();
-    let mut current_feature: Option<usize> = None;
-    let mut travel = FeatureSummary {
-        name: "travel".into(),
-        kind: None,
-        moves: 0,
-        distance_mm: 0.0,
-        filament_mm: 0.0,
-        time_s: 0.0,
-    };
-    let mut temperatures = Vec::new();
-    let mut fans = Vec::new();
+    let mut acc = Accounts::new();
     let mut next_progress = PROGRESS_STEP;
 
     gcode::for_each_line(input, strictness, &mut warnings, |raw, line, warnings| {
-        totals.lines += 1;
+        acc.totals.lines += 1;
         if raw.offset >= next_progress {
             next_progress = raw.offset + PROGRESS_STEP;
             if !progress(raw.offset as f64 / input.len() as f64) {
@@ -136,69 +179,61 @@ pub fn analyze_with_progress(
         let Some(line) = line else { return Ok(()) };
         if let Some(comment) = line.comment {
             match classify_comment(comment) {
-                Some(Marker::Layer { kind, z }) => {
-                    layer_tracker.marker(kind, z, raw.number);
-                }
-                Some(Marker::Feature(name)) => {
-                    current_feature = Some(feature_index(&mut features, &mut feature_names, name));
-                }
+                Some(Marker::Layer { kind, z }) => acc.layers.marker(kind, z, raw.number),
+                Some(Marker::Feature(name)) => acc.feature(name),
                 None => info.observe(comment),
             }
+        }
+        if planner.limits_mut().apply_command(line, units) {
+            return Ok(());
         }
         let Some(event) = machine.apply(raw.number, line, warnings) else {
             return Ok(());
         };
         match event {
             Event::Move(m) => {
-                let t = m.nominal_time();
-                account_move(&m, t, &mut totals);
-                let summary = if m.is_extruding() {
-                    let i = match current_feature {
-                        Some(i) => i,
-                        None => {
-                            let i = feature_index(&mut features, &mut feature_names, "unmarked");
-                            current_feature = Some(i);
-                            i
-                        }
-                    };
-                    &mut features[i]
-                } else {
-                    &mut travel
-                };
-                summary.moves += 1;
-                summary.distance_mm += m.length_mm;
-                summary.filament_mm += m.extrusion();
-                summary.time_s += t;
-                layer_tracker.motion(&m, t);
+                let seq = acc.read_move(&m);
+                if print_limits.is_none() && m.is_extruding() {
+                    print_limits = Some(planner.limits().clone());
+                }
+                planner.push(&m, seq, &mut |pm| acc.planned(pm));
             }
             Event::Dwell(s) => {
-                totals.time_s += s;
-                layer_tracker.dwell(s);
+                planner.flush(&mut |pm| acc.planned(pm));
+                acc.stamp_all(planner.elapsed_s());
+                planner.dwell(s, &mut |pm| acc.planned(pm));
+                acc.dwell(s);
             }
             Event::Temperature {
                 heater,
                 target_c,
                 wait,
-            } => temperatures.push(TemperatureEvent {
-                line: raw.number,
-                time_s: totals.time_s,
-                heater,
-                target_c,
-                wait,
-            }),
-            Event::Fan { index, speed } => fans.push(FanEvent {
-                line: raw.number,
-                time_s: totals.time_s,
-                index,
-                speed,
-            }),
-            Event::Home(_) => {}
+            } => {
+                acc.temperature(raw.number, heater, target_c, wait);
+                if wait {
+                    // The firmware finishes every queued move before it waits.
+                    planner.flush(&mut |pm| acc.planned(pm));
+                }
+            }
+            Event::Fan { index, speed } => acc.fan(raw.number, index, speed),
+            Event::Home(_) => planner.flush(&mut |pm| acc.planned(pm)),
         }
         Ok(())
     })?;
+    planner.flush(&mut |pm| acc.planned(pm));
+    acc.stamp_all(planner.elapsed_s());
     progress(1.0);
 
-    let (layer_list, layer_source) = layer_tracker.finish();
+    let Accounts {
+        totals,
+        mut features,
+        travel,
+        layers,
+        temperatures,
+        fans,
+        ..
+    } = acc;
+    let (layer_list, layer_source) = layers.finish();
     let filament_mm = machine.position()[axis::E];
     let diameter = options
         .filament_diameter_mm
@@ -219,10 +254,17 @@ pub fn analyze_with_progress(
             bytes: input.len() as u64,
             lines: totals.lines,
             slicer: info.slicer,
-            flavor: info.flavor,
+            flavor: info.flavor.or(pre.flavor),
+            slicer_time_s: pre.slicer_time_s,
         },
-        time_s: totals.time_s,
-        time_model: "nominal".into(),
+        time_s: planner.elapsed_s(),
+        time_model: "planner".into(),
+        machine: MachineInfo {
+            profile: profile.name,
+            junction_model: model,
+            reason: model_reason,
+            limits: print_limits.unwrap_or_else(|| planner.limits().clone()),
+        },
         moves: totals.moves,
         extruding_moves: totals.extruding_moves,
         layers: layer_list.len() as u64,
@@ -254,59 +296,17 @@ pub fn analyze_with_progress(
 
 fn validate_options(o: &AnalyzeOptions) -> Result<(), Error> {
     let positive = |v: Option<f64>| v.is_none_or(|x| x.is_finite() && x > 0.0);
-    if !positive(o.filament_diameter_mm) || !positive(o.density_g_cm3) {
+    if !positive(o.filament_diameter_mm)
+        || !positive(o.density_g_cm3)
+        || !positive(o.arc_segment_mm)
+    {
         return Err(Error::new(
             0,
             0,
             ErrorKind::InvalidOption {
-                reason: "filament_diameter_mm and density_g_cm3 must be positive numbers",
+                reason: "filament_diameter_mm, density_g_cm3 and arc_segment_mm must be positive numbers",
             },
         ));
     }
     Ok(())
-}
-
-fn feature_index(
-    features: &mut Vec<FeatureSummary>,
-    index: &mut HashMap<String, usize>,
-    name: &str,
-) -> usize {
-    if let Some(&i) = index.get(name) {
-        return i;
-    }
-    index.insert(name.to_string(), features.len());
-    features.push(FeatureSummary {
-        name: name.to_string(),
-        kind: Some(feature_kind(name)),
-        moves: 0,
-        distance_mm: 0.0,
-        filament_mm: 0.0,
-        time_s: 0.0,
-    });
-    features.len() - 1
-}
-
-fn account_move(m: &Move, t: f64, totals: &mut Totals) {
-    totals.moves += 1;
-    totals.time_s += t;
-    totals.distance_mm += m.length_mm;
-    if m.is_extruding() {
-        totals.extruding_moves += 1;
-        totals.extrude_distance_mm += m.length_mm;
-        let b = totals.bounds.get_or_insert(Bounds {
-            min: [f64::INFINITY; 3],
-            max: [f64::NEG_INFINITY; 3],
-        });
-        for p in [&m.from, &m.to] {
-            for ((lo, hi), v) in b.min.iter_mut().zip(b.max.iter_mut()).zip(&p[..3]) {
-                *lo = lo.min(*v);
-                *hi = hi.max(*v);
-            }
-        }
-    } else {
-        totals.travel_distance_mm += m.length_mm;
-        if m.extrusion() < -1e-12 {
-            totals.retractions += 1;
-        }
-    }
 }

@@ -16,8 +16,10 @@ pub struct Report {
     pub file: FileInfo,
     /// Estimated print time, s (nominal: path length over feed rate, plus dwells).
     pub time_s: f64,
-    /// How `time_s` was computed.
+    /// How `time_s` was computed (`planner`: firmware look-ahead with the junction model below).
     pub time_model: String,
+    /// The machine the file was planned for.
+    pub machine: MachineInfo,
     /// Motion commands that moved something (XYZ, rotary axes or the extruder).
     pub moves: u64,
     /// Of those, moves that laid down material.
@@ -73,6 +75,21 @@ pub struct FileInfo {
     pub slicer: Option<String>,
     /// Firmware flavour declared in the file.
     pub flavor: Option<String>,
+    /// The slicer's own print-time estimate written in the file, s.
+    pub slicer_time_s: Option<f64>,
+}
+
+/// The machine a file was planned for.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MachineInfo {
+    /// Profile name.
+    pub profile: String,
+    /// Junction model used.
+    pub junction_model: crate::plan::JunctionModel,
+    /// Why this profile and model.
+    pub reason: String,
+    /// Limits in force at the first printing move, each with where it came from.
+    pub limits: crate::plan::Limits,
 }
 
 /// Extrusion settings used for filament and mass.

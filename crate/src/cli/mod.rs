@@ -14,6 +14,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use quietpath::analyze::{analyze_with_progress, AnalyzeOptions, ExtrusionModeOption};
 use quietpath::error::Warnings;
 use quietpath::gcode::{self, Strictness};
+use quietpath::plan::{JunctionModel, MachineProfile};
 
 /// Quieter, cheaper 3D-printer toolpaths.
 #[derive(Debug, Parser)]
@@ -76,6 +77,26 @@ struct AnalyzeArgs {
     /// Starting extrusion mode (default: from M82/M83, else inferred from the E values).
     #[arg(long, value_enum)]
     extrusion: Option<ExtrusionArg>,
+    /// Machine preset: prusa-mk3s, creality-ender3, voron-klipper, vtg-ldam-servo
+    /// (default: chosen from the file's flavour).
+    #[arg(long, value_name = "PRESET")]
+    machine: Option<String>,
+    /// Machine profile as a JSON file (the serde form of a profile; wins over --machine).
+    #[arg(long, value_name = "FILE")]
+    machine_file: Option<PathBuf>,
+    /// Junction model (default: the profile's, or Klipper's for files that drive Klipper).
+    #[arg(long, value_enum)]
+    junction: Option<JunctionArg>,
+    /// Length of the straight segments arcs are split into, mm (default 1).
+    #[arg(long, value_name = "MM")]
+    arc_segment: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum JunctionArg {
+    ClassicJerk,
+    JunctionDeviation,
+    Klipper,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -85,8 +106,27 @@ enum ExtrusionArg {
 }
 
 impl AnalyzeArgs {
-    fn options(&self) -> AnalyzeOptions {
-        AnalyzeOptions {
+    fn options(&self) -> Result<AnalyzeOptions, String> {
+        let machine_profile = match &self.machine_file {
+            Some(path) => {
+                let text = std::fs::read_to_string(path)
+                    .map_err(|e| format!("{}: {e}", path.display()))?;
+                Some(
+                    MachineProfile::from_json(&text)
+                        .map_err(|e| format!("{}: {e}", path.display()))?,
+                )
+            }
+            None => None,
+        };
+        Ok(AnalyzeOptions {
+            machine: self.machine.clone(),
+            machine_profile,
+            junction_model: self.junction.map(|j| match j {
+                JunctionArg::ClassicJerk => JunctionModel::ClassicJerk,
+                JunctionArg::JunctionDeviation => JunctionModel::JunctionDeviation,
+                JunctionArg::Klipper => JunctionModel::Klipper,
+            }),
+            arc_segment_mm: self.arc_segment,
             strict: self.strict,
             filament_diameter_mm: self.filament_diameter,
             density_g_cm3: self.density,
@@ -94,7 +134,7 @@ impl AnalyzeArgs {
                 ExtrusionArg::Absolute => ExtrusionModeOption::Absolute,
                 ExtrusionArg::Relative => ExtrusionModeOption::Relative,
             }),
-        }
+        })
     }
 }
 
@@ -124,7 +164,8 @@ fn run(cli: Cli) -> Result<(), String> {
             let mut bar = output::ProgressBar::new(
                 input.len() >= PROGRESS_MIN_BYTES && std::io::stderr().is_terminal(),
             );
-            let report = analyze_with_progress(&input, &opts.options(), &mut |f| bar.update(f))
+            let options = opts.options()?;
+            let report = analyze_with_progress(&input, &options, &mut |f| bar.update(f))
                 .map_err(|e| format!("{}:{}", file.display(), e))?;
             bar.finish();
             let mut stdout = std::io::stdout().lock();

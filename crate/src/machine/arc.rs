@@ -52,6 +52,8 @@ pub struct Arc {
     pub radius: f64,
     /// Signed sweep angle, radians: negative clockwise (`G2`), positive counter-clockwise (`G3`).
     pub sweep: f64,
+    /// Angle of the start point seen from the centre, radians.
+    pub start_angle: f64,
 }
 
 /// How an arc was specified.
@@ -114,6 +116,7 @@ impl Arc {
                 center,
                 radius,
                 sweep: signed,
+                start_angle: a0,
             },
             mismatch,
         ))
@@ -130,11 +133,22 @@ impl Arc {
     }
 
     /// Point in the plane at fraction `t` (0..=1) of the sweep.
-    pub fn point_at(&self, start_angle: f64, t: f64) -> [f64; 2] {
-        let a = start_angle + self.sweep * t;
+    pub fn point_at(&self, t: f64) -> [f64; 2] {
+        let a = self.start_angle + self.sweep * t;
         [
             self.center[0] + self.radius * cos(a),
             self.center[1] + self.radius * sin(a),
+        ]
+    }
+
+    /// Displacement in the plane from the start point to fraction `t` of the sweep (free of
+    /// the absolute coordinates, so it holds after `G92` shifts too).
+    pub fn offset_at(&self, t: f64) -> [f64; 2] {
+        let a0 = self.start_angle;
+        let a = a0 + self.sweep * t;
+        [
+            self.radius * (cos(a) - cos(a0)),
+            self.radius * (sin(a) - sin(a0)),
         ]
     }
 }
@@ -328,7 +342,7 @@ mod tests {
             1,
         )
         .unwrap();
-        let p = a.point_at(0.0, 0.5);
+        let p = a.point_at(0.5);
         assert!(close(p[0].hypot(p[1]), 10.0));
         assert!(close(p[0], p[1]));
     }

@@ -611,6 +611,17 @@ impl Machine {
             );
             return None;
         };
+        let too_big = match spec {
+            ArcSpec::Radius(r) => r.abs() > MAX_COORDINATE,
+            ArcSpec::Offsets(i, j) => i.abs() > MAX_COORDINATE || j.abs() > MAX_COORDINATE,
+        };
+        if too_big {
+            warnings.push(
+                line_no,
+                "arc radius or centre out of range; treated as a straight move",
+            );
+            return None;
+        }
         let turns = p.get(b'P').map_or(1, |t| t.clamp(1.0, 1000.0) as u32);
         let start = [self.logical[a0], self.logical[a1]];
         let end = [target[a0], target[a1]];

@@ -1,0 +1,233 @@
+//! Machine motion limits and where each one came from.
+//!
+//! Precedence, highest first: the file's own commands (`M201`, `M203`, `M204`, `M205`, `M566`,
+//! Klipper's `SET_VELOCITY_LIMIT`), applied at the line where they appear, as firmware does;
+//! the slicer's settings block (`; machine_max_acceleration_x = 9000,1000`, normal-mode column),
+//! which describes the machine the file was sliced for; and the machine profile.
+
+use serde::{Deserialize, Serialize};
+
+use crate::gcode::Line;
+
+/// Where a limit's current value came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LimitSource {
+    /// The machine profile (preset or JSON).
+    Profile,
+    /// The slicer's settings block in the file.
+    SlicerSettings,
+    /// A command in the file (`M201`…, `SET_VELOCITY_LIMIT`).
+    Command,
+    /// An option of the analysis.
+    Option,
+}
+
+/// How junction speeds between consecutive moves are limited.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum JunctionModel {
+    /// Marlin's (and Prusa firmware's) classic per-axis jerk, the logic of the thesis's
+    /// Appendix A.
+    ClassicJerk,
+    /// Marlin 2's junction deviation, with its small-segment rule.
+    JunctionDeviation,
+    /// Klipper's square-corner velocity with `minimum_cruise_ratio`.
+    Klipper,
+}
+
+/// One limit value with its origin.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Limit {
+    /// The value (mm/s, mm/s², mm or a ratio).
+    pub value: f64,
+    /// Where it came from.
+    pub source: LimitSource,
+}
+
+impl Limit {
+    /// A profile value.
+    pub const fn profile(value: f64) -> Self {
+        Self {
+            value,
+            source: LimitSource::Profile,
+        }
+    }
+}
+
+/// The motion limits in force. Axis arrays are X, Y, Z, E.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Limits {
+    /// Maximum feed rate per axis, mm/s (`M203`).
+    pub max_feedrate: [Limit; 4],
+    /// Maximum acceleration per axis, mm/s² (`M201`).
+    pub max_acceleration: [Limit; 4],
+    /// Acceleration for printing moves, mm/s² (`M204 P`, or `S`).
+    pub acceleration: Limit,
+    /// Acceleration for E-only moves, mm/s² (`M204 R`).
+    pub retract_acceleration: Limit,
+    /// Acceleration for travel moves, mm/s² (`M204 T`, or `S`).
+    pub travel_acceleration: Limit,
+    /// Classic jerk per axis, mm/s (`M205 X Y Z E`, RepRapFirmware `M566` in mm/min).
+    pub max_jerk: [Limit; 4],
+    /// Junction deviation, mm (`M205 J`).
+    pub junction_deviation: Limit,
+    /// Klipper square-corner velocity, mm/s.
+    pub square_corner_velocity: Limit,
+    /// Klipper `minimum_cruise_ratio` (older `max_accel_to_decel` is converted to it).
+    pub minimum_cruise_ratio: Limit,
+    /// Minimum feed rate of printing moves, mm/s (`M205 S`).
+    pub min_feedrate: Limit,
+    /// Minimum feed rate of travel moves, mm/s (`M205 T`).
+    pub min_travel_feedrate: Limit,
+    /// Length of the straight segments arcs are split into, mm.
+    pub arc_segment_mm: Limit,
+}
+
+/// Units of `M203`/`M566` feed rates: Marlin takes mm/s, RepRapFirmware mm/min.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FeedUnits {
+    /// mm/s.
+    PerSecond,
+    /// mm/min.
+    PerMinute,
+}
+
+fn set(limit: &mut Limit, value: Option<f64>, source: LimitSource) {
+    if let Some(v) = value.filter(|v| v.is_finite() && *v >= 0.0) {
+        *limit = Limit { value: v, source };
+    }
+}
+
+impl Limits {
+    /// Applies a limit command; returns whether the line was one.
+    pub fn apply_command(&mut self, line: &Line<'_>, units: FeedUnits) -> bool {
+        let src = LimitSource::Command;
+        let p = &line.params;
+        let per_s = |v: Option<f64>| match units {
+            FeedUnits::PerSecond => v,
+            FeedUnits::PerMinute => v.map(|x| x / 60.0),
+        };
+        if let Some(code) = line.code() {
+            if code.letter != b'M' || code.sub.is_some() {
+                return false;
+            }
+            match code.number {
+                201 => {
+                    for (i, l) in b"XYZE".iter().enumerate() {
+                        set(&mut self.max_acceleration[i], p.get(*l), src);
+                    }
+                }
+                203 => {
+                    for (i, l) in b"XYZE".iter().enumerate() {
+                        set(&mut self.max_feedrate[i], per_s(p.get(*l)), src);
+                    }
+                }
+                204 => {
+                    // Marlin: S sets printing and travel acceleration (legacy); P, R, T each.
+                    set(&mut self.acceleration, p.get(b'S'), src);
+                    set(&mut self.travel_acceleration, p.get(b'S'), src);
+                    set(&mut self.acceleration, p.get(b'P'), src);
+                    set(&mut self.retract_acceleration, p.get(b'R'), src);
+                    set(&mut self.travel_acceleration, p.get(b'T'), src);
+                }
+                205 => {
+                    for (i, l) in b"XYZE".iter().enumerate() {
+                        set(&mut self.max_jerk[i], p.get(*l), src);
+                    }
+                    set(&mut self.min_feedrate, p.get(b'S'), src);
+                    set(&mut self.min_travel_feedrate, p.get(b'T'), src);
+                    set(&mut self.junction_deviation, p.get(b'J'), src);
+                }
+                566 => {
+                    // RepRapFirmware: jerk in mm/min.
+                    for (i, l) in b"XYZE".iter().enumerate() {
+                        set(&mut self.max_jerk[i], p.get(*l).map(|v| v / 60.0), src);
+                    }
+                }
+                _ => return false,
+            }
+            return true;
+        }
+        if let crate::gcode::Command::Extended(name) = line.command {
+            if name.eq_ignore_ascii_case(b"SET_VELOCITY_LIMIT") {
+                let num = |key: &str| {
+                    line.extended_arg(key)
+                        .and_then(|v| std::str::from_utf8(v).ok())
+                        .and_then(|v| v.parse::<f64>().ok())
+                };
+                if let Some(v) = num("VELOCITY") {
+                    for i in 0..2 {
+                        set(&mut self.max_feedrate[i], Some(v), src);
+                    }
+                }
+                if let Some(a) = num("ACCEL") {
+                    // Klipper's toolhead acceleration: there are no per-axis X/Y limits.
+                    set(&mut self.acceleration, Some(a), src);
+                    set(&mut self.travel_acceleration, Some(a), src);
+                }
+                set(
+                    &mut self.square_corner_velocity,
+                    num("SQUARE_CORNER_VELOCITY"),
+                    src,
+                );
+                set(
+                    &mut self.minimum_cruise_ratio,
+                    num("MINIMUM_CRUISE_RATIO"),
+                    src,
+                );
+                if let Some(a2d) = num("ACCEL_TO_DECEL") {
+                    // Older Klipper: max_accel_to_decel; the cruise ratio it implies.
+                    let accel = self.acceleration.value.max(1e-9);
+                    set(
+                        &mut self.minimum_cruise_ratio,
+                        Some((1.0 - a2d / accel).clamp(0.0, 0.99)),
+                        src,
+                    );
+                }
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Applies one `; key = value` line of a slicer's settings block (PrusaSlicer, SuperSlicer,
+    /// OrcaSlicer). Values with two columns (`9000,1000`) are normal and silent mode: the normal
+    /// one is used.
+    pub fn apply_setting(&mut self, key: &str, value: &str) {
+        let src = LimitSource::SlicerSettings;
+        let v = value
+            .split(',')
+            .next()
+            .and_then(|s| s.trim().parse::<f64>().ok());
+        let axis = |suffix: &str| match suffix {
+            "x" => Some(0),
+            "y" => Some(1),
+            "z" => Some(2),
+            "e" => Some(3),
+            _ => None,
+        };
+        if let Some(a) = key.strip_prefix("machine_max_acceleration_") {
+            match a {
+                "extruding" => set(&mut self.acceleration, v, src),
+                "retracting" => set(&mut self.retract_acceleration, v, src),
+                "travel" => set(&mut self.travel_acceleration, v, src),
+                _ => {
+                    if let Some(i) = axis(a) {
+                        set(&mut self.max_acceleration[i], v, src);
+                    }
+                }
+            }
+        } else if let Some(i) = key.strip_prefix("machine_max_feedrate_").and_then(axis) {
+            set(&mut self.max_feedrate[i], v, src);
+        } else if let Some(i) = key.strip_prefix("machine_max_jerk_").and_then(axis) {
+            set(&mut self.max_jerk[i], v, src);
+        } else if key == "machine_min_extruding_rate" {
+            set(&mut self.min_feedrate, v, src);
+        } else if key == "machine_min_travel_rate" {
+            set(&mut self.min_travel_feedrate, v, src);
+        } else if key == "machine_max_junction_deviation" {
+            set(&mut self.junction_deviation, v, src);
+        }
+    }
+}

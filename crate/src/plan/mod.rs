@@ -1,0 +1,531 @@
+//! Firmware-faithful motion planning: per-move trapezoids with look-ahead over the whole file.
+//!
+//! The planner follows the structure every firmware (and PrusaSlicer's estimator) shares:
+//! each move becomes a block with a cruise speed (the feed rate, clamped by per-axis maximum
+//! feed rates), an acceleration (printing, travel or retraction, clamped by per-axis maximum
+//! accelerations) and a maximum entry speed from the junction model; a reverse pass lowers entry
+//! speeds so every block can brake in time, a forward pass lowers them so every block can be
+//! reached, and each block's trapezoid follows. Memory is bounded: blocks are planned in a
+//! window of [`REFRESH_THRESHOLD`] and all but the last [`KEEP_BLOCKS`] are final and handed to
+//! the caller's sink, as PrusaSlicer's time estimator does.
+//!
+//! Arcs are split into straight segments of `arc_segment_mm` (a machine setting), as firmware
+//! splits them.
+
+pub mod junction;
+pub mod limits;
+pub mod profiles;
+pub mod trapezoid;
+
+use std::collections::VecDeque;
+
+use serde::Serialize;
+
+use crate::machine::{axis, Move, MoveKind};
+use junction::Segment;
+pub use limits::{FeedUnits, JunctionModel, Limit, LimitSource, Limits};
+pub use profiles::Profile as MachineProfile;
+pub use trapezoid::Profile;
+
+/// Blocks kept un-finalised at the end of the window (they may still slow down for what follows).
+pub const KEEP_BLOCKS: usize = 64;
+/// Window size at which the planner recalculates and finalises blocks.
+pub const REFRESH_THRESHOLD: usize = KEEP_BLOCKS * 4;
+/// Most straight segments one arc is split into.
+pub const MAX_ARC_SEGMENTS: usize = 100_000;
+
+/// What a move does, which decides its acceleration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MoveClass {
+    /// Moves the tool and extrudes.
+    Print,
+    /// Moves the tool without extruding.
+    Travel,
+    /// Moves only the extruder (retraction, recovery, priming).
+    Retract,
+}
+
+/// A planned move, final: what the machine does, phase by phase.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PlannedMove {
+    /// 1-based source line.
+    pub line: u32,
+    /// Caller's tag given with the move (feature and layer indices, for example).
+    pub tag: u64,
+    /// Kind of move.
+    pub class: MoveClass,
+    /// Displacement per axis X, Y, Z, E, mm.
+    pub delta: [f64; 4],
+    /// Path length the speeds refer to (XYZ, or E for extruder-only moves), mm.
+    pub distance: f64,
+    /// Speed profile along the path.
+    pub profile: Profile,
+    /// Time at which the move starts, s from the start of the file.
+    pub start_s: f64,
+}
+
+impl PlannedMove {
+    /// Duration, s.
+    pub fn duration(&self) -> f64 {
+        self.profile.duration()
+    }
+
+    /// The fraction of the path speed that axis `i` (0..4 = X, Y, Z, E) moves at.
+    pub fn axis_share(&self, i: usize) -> f64 {
+        if self.distance > 0.0 {
+            self.delta[i].abs() / self.distance
+        } else {
+            0.0
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Block {
+    line: u32,
+    tag: u64,
+    class: MoveClass,
+    delta: [f64; 4],
+    distance: f64,
+    acceleration: f64,
+    entry: f64,
+    cruise: f64,
+    exit: f64,
+    max_entry: f64,
+    /// Speed the block may end at if nothing follows it.
+    safe: f64,
+    /// Highest cruise speed Klipper's minimum cruise ratio allows, as an accel-to-decel rate.
+    accel_to_decel: f64,
+    nominal_length: bool,
+    recalculate: bool,
+    profile: Profile,
+}
+
+impl Block {
+    fn calculate_trapezoid(&mut self) {
+        let mut cruise = self.cruise;
+        if self.accel_to_decel > 0.0 && self.accel_to_decel < self.acceleration {
+            // Klipper: the peak of a move is limited as if it accelerated and decelerated at
+            // `accel_to_decel` = accel (1 - minimum_cruise_ratio), so short zig-zags do not
+            // reach full speed only to brake at once.
+            let v2 = 0.5 * (self.entry * self.entry + self.exit * self.exit)
+                + self.distance * self.accel_to_decel;
+            cruise = cruise.min(v2.sqrt()).max(self.entry).max(self.exit);
+        }
+        self.profile = Profile::new(
+            self.distance,
+            self.entry,
+            cruise,
+            self.exit,
+            self.acceleration,
+        );
+    }
+}
+
+/// The streaming planner.
+#[derive(Debug, Clone)]
+pub struct Planner {
+    limits: Limits,
+    model: JunctionModel,
+    blocks: VecDeque<Block>,
+    prev: Option<Segment>,
+    elapsed_s: f64,
+    finalized: u64,
+}
+
+impl Planner {
+    /// A planner at rest with these limits and junction model.
+    pub fn new(limits: Limits, model: JunctionModel) -> Self {
+        Self {
+            limits,
+            model,
+            blocks: VecDeque::with_capacity(REFRESH_THRESHOLD + 1),
+            prev: None,
+            elapsed_s: 0.0,
+            finalized: 0,
+        }
+    }
+
+    /// The limits in force.
+    pub fn limits(&self) -> &Limits {
+        &self.limits
+    }
+
+    /// The limits, for commands that change them. New values apply to moves pushed after.
+    pub fn limits_mut(&mut self) -> &mut Limits {
+        &mut self.limits
+    }
+
+    /// The junction model.
+    pub fn model(&self) -> JunctionModel {
+        self.model
+    }
+
+    /// Time of all finalised moves and dwells, s.
+    pub fn elapsed_s(&self) -> f64 {
+        self.elapsed_s
+    }
+
+    /// Number of moves finalised so far.
+    pub fn finalized(&self) -> u64 {
+        self.finalized
+    }
+
+    /// Number of moves pushed so far (finalised or not).
+    pub fn pushed(&self) -> u64 {
+        self.finalized + self.blocks.len() as u64
+    }
+
+    /// Plans a motion; finalised moves go to `sink`.
+    pub fn push(&mut self, m: &Move, tag: u64, sink: &mut impl FnMut(&PlannedMove)) {
+        match m.kind {
+            MoveKind::Arc(arc) => {
+                let (p0, p1, h) = arc.plane.axes();
+                let seg = self.limits.arc_segment_mm.value.max(0.01);
+                let n = ((m.length_mm / seg).floor() as usize).clamp(1, MAX_ARC_SEGMENTS);
+                let mut prev = [0.0f64; 4];
+                for k in 1..=n {
+                    let t = k as f64 / n as f64;
+                    let mut cur = [0.0f64; 4];
+                    let p = arc.offset_at(t);
+                    cur[p0] = p[0];
+                    cur[p1] = p[1];
+                    cur[h] = (m.to[h] - m.from[h]) * t;
+                    cur[3] = (m.to[axis::E] - m.from[axis::E]) * t;
+                    let d = [
+                        cur[0] - prev[0],
+                        cur[1] - prev[1],
+                        cur[2] - prev[2],
+                        cur[3] - prev[3],
+                    ];
+                    self.push_segment(m.line, tag, d, m.feed_mm_s, sink);
+                    prev = cur;
+                }
+            }
+            _ => {
+                let d = [
+                    m.to[axis::X] - m.from[axis::X],
+                    m.to[axis::Y] - m.from[axis::Y],
+                    m.to[axis::Z] - m.from[axis::Z],
+                    m.to[axis::E] - m.from[axis::E],
+                ];
+                if d.iter().all(|v| v.abs() < 1e-12) {
+                    // Rotary-only moves: timed at the feed rate over their angle, no dynamics.
+                    let t = m.nominal_time();
+                    if t > 0.0 {
+                        self.dwell(t, sink);
+                    }
+                    return;
+                }
+                self.push_segment(m.line, tag, d, m.feed_mm_s, sink);
+            }
+        }
+    }
+
+    fn push_segment(
+        &mut self,
+        line: u32,
+        tag: u64,
+        delta: [f64; 4],
+        feed: f64,
+        sink: &mut impl FnMut(&PlannedMove),
+    ) {
+        let l = &self.limits;
+        let xyz = (delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]).sqrt();
+        let (distance, class) = if xyz > 1e-9 {
+            (
+                xyz,
+                if delta[3] > 1e-12 {
+                    MoveClass::Print
+                } else {
+                    MoveClass::Travel
+                },
+            )
+        } else {
+            (delta[3].abs(), MoveClass::Retract)
+        };
+        if distance <= 1e-12 {
+            return;
+        }
+        // Cruise speed: the feed rate (at least the minimum), then every axis within its limit.
+        let min_feed = match class {
+            MoveClass::Travel => l.min_travel_feedrate.value,
+            _ => l.min_feedrate.value,
+        };
+        let mut cruise = feed.max(min_feed).max(crate::machine::MIN_FEED_MM_S);
+        let mut axis_feedrate = [0.0; 4];
+        let mut factor: f64 = 1.0;
+        for i in 0..4 {
+            axis_feedrate[i] = cruise * delta[i] / distance;
+            let max = l.max_feedrate[i].value;
+            if max > 0.0 && axis_feedrate[i].abs() > max {
+                factor = factor.min(max / axis_feedrate[i].abs());
+            }
+        }
+        cruise *= factor;
+        for v in &mut axis_feedrate {
+            *v *= factor;
+        }
+        // Acceleration: by kind of move, then every axis within its limit.
+        let mut acceleration = match class {
+            MoveClass::Print => l.acceleration.value,
+            MoveClass::Travel => l.travel_acceleration.value,
+            MoveClass::Retract => l.retract_acceleration.value,
+        };
+        for (d, max) in delta.iter().zip(&l.max_acceleration) {
+            let (d, max) = (d.abs(), max.value);
+            if d > 1e-12 && max > 0.0 && acceleration * d / distance > max {
+                acceleration = max * distance / d;
+            }
+        }
+        let acceleration = acceleration.max(1e-3);
+        let unit = if class == MoveClass::Retract {
+            [0.0; 3]
+        } else {
+            [delta[0] / xyz, delta[1] / xyz, delta[2] / xyz]
+        };
+        let safe = match self.model {
+            JunctionModel::ClassicJerk => junction::safe_speed(&axis_feedrate, cruise, l),
+            _ => junction::MINIMUM_PLANNER_SPEED.min(cruise),
+        };
+        let curr = Segment {
+            axis_feedrate,
+            cruise,
+            safe,
+            unit,
+            distance,
+            acceleration,
+        };
+        let vmax_junction = match (&self.prev, self.model) {
+            (None, _) => safe,
+            (Some(prev), JunctionModel::ClassicJerk) => junction::classic_jerk(prev, &curr, l),
+            (Some(prev), JunctionModel::JunctionDeviation) => {
+                junction::junction_deviation(prev, &curr, l)
+            }
+            (Some(prev), JunctionModel::Klipper) => junction::klipper(prev, &curr, l),
+        };
+        let v_allowable = trapezoid::max_allowable_speed(-acceleration, safe, distance);
+        let accel_to_decel = match self.model {
+            JunctionModel::Klipper => {
+                acceleration * (1.0 - l.minimum_cruise_ratio.value.clamp(0.0, 0.99))
+            }
+            _ => 0.0,
+        };
+        let mut block = Block {
+            line,
+            tag,
+            class,
+            delta,
+            distance,
+            acceleration,
+            entry: vmax_junction.min(v_allowable),
+            cruise,
+            exit: safe,
+            max_entry: vmax_junction,
+            safe,
+            accel_to_decel,
+            nominal_length: cruise <= v_allowable,
+            recalculate: true,
+            profile: Profile::default(),
+        };
+        block.calculate_trapezoid();
+        self.prev = Some(curr);
+        self.blocks.push_back(block);
+        if self.blocks.len() > REFRESH_THRESHOLD {
+            self.plan_window(KEEP_BLOCKS, sink);
+        }
+    }
+
+    /// A dwell (`G4`) or any wait: every queued move completes first, then time passes.
+    pub fn dwell(&mut self, secs: f64, sink: &mut impl FnMut(&PlannedMove)) {
+        self.flush(sink);
+        self.elapsed_s += secs.max(0.0);
+    }
+
+    /// Finalises every queued move (end of file, or a command that waits for motion to end).
+    pub fn flush(&mut self, sink: &mut impl FnMut(&PlannedMove)) {
+        self.plan_window(0, sink);
+        self.prev = None;
+    }
+
+    /// Look-ahead over the window, then finalises all but `keep` blocks.
+    fn plan_window(&mut self, keep: usize, sink: &mut impl FnMut(&PlannedMove)) {
+        let n = self.blocks.len();
+        if n == 0 {
+            return;
+        }
+        // Reverse pass: every block must be able to brake to the next block's entry speed.
+        for i in (0..n.saturating_sub(1)).rev() {
+            let next_entry = self.blocks[i + 1].entry;
+            let b = &mut self.blocks[i];
+            if b.entry != b.max_entry {
+                b.entry = if !b.nominal_length && b.max_entry > next_entry {
+                    b.max_entry.min(trapezoid::max_allowable_speed(
+                        -b.acceleration,
+                        next_entry,
+                        b.distance,
+                    ))
+                } else {
+                    b.max_entry
+                };
+                b.recalculate = true;
+            }
+        }
+        // Forward pass: every block must be reachable from the previous block's entry speed.
+        for i in 1..n {
+            let (prev_nominal, prev_entry, prev_accel, prev_distance) = {
+                let p = &self.blocks[i - 1];
+                (p.nominal_length, p.entry, p.acceleration, p.distance)
+            };
+            let b = &mut self.blocks[i];
+            if !prev_nominal && prev_entry < b.entry {
+                let entry = b.entry.min(trapezoid::max_allowable_speed(
+                    -prev_accel,
+                    prev_entry,
+                    prev_distance,
+                ));
+                if entry != b.entry {
+                    b.entry = entry;
+                    b.recalculate = true;
+                }
+            }
+        }
+        // Trapezoids: each block exits at the next block's entry speed.
+        for i in 0..n {
+            let next = self.blocks.get(i + 1).map(|b| (b.entry, b.recalculate));
+            let b = &mut self.blocks[i];
+            let next_recalc = next.is_some_and(|(_, r)| r);
+            if b.recalculate || next_recalc || next.is_none() {
+                b.exit = next.map_or(b.safe, |(e, _)| e);
+                b.calculate_trapezoid();
+                b.recalculate = false;
+            }
+        }
+        let finalize = n.saturating_sub(keep);
+        for b in self.blocks.drain(..finalize) {
+            let pm = PlannedMove {
+                line: b.line,
+                tag: b.tag,
+                class: b.class,
+                delta: b.delta,
+                distance: b.distance,
+                profile: b.profile,
+                start_s: self.elapsed_s,
+            };
+            self.elapsed_s += b.profile.duration();
+            self.finalized += 1;
+            sink(&pm);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::Warnings;
+    use crate::gcode::parse_line;
+    use crate::machine::{Event, Machine};
+
+    fn plan(src: &str, model: JunctionModel) -> Vec<PlannedMove> {
+        let mut limits = MachineProfile::preset("prusa-mk3s").expect("preset").limits;
+        limits.max_feedrate = [Limit::profile(1000.0); 4];
+        limits.max_acceleration = [Limit::profile(100_000.0); 4];
+        limits.acceleration = Limit::profile(1000.0);
+        limits.travel_acceleration = Limit::profile(1000.0);
+        limits.max_jerk = [Limit::profile(10.0); 4];
+        let mut planner = Planner::new(limits, model);
+        let mut machine = Machine::default();
+        let mut w = Warnings::default();
+        let mut out = Vec::new();
+        for (i, l) in src.lines().enumerate() {
+            if let Some(Event::Move(m)) =
+                machine.apply(i as u32 + 1, &parse_line(l.as_bytes()).expect(l), &mut w)
+            {
+                planner.push(&m, 0, &mut |p| out.push(*p));
+            }
+        }
+        planner.flush(&mut |p| out.push(*p));
+        out
+    }
+
+    #[test]
+    fn a_lone_move_is_a_trapezoid_from_and_to_the_safe_speed() {
+        // Classic jerk: a single X move starts and ends at the X jerk (10 mm/s).
+        let p = plan("G1 X100 F3000", JunctionModel::ClassicJerk);
+        assert_eq!(p.len(), 1);
+        let pr = p[0].profile;
+        assert!((pr.entry - 10.0).abs() < 1e-9 && (pr.exit - 10.0).abs() < 1e-9);
+        assert!((pr.peak - 50.0).abs() < 1e-9);
+        let ramp = (50.0f64 * 50.0 - 100.0) / 2000.0;
+        let expected = 2.0 * (40.0 / 1000.0) + (100.0 - 2.0 * ramp) / 50.0;
+        assert!(
+            (p[0].duration() - expected).abs() < 1e-9,
+            "{} vs {expected}",
+            p[0].duration()
+        );
+    }
+
+    #[test]
+    fn a_square_slows_at_each_corner_by_the_model() {
+        let src = "G1 X10 F6000\nG1 Y10\nG1 X0\nG1 Y0";
+        for model in [
+            JunctionModel::ClassicJerk,
+            JunctionModel::JunctionDeviation,
+            JunctionModel::Klipper,
+        ] {
+            let p = plan(src, model);
+            assert_eq!(p.len(), 4);
+            for w in p.windows(2) {
+                assert!(
+                    (w[0].profile.exit - w[1].profile.entry).abs() < 1e-9,
+                    "{model:?}: speeds continuous"
+                );
+                assert!(
+                    w[1].profile.entry < 20.0,
+                    "{model:?}: corner at {}",
+                    w[1].profile.entry
+                );
+            }
+            let total: f64 = p.iter().map(PlannedMove::duration).sum();
+            assert!(total > 40.0 / 100.0, "{model:?}: slower than nominal");
+        }
+    }
+
+    #[test]
+    fn straight_collinear_segments_do_not_slow_down() {
+        let src = "G1 X10 F6000\nG1 X20\nG1 X30\nG1 X40";
+        let p = plan(src, JunctionModel::ClassicJerk);
+        assert!(
+            (p[1].profile.entry - 100.0).abs() < 1e-9 && (p[2].profile.entry - 100.0).abs() < 1e-9
+        );
+    }
+
+    #[test]
+    fn arcs_are_split_into_segments_of_the_setting() {
+        // A full circle of radius 10: 62.8 mm, so 62 segments of about 1 mm.
+        let p = plan(
+            "G1 X10 Y0 F600\nG2 X10 Y0 I-10 J0",
+            JunctionModel::JunctionDeviation,
+        );
+        assert_eq!(p.len(), 1 + 62);
+        let len: f64 = p[1..].iter().map(|m| m.distance).sum();
+        // Chords are a little shorter than the arc.
+        assert!(len < 20.0 * std::f64::consts::PI && len > 0.999 * 20.0 * std::f64::consts::PI);
+    }
+
+    #[test]
+    fn long_files_stream_with_bounded_memory() {
+        let mut src = String::from("G1 F6000\n");
+        for i in 0..5000 {
+            src += &format!("G1 X{} Y{}\n", i % 7, i % 3);
+        }
+        let p = plan(&src, JunctionModel::ClassicJerk);
+        assert!(p.len() > 4000);
+        let mut t = 0.0;
+        for m in &p {
+            assert!((m.start_s - t).abs() < 1e-6);
+            t += m.duration();
+        }
+    }
+}

@@ -1,0 +1,154 @@
+//! Constant-acceleration velocity profiles (trapezoids and triangles) along one move.
+
+/// Distance needed to go from speed `v0` to `v1` at acceleration `a` (negative to brake).
+#[inline]
+pub fn acceleration_distance(v0: f64, v1: f64, a: f64) -> f64 {
+    if a == 0.0 {
+        0.0
+    } else {
+        (v1 * v1 - v0 * v0) / (2.0 * a)
+    }
+}
+
+/// Highest speed at the start of a distance `d` from which speed `v_target` can still be
+/// reached with acceleration `a` (`a` negative: braking, as firmware calls it).
+#[inline]
+pub fn max_allowable_speed(a: f64, v_target: f64, d: f64) -> f64 {
+    (v_target * v_target - 2.0 * a * d).max(0.0).sqrt()
+}
+
+/// Where acceleration from `v0` must stop so that braking at the same rate ends at `v1` after
+/// `d` (the peak of a triangular profile).
+#[inline]
+pub fn intersection_distance(v0: f64, v1: f64, a: f64, d: f64) -> f64 {
+    if a == 0.0 {
+        0.0
+    } else {
+        (2.0 * a * d - v0 * v0 + v1 * v1) / (4.0 * a)
+    }
+}
+
+/// The phases of one move's speed profile along its path.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct Profile {
+    /// Speed at the start, mm/s.
+    pub entry: f64,
+    /// Highest speed reached (the cruise speed, or the peak of a triangle), mm/s.
+    pub peak: f64,
+    /// Speed at the end, mm/s.
+    pub exit: f64,
+    /// Acceleration (and deceleration) magnitude, mm/s².
+    pub acceleration: f64,
+    /// Time accelerating, s.
+    pub accel_s: f64,
+    /// Time at constant speed, s.
+    pub cruise_s: f64,
+    /// Time decelerating, s.
+    pub decel_s: f64,
+    /// Distance accelerating, mm.
+    pub accel_mm: f64,
+    /// Distance at constant speed, mm.
+    pub cruise_mm: f64,
+}
+
+impl Profile {
+    /// Total time, s.
+    pub fn duration(&self) -> f64 {
+        self.accel_s + self.cruise_s + self.decel_s
+    }
+
+    /// The profile of a move of length `d` entered at `entry`, left at `exit`, cruising at most
+    /// at `cruise`, with acceleration `a` (firmware `calculate_trapezoid`). Entry and exit must
+    /// be reachable (the look-ahead guarantees it); if not, they are lowered.
+    pub fn new(d: f64, entry: f64, cruise: f64, exit: f64, a: f64) -> Profile {
+        let cruise = cruise.max(entry).max(exit);
+        if d <= 0.0 || a <= 0.0 || cruise <= 0.0 {
+            let t = if cruise > 0.0 {
+                d.max(0.0) / cruise
+            } else {
+                0.0
+            };
+            return Profile {
+                entry,
+                peak: cruise,
+                exit,
+                acceleration: a,
+                cruise_s: t,
+                cruise_mm: d.max(0.0),
+                ..Profile::default()
+            };
+        }
+        let mut accel_mm = acceleration_distance(entry, cruise, a).max(0.0);
+        let decel_mm = acceleration_distance(cruise, exit, -a).max(0.0);
+        let mut cruise_mm = d - accel_mm - decel_mm;
+        let mut peak = cruise;
+        let (mut entry, mut exit) = (entry, exit);
+        if cruise_mm < 0.0 {
+            // Triangle: the cruise speed is never reached.
+            accel_mm = intersection_distance(entry, exit, a, d).clamp(0.0, d);
+            cruise_mm = 0.0;
+            peak = (entry * entry + 2.0 * a * accel_mm).sqrt();
+            // Unreachable end speeds (only with inconsistent input) are clipped to the peak.
+            entry = entry.min(peak);
+            exit = exit.min(peak);
+        }
+        let accel_s = (peak - entry) / a;
+        let decel_s = (peak - exit) / a;
+        let cruise_s = if peak > 0.0 { cruise_mm / peak } else { 0.0 };
+        Profile {
+            entry,
+            peak,
+            exit,
+            acceleration: a,
+            accel_s,
+            cruise_s,
+            decel_s,
+            accel_mm,
+            cruise_mm,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() < 1e-9 * (1.0 + b.abs())
+    }
+
+    #[test]
+    fn trapezoid_closed_form() {
+        // 100 mm at up to 50 mm/s from and to rest with 1000 mm/s²: 1.25 mm each way,
+        // 97.5 mm cruising.
+        let p = Profile::new(100.0, 0.0, 50.0, 0.0, 1000.0);
+        assert!(close(p.accel_s, 0.05) && close(p.decel_s, 0.05));
+        assert!(close(p.cruise_mm, 97.5));
+        assert!(close(p.duration(), 0.1 + 97.5 / 50.0));
+    }
+
+    #[test]
+    fn triangle_closed_form() {
+        // 1 mm from rest to rest at 1000 mm/s², cruise 100 mm/s never reached:
+        // peak sqrt(a d) = 31.62 mm/s, time 2 sqrt(d/a).
+        let p = Profile::new(1.0, 0.0, 100.0, 0.0, 1000.0);
+        assert!(close(p.peak, 1000f64.sqrt()));
+        assert!(close(p.duration(), 2.0 * (1.0f64 / 1000.0).sqrt()));
+        assert_eq!(p.cruise_s, 0.0);
+    }
+
+    #[test]
+    fn asymmetric_entry_and_exit() {
+        let p = Profile::new(10.0, 20.0, 40.0, 10.0, 500.0);
+        let d = p.accel_mm + p.cruise_mm + acceleration_distance(p.peak, p.exit, -500.0);
+        assert!(close(d, 10.0));
+        assert!(close(p.accel_s, 20.0 / 500.0));
+        assert!(close(p.decel_s, 30.0 / 500.0));
+    }
+
+    #[test]
+    fn allowable_speed_inverts_braking() {
+        let v = max_allowable_speed(-1000.0, 10.0, 2.0);
+        assert!(close(acceleration_distance(v, 10.0, -1000.0), 2.0));
+    }
+}
