@@ -86,6 +86,12 @@ impl Params {
         slot(letter).is_some_and(|i| self.present & (1 << i) != 0)
     }
 
+    /// Whether some word has no number (`G28 X`).
+    #[inline]
+    pub fn has_bare_word(&self) -> bool {
+        self.bare != 0
+    }
+
     /// Whether the line has no words.
     #[inline]
     pub fn is_empty(&self) -> bool {

@@ -534,10 +534,7 @@ impl Machine {
         warnings: &mut Warnings,
     ) -> Option<Event> {
         self.set_feed(line_no, line, warnings);
-        if AXIS_LETTERS
-            .iter()
-            .any(|&l| line.params.has(l) && line.params.get(l).is_none())
-        {
+        if line.params.has_bare_word() {
             warnings.push(line_no, "axis word without a value ignored");
         }
         let target = self.target(line);

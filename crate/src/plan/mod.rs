@@ -81,6 +81,31 @@ impl PlannedMove {
     }
 }
 
+/// Largest chord deviation of arc segments, mm (Marlin 2's `MAX_ARC_DEVIATION`).
+pub const MAX_ARC_DEVIATION_MM: f64 = 0.02;
+/// Shortest arc segment, mm (Marlin 2's `MIN_ARC_SEGMENT_MM`).
+pub const MIN_ARC_SEGMENT_MM: f64 = 0.1;
+/// Segments per second the firmware aims for at least (Marlin 2's `ARC_SEGMENTS_PER_SEC`).
+pub const ARC_SEGMENTS_PER_SEC: f64 = 50.0;
+
+/// Number of straight segments an arc is split into, as Marlin 2's `plan_arc` does: segments
+/// short enough to keep the chord within [`MAX_ARC_DEVIATION_MM`] and to run at least
+/// [`ARC_SEGMENTS_PER_SEC`] at the feed rate, but between [`MIN_ARC_SEGMENT_MM`] and the
+/// machine's `arc_segment_mm`.
+pub fn arc_segments(radius: f64, planar_length: f64, feed_mm_s: f64, max_segment_mm: f64) -> usize {
+    let max = max_segment_mm.max(MIN_ARC_SEGMENT_MM);
+    let seg = (8.0 * radius * MAX_ARC_DEVIATION_MM)
+        .sqrt()
+        .min(feed_mm_s / ARC_SEGMENTS_PER_SEC)
+        .clamp(MIN_ARC_SEGMENT_MM, max);
+    let n = planar_length / seg + 0.8;
+    if n.is_finite() {
+        (n as usize).clamp(1, MAX_ARC_SEGMENTS)
+    } else {
+        MAX_ARC_SEGMENTS
+    }
+}
+
 #[derive(Debug, Clone)]
 struct Block {
     line: u32,
@@ -182,8 +207,12 @@ impl Planner {
         match m.kind {
             MoveKind::Arc(arc) => {
                 let (p0, p1, h) = arc.plane.axes();
-                let seg = self.limits.arc_segment_mm.value.max(0.01);
-                let n = ((m.length_mm / seg).floor() as usize).clamp(1, MAX_ARC_SEGMENTS);
+                let n = arc_segments(
+                    arc.radius,
+                    arc.planar_length(),
+                    m.feed_mm_s,
+                    self.limits.arc_segment_mm.value,
+                );
                 let mut prev = [0.0f64; 4];
                 for k in 1..=n {
                     let t = k as f64 / n as f64;
@@ -312,7 +341,7 @@ impl Planner {
             }
             _ => 0.0,
         };
-        let mut block = Block {
+        let block = Block {
             line,
             tag,
             class,
@@ -329,7 +358,7 @@ impl Planner {
             recalculate: true,
             profile: Profile::default(),
         };
-        block.calculate_trapezoid();
+        // The trapezoid is computed by the look-ahead (the block is flagged for it).
         self.prev = Some(curr);
         self.blocks.push_back(block);
         if self.blocks.len() > REFRESH_THRESHOLD {
@@ -357,19 +386,24 @@ impl Planner {
         }
         // Reverse pass: every block must be able to brake to the next block's entry speed.
         for i in (0..n.saturating_sub(1)).rev() {
-            let next_entry = self.blocks[i + 1].entry;
+            let (next_entry, next_changed) =
+                (self.blocks[i + 1].entry, self.blocks[i + 1].recalculate);
             let b = &mut self.blocks[i];
-            if b.entry != b.max_entry {
-                b.entry = if !b.nominal_length && b.max_entry > next_entry {
+            if b.entry != b.max_entry || next_changed {
+                // A block of nominal length reaches any junction speed within itself.
+                let entry = if b.nominal_length {
+                    b.max_entry
+                } else {
                     b.max_entry.min(trapezoid::max_allowable_speed(
                         -b.acceleration,
                         next_entry,
                         b.distance,
                     ))
-                } else {
-                    b.max_entry
                 };
-                b.recalculate = true;
+                if entry != b.entry {
+                    b.entry = entry;
+                    b.recalculate = true;
+                }
             }
         }
         // Forward pass: every block must be reachable from the previous block's entry speed.
@@ -502,16 +536,26 @@ mod tests {
     }
 
     #[test]
-    fn arcs_are_split_into_segments_of_the_setting() {
-        // A full circle of radius 10: 62.8 mm, so 62 segments of about 1 mm.
+    fn arcs_are_split_like_marlin_2() {
+        // A full circle of radius 10 (62.83 mm). At 10 mm/s the 50-segments-per-second rule
+        // gives 0.2 mm segments: 62.83 / 0.2 + 0.8 -> 314 segments.
         let p = plan(
             "G1 X10 Y0 F600\nG2 X10 Y0 I-10 J0",
             JunctionModel::JunctionDeviation,
         );
-        assert_eq!(p.len(), 1 + 62);
+        assert_eq!(p.len(), 1 + 314);
         let len: f64 = p[1..].iter().map(|m| m.distance).sum();
         // Chords are a little shorter than the arc.
         assert!(len < 20.0 * std::f64::consts::PI && len > 0.999 * 20.0 * std::f64::consts::PI);
+        // At 100 mm/s the chord-deviation rule wins: sqrt(8 r 0.02) = 1.265 mm, under the 2 mm cap.
+        let seg = (8.0f64 * 10.0 * 0.02).sqrt();
+        assert_eq!(
+            arc_segments(10.0, 62.83, 100.0, 2.0),
+            (62.83 / seg + 0.8) as usize
+        );
+        // The machine's maximum segment length caps it, 0.1 mm floors it.
+        assert_eq!(arc_segments(1000.0, 100.0, 1000.0, 1.0), 100);
+        assert_eq!(arc_segments(0.001, 1.0, 0.01, 1.0), 10);
     }
 
     #[test]
