@@ -143,7 +143,7 @@ pub fn klipper(prev: &Segment, curr: &Segment, limits: &Limits) -> f64 {
     let one_minus_sin = 1.0 - sin_d2;
     if one_minus_sin > 0.0 && cos_d2 > 0.0 {
         let r_jd = sin_d2 / one_minus_sin;
-        let jd = |accel: f64| scv * scv * (std::f64::consts::SQRT_2 - 1.0) / accel.max(1e-9);
+        let jd = |accel: f64| klipper_junction_deviation(scv, accel);
         let quarter_tan = 0.25 * sin_d2 / cos_d2;
         max_v2 = max_v2
             .min(r_jd * jd(curr.acceleration) * curr.acceleration)
@@ -152,6 +152,12 @@ pub fn klipper(prev: &Segment, curr: &Segment, limits: &Limits) -> f64 {
             .min(2.0 * prev.distance * prev.acceleration * quarter_tan);
     }
     max_v2.max(0.0).sqrt()
+}
+
+/// Klipper's junction deviation for a square-corner velocity and acceleration:
+/// `scv² (√2 − 1) / accel`, the deviation at which a 90° corner runs at exactly `scv`.
+pub fn klipper_junction_deviation(scv: f64, accel: f64) -> f64 {
+    scv * scv * (std::f64::consts::SQRT_2 - 1.0) / accel.max(1e-9)
 }
 
 fn is_e_only(s: &Segment) -> bool {
@@ -226,6 +232,14 @@ mod tests {
             let v = klipper(&a, &b, &l);
             assert!((v - 5.0).abs() < 1e-9, "{accel}: {v}");
         }
+    }
+
+    #[test]
+    fn klipper_junction_deviation_value() {
+        // Klipper's defaults: scv 5 mm/s, accel 3000 mm/s² -> 0.0020711 mm.
+        let jd = klipper_junction_deviation(5.0, 3000.0);
+        assert!((jd - 25.0 * (2f64.sqrt() - 1.0) / 3000.0).abs() < 1e-15);
+        assert!((jd - 0.002_071_1).abs() < 1e-7, "{jd}");
     }
 
     #[test]

@@ -124,11 +124,12 @@ struct Block {
     accel_to_decel: f64,
     nominal_length: bool,
     recalculate: bool,
-    profile: Profile,
 }
 
 impl Block {
-    fn calculate_trapezoid(&mut self) {
+    /// The block's speed profile for its current entry and exit speeds. Only finalised blocks
+    /// need it, so the look-ahead passes work on speeds alone.
+    fn profile(&self) -> Profile {
         let mut cruise = self.cruise;
         if self.accel_to_decel > 0.0 && self.accel_to_decel < self.acceleration {
             // Klipper: the peak of a move is limited as if it accelerated and decelerated at
@@ -138,13 +139,13 @@ impl Block {
                 + self.distance * self.accel_to_decel;
             cruise = cruise.min(v2.sqrt()).max(self.entry).max(self.exit);
         }
-        self.profile = Profile::new(
+        Profile::new(
             self.distance,
             self.entry,
             cruise,
             self.exit,
             self.acceleration,
-        );
+        )
     }
 }
 
@@ -277,6 +278,7 @@ impl Planner {
         if distance <= 1e-12 {
             return;
         }
+        let inv_distance = 1.0 / distance;
         // Cruise speed: the feed rate (at least the minimum), then every axis within its limit.
         let min_feed = match class {
             MoveClass::Travel => l.min_travel_feedrate.value,
@@ -286,7 +288,7 @@ impl Planner {
         let mut axis_feedrate = [0.0; 4];
         let mut factor: f64 = 1.0;
         for i in 0..4 {
-            axis_feedrate[i] = cruise * delta[i] / distance;
+            axis_feedrate[i] = cruise * delta[i] * inv_distance;
             let max = l.max_feedrate[i].value;
             if max > 0.0 && axis_feedrate[i].abs() > max {
                 factor = factor.min(max / axis_feedrate[i].abs());
@@ -304,7 +306,7 @@ impl Planner {
         };
         for (d, max) in delta.iter().zip(&l.max_acceleration) {
             let (d, max) = (d.abs(), max.value);
-            if d > 1e-12 && max > 0.0 && acceleration * d / distance > max {
+            if d > 1e-12 && max > 0.0 && acceleration * d * inv_distance > max {
                 acceleration = max * distance / d;
             }
         }
@@ -312,7 +314,11 @@ impl Planner {
         let unit = if class == MoveClass::Retract {
             [0.0; 3]
         } else {
-            [delta[0] / xyz, delta[1] / xyz, delta[2] / xyz]
+            [
+                delta[0] * inv_distance,
+                delta[1] * inv_distance,
+                delta[2] * inv_distance,
+            ]
         };
         let safe = match self.model {
             JunctionModel::ClassicJerk => junction::safe_speed(&axis_feedrate, cruise, l),
@@ -356,9 +362,7 @@ impl Planner {
             accel_to_decel,
             nominal_length: cruise <= v_allowable,
             recalculate: true,
-            profile: Profile::default(),
         };
-        // The trapezoid is computed by the look-ahead (the block is flagged for it).
         self.prev = Some(curr);
         self.blocks.push_back(block);
         if self.blocks.len() > REFRESH_THRESHOLD {
@@ -425,29 +429,30 @@ impl Planner {
                 }
             }
         }
-        // Trapezoids: each block exits at the next block's entry speed.
+        // Exit speeds: each block exits at the next block's entry speed (the last one at its
+        // safe speed until something follows it).
         for i in 0..n {
             let next = self.blocks.get(i + 1).map(|b| (b.entry, b.recalculate));
             let b = &mut self.blocks[i];
             let next_recalc = next.is_some_and(|(_, r)| r);
             if b.recalculate || next_recalc || next.is_none() {
                 b.exit = next.map_or(b.safe, |(e, _)| e);
-                b.calculate_trapezoid();
                 b.recalculate = false;
             }
         }
         let finalize = n.saturating_sub(keep);
         for b in self.blocks.drain(..finalize) {
+            let profile = b.profile();
             let pm = PlannedMove {
                 line: b.line,
                 tag: b.tag,
                 class: b.class,
                 delta: b.delta,
                 distance: b.distance,
-                profile: b.profile,
+                profile,
                 start_s: self.elapsed_s,
             };
-            self.elapsed_s += b.profile.duration();
+            self.elapsed_s += profile.duration();
             self.finalized += 1;
             sink(&pm);
         }
