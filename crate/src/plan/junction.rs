@@ -236,10 +236,10 @@ mod tests {
 
     #[test]
     fn klipper_junction_deviation_value() {
-        // Klipper's defaults: scv 5 mm/s, accel 3000 mm/s² -> 0.0020711 mm.
+        // Klipper defaults: scv 5 mm/s, accel 3000 mm/s² -> 0.0034518 mm.
         let jd = klipper_junction_deviation(5.0, 3000.0);
         assert!((jd - 25.0 * (2f64.sqrt() - 1.0) / 3000.0).abs() < 1e-15);
-        assert!((jd - 0.002_071_1).abs() < 1e-7, "{jd}");
+        assert!((jd - 0.003_451_8).abs() < 1e-7, "{jd}");
     }
 
     #[test]
