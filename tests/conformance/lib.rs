@@ -12,6 +12,12 @@ pub fn corpus_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus")
 }
 
+/// The repository's own test inputs: `tests/fixtures` (G-code sliced here from the OpenSCAD
+/// models beside it; `tests/fixtures/README.md` says how).
+pub fn fixtures_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
+}
+
 /// One row of the table in `SOURCES.md`.
 #[derive(Debug, Clone)]
 pub struct CorpusFile {

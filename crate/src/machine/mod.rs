@@ -78,6 +78,8 @@ pub enum MoveKind {
     Arc(Arc),
     /// `G10`/`G11` firmware retraction or recovery (E only).
     FirmwareRetract,
+    /// `G28` homing, as a straight move to 0.
+    Home,
 }
 
 /// One motion, in machine coordinates.
@@ -356,7 +358,7 @@ impl Machine {
                 self.inches = false;
                 None
             }
-            (b'G', 28, None) => Some(self.home(line)),
+            (b'G', 28, None) => self.home(line_no, line),
             (b'G', 90, None) => {
                 self.relative_axes = false;
                 None
@@ -664,23 +666,31 @@ impl Machine {
         }))
     }
 
-    fn home(&mut self, line: &Line<'_>) -> Event {
-        let named: Vec<usize> = [axis::X, axis::Y, axis::Z]
-            .into_iter()
-            .filter(|&i| line.params.has(AXIS_LETTERS[i]))
-            .collect();
-        let axes = if named.is_empty() {
-            vec![axis::X, axis::Y, axis::Z]
-        } else {
-            named
-        };
-        let mut mask = 0u16;
-        for i in axes {
-            self.logical[i] = 0.0;
-            self.physical[i] = 0.0;
-            mask |= 1 << i;
+    /// `G28`: the named axes (all of X, Y, Z if none) go to 0. Timed as a move to 0 at the
+    /// modal feed rate, as PrusaSlicer's estimator does; real homing is slower near the switch,
+    /// but its approach dominates.
+    fn home(&mut self, line_no: u32, line: &Line<'_>) -> Option<Event> {
+        let any = [axis::X, axis::Y, axis::Z]
+            .iter()
+            .any(|&i| line.params.has(AXIS_LETTERS[i]));
+        let from = self.physical;
+        for i in [axis::X, axis::Y, axis::Z] {
+            if !any || line.params.has(AXIS_LETTERS[i]) {
+                self.logical[i] = 0.0;
+                self.physical[i] = 0.0;
+            }
         }
-        Event::Home(mask)
+        let to = self.physical;
+        let d = |i: usize| to[i] - from[i];
+        let length_mm = (d(0) * d(0) + d(1) * d(1) + d(2) * d(2)).sqrt();
+        (length_mm > 0.0).then_some(Event::Move(Move {
+            line: line_no,
+            kind: MoveKind::Home,
+            from,
+            to,
+            feed_mm_s: self.feed_mm_s * self.speed_factor,
+            length_mm,
+        }))
     }
 
     fn set_position(&mut self, line_no: u32, line: &Line<'_>, warnings: &mut Warnings) {
@@ -808,7 +818,9 @@ mod tests {
             "G1 X5 Y5 Z5\nG28 X\nM109 S210\nM140 S60\nM106 S127.5\nM106 S0.5\nM107\nG4 P500\nG4 S2",
             MachineConfig::default(),
         );
-        assert!(matches!(ev[1], Event::Home(1)));
+        assert!(
+            matches!(ev[1], Event::Move(Move { kind: MoveKind::Home, to, from, .. }) if to[axis::X] == 0.0 && to[axis::Y] == 5.0 && from[axis::X] == 5.0)
+        );
         assert!(matches!(
             ev[2],
             Event::Temperature {
