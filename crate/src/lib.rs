@@ -20,9 +20,12 @@
 //! - [`gcode`]: zero-copy lines and words, slicer dialects, lossless writing.
 //! - [`machine`]: modal printer state, arcs, extrusion modes; turns lines into motion events.
 //! - [`analyze`](mod@analyze): one streaming pass giving the report.
+//! - [`plan`]: firmware-style motion planning (trapezoids, junctions, look-ahead).
+//! - [`energy`]: energy (thesis stepper model, VTG servo/fuse/aux model) and CO₂.
 //! - [`math`]: portable transcendental functions (identical results native and wasm).
 
 pub mod analyze;
+pub mod energy;
 pub mod error;
 pub mod gcode;
 pub mod machine;

@@ -144,3 +144,13 @@ fn absurd_geometry_and_feeds_stay_finite() {
     assert!(!r.warnings.is_empty());
     serde_json::to_string(&r).expect("a report always serialises");
 }
+
+#[test]
+fn vanishing_times_do_not_make_nan_energy_shares() {
+    // Found by the property tests: a hot heater and a subnormal E move. The whole print lasts
+    // next to nothing, and auxiliary energy must still be shared out without 0/0.
+    let r = lenient(b"M104 S11196.13267578347\nG0 E2.2250738585072014e-308\n").expect("lenient");
+    let json = serde_json::to_string(&r).expect("serialises");
+    assert!(!json.contains("null,\"time_s\"") && r.features.iter().all(|f| f.energy_j.is_finite()));
+    assert!(r.energy.total_j.is_finite());
+}

@@ -7,6 +7,7 @@ use std::collections::{HashMap, VecDeque};
 
 use super::layers::LayerTracker;
 use super::report::{Bounds, FanEvent, FeatureSummary, TemperatureEvent};
+use crate::energy::Accumulator;
 use crate::gcode::feature_kind;
 use crate::machine::{Heater, Move};
 use crate::plan::PlannedMove;
@@ -57,11 +58,13 @@ pub struct Accounts {
     pending: VecDeque<(u64, Pending)>,
     pub temperatures: Vec<TemperatureEvent>,
     pub fans: Vec<FanEvent>,
+    /// Energy models, fed every planned move and dwell.
+    pub energy: Accumulator,
     moves_read: u64,
 }
 
 impl Accounts {
-    pub fn new() -> Self {
+    pub fn new(energy: Accumulator) -> Self {
         Self {
             totals: Totals::default(),
             features: Vec::new(),
@@ -73,6 +76,7 @@ impl Accounts {
             pending: VecDeque::new(),
             temperatures: Vec::new(),
             fans: Vec::new(),
+            energy,
             moves_read: 0,
         }
     }
@@ -128,6 +132,7 @@ impl Accounts {
 
     /// A move's plan is final.
     pub fn planned(&mut self, pm: &PlannedMove) {
+        let joules = self.energy.planned(pm);
         self.stamp_until(pm.tag, pm.start_s);
         while self.tags.front().is_some_and(|t| t.0 < pm.tag) {
             self.tags.pop_front();
@@ -136,14 +141,17 @@ impl Accounts {
             return;
         };
         let d = pm.duration();
-        self.slot(slot).time_s += d;
-        self.layers.add_time(layers, d);
+        let s = self.slot(slot);
+        s.time_s += d;
+        s.energy_j += joules;
+        self.layers.add_time_energy(layers, d, joules);
     }
 
     /// Time passing outside moves (a dwell), charged to the current layer.
     pub fn dwell(&mut self, secs: f64) {
+        let joules = self.energy.dwell(secs);
         let current = self.layers.current();
-        self.layers.add_time(current, secs);
+        self.layers.add_time_energy(current, secs, joules);
     }
 
     /// A heater target; timed when the moves before it are planned.
@@ -211,6 +219,7 @@ fn summary(name: &str, kind_of: Option<&str>) -> FeatureSummary {
         distance_mm: 0.0,
         filament_mm: 0.0,
         time_s: 0.0,
+        energy_j: 0.0,
     }
 }
 

@@ -36,6 +36,7 @@ impl Count {
             travel_distance_mm: 0.0,
             filament_mm: 0.0,
             time_s: 0.0,
+            energy_j: 0.0,
         });
     }
 
@@ -58,9 +59,10 @@ impl Count {
         u32::try_from(self.layers.len()).map_or(NO_LAYER, |n| n.wrapping_sub(1))
     }
 
-    fn add_time(&mut self, index: u32, secs: f64) {
+    fn add_time_energy(&mut self, index: u32, secs: f64, joules: f64) {
         if let Some(l) = self.layers.get_mut(index as usize) {
             l.time_s += secs;
+            l.energy_j += joules;
         }
     }
 }
@@ -103,7 +105,7 @@ impl LayerTracker {
         self.by_marker.start(line, z);
     }
 
-    /// A move (its time comes later, from the planner, through [`LayerTracker::add_time`]).
+    /// A move (its time comes later, from the planner, through [`LayerTracker::add_time_energy`]).
     pub fn motion(&mut self, m: &Move) {
         if m.is_extruding() {
             let z = m.to[axis::Z];
@@ -152,10 +154,10 @@ impl LayerTracker {
         (self.by_marker.current(), self.by_z.current())
     }
 
-    /// Adds time to a layer of each count, as given by [`LayerTracker::current`].
-    pub fn add_time(&mut self, (by_marker, by_z): (u32, u32), secs: f64) {
-        self.by_marker.add_time(by_marker, secs);
-        self.by_z.add_time(by_z, secs);
+    /// Adds time and energy to a layer of each count, as given by [`LayerTracker::current`].
+    pub fn add_time_energy(&mut self, (by_marker, by_z): (u32, u32), secs: f64, joules: f64) {
+        self.by_marker.add_time_energy(by_marker, secs, joules);
+        self.by_z.add_time_energy(by_z, secs, joules);
     }
 
     /// The layer list and how it was counted.

@@ -1,5 +1,5 @@
 //! `analyze`: one streaming pass over a file giving time (from the motion planner), distances,
-//! filament, layers, features, temperatures and fans.
+//! filament, layers, features, temperatures, fans and energy (from [`crate::energy`]).
 
 mod accounting;
 mod layers;
@@ -8,6 +8,7 @@ pub mod report;
 
 use serde::Deserialize;
 
+use crate::energy::{Accumulator, EnergyOptions};
 use crate::error::{Error, ErrorKind, Warnings};
 use crate::gcode::{self, classify_comment, Marker, SlicerInfo, Strictness};
 use crate::machine::{self, axis, Event, ExtrusionMode, Machine, MachineConfig};
@@ -41,6 +42,9 @@ pub struct AnalyzeOptions {
     pub junction_model: Option<JunctionModel>,
     /// Length of the segments arcs are split into, mm (default: the profile's, 1 mm).
     pub arc_segment_mm: Option<f64>,
+    /// Energy model settings (coefficients, material, powers, emission factors); default:
+    /// [`EnergyOptions::default`].
+    pub energy: Option<EnergyOptions>,
 }
 
 /// Starting extrusion mode, as an option.
@@ -165,7 +169,8 @@ pub fn analyze_with_progress(
         ..MachineConfig::default()
     });
     let mut info = SlicerInfo::default();
-    let mut acc = Accounts::new();
+    let energy_options = options.energy.clone().unwrap_or_default();
+    let mut acc = Accounts::new(Accumulator::new(&energy_options, &profile.name));
     let mut next_progress = PROGRESS_STEP;
 
     gcode::for_each_line(input, strictness, &mut warnings, |raw, line, warnings| {
@@ -181,7 +186,10 @@ pub fn analyze_with_progress(
             match classify_comment(comment) {
                 Some(Marker::Layer { kind, z }) => acc.layers.marker(kind, z, raw.number),
                 Some(Marker::Feature(name)) => acc.feature(name),
-                None => info.observe(comment),
+                None => {
+                    info.observe(comment);
+                    acc.energy.comment(comment);
+                }
             }
         }
         if planner.limits_mut().apply_command(line, units) {
@@ -231,9 +239,10 @@ pub fn analyze_with_progress(
         layers,
         temperatures,
         fans,
+        energy: energy_acc,
         ..
     } = acc;
-    let (layer_list, layer_source) = layers.finish();
+    let (mut layer_list, layer_source) = layers.finish();
     let filament_mm = machine.position()[axis::E];
     let diameter = options
         .filament_diameter_mm
@@ -247,6 +256,21 @@ pub fn analyze_with_progress(
     if travel.moves > 0 {
         features.push(travel);
     }
+    let time_s = planner.elapsed_s();
+    let material_g = volume * density / 1000.0;
+    let energy = energy_acc.finish(time_s, material_g, &temperatures, &fans);
+    // Auxiliary energy is shared out by time (see `crate::energy`).
+    // (Shares are taken as fractions of the total first, so a vanishing total time cannot
+    // turn into an infinite rate.)
+    if time_s > 0.0 {
+        let share = |t: f64| energy.aux_j * (t / time_s).clamp(0.0, 1.0);
+        for f in &mut features {
+            f.energy_j += share(f.time_s);
+        }
+        for l in &mut layer_list {
+            l.energy_j += share(l.time_s);
+        }
+    }
     let (warnings, warnings_dropped) = warnings.into_parts();
     Ok(Report {
         version: crate::VERSION.to_string(),
@@ -257,7 +281,7 @@ pub fn analyze_with_progress(
             flavor: info.flavor.or(pre.flavor),
             slicer_time_s: pre.slicer_time_s,
         },
-        time_s: planner.elapsed_s(),
+        time_s,
         time_model: "planner".into(),
         machine: MachineInfo {
             profile: profile.name,
@@ -274,7 +298,7 @@ pub fn analyze_with_progress(
         travel_distance_mm: totals.travel_distance_mm,
         filament_mm,
         filament_volume_mm3: volume,
-        material_g: volume * density / 1000.0,
+        material_g,
         retractions: totals.retractions,
         extrusion: ExtrusionInfo {
             mode,
@@ -287,7 +311,7 @@ pub fn analyze_with_progress(
         layer_list,
         temperatures,
         fans,
-        energy: Energy::default(),
+        energy,
         toolpath: Toolpath::default(),
         warnings,
         warnings_dropped,
@@ -296,6 +320,9 @@ pub fn analyze_with_progress(
 
 fn validate_options(o: &AnalyzeOptions) -> Result<(), Error> {
     let positive = |v: Option<f64>| v.is_none_or(|x| x.is_finite() && x > 0.0);
+    if let Some(reason) = o.energy.as_ref().and_then(|e| e.validate().err()) {
+        return Err(Error::new(0, 0, ErrorKind::InvalidOption { reason }));
+    }
     if !positive(o.filament_diameter_mm)
         || !positive(o.density_g_cm3)
         || !positive(o.arc_segment_mm)

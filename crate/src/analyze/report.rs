@@ -140,6 +140,9 @@ pub struct FeatureSummary {
     pub filament_mm: f64,
     /// Time, s (same model as `time_s`).
     pub time_s: f64,
+    /// Energy of its moves, J: their `E_servo` plus the share of `E_aux` of their time (see
+    /// [`crate::energy`]).
+    pub energy_j: f64,
 }
 
 /// Totals for one layer.
@@ -161,6 +164,8 @@ pub struct LayerSummary {
     pub filament_mm: f64,
     /// Time, s.
     pub time_s: f64,
+    /// Energy, J: `E_servo` of its moves and dwells plus the share of `E_aux` of its time.
+    pub energy_j: f64,
 }
 
 /// A heater target set at some point of the print.
@@ -191,9 +196,40 @@ pub struct FanEvent {
     pub speed: f64,
 }
 
-/// Energy figures; filled in by the energy models.
+/// Energy and carbon figures (see [`crate::energy`] for the models, their units and sources).
+///
+/// `total_j = servo_j + fuse_j + aux_j` (VTG eq. 16); `co2_g` is eq. 17.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct Energy {}
+pub struct Energy {
+    /// X/Y stepper energy by the thesis model (eq. 28), J. Always computed.
+    pub thesis_j: f64,
+    /// Energy of the X/Y drives, `E_servo`, J (equal to `thesis_j` with the thesis model).
+    pub servo_j: f64,
+    /// Model that gave `servo_j`: `thesis` or `physical`.
+    pub servo_model: crate::energy::ServoModel,
+    /// Heat to melt the filament, `E_fuse`, J.
+    pub fuse_j: f64,
+    /// Heaters, fans and electronics over the print, `E_aux`, J.
+    pub aux_j: f64,
+    /// `E = E_servo + E_fuse + E_aux`, J.
+    pub total_j: f64,
+    /// The same in kWh.
+    pub total_kwh: f64,
+    /// Material mass the fuse and carbon figures use, g.
+    pub material_g: f64,
+    /// Carbon emission `f_e·E + f_m·m`, g CO₂.
+    pub co2_g: f64,
+    /// The thesis terms `A`, `B`, `C`, `H` and the coefficients used.
+    pub thesis: crate::energy::ThesisReport,
+    /// The physical servo model's parts, when it gave `servo_j`.
+    pub physical_servo: Option<crate::energy::ServoReport>,
+    /// How `fuse_j` was computed.
+    pub fuse: crate::energy::FuseReport,
+    /// `aux_j` by system.
+    pub aux: crate::energy::AuxReport,
+    /// `co2_g` by source and the factors used.
+    pub co2: crate::energy::Co2Report,
+}
 
 /// Toolpath metrics; filled in by the VTG module.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]

@@ -2,6 +2,7 @@
 //! `--json` output is the serde form of the same type the JS API returns.
 
 mod bench;
+mod calibrate;
 mod output;
 mod table;
 
@@ -50,6 +51,21 @@ enum Cmd {
         #[arg(long)]
         force: bool,
     },
+    /// Fit the thesis energy model's coefficients to measured energies (least squares without
+    /// intercept).
+    ///
+    /// The CSV has rows `A,B,C,H,E` (thesis terms, energy in W·ms) or rows
+    /// `gcode_path,energy_j` (each G-code file is analyzed for its terms; relative paths are
+    /// resolved against the CSV's folder). A header line is optional.
+    Calibrate {
+        /// CSV file to read.
+        file: PathBuf,
+        /// Print the fit as JSON.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        opts: AnalyzeArgs,
+    },
     /// Measure parsing and analysis throughput on a file.
     Bench {
         /// G-code file to read.
@@ -90,6 +106,10 @@ struct AnalyzeArgs {
     /// Length of the straight segments arcs are split into, mm (default 1).
     #[arg(long, value_name = "MM")]
     arc_segment: Option<f64>,
+    /// Energy settings as a JSON file (the serde form of `EnergyOptions`: coefficients,
+    /// material, powers, emission factors; every field optional).
+    #[arg(long, value_name = "FILE")]
+    energy: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -118,7 +138,16 @@ impl AnalyzeArgs {
             }
             None => None,
         };
+        let energy = match &self.energy {
+            Some(path) => {
+                let text = std::fs::read_to_string(path)
+                    .map_err(|e| format!("{}: {e}", path.display()))?;
+                Some(serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?)
+            }
+            None => None,
+        };
         Ok(AnalyzeOptions {
+            energy,
             machine: self.machine.clone(),
             machine_profile,
             junction_model: self.junction.map(|j| match j {
@@ -197,6 +226,17 @@ fn run(cli: Cli) -> Result<(), String> {
             output::write_atomically(&file, &output, force, |out| {
                 gcode::write_with_edits(&input, &[], out)
             })
+        }
+        Cmd::Calibrate { file, json, opts } => {
+            let options = opts.options()?;
+            let fit = calibrate::run(&file, &options)?;
+            let mut stdout = std::io::stdout().lock();
+            if json {
+                output::write_json(&mut stdout, &fit)?;
+            } else {
+                calibrate::print(&mut stdout, &file, &fit).map_err(|e| e.to_string())?;
+            }
+            stdout.flush().map_err(|e| e.to_string())
         }
         Cmd::Bench { file, runs, json } => {
             let input = read(&file)?;

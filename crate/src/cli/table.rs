@@ -81,20 +81,47 @@ pub fn write_report(out: &mut impl Write, path: &Path, r: &Report) -> io::Result
             ),
         )?;
     }
+    let e = &r.energy;
+    row(
+        out,
+        "energy",
+        format!(
+            "{:.1} kJ = {:.3} kWh (servo {:.1} kJ, {}; fuse {:.1} kJ; aux {:.1} kJ)",
+            e.total_j / 1e3,
+            e.total_kwh,
+            e.servo_j / 1e3,
+            match e.servo_model {
+                quietpath::energy::ServoModel::Physical => "physical model",
+                _ => "thesis model",
+            },
+            e.fuse_j / 1e3,
+            e.aux_j / 1e3
+        ),
+    )?;
+    row(
+        out,
+        "stepper (thesis)",
+        format!(
+            "{:.1} J (A {:.0}, B {:.0}, C {:.0} mm, H {:.1} s)",
+            e.thesis_j, e.thesis.a, e.thesis.b, e.thesis.c, e.thesis.h
+        ),
+    )?;
+    row(out, "CO2", format!("{:.1} g", e.co2_g))?;
     writeln!(
         out,
-        "\n  {:<28} {:>8} {:>12} {:>12} {:>10}",
-        "feature", "moves", "distance mm", "filament mm", "time"
+        "\n  {:<28} {:>8} {:>12} {:>12} {:>10} {:>10}",
+        "feature", "moves", "distance mm", "filament mm", "time", "energy J"
     )?;
     for f in &r.features {
         writeln!(
             out,
-            "  {:<28} {:>8} {:>12.1} {:>12.1} {:>10}",
+            "  {:<28} {:>8} {:>12.1} {:>12.1} {:>10} {:>10.0}",
             f.name.chars().take(28).collect::<String>(),
             f.moves,
             f.distance_mm,
             f.filament_mm,
-            duration(f.time_s)
+            duration(f.time_s),
+            f.energy_j
         )?;
     }
     let dropped = r.warnings_dropped;

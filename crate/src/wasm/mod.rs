@@ -8,6 +8,7 @@ use js_sys::{Function, Reflect, Uint8Array};
 use wasm_bindgen::prelude::*;
 
 use crate::analyze::{analyze_with_progress, AnalyzeOptions};
+use crate::energy::calibrate::{self, CalibrationError, CsvRows, Observation};
 use crate::error::Error;
 
 /// Installs the panic hook so that a bug shows its message in the console instead of an
@@ -93,4 +94,61 @@ pub fn analyze_js(
     let mut progress = progress_fn(on_progress);
     let report = analyze_with_progress(&bytes, &opts, &mut progress).map_err(|e| js_error(&e))?;
     to_js(&report)
+}
+
+/// A calibration error as a JS `Error` with `kind` and the error's fields (`row`, `column`...).
+fn calibration_error(e: &CalibrationError) -> JsValue {
+    let err = js_sys::Error::new(&e.to_string());
+    if let Ok(fields) = to_js(e) {
+        let _ = js_sys::Object::assign(&err, &fields.into());
+    }
+    err.into()
+}
+
+/// One calibration row from JS: `[A, B, C, H, E]` or `{a, b, c, h, e}` (E in W·ms).
+#[derive(serde::Deserialize)]
+#[serde(untagged)]
+enum RowInput {
+    Array([f64; 5]),
+    Object(Observation),
+}
+
+/// Fits the thesis energy model (`quietpath calibrate --json`): `rows` is an array of
+/// `[A, B, C, H, E]` or `{a, b, c, h, e}` rows, or CSV text with `A,B,C,H,E` rows (G-code rows
+/// need files, so only the CLI takes them). Rows are numbered from 1 in errors and residuals.
+#[wasm_bindgen]
+pub fn calibrate(rows: JsValue) -> Result<JsValue, JsValue> {
+    let observations = if let Some(text) = rows.as_string() {
+        match calibrate::parse_csv(&text).map_err(|e| calibration_error(&e))? {
+            CsvRows::Terms(rows) => rows,
+            CsvRows::Gcode(_) => {
+                return Err(message_error(
+                    "G-code rows need the files: use the CLI, or give A,B,C,H,E rows",
+                ))
+            }
+        }
+    } else {
+        let input: Vec<RowInput> = serde_wasm_bindgen::from_value(rows)
+            .map_err(|e| message_error(&format!("invalid rows: {e}")))?;
+        input
+            .into_iter()
+            .enumerate()
+            .map(|(i, r)| match r {
+                RowInput::Array([a, b, c, h, e]) => Observation {
+                    row: i + 1,
+                    a,
+                    b,
+                    c,
+                    h,
+                    e,
+                },
+                RowInput::Object(o) => Observation {
+                    row: if o.row == 0 { i + 1 } else { o.row },
+                    ..o
+                },
+            })
+            .collect()
+    };
+    let fit = calibrate::fit(&observations).map_err(|e| calibration_error(&e))?;
+    to_js(&fit)
 }
