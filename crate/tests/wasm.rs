@@ -72,3 +72,29 @@ fn binding_returns_plain_objects_and_js_errors() {
     let bad_opts = js_sys::JSON::parse(r#"{"filament_diameter_mm": -1}"#).expect("json");
     assert!(quietpath::wasm::analyze_js(JsValue::from_str("G1 X1"), bad_opts, None).is_err());
 }
+
+/// The thesis's Table 3, read at compile time from the committed fixture.
+const TABLE3: &str = include_str!("data/thesis_table3.csv");
+
+#[wasm_bindgen_test]
+fn calibrate_reproduces_table_3_in_wasm() {
+    let fit = quietpath::wasm::calibrate(JsValue::from_str(TABLE3)).expect("fit");
+    let get = |k: &str| {
+        Reflect::get(&fit, &JsValue::from_str(k))
+            .expect(k)
+            .as_f64()
+            .expect(k)
+    };
+    for (k, published) in [
+        ("k_a_mx", 0.134857071),
+        ("k_a_my", 0.131575661),
+        ("k_c", 69.14025683),
+        ("k_h", 832.7358875),
+    ] {
+        let v = get(k);
+        assert!(((v - published) / published).abs() < 5e-7, "{k}: {v}");
+    }
+    let bad = quietpath::wasm::calibrate(JsValue::from_str("A,B,C,H,E\n1,2,3,4,x\n"))
+        .expect_err("bad row");
+    assert!(bad.is_instance_of::<js_sys::Error>());
+}
