@@ -1,16 +1,19 @@
-//! Where time goes: planned moves are finalised by the look-ahead some moves after they were
-//! read, so each move carries a sequence number, and the feature and layers it belongs to wait
-//! in a queue (bounded by the planner's window) until its time is known. Temperature and fan
-//! events wait the same way for the time at which they happen.
+//! Bookkeeping in two halves. The read side ([`Accounts`]) counts what the file says as lines
+//! are read: moves, distances, filament, features, layers. The timing side ([`Timing`]) owns
+//! the planner and the energy model and learns each move's time when the look-ahead finalises
+//! it, some moves later; the two talk only through [`TimeMsg`]s, so the timing side can run on
+//! its own thread natively (see `analyze`). Each move carries a sequence number, its feature
+//! slot and its layers; temperature and fan events wait for the time at which they happen.
 
 use std::collections::{HashMap, VecDeque};
 
 use super::layers::LayerTracker;
 use super::report::{Bounds, FanEvent, FeatureSummary, TemperatureEvent};
 use crate::energy::Accumulator;
+use crate::energy::Material;
 use crate::gcode::feature_kind;
 use crate::machine::{Heater, Move};
-use crate::plan::PlannedMove;
+use crate::plan::{Limits, PlannedMove, Planner};
 
 /// Feature slot of travel moves.
 pub const TRAVEL: u32 = u32::MAX;
@@ -28,8 +31,9 @@ pub struct Totals {
     pub bounds: Option<Bounds>,
 }
 
+/// An event waiting for its time.
 #[derive(Debug, Clone, Copy)]
-enum Pending {
+pub enum Pending {
     Temperature {
         line: u32,
         heater: Heater,
@@ -52,19 +56,13 @@ pub struct Accounts {
     current_feature: Option<usize>,
     pub travel: FeatureSummary,
     pub layers: LayerTracker,
-    /// (move sequence number, feature slot, layers) of moves not yet finalised.
-    tags: VecDeque<(u64, u32, (u32, u32))>,
-    /// Events waiting for their time: (moves read before them, event).
-    pending: VecDeque<(u64, Pending)>,
-    pub temperatures: Vec<TemperatureEvent>,
-    pub fans: Vec<FanEvent>,
-    /// Energy models, fed every planned move and dwell.
-    pub energy: Accumulator,
+    /// Material named in the file's comments, if any.
+    pub material: Option<Material>,
     moves_read: u64,
 }
 
 impl Accounts {
-    pub fn new(energy: Accumulator) -> Self {
+    pub fn new() -> Self {
         Self {
             totals: Totals::default(),
             features: Vec::new(),
@@ -72,12 +70,15 @@ impl Accounts {
             current_feature: None,
             travel: summary("travel", None),
             layers: LayerTracker::new(),
-            tags: VecDeque::new(),
-            pending: VecDeque::new(),
-            temperatures: Vec::new(),
-            fans: Vec::new(),
-            energy,
+            material: None,
             moves_read: 0,
+        }
+    }
+
+    /// A comment that is not a marker (learns the material).
+    pub fn comment(&mut self, comment: &[u8]) {
+        if self.material.is_none() {
+            self.material = Material::from_comment(comment);
         }
     }
 
@@ -97,8 +98,8 @@ impl Accounts {
     }
 
     /// A move was read; returns its sequence number (the planner's tag).
-    pub fn read_move(&mut self, m: &Move) -> u64 {
-        account_move(m, &mut self.totals);
+    pub fn read_move(&mut self, m: Move) -> TimeMsg {
+        account_move(&m, &mut self.totals);
         let slot = if m.is_extruding() {
             let i = match self.current_feature {
                 Some(i) => i,
@@ -116,11 +117,64 @@ impl Accounts {
         s.moves += 1;
         s.distance_mm += m.length_mm;
         s.filament_mm += m.extrusion();
-        self.layers.motion(m);
+        self.layers.motion(&m);
         let seq = self.moves_read;
-        self.tags.push_back((seq, slot, self.layers.current()));
         self.moves_read += 1;
-        seq
+        TimeMsg::Move {
+            m,
+            seq,
+            slot,
+            layers: self.layers.current(),
+        }
+    }
+
+    /// A dwell, charged to the current layer.
+    pub fn dwell(&self, secs: f64) -> TimeMsg {
+        TimeMsg::Dwell {
+            secs,
+            layers: self.layers.current(),
+        }
+    }
+
+    /// A heater target, to be timed.
+    pub fn temperature(&self, line: u32, heater: Heater, target_c: f64, wait: bool) -> TimeMsg {
+        TimeMsg::Event {
+            before: self.moves_read,
+            event: Pending::Temperature {
+                line,
+                heater,
+                target_c,
+                wait,
+            },
+        }
+    }
+
+    /// A fan speed, to be timed.
+    pub fn fan(&self, line: u32, index: u16, speed: f64) -> TimeMsg {
+        TimeMsg::Event {
+            before: self.moves_read,
+            event: Pending::Fan { line, index, speed },
+        }
+    }
+
+    /// Adds the timing side's per-feature and per-layer times and energies.
+    pub fn merge(&mut self, timing: &Timing) {
+        for (i, (t, e)) in timing.feature_time.iter().enumerate() {
+            if let Some(f) = self.features.get_mut(i) {
+                f.time_s += t;
+                f.energy_j += e;
+            }
+        }
+        self.travel.time_s += timing.travel_time.0;
+        self.travel.energy_j += timing.travel_time.1;
+        for (i, (t, e)) in timing.layer_time[0].iter().enumerate() {
+            self.layers
+                .add_time_energy((i as u32, super::layers::NO_LAYER), *t, *e);
+        }
+        for (i, (t, e)) in timing.layer_time[1].iter().enumerate() {
+            self.layers
+                .add_time_energy((super::layers::NO_LAYER, i as u32), *t, *e);
+        }
     }
 
     fn slot(&mut self, slot: u32) -> &mut FeatureSummary {
@@ -129,9 +183,153 @@ impl Accounts {
             _ => &mut self.travel,
         }
     }
+}
 
-    /// A move's plan is final.
-    pub fn planned(&mut self, pm: &PlannedMove) {
+/// What the read side tells the timing side, in file order.
+///
+/// Moves travel by value in batches: boxing them would cost an allocation per move, and the
+/// batches are recycled, so the size of the largest variant costs nothing extra.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone)]
+pub enum TimeMsg {
+    /// A move, with its sequence number, feature slot and layers (marker count, Z count).
+    Move {
+        m: Move,
+        seq: u64,
+        slot: u32,
+        layers: (u32, u32),
+    },
+    /// A dwell: the queue drains, then time passes.
+    Dwell { secs: f64, layers: (u32, u32) },
+    /// The firmware finishes every queued move (heater wait).
+    Flush,
+    /// New limits from a command in the file.
+    Limits(Box<Limits>),
+    /// An event that happens before move number `before`.
+    Event { before: u64, event: Pending },
+}
+
+/// The timing side: planner, energy and per-slot times.
+#[derive(Debug)]
+pub struct Timing {
+    pub planner: Planner,
+    pub energy: Accumulator,
+    /// (time, energy) per feature slot.
+    feature_time: Vec<(f64, f64)>,
+    travel_time: (f64, f64),
+    /// (time, energy) per layer: by markers, by Z.
+    layer_time: [Vec<(f64, f64)>; 2],
+    /// (sequence, slot, layers) of moves not yet finalised.
+    tags: VecDeque<(u64, u32, (u32, u32))>,
+    pending: VecDeque<(u64, Pending)>,
+    pub temperatures: Vec<TemperatureEvent>,
+    pub fans: Vec<FanEvent>,
+}
+
+fn add(v: &mut Vec<(f64, f64)>, i: u32, t: f64, e: f64) {
+    if i == super::layers::NO_LAYER || i == TRAVEL {
+        return;
+    }
+    let i = i as usize;
+    if v.len() <= i {
+        v.resize(i + 1, (0.0, 0.0));
+    }
+    v[i].0 += t;
+    v[i].1 += e;
+}
+
+impl Timing {
+    pub fn new(planner: Planner, energy: Accumulator) -> Self {
+        Self {
+            planner,
+            energy,
+            feature_time: Vec::new(),
+            travel_time: (0.0, 0.0),
+            layer_time: [Vec::new(), Vec::new()],
+            tags: VecDeque::new(),
+            pending: VecDeque::new(),
+            temperatures: Vec::new(),
+            fans: Vec::new(),
+        }
+    }
+
+    /// Handles one message from the read side.
+    pub fn handle(&mut self, msg: TimeMsg) {
+        let (planner, mut side) = self.split();
+        match msg {
+            TimeMsg::Move {
+                m,
+                seq,
+                slot,
+                layers,
+            } => {
+                side.tags.push_back((seq, slot, layers));
+                planner.push(&m, seq, &mut |pm| side.planned(pm));
+            }
+            TimeMsg::Dwell { secs, layers } => {
+                planner.flush(&mut |pm| side.planned(pm));
+                side.stamp_until(u64::MAX, planner.elapsed_s());
+                planner.dwell(secs, &mut |pm| side.planned(pm));
+                let joules = side.energy.dwell(secs);
+                add(&mut side.layer_time[0], layers.0, secs, joules);
+                add(&mut side.layer_time[1], layers.1, secs, joules);
+            }
+            TimeMsg::Flush => planner.flush(&mut |pm| side.planned(pm)),
+            TimeMsg::Limits(l) => *planner.limits_mut() = *l,
+            TimeMsg::Event { before, event } => side.pending.push_back((before, event)),
+        }
+    }
+
+    /// End of file: every move is final and every event timed.
+    pub fn finish(&mut self) {
+        self.handle(TimeMsg::Flush);
+        let (planner, mut side) = self.split();
+        side.stamp_until(u64::MAX, planner.elapsed_s());
+    }
+
+    /// The planner, and the rest for its sink.
+    fn split(&mut self) -> (&mut Planner, Side<'_>) {
+        let Timing {
+            planner,
+            energy,
+            feature_time,
+            travel_time,
+            layer_time,
+            tags,
+            pending,
+            temperatures,
+            fans,
+        } = self;
+        (
+            planner,
+            Side {
+                energy,
+                feature_time,
+                travel_time,
+                layer_time,
+                tags,
+                pending,
+                temperatures,
+                fans,
+            },
+        )
+    }
+}
+
+/// The timing side without its planner (what the planner's sink may touch).
+struct Side<'a> {
+    energy: &'a mut Accumulator,
+    feature_time: &'a mut Vec<(f64, f64)>,
+    travel_time: &'a mut (f64, f64),
+    layer_time: &'a mut [Vec<(f64, f64)>; 2],
+    tags: &'a mut VecDeque<(u64, u32, (u32, u32))>,
+    pending: &'a mut VecDeque<(u64, Pending)>,
+    temperatures: &'a mut Vec<TemperatureEvent>,
+    fans: &'a mut Vec<FanEvent>,
+}
+
+impl Side<'_> {
+    fn planned(&mut self, pm: &PlannedMove) {
         let joules = self.energy.planned(pm);
         self.stamp_until(pm.tag, pm.start_s);
         while self.tags.front().is_some_and(|t| t.0 < pm.tag) {
@@ -141,36 +339,14 @@ impl Accounts {
             return;
         };
         let d = pm.duration();
-        let s = self.slot(slot);
-        s.time_s += d;
-        s.energy_j += joules;
-        self.layers.add_time_energy(layers, d, joules);
-    }
-
-    /// Time passing outside moves (a dwell), charged to the current layer.
-    pub fn dwell(&mut self, secs: f64) {
-        let joules = self.energy.dwell(secs);
-        let current = self.layers.current();
-        self.layers.add_time_energy(current, secs, joules);
-    }
-
-    /// A heater target; timed when the moves before it are planned.
-    pub fn temperature(&mut self, line: u32, heater: Heater, target_c: f64, wait: bool) {
-        self.pending.push_back((
-            self.moves_read,
-            Pending::Temperature {
-                line,
-                heater,
-                target_c,
-                wait,
-            },
-        ));
-    }
-
-    /// A fan speed; timed when the moves before it are planned.
-    pub fn fan(&mut self, line: u32, index: u16, speed: f64) {
-        self.pending
-            .push_back((self.moves_read, Pending::Fan { line, index, speed }));
+        if slot == TRAVEL {
+            self.travel_time.0 += d;
+            self.travel_time.1 += joules;
+        } else {
+            add(self.feature_time, slot, d, joules);
+        }
+        add(&mut self.layer_time[0], layers.0, d, joules);
+        add(&mut self.layer_time[1], layers.1, d, joules);
     }
 
     /// Stamps events that come before move `seq` with `time_s`.
@@ -203,11 +379,6 @@ impl Accounts {
                 }),
             }
         }
-    }
-
-    /// Stamps every waiting event with `time_s` (after a flush: all moves before are done).
-    pub fn stamp_all(&mut self, time_s: f64) {
-        self.stamp_until(u64::MAX, time_s);
     }
 }
 

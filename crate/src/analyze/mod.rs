@@ -3,6 +3,7 @@
 
 mod accounting;
 mod layers;
+mod pipeline;
 pub mod prescan;
 pub mod report;
 
@@ -13,7 +14,7 @@ use crate::error::{Error, ErrorKind, Warnings};
 use crate::gcode::{self, classify_comment, Marker, SlicerInfo, Strictness};
 use crate::machine::{self, axis, Event, ExtrusionMode, Machine, MachineConfig};
 use crate::plan::{FeedUnits, JunctionModel, Limit, LimitSource, MachineProfile, Planner};
-use accounting::Accounts;
+use accounting::{Accounts, TimeMsg, Timing};
 pub use report::*;
 
 /// Default filament diameter when the file does not declare one, mm.
@@ -161,87 +162,95 @@ pub fn analyze_with_progress(
     } else {
         FeedUnits::PerSecond
     };
-    let mut planner = Planner::new(limits, model);
+    let mut limits_now = limits.clone();
     let mut print_limits = None;
+    let mut timing = Timing::new(
+        Planner::new(limits, model),
+        Accumulator::new(&options.energy.clone().unwrap_or_default(), &profile.name),
+    );
 
     let mut machine = Machine::new(MachineConfig {
         extrusion: mode,
         ..MachineConfig::default()
     });
     let mut info = SlicerInfo::default();
-    let energy_options = options.energy.clone().unwrap_or_default();
-    let mut acc = Accounts::new(Accumulator::new(&energy_options, &profile.name));
+    let mut acc = Accounts::new();
     let mut next_progress = PROGRESS_STEP;
 
-    gcode::for_each_line(input, strictness, &mut warnings, |raw, line, warnings| {
-        acc.totals.lines += 1;
-        if raw.offset >= next_progress {
-            next_progress = raw.offset + PROGRESS_STEP;
-            if !progress(raw.offset as f64 / input.len() as f64) {
-                return Err(Error::new(raw.number, 0, ErrorKind::Cancelled));
-            }
-        }
-        let Some(line) = line else { return Ok(()) };
-        if let Some(comment) = line.comment {
-            match classify_comment(comment) {
-                Some(Marker::Layer { kind, z }) => acc.layers.marker(kind, z, raw.number),
-                Some(Marker::Feature(name)) => acc.feature(name),
-                None => {
-                    info.observe(comment);
-                    acc.energy.comment(comment);
+    let read = |to_timing: &mut dyn FnMut(TimeMsg)| -> Result<(), Error> {
+        gcode::for_each_line(input, strictness, &mut warnings, |raw, line, warnings| {
+            acc.totals.lines += 1;
+            if raw.offset >= next_progress {
+                next_progress = raw.offset + PROGRESS_STEP;
+                if !progress(raw.offset as f64 / input.len() as f64) {
+                    return Err(Error::new(raw.number, 0, ErrorKind::Cancelled));
                 }
             }
-        }
-        if planner.limits_mut().apply_command(line, units) {
-            return Ok(());
-        }
-        let Some(event) = machine.apply(raw.number, line, warnings) else {
-            return Ok(());
-        };
-        match event {
-            Event::Move(m) => {
-                let seq = acc.read_move(&m);
-                if print_limits.is_none() && m.is_extruding() {
-                    print_limits = Some(planner.limits().clone());
-                }
-                planner.push(&m, seq, &mut |pm| acc.planned(pm));
-            }
-            Event::Dwell(s) => {
-                planner.flush(&mut |pm| acc.planned(pm));
-                acc.stamp_all(planner.elapsed_s());
-                planner.dwell(s, &mut |pm| acc.planned(pm));
-                acc.dwell(s);
-            }
-            Event::Temperature {
-                heater,
-                target_c,
-                wait,
-            } => {
-                acc.temperature(raw.number, heater, target_c, wait);
-                if wait {
-                    // The firmware finishes every queued move before it waits.
-                    planner.flush(&mut |pm| acc.planned(pm));
+            let Some(line) = line else { return Ok(()) };
+            if let Some(comment) = line.comment {
+                match classify_comment(comment) {
+                    Some(Marker::Layer { kind, z }) => acc.layers.marker(kind, z, raw.number),
+                    Some(Marker::Feature(name)) => acc.feature(name),
+                    None => {
+                        info.observe(comment);
+                        acc.comment(comment);
+                    }
                 }
             }
-            Event::Fan { index, speed } => acc.fan(raw.number, index, speed),
-            Event::Home(_) => planner.flush(&mut |pm| acc.planned(pm)),
-        }
-        Ok(())
-    })?;
-    planner.flush(&mut |pm| acc.planned(pm));
-    acc.stamp_all(planner.elapsed_s());
+            if limits_now.apply_command(line, units) {
+                to_timing(TimeMsg::Limits(Box::new(limits_now.clone())));
+                return Ok(());
+            }
+            let Some(event) = machine.apply(raw.number, line, warnings) else {
+                return Ok(());
+            };
+            match event {
+                Event::Move(m) => {
+                    if print_limits.is_none() && m.is_extruding() {
+                        print_limits = Some(limits_now.clone());
+                    }
+                    to_timing(acc.read_move(m));
+                }
+                Event::Dwell(secs) => to_timing(acc.dwell(secs)),
+                Event::Temperature {
+                    heater,
+                    target_c,
+                    wait,
+                } => {
+                    to_timing(acc.temperature(raw.number, heater, target_c, wait));
+                    if wait {
+                        // The firmware finishes every queued move before it waits.
+                        to_timing(TimeMsg::Flush);
+                    }
+                }
+                Event::Fan { index, speed } => to_timing(acc.fan(raw.number, index, speed)),
+                Event::Home(_) => to_timing(TimeMsg::Flush),
+            }
+            Ok(())
+        })
+    };
+    pipeline::run(input.len(), &mut timing, read)?;
+    timing.finish();
     progress(1.0);
+    acc.merge(&timing);
+    if let Some(m) = acc.material {
+        timing.energy.set_material_from_file(m);
+    }
 
     let Accounts {
         totals,
         mut features,
         travel,
         layers,
-        temperatures,
-        fans,
-        energy: energy_acc,
         ..
     } = acc;
+    let Timing {
+        planner,
+        energy: energy_acc,
+        temperatures,
+        fans,
+        ..
+    } = timing;
     let (mut layer_list, layer_source) = layers.finish();
     let filament_mm = machine.position()[axis::E];
     let diameter = options
@@ -287,7 +296,7 @@ pub fn analyze_with_progress(
             profile: profile.name,
             junction_model: model,
             reason: model_reason,
-            limits: print_limits.unwrap_or_else(|| planner.limits().clone()),
+            limits: print_limits.unwrap_or(limits_now),
         },
         moves: totals.moves,
         extruding_moves: totals.extruding_moves,

@@ -215,12 +215,10 @@ impl Accumulator {
         }
     }
 
-    /// A comment of the file (learns the material from `filament_type`). Cheap.
-    #[inline]
-    pub fn comment(&mut self, comment: &[u8]) {
-        if self.material.is_none() {
-            self.material = Material::from_comment(comment);
-        }
+    /// The material the file names in its comments (`filament_type`), used unless the
+    /// options name one.
+    pub fn set_material_from_file(&mut self, material: Material) {
+        self.material.get_or_insert(material);
     }
 
     /// The energy report for a print of `time_s` seconds laying `material_g` grams.
