@@ -224,7 +224,6 @@ pub fn analyze_with_progress(
                     }
                 }
                 Event::Fan { index, speed } => to_timing(acc.fan(raw.number, index, speed)),
-                Event::Home(_) => to_timing(TimeMsg::Flush),
             }
             Ok(())
         })

@@ -174,8 +174,6 @@ pub enum Event {
         /// Speed fraction.
         speed: f64,
     },
-    /// `G28`: the named axes (bit `i` for axis index `i`) were homed.
-    Home(u16),
 }
 
 /// Settings of the state machine.
