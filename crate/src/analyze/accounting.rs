@@ -158,7 +158,7 @@ impl Accounts {
     }
 
     /// Adds the timing side's per-feature and per-layer times and energies.
-    pub fn merge(&mut self, timing: &Timing) {
+    pub fn merge(&mut self, timing: &TimeBook) {
         for (i, (t, e)) in timing.feature_time.iter().enumerate() {
             if let Some(f) = self.features.get_mut(i) {
                 f.time_s += t;
@@ -209,10 +209,16 @@ pub enum TimeMsg {
     Event { before: u64, event: Pending },
 }
 
-/// The timing side: planner, energy and per-slot times.
+/// The timing side: the planner, and the book its finalised moves are written into.
 #[derive(Debug)]
 pub struct Timing {
     pub planner: Planner,
+    pub book: TimeBook,
+}
+
+/// Times, energies and timed events, as planned moves are finalised.
+#[derive(Debug)]
+pub struct TimeBook {
     pub energy: Accumulator,
     /// (time, energy) per feature slot.
     feature_time: Vec<(f64, f64)>,
@@ -240,8 +246,7 @@ fn add(v: &mut Vec<(f64, f64)>, i: u32, t: f64, e: f64) {
 
 impl Timing {
     pub fn new(planner: Planner, energy: Accumulator) -> Self {
-        Self {
-            planner,
+        let book = TimeBook {
             energy,
             feature_time: Vec::new(),
             travel_time: (0.0, 0.0),
@@ -250,12 +255,13 @@ impl Timing {
             pending: VecDeque::new(),
             temperatures: Vec::new(),
             fans: Vec::new(),
-        }
+        };
+        Self { planner, book }
     }
 
     /// Handles one message from the read side.
     pub fn handle(&mut self, msg: TimeMsg) {
-        let (planner, mut side) = self.split();
+        let Timing { planner, book } = self;
         match msg {
             TimeMsg::Move {
                 m,
@@ -263,72 +269,31 @@ impl Timing {
                 slot,
                 layers,
             } => {
-                side.tags.push_back((seq, slot, layers));
-                planner.push(&m, seq, &mut |pm| side.planned(pm));
+                book.tags.push_back((seq, slot, layers));
+                planner.push(&m, seq, &mut |pm| book.planned(pm));
             }
             TimeMsg::Dwell { secs, layers } => {
-                planner.flush(&mut |pm| side.planned(pm));
-                side.stamp_until(u64::MAX, planner.elapsed_s());
-                planner.dwell(secs, &mut |pm| side.planned(pm));
-                let joules = side.energy.dwell(secs);
-                add(&mut side.layer_time[0], layers.0, secs, joules);
-                add(&mut side.layer_time[1], layers.1, secs, joules);
+                planner.flush(&mut |pm| book.planned(pm));
+                book.stamp_until(u64::MAX, planner.elapsed_s());
+                planner.dwell(secs, &mut |pm| book.planned(pm));
+                let joules = book.energy.dwell(secs);
+                add(&mut book.layer_time[0], layers.0, secs, joules);
+                add(&mut book.layer_time[1], layers.1, secs, joules);
             }
-            TimeMsg::Flush => planner.flush(&mut |pm| side.planned(pm)),
+            TimeMsg::Flush => planner.flush(&mut |pm| book.planned(pm)),
             TimeMsg::Limits(l) => *planner.limits_mut() = *l,
-            TimeMsg::Event { before, event } => side.pending.push_back((before, event)),
+            TimeMsg::Event { before, event } => book.pending.push_back((before, event)),
         }
     }
 
     /// End of file: every move is final and every event timed.
     pub fn finish(&mut self) {
         self.handle(TimeMsg::Flush);
-        let (planner, mut side) = self.split();
-        side.stamp_until(u64::MAX, planner.elapsed_s());
-    }
-
-    /// The planner, and the rest for its sink.
-    fn split(&mut self) -> (&mut Planner, Side<'_>) {
-        let Timing {
-            planner,
-            energy,
-            feature_time,
-            travel_time,
-            layer_time,
-            tags,
-            pending,
-            temperatures,
-            fans,
-        } = self;
-        (
-            planner,
-            Side {
-                energy,
-                feature_time,
-                travel_time,
-                layer_time,
-                tags,
-                pending,
-                temperatures,
-                fans,
-            },
-        )
+        self.book.stamp_until(u64::MAX, self.planner.elapsed_s());
     }
 }
 
-/// The timing side without its planner (what the planner's sink may touch).
-struct Side<'a> {
-    energy: &'a mut Accumulator,
-    feature_time: &'a mut Vec<(f64, f64)>,
-    travel_time: &'a mut (f64, f64),
-    layer_time: &'a mut [Vec<(f64, f64)>; 2],
-    tags: &'a mut VecDeque<(u64, u32, (u32, u32))>,
-    pending: &'a mut VecDeque<(u64, Pending)>,
-    temperatures: &'a mut Vec<TemperatureEvent>,
-    fans: &'a mut Vec<FanEvent>,
-}
-
-impl Side<'_> {
+impl TimeBook {
     fn planned(&mut self, pm: &PlannedMove) {
         let joules = self.energy.planned(pm);
         self.stamp_until(pm.tag, pm.start_s);
@@ -343,7 +308,7 @@ impl Side<'_> {
             self.travel_time.0 += d;
             self.travel_time.1 += joules;
         } else {
-            add(self.feature_time, slot, d, joules);
+            add(&mut self.feature_time, slot, d, joules);
         }
         add(&mut self.layer_time[0], layers.0, d, joules);
         add(&mut self.layer_time[1], layers.1, d, joules);

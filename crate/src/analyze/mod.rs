@@ -14,7 +14,7 @@ use crate::error::{Error, ErrorKind, Warnings};
 use crate::gcode::{self, classify_comment, Marker, SlicerInfo, Strictness};
 use crate::machine::{self, axis, Event, ExtrusionMode, Machine, MachineConfig};
 use crate::plan::{FeedUnits, JunctionModel, Limit, LimitSource, MachineProfile, Planner};
-use accounting::{Accounts, TimeMsg, Timing};
+use accounting::{Accounts, TimeBook, TimeMsg, Timing};
 pub use report::*;
 
 /// Default filament diameter when the file does not declare one, mm.
@@ -231,9 +231,9 @@ pub fn analyze_with_progress(
     pipeline::run(input.len(), &mut timing, read)?;
     timing.finish();
     progress(1.0);
-    acc.merge(&timing);
+    acc.merge(&timing.book);
     if let Some(m) = acc.material {
-        timing.energy.set_material_from_file(m);
+        timing.book.energy.set_material_from_file(m);
     }
 
     let Accounts {
@@ -243,13 +243,13 @@ pub fn analyze_with_progress(
         layers,
         ..
     } = acc;
-    let Timing {
-        planner,
+    let Timing { planner, book } = timing;
+    let TimeBook {
         energy: energy_acc,
         temperatures,
         fans,
         ..
-    } = timing;
+    } = book;
     let (mut layer_list, layer_source) = layers.finish();
     let filament_mm = machine.position()[axis::E];
     let diameter = options
