@@ -13,7 +13,7 @@ use crate::energy::Accumulator;
 use crate::energy::Material;
 use crate::gcode::feature_kind;
 use crate::machine::{Heater, Move};
-use crate::plan::{Limits, PlannedMove, Planner};
+use crate::plan::{Limits, Motion, PlannedMove, Planner};
 
 /// Feature slot of travel moves.
 pub const TRAVEL: u32 = u32::MAX;
@@ -121,7 +121,7 @@ impl Accounts {
         let seq = self.moves_read;
         self.moves_read += 1;
         TimeMsg::Move {
-            m,
+            m: Motion::from(&m),
             seq,
             slot,
             layers: self.layers.current(),
@@ -194,7 +194,7 @@ impl Accounts {
 pub enum TimeMsg {
     /// A move, with its sequence number, feature slot and layers (marker count, Z count).
     Move {
-        m: Move,
+        m: Motion,
         seq: u64,
         slot: u32,
         layers: (u32, u32),

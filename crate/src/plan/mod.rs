@@ -34,6 +34,50 @@ pub const REFRESH_THRESHOLD: usize = KEEP_BLOCKS * 4;
 /// Most straight segments one arc is split into.
 pub const MAX_ARC_SEGMENTS: usize = 100_000;
 
+/// What the planner needs of a move: its X, Y, Z, E displacement, its arc if it is one, its
+/// feed rate. (A [`Move`] carries every axis at both ends; this is what crosses to the timing
+/// side, so it is kept small.)
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Motion {
+    /// 1-based source line.
+    pub line: u32,
+    /// Displacement X, Y, Z, E, mm.
+    pub delta: [f64; 4],
+    /// The arc, for `G2`/`G3`.
+    pub arc: Option<crate::machine::Arc>,
+    /// Requested feed rate, mm/s.
+    pub feed_mm_s: f64,
+    /// Time of a move of the rotary axes alone at its feed rate, s (0 otherwise).
+    pub rotary_time_s: f64,
+}
+
+impl From<&Move> for Motion {
+    fn from(m: &Move) -> Self {
+        let delta = [
+            m.to[axis::X] - m.from[axis::X],
+            m.to[axis::Y] - m.from[axis::Y],
+            m.to[axis::Z] - m.from[axis::Z],
+            m.to[axis::E] - m.from[axis::E],
+        ];
+        let arc = match m.kind {
+            MoveKind::Arc(a) => Some(a),
+            _ => None,
+        };
+        let rotary_time_s = if arc.is_none() && delta.iter().all(|v| v.abs() < 1e-12) {
+            m.nominal_time()
+        } else {
+            0.0
+        };
+        Motion {
+            line: m.line,
+            delta,
+            arc,
+            feed_mm_s: m.feed_mm_s,
+            rotary_time_s,
+        }
+    }
+}
+
 /// What a move does, which decides its acceleration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -204,9 +248,9 @@ impl Planner {
     }
 
     /// Plans a motion; finalised moves go to `sink`.
-    pub fn push(&mut self, m: &Move, tag: u64, sink: &mut impl FnMut(&PlannedMove)) {
-        match m.kind {
-            MoveKind::Arc(arc) => {
+    pub fn push(&mut self, m: &Motion, tag: u64, sink: &mut impl FnMut(&PlannedMove)) {
+        match m.arc {
+            Some(arc) => {
                 let (p0, p1, h) = arc.plane.axes();
                 let n = arc_segments(
                     arc.radius,
@@ -221,8 +265,8 @@ impl Planner {
                     let p = arc.offset_at(t);
                     cur[p0] = p[0];
                     cur[p1] = p[1];
-                    cur[h] = (m.to[h] - m.from[h]) * t;
-                    cur[3] = (m.to[axis::E] - m.from[axis::E]) * t;
+                    cur[h] = m.delta[h] * t;
+                    cur[3] = m.delta[3] * t;
                     let d = [
                         cur[0] - prev[0],
                         cur[1] - prev[1],
@@ -233,22 +277,15 @@ impl Planner {
                     prev = cur;
                 }
             }
-            _ => {
-                let d = [
-                    m.to[axis::X] - m.from[axis::X],
-                    m.to[axis::Y] - m.from[axis::Y],
-                    m.to[axis::Z] - m.from[axis::Z],
-                    m.to[axis::E] - m.from[axis::E],
-                ];
-                if d.iter().all(|v| v.abs() < 1e-12) {
+            None => {
+                if m.delta.iter().all(|v| v.abs() < 1e-12) {
                     // Rotary-only moves: timed at the feed rate over their angle, no dynamics.
-                    let t = m.nominal_time();
-                    if t > 0.0 {
-                        self.dwell(t, sink);
+                    if m.rotary_time_s > 0.0 {
+                        self.dwell(m.rotary_time_s, sink);
                     }
                     return;
                 }
-                self.push_segment(m.line, tag, d, m.feed_mm_s, sink);
+                self.push_segment(m.line, tag, m.delta, m.feed_mm_s, sink);
             }
         }
     }
@@ -481,7 +518,7 @@ mod tests {
             if let Some(Event::Move(m)) =
                 machine.apply(i as u32 + 1, &parse_line(l.as_bytes()).expect(l), &mut w)
             {
-                planner.push(&m, 0, &mut |p| out.push(*p));
+                planner.push(&Motion::from(&m), 0, &mut |p| out.push(*p));
             }
         }
         planner.flush(&mut |p| out.push(*p));
