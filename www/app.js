@@ -284,6 +284,17 @@ function plain(value) {
   return JSON.parse(toJson(value) ?? 'null');
 }
 
+function formatEnergy(j) {
+  if (!isNum(j)) return '—';
+  if (Math.abs(j) >= 3.6e6) return `${fmt1.format(j / 3.6e6)} kWh`;
+  if (Math.abs(j) >= 1e3) return `${fmt1.format(j / 1e3)} kJ`;
+  return `${fmt1.format(j)} J`;
+}
+
+function signedPercent(x) {
+  return `${x >= 0 ? '+' : '−'}${fmt1.format(Math.abs(x) * 100)} %`;
+}
+
 function summaryRows(r, name, ms) {
   const file = r.file ?? {};
   const extrusion = r.extrusion ?? {};
@@ -291,6 +302,8 @@ function summaryRows(r, name, ms) {
   const rows = [
     ['File', name],
     ['Print time', formatDuration(r.time_s)],
+    ['Slicer estimate', isNum(file.slicer_time_s) ? `${formatDuration(file.slicer_time_s)} (${signedPercent(r.time_s / file.slicer_time_s - 1)})` : '—'],
+    ['Machine', r.machine ? `${r.machine.profile} · ${String(r.machine.junction_model).replaceAll('_', ' ')}` : '—'],
     ['Moves', formatCount(r.moves)],
     ['Layers', formatCount(r.layers)],
     ['Distance', formatLength(r.distance_mm)],
@@ -299,6 +312,8 @@ function summaryRows(r, name, ms) {
     ['Slicer', file.slicer ?? 'unknown'],
     ['Flavor', file.flavor ?? '—'],
     ['Extrusion mode', extrusion.mode ? `${extrusion.mode}${extrusion.source ? ` (${extrusion.source})` : ''}` : '—'],
+    ['Energy', isNum(r.energy?.total_j) ? `${formatEnergy(r.energy.total_j)} (stepper ${formatEnergy(r.energy.thesis_j)}, melting ${formatEnergy(r.energy.fuse_j)}, auxiliary ${formatEnergy(r.energy.aux_j)})` : '—'],
+    ['CO₂', isNum(r.energy?.co2_g) ? `${fmt1.format(r.energy.co2_g)} g` : '—'],
     ['Warnings', formatCount(warnings.length)],
     ['Size', `${formatBytes(file.bytes)} · ${formatCount(file.lines)} lines`],
   ];
@@ -317,6 +332,7 @@ function renderStats(r) {
     ['Print time', formatDuration(r.time_s), isNum(r.moves) ? `${formatCount(r.moves)} moves` : ''],
     ['Filament', formatLength(r.filament_mm), isNum(r.material_g) ? `${fmt1.format(r.material_g)} g` : ''],
     ['Layers', formatCount(r.layers), r.bounds?.max ? `${fmt1.format(r.bounds.max[2] - r.bounds.min[2])} mm tall` : ''],
+    ['Energy', isNum(r.energy?.total_j) ? formatEnergy(r.energy.total_j) : '—', isNum(r.energy?.co2_g) ? `${fmt1.format(r.energy.co2_g)} g CO₂` : ''],
     ['Warnings', formatCount(warnings), warnings ? 'see below' : 'clean file'],
   ];
   els.stats.replaceChildren(
