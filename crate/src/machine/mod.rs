@@ -293,18 +293,10 @@ impl Machine {
     ) -> Option<Event> {
         match line.command {
             Command::Code(code) => self.apply_code(line_no, code, line, warnings),
-            Command::Extended(name) => {
-                self.apply_extended(name, line);
-                None
-            }
-            Command::None | Command::Bare => None,
+            // Klipper extended commands change no motion state modelled here (limits are read
+            // by the planner; SET_GCODE_OFFSET-style shifts do not change relative motion).
+            Command::Extended(_) | Command::None | Command::Bare => None,
         }
-    }
-
-    fn apply_extended(&mut self, name: &[u8], line: &Line<'_>) {
-        // Klipper's M220/M221 equivalents are macros; the one core command that changes
-        // motion state here is SET_GCODE_OFFSET, which only shifts coordinates.
-        let _ = (name, line);
     }
 
     fn apply_code(
