@@ -22,15 +22,25 @@
 //! - [`analyze`](mod@analyze): one streaming pass giving the report.
 //! - [`plan`]: firmware-style motion planning (trapezoids, junctions, look-ahead).
 //! - [`energy`]: energy (thesis stepper model, VTG servo/fuse/aux model) and CO₂.
+//! - [`path`]: every move of a file with its layer, feature and planned timing.
+//! - [`dynamics`]: lumped-mass axis model, trajectory deviation, vibration spectra.
+//! - [`vtg`]: vibration-suppressed toolpath generation.
+//! - [`infill`]: infill regeneration and the energy-driven search.
+//! - [`orient`]: tool-orientation smoothing for multi-axis toolpaths.
 //! - [`math`]: portable transcendental functions (identical results native and wasm).
 
 pub mod analyze;
+pub mod dynamics;
 pub mod energy;
 pub mod error;
 pub mod gcode;
+pub mod infill;
 pub mod machine;
 pub mod math;
+pub mod orient;
+pub mod path;
 pub mod plan;
+pub mod vtg;
 
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;

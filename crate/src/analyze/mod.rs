@@ -2,7 +2,7 @@
 //! filament, layers, features, temperatures, fans and energy (from [`crate::energy`]).
 
 mod accounting;
-mod layers;
+pub(crate) mod layers;
 mod pipeline;
 pub mod prescan;
 pub mod report;
@@ -109,12 +109,25 @@ fn choose_machine(
     Ok((profile, model, why))
 }
 
-/// [`analyze`] with progress reports and cancellation.
-pub fn analyze_with_progress(
-    input: &[u8],
-    options: &AnalyzeOptions,
-    progress: Progress<'_>,
-) -> Result<Report, Error> {
+/// What every pass over a file needs before its first line: validated options, the extrusion
+/// mode, the head/tail prescan, the machine profile, junction model and starting limits.
+/// Shared by [`analyze`] and by [`crate::path::extract`] so both read a file the same way.
+#[derive(Debug)]
+pub(crate) struct Setup {
+    pub strictness: Strictness,
+    pub mode: ExtrusionMode,
+    pub source: machine::ModeSource,
+    pub warnings: Warnings,
+    pub pre: prescan::Prescan,
+    pub profile: MachineProfile,
+    pub model: JunctionModel,
+    pub model_reason: String,
+    pub limits: crate::plan::Limits,
+    pub units: FeedUnits,
+}
+
+/// Builds the [`Setup`] of a pass over `input`.
+pub(crate) fn prepare(input: &[u8], options: &AnalyzeOptions) -> Result<Setup, Error> {
     validate_options(options)?;
     let strictness = if options.strict {
         Strictness::Strict
@@ -162,6 +175,38 @@ pub fn analyze_with_progress(
     } else {
         FeedUnits::PerSecond
     };
+    Ok(Setup {
+        strictness,
+        mode,
+        source,
+        warnings,
+        pre,
+        profile,
+        model,
+        model_reason,
+        limits,
+        units,
+    })
+}
+
+/// [`analyze`] with progress reports and cancellation.
+pub fn analyze_with_progress(
+    input: &[u8],
+    options: &AnalyzeOptions,
+    progress: Progress<'_>,
+) -> Result<Report, Error> {
+    let Setup {
+        strictness,
+        mode,
+        source,
+        mut warnings,
+        pre,
+        profile,
+        model,
+        model_reason,
+        limits,
+        units,
+    } = prepare(input, options)?;
     let mut limits_now = limits.clone();
     let mut print_limits = None;
     let mut timing = Timing::new(

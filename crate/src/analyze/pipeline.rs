@@ -9,10 +9,13 @@ use super::accounting::{TimeMsg, Timing};
 use crate::error::Error;
 
 /// Messages per batch sent to the timing thread.
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
 pub const BATCH: usize = 2048;
 /// Batches that may wait for the timing thread before the reader blocks.
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
 pub const QUEUED_BATCHES: usize = 8;
 /// Files smaller than this are analyzed on one thread (a thread costs more than it saves).
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
 pub const THREAD_MIN_BYTES: usize = 1 << 20;
 
 /// Runs `read`, which produces the messages, and the timing side that consumes them.

@@ -3,8 +3,12 @@
 
 mod bench;
 mod calibrate;
+mod infill;
 mod output;
+mod smooth;
 mod table;
+mod vibration;
+mod vtg;
 
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -66,6 +70,15 @@ enum Cmd {
         #[command(flatten)]
         opts: AnalyzeArgs,
     },
+    /// Simulate the machine's axis dynamics: natural frequencies, trajectory deviation,
+    /// per-layer vibration amplitude and the acceleration spectrum (Welch PSD).
+    Vibration(vibration::Args),
+    /// Rewrite a file as a vibration-suppressed toolpath (VTG).
+    Vtg(vtg::Args),
+    /// Regenerate sparse infill, searching pattern, infill angle and part orientation.
+    Infill(infill::Args),
+    /// Smooth the tool orientation of a multi-axis toolpath within a tolerance cone.
+    Smooth(smooth::Args),
     /// Measure parsing and analysis throughput on a file.
     Bench {
         /// G-code file to read.
@@ -238,6 +251,10 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             stdout.flush().map_err(|e| e.to_string())
         }
+        Cmd::Vibration(args) => vibration::run(args),
+        Cmd::Vtg(args) => vtg::run(args),
+        Cmd::Infill(args) => infill::run(args),
+        Cmd::Smooth(args) => smooth::run(args),
         Cmd::Bench { file, runs, json } => {
             let input = read(&file)?;
             let figures = bench::run(&input, runs.max(1)).map_err(|e| e.to_string())?;

@@ -1,0 +1,1 @@
+//! Infill regeneration and the energy-driven search over pattern, infill angle and orientation.

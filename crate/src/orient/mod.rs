@@ -1,0 +1,1 @@
+//! Tool-orientation smoothing for multi-axis toolpaths (orientation-smoothing paper, eq. 1–7).

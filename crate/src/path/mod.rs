@@ -1,0 +1,323 @@
+//! The print path as a list: every move of a file with its feature, layer and (optionally) the
+//! planner's timing.
+//!
+//! `analyze` streams and keeps only sums; the optimisers (VTG, infill regeneration) and the
+//! dynamics simulation need the moves themselves, in order, grouped by layer and feature. This
+//! module reads a file exactly as `analyze` does (same extrusion-mode inference, prescan,
+//! machine profile and limits, see [`crate::analyze`]) and keeps each move.
+//!
+//! ```
+//! let gcode = b";LAYER_CHANGE\n;TYPE:Internal infill\nG1 X10 Y0 E0.5 F1200\nG1 X10 Y10 E0.5\n";
+//! let path = quietpath::path::extract(gcode, &Default::default(), true).unwrap();
+//! assert_eq!(path.moves.len(), 2);
+//! assert_eq!(path.layers.len(), 1);
+//! assert_eq!(path.feature_kind(&path.moves[0]), Some(quietpath::gcode::FeatureKind::SparseInfill));
+//! assert!(path.moves[1].timing.is_some());
+//! ```
+
+use serde::Serialize;
+
+use crate::analyze::{layers::LayerTracker, prepare, AnalyzeOptions, LayerSource, Setup};
+use crate::error::{Error, Warning};
+use crate::gcode::{self, classify_comment, feature_kind, FeatureKind, Marker};
+use crate::machine::{Event, ExtrusionMode, Machine, MachineConfig, MoveKind, Pos};
+use crate::plan::{JunctionModel, Limits, MachineProfile, Motion, PlannedMove, Planner, Profile};
+
+/// Feature index of moves before the file names any feature.
+pub const NO_FEATURE: u16 = u16::MAX;
+/// Layer index of moves before the first layer.
+pub const NO_LAYER: u32 = crate::analyze::layers::NO_LAYER;
+
+/// When and how fast the machine runs one move (from the motion planner).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MoveTiming {
+    /// Time the move starts, s from the start of the file.
+    pub start_s: f64,
+    /// Speed profile along the path.
+    pub profile: Profile,
+}
+
+/// One move of the file, in machine coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PathMove {
+    /// 1-based source line.
+    pub line: u32,
+    /// `G0`, `G1`, `G2`/`G3` (with its arc), firmware retraction, homing.
+    pub kind: MoveKind,
+    /// Start position (E: net filament so far).
+    pub from: Pos,
+    /// End position.
+    pub to: Pos,
+    /// Requested feed rate, mm/s.
+    pub feed_mm_s: f64,
+    /// Tool-tip path length, mm.
+    pub length_mm: f64,
+    /// Index into [`PrintPath::features`], or [`NO_FEATURE`].
+    pub feature: u16,
+    /// Index into [`PrintPath::layers`], or [`NO_LAYER`].
+    pub layer: u32,
+    /// The planner's timing, when asked for.
+    pub timing: Option<MoveTiming>,
+}
+
+impl PathMove {
+    /// Filament pushed (negative for a retraction), mm.
+    pub fn extrusion(&self) -> f64 {
+        self.to[crate::machine::axis::E] - self.from[crate::machine::axis::E]
+    }
+
+    /// Whether the move lays down material.
+    pub fn is_extruding(&self) -> bool {
+        self.length_mm > 1e-9 && self.extrusion() > 1e-12
+    }
+}
+
+/// A layer: its height and the range of moves in it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PathLayer {
+    /// Height, mm (from the marker, else the first extrusion).
+    pub z: Option<f64>,
+    /// 1-based line where the layer starts.
+    pub line: u32,
+    /// Moves of the layer: `moves[first..end]`.
+    pub first: usize,
+    /// One past the layer's last move.
+    pub end: usize,
+}
+
+/// A named feature (`;TYPE:` and equivalents) and what kind it is.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PathFeature {
+    /// The slicer's name.
+    pub name: String,
+    /// The normalised kind.
+    pub kind: FeatureKind,
+}
+
+/// Every move of a file, with layers and features.
+#[derive(Debug, Clone, Serialize)]
+pub struct PrintPath {
+    /// Moves in file order.
+    pub moves: Vec<PathMove>,
+    /// Layers in order; moves before the first layer belong to none.
+    pub layers: Vec<PathLayer>,
+    /// How layers were counted.
+    pub layer_source: LayerSource,
+    /// Features named in the file.
+    pub features: Vec<PathFeature>,
+    /// Machine profile the file is planned with.
+    pub profile: MachineProfile,
+    /// Junction model.
+    pub junction_model: JunctionModel,
+    /// Limits in force at the first extrusion (after the file's own commands).
+    pub print_limits: Limits,
+    /// Extrusion mode at the start of the file.
+    pub extrusion_mode: ExtrusionMode,
+    /// Total planned time, s (0 without planning).
+    pub time_s: f64,
+    /// Warnings met while reading.
+    pub warnings: Vec<Warning>,
+}
+
+impl PrintPath {
+    /// The kind of a move's feature, if the file named one.
+    pub fn feature_kind(&self, m: &PathMove) -> Option<FeatureKind> {
+        self.features.get(m.feature as usize).map(|f| f.kind)
+    }
+
+    /// The moves of layer `i`.
+    pub fn layer_moves(&self, i: usize) -> &[PathMove] {
+        self.layers
+            .get(i)
+            .map_or(&[][..], |l| &self.moves[l.first..l.end])
+    }
+}
+
+/// Reads every move of `input` the way [`crate::analyze::analyze`] does. With `plan`, each move
+/// also gets the planner's timing (look-ahead over the whole file, limit commands applied where
+/// they appear, dwells and heater waits flushing the queue as firmware does).
+pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<PrintPath, Error> {
+    let Setup {
+        strictness,
+        mode,
+        mut warnings,
+        profile,
+        model,
+        limits,
+        units,
+        ..
+    } = prepare(input, options)?;
+    let mut machine = Machine::new(MachineConfig {
+        extrusion: mode,
+        ..MachineConfig::default()
+    });
+    let mut planner = Planner::new(limits.clone(), model);
+    let mut limits_now = limits;
+    let mut print_limits = None;
+    let mut tracker = LayerTracker::new();
+    let mut moves: Vec<PathMove> = Vec::new();
+    // Both layer counts per move; the one the tracker settles on is picked at the end.
+    let mut layer_pairs: Vec<(u32, u32)> = Vec::new();
+    let mut features: Vec<PathFeature> = Vec::new();
+    let mut current_feature = NO_FEATURE;
+
+    fn set_timing(moves: &mut [PathMove], pm: &PlannedMove) {
+        if let Some(m) = moves.get_mut(pm.tag as usize) {
+            m.timing = Some(MoveTiming {
+                start_s: pm.start_s,
+                profile: pm.profile,
+            });
+        }
+    }
+
+    gcode::for_each_line(input, strictness, &mut warnings, |raw, line, warnings| {
+        let Some(line) = line else { return Ok(()) };
+        if let Some(comment) = line.comment {
+            match classify_comment(comment) {
+                Some(Marker::Layer { kind, z }) => tracker.marker(kind, z, raw.number),
+                Some(Marker::Feature(name)) => {
+                    current_feature = match features.iter().position(|f| f.name == name) {
+                        Some(i) => i as u16,
+                        None if features.len() < NO_FEATURE as usize => {
+                            features.push(PathFeature {
+                                name: name.to_string(),
+                                kind: feature_kind(name),
+                            });
+                            (features.len() - 1) as u16
+                        }
+                        None => NO_FEATURE,
+                    };
+                }
+                None => {}
+            }
+        }
+        if limits_now.apply_command(line, units) {
+            if plan {
+                *planner.limits_mut() = limits_now.clone();
+            }
+            return Ok(());
+        }
+        match machine.apply(raw.number, line, warnings) {
+            Some(Event::Move(m)) => {
+                if print_limits.is_none() && m.is_extruding() {
+                    print_limits = Some(limits_now.clone());
+                }
+                tracker.motion(&m);
+                layer_pairs.push(tracker.current());
+                let index = moves.len();
+                moves.push(PathMove {
+                    line: m.line,
+                    kind: m.kind,
+                    from: m.from,
+                    to: m.to,
+                    feed_mm_s: m.feed_mm_s,
+                    length_mm: m.length_mm,
+                    feature: current_feature,
+                    layer: NO_LAYER,
+                    timing: None,
+                });
+                if plan {
+                    planner.push(&Motion::from(&m), index as u64, &mut |pm| {
+                        set_timing(&mut moves, pm)
+                    });
+                }
+            }
+            Some(Event::Dwell(secs)) if plan => {
+                planner.dwell(secs, &mut |pm| set_timing(&mut moves, pm));
+            }
+            Some(Event::Temperature { wait: true, .. }) if plan => {
+                planner.flush(&mut |pm| set_timing(&mut moves, pm));
+            }
+            _ => {}
+        }
+        Ok(())
+    })?;
+    if plan {
+        planner.flush(&mut |pm| set_timing(&mut moves, pm));
+    }
+
+    let (summaries, layer_source) = tracker.finish();
+    let by_marker = matches!(layer_source, LayerSource::Markers(_));
+    for (m, &(a, b)) in moves.iter_mut().zip(&layer_pairs) {
+        m.layer = if by_marker { a } else { b };
+    }
+    let mut layers: Vec<PathLayer> = summaries
+        .iter()
+        .map(|s| PathLayer {
+            z: s.z,
+            line: s.line,
+            first: 0,
+            end: 0,
+        })
+        .collect();
+    // Moves are in file order and layer indices never decrease, so each layer is one range.
+    let mut i = 0;
+    for (k, layer) in layers.iter_mut().enumerate() {
+        while i < moves.len() && moves[i].layer != k as u32 && moves[i].layer < k as u32 {
+            i += 1;
+        }
+        layer.first = i;
+        while i < moves.len() && moves[i].layer == k as u32 {
+            i += 1;
+        }
+        layer.end = i;
+    }
+    let (warnings, _) = warnings.into_parts();
+    Ok(PrintPath {
+        moves,
+        layers,
+        layer_source,
+        features,
+        profile,
+        junction_model: model,
+        print_limits: print_limits.unwrap_or(limits_now),
+        extrusion_mode: mode,
+        time_s: planner.elapsed_s(),
+        warnings,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SAMPLE: &[u8] = b"G21\nG90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2 F600\n;TYPE:Perimeter\n\
+G1 X10 Y0 E0.5 F1200\nG1 X10 Y10 E0.5\n;TYPE:Internal infill\nG1 X0 Y10 E0.5\n\
+;LAYER_CHANGE\n;Z:0.4\nG1 Z0.4\nG1 X0 Y0 E0.5\n";
+
+    #[test]
+    fn moves_layers_and_features_follow_the_file() {
+        let p = extract(SAMPLE, &AnalyzeOptions::default(), false).unwrap();
+        assert_eq!(p.moves.len(), 6);
+        assert_eq!(p.layers.len(), 2);
+        assert_eq!((p.layers[0].first, p.layers[0].end), (0, 4));
+        assert_eq!((p.layers[1].first, p.layers[1].end), (4, 6));
+        assert_eq!(p.feature_kind(&p.moves[1]), Some(FeatureKind::InnerWall));
+        assert_eq!(p.feature_kind(&p.moves[3]), Some(FeatureKind::SparseInfill));
+        assert_eq!(p.moves[0].feature, NO_FEATURE);
+        assert!(p.moves.iter().all(|m| m.timing.is_none()));
+    }
+
+    #[test]
+    fn planned_time_equals_analyze() {
+        let p = extract(SAMPLE, &AnalyzeOptions::default(), true).unwrap();
+        let r = crate::analyze::analyze(SAMPLE, &AnalyzeOptions::default()).unwrap();
+        assert!(
+            (p.time_s - r.time_s).abs() < 1e-12,
+            "{} vs {}",
+            p.time_s,
+            r.time_s
+        );
+        let sum: f64 = p
+            .moves
+            .iter()
+            .map(|m| m.timing.unwrap().profile.duration())
+            .sum();
+        assert!((sum - r.time_s).abs() < 1e-9);
+        // Consecutive moves start when the previous one ends (no dwell in the sample).
+        for w in p.moves.windows(2) {
+            let (a, b) = (w[0].timing.unwrap(), w[1].timing.unwrap());
+            assert!((a.start_s + a.profile.duration() - b.start_s).abs() < 1e-9);
+        }
+    }
+}
