@@ -1,0 +1,1 @@
+//! Conformance of `orient` on the real corpus (filled in with the capability).

@@ -1,0 +1,1 @@
+//! Conformance of `vtg` on the real corpus (filled in with the capability).
