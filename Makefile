@@ -18,10 +18,16 @@ setup:
 setup-test:
 	@scripts/setup.sh test
 
-## Build the wasm package (pkg/, --target web) and link it into the playground.
+## Build the npm package (pkg/: web, node and bundler builds under one package.json), link the
+## web build into the playground and copy uPlot beside it.
 pkg: setup
-	wasm-pack build crate --release --target web --out-dir ../pkg --out-name quietpath
-	ln -sfn ../pkg www/pkg
+	wasm-pack build crate --release --target web --out-dir ../pkg/web --out-name quietpath
+	wasm-pack build crate --release --target nodejs --out-dir ../pkg/node --out-name quietpath
+	wasm-pack build crate --release --target bundler --out-dir ../pkg/bundler --out-name quietpath
+	node scripts/package.mjs
+	ln -sfn ../pkg/web www/pkg
+	mkdir -p www/vendor
+	cp node_modules/uplot/dist/uPlot.esm.js node_modules/uplot/dist/uPlot.min.css www/vendor/
 
 ## Build the wasm and serve the playground on http://127.0.0.1:$(PORT)
 serve: pkg
@@ -37,6 +43,7 @@ test: setup-test lint test-rust test-wasm test-js
 lint:
 	cargo fmt --all -- --check
 	cargo clippy --workspace --all-targets -- -D warnings
+	cargo clippy -p quietpath --lib --target wasm32-unknown-unknown -- -D warnings
 	RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 
 test-rust:

@@ -1,5 +1,6 @@
-// Tests of the wasm package's JavaScript API (pkg/quietpath.js, wasm-pack
-// --target web), loaded in Node with initSync. Run with `npm test` or
+// Tests of the npm package's JavaScript API: the Node build (pkg/node, what
+// `import 'quietpath'` gives in Node) for everything, and the web build
+// (pkg/web, loaded with initSync) for agreement. Run with `npm test` or
 // `node --test tests/js/`. Needs pkg/ built and the corpus in ../shared/corpus.
 
 import { test, describe } from 'node:test';
@@ -25,11 +26,11 @@ const CLI_FILES = [
   { name: 'prusaslicer-2.7.4_screw_arcfit.gcode', exact: true },
 ];
 
-for (const f of ['quietpath.js', 'quietpath_bg.wasm']) {
+for (const f of ['package.json', 'node/quietpath.js', 'web/quietpath.js', 'web/quietpath_bg.wasm']) {
   if (!fs.existsSync(path.join(pkgDir, f))) {
     throw new Error(
       `${path.join(pkgDir, f)} is missing: build it first with ` +
-        '`wasm-pack build crate --target web --out-dir ../pkg --out-name quietpath` (or make)',
+        '`make pkg`',
     );
   }
 }
@@ -37,8 +38,9 @@ if (!fs.existsSync(corpusDir)) {
   throw new Error(`corpus not found at ${corpusDir} (shared/ must sit next to the repository)`);
 }
 
-const qp = await import(pathToFileURL(path.join(pkgDir, 'quietpath.js')).href);
-qp.initSync({ module: fs.readFileSync(path.join(pkgDir, 'quietpath_bg.wasm')) });
+const qp = await import(pathToFileURL(path.join(pkgDir, 'node', 'quietpath.js')).href);
+const web = await import(pathToFileURL(path.join(pkgDir, 'web', 'quietpath.js')).href);
+web.initSync({ module: fs.readFileSync(path.join(pkgDir, 'web', 'quietpath_bg.wasm')) });
 
 const corpus = (name) => fs.readFileSync(path.join(corpusDir, name));
 const corpusFiles = fs
@@ -337,7 +339,8 @@ describe('wasm and CLI agree', () => {
     .map((p) => path.join(repoRoot, 'target', p, process.platform === 'win32' ? 'quietpath.exe' : 'quietpath'))
     .filter((p) => fs.existsSync(p))
     .sort((a, b) => fs.statSync(b).mtimeMs - fs.statSync(a).mtimeMs)[0];
-  const skip = cli ? false : 'no CLI binary at target/release/quietpath or target/debug/quietpath (cargo build first)';
+  assert.ok(cli, 'no CLI binary at target/release/quietpath or target/debug/quietpath (make cli first)');
+  const skip = false;
 
   for (const { name, exact } of CLI_FILES) {
     test(`${name}: quietpath analyze --json ${exact ? 'equals' : 'matches (≤ 1e-12 relative)'} the wasm report`, { skip }, () => {

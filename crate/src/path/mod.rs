@@ -15,6 +15,10 @@
 //! assert!(path.moves[1].timing.is_some());
 //! ```
 
+mod geometry;
+
+pub use geometry::{LayerGeometry, SegmentKind, ARC_CHORD_DEG};
+
 use serde::Serialize;
 
 use crate::analyze::{layers::LayerTracker, prepare, AnalyzeOptions, LayerSource, Setup};
@@ -250,17 +254,29 @@ pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<Pri
             end: 0,
         })
         .collect();
-    // Moves are in file order and layer indices never decrease, so each layer is one range.
-    let mut i = 0;
-    for (k, layer) in layers.iter_mut().enumerate() {
-        while i < moves.len() && moves[i].layer != k as u32 && moves[i].layer < k as u32 {
-            i += 1;
+    // Moves are in file order and layer indices never decrease (moves before the first layer
+    // have none), so each layer is one range.
+    let mut seen = vec![false; layers.len()];
+    for (i, m) in moves.iter().enumerate() {
+        let Some(layer) = layers.get_mut(m.layer as usize) else {
+            continue;
+        };
+        let k = m.layer as usize;
+        if !seen[k] {
+            seen[k] = true;
+            layer.first = i;
         }
-        layer.first = i;
-        while i < moves.len() && moves[i].layer == k as u32 {
-            i += 1;
+        layer.end = i + 1;
+    }
+    // A layer without moves (two markers in a row) is an empty range where the next one starts.
+    let mut next = moves.len();
+    for (layer, seen) in layers.iter_mut().zip(&seen).rev() {
+        if *seen {
+            next = layer.first;
+        } else {
+            layer.first = next;
+            layer.end = next;
         }
-        layer.end = i;
     }
     let (warnings, _) = warnings.into_parts();
     Ok(PrintPath {
@@ -281,20 +297,23 @@ pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<Pri
 mod tests {
     use super::*;
 
-    const SAMPLE: &[u8] = b"G21\nG90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2 F600\n;TYPE:Perimeter\n\
+    const SAMPLE: &[u8] =
+        b"G21\nG90\nM83\nG1 X5 Y5 F3000\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2 F600\n;TYPE:Perimeter\n\
 G1 X10 Y0 E0.5 F1200\nG1 X10 Y10 E0.5\n;TYPE:Internal infill\nG1 X0 Y10 E0.5\n\
 ;LAYER_CHANGE\n;Z:0.4\nG1 Z0.4\nG1 X0 Y0 E0.5\n";
 
     #[test]
     fn moves_layers_and_features_follow_the_file() {
         let p = extract(SAMPLE, &AnalyzeOptions::default(), false).unwrap();
-        assert_eq!(p.moves.len(), 6);
+        // The travel comes before the first layer: it belongs to none.
+        assert_eq!(p.moves.len(), 7);
+        assert_eq!(p.moves[0].layer, NO_LAYER);
         assert_eq!(p.layers.len(), 2);
-        assert_eq!((p.layers[0].first, p.layers[0].end), (0, 4));
-        assert_eq!((p.layers[1].first, p.layers[1].end), (4, 6));
-        assert_eq!(p.feature_kind(&p.moves[1]), Some(FeatureKind::InnerWall));
-        assert_eq!(p.feature_kind(&p.moves[3]), Some(FeatureKind::SparseInfill));
-        assert_eq!(p.moves[0].feature, NO_FEATURE);
+        assert_eq!((p.layers[0].first, p.layers[0].end), (1, 5));
+        assert_eq!((p.layers[1].first, p.layers[1].end), (5, 7));
+        assert_eq!(p.feature_kind(&p.moves[2]), Some(FeatureKind::InnerWall));
+        assert_eq!(p.feature_kind(&p.moves[4]), Some(FeatureKind::SparseInfill));
+        assert_eq!(p.moves[1].feature, NO_FEATURE);
         assert!(p.moves.iter().all(|m| m.timing.is_none()));
     }
 

@@ -4,12 +4,32 @@
 //! parsed by the JS engine), so a report from the browser, Node and the CLI is identical.
 //! Errors become JS `Error` objects carrying `line`, `column` and `kind` properties.
 
+mod session;
+
+pub use session::Session;
+
 use js_sys::{Function, Reflect, Uint8Array};
 use wasm_bindgen::prelude::*;
+use wasm_bindgen::JsCast;
 
 use crate::analyze::{analyze_with_progress, AnalyzeOptions};
 use crate::energy::calibrate::{self, CalibrationError, CsvRows, Observation};
 use crate::error::Error;
+
+#[wasm_bindgen(typescript_custom_section)]
+const TYPES: &str = include_str!("types.d.ts");
+
+#[wasm_bindgen]
+extern "C" {
+    /// `AnalyzeOptions` in TypeScript.
+    #[wasm_bindgen(typescript_type = "AnalyzeOptions")]
+    #[derive(Debug)]
+    pub type JsAnalyzeOptions;
+    /// `ProgressCallback` in TypeScript.
+    #[wasm_bindgen(typescript_type = "ProgressCallback")]
+    #[derive(Debug)]
+    pub type JsProgress;
+}
 
 /// Installs the panic hook so that a bug shows its message in the console instead of an
 /// anonymous `unreachable`.
@@ -57,10 +77,12 @@ fn input_bytes(input: &JsValue) -> Result<Vec<u8>, JsValue> {
     ))
 }
 
-fn options<T: serde::de::DeserializeOwned + Default>(value: &JsValue) -> Result<T, JsValue> {
-    if value.is_undefined() || value.is_null() {
+fn options<T: serde::de::DeserializeOwned + Default>(
+    value: Option<&JsValue>,
+) -> Result<T, JsValue> {
+    let Some(value) = value.filter(|v| !v.is_undefined() && !v.is_null()) else {
         return Ok(T::default());
-    }
+    };
     serde_wasm_bindgen::from_value(value.clone())
         .map_err(|e| message_error(&format!("invalid options: {e}")))
 }
@@ -71,7 +93,8 @@ fn to_js<T: serde::Serialize>(value: &T) -> Result<JsValue, JsValue> {
 }
 
 /// Progress adapter: calls `f(fraction)`; a callback returning `false` cancels the job.
-fn progress_fn(f: Option<Function>) -> impl FnMut(f64) -> bool {
+fn progress_fn(f: Option<JsProgress>) -> impl FnMut(f64) -> bool {
+    let f: Option<Function> = f.map(|f| f.unchecked_into());
     move |fraction| match &f {
         Some(f) => match f.call1(&JsValue::NULL, &JsValue::from_f64(fraction)) {
             Ok(v) => v.as_bool() != Some(false),
@@ -83,14 +106,14 @@ fn progress_fn(f: Option<Function>) -> impl FnMut(f64) -> bool {
 
 /// Analyzes G-code (`string`, `Uint8Array` or `ArrayBuffer`); same report as
 /// `quietpath analyze --json`.
-#[wasm_bindgen(js_name = analyze)]
+#[wasm_bindgen(js_name = analyze, unchecked_return_type = "Report")]
 pub fn analyze_js(
-    input: JsValue,
-    options_value: JsValue,
-    on_progress: Option<Function>,
+    #[wasm_bindgen(unchecked_param_type = "string | Uint8Array | ArrayBuffer")] input: JsValue,
+    options_value: Option<JsAnalyzeOptions>,
+    on_progress: Option<JsProgress>,
 ) -> Result<JsValue, JsValue> {
     let bytes = input_bytes(&input)?;
-    let opts: AnalyzeOptions = options(&options_value)?;
+    let opts: AnalyzeOptions = options(options_value.as_deref())?;
     let mut progress = progress_fn(on_progress);
     let report = analyze_with_progress(&bytes, &opts, &mut progress).map_err(|e| js_error(&e))?;
     to_js(&report)
@@ -116,8 +139,10 @@ enum RowInput {
 /// Fits the thesis energy model (`quietpath calibrate --json`): `rows` is an array of
 /// `[A, B, C, H, E]` or `{a, b, c, h, e}` rows, or CSV text with `A,B,C,H,E` rows (G-code rows
 /// need files, so only the CLI takes them). Rows are numbered from 1 in errors and residuals.
-#[wasm_bindgen]
-pub fn calibrate(rows: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(unchecked_return_type = "CalibrationFit")]
+pub fn calibrate(
+    #[wasm_bindgen(unchecked_param_type = "CalibrationRow[] | string")] rows: JsValue,
+) -> Result<JsValue, JsValue> {
     let observations = if let Some(text) = rows.as_string() {
         match calibrate::parse_csv(&text).map_err(|e| calibration_error(&e))? {
             CsvRows::Terms(rows) => rows,

@@ -1,0 +1,165 @@
+//! Drawing data of a layer: flat arrays of segments with what a viewer colours them by.
+//!
+//! The playground's layer viewer draws thousands of segments per frame; it gets them as flat
+//! `f32` arrays (typed arrays in JS) rather than objects. Arcs are split into chords no more
+//! than [`ARC_CHORD_DEG`] apart, enough for a screen.
+
+use serde::Serialize;
+
+use super::{PathMove, PrintPath, NO_FEATURE};
+use crate::machine::{axis, MoveKind, Plane};
+
+/// Largest angle an arc's drawing chord spans, degrees.
+pub const ARC_CHORD_DEG: f64 = 10.0;
+
+/// What a segment is, for colouring. The numbers are part of the JS API.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[repr(u8)]
+pub enum SegmentKind {
+    /// A travel (no extrusion).
+    Travel = 0,
+    /// Outer wall.
+    OuterWall = 1,
+    /// Inner walls.
+    InnerWall = 2,
+    /// Sparse infill.
+    SparseInfill = 3,
+    /// Solid infill, skins.
+    SolidInfill = 4,
+    /// Bridges.
+    Bridge = 5,
+    /// Gap fill.
+    GapFill = 6,
+    /// Support.
+    Support = 7,
+    /// Skirt, brim, raft.
+    Adhesion = 8,
+    /// Any other extrusion (unnamed features, custom blocks).
+    Other = 9,
+}
+
+/// Segments of one layer, as parallel flat arrays (segment `i` is
+/// `xy[4i..4i+4] = [x0, y0, x1, y1]`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct LayerGeometry {
+    /// Layer height, mm, if known.
+    pub z: Option<f64>,
+    /// Segment end points, mm.
+    pub xy: Vec<f32>,
+    /// [`SegmentKind`] of each segment.
+    pub kind: Vec<u8>,
+    /// Peak planned speed of the move each segment belongs to, mm/s (its requested feed rate
+    /// when the path was extracted without planning).
+    pub speed: Vec<f32>,
+    /// Curvature at the segment's start: turning angle to the previous printing segment over
+    /// the mean of their lengths, 1/mm (0 after a travel and on travels).
+    pub curvature: Vec<f32>,
+}
+
+fn segment_kind(path: &PrintPath, m: &PathMove) -> SegmentKind {
+    use crate::gcode::FeatureKind as F;
+    if !m.is_extruding() {
+        return SegmentKind::Travel;
+    }
+    if m.feature == NO_FEATURE {
+        return SegmentKind::Other;
+    }
+    match path.feature_kind(m) {
+        Some(F::OuterWall) => SegmentKind::OuterWall,
+        Some(F::InnerWall) => SegmentKind::InnerWall,
+        Some(F::SparseInfill) => SegmentKind::SparseInfill,
+        Some(F::SolidInfill) => SegmentKind::SolidInfill,
+        Some(F::Bridge) => SegmentKind::Bridge,
+        Some(F::GapFill) => SegmentKind::GapFill,
+        Some(F::Support) => SegmentKind::Support,
+        Some(F::Adhesion) => SegmentKind::Adhesion,
+        Some(F::Other) | None => SegmentKind::Other,
+    }
+}
+
+impl PrintPath {
+    /// The drawing data of layer `layer` (empty past the last layer).
+    pub fn layer_geometry(&self, layer: usize) -> LayerGeometry {
+        let mut g = LayerGeometry {
+            z: self.layers.get(layer).and_then(|l| l.z),
+            ..LayerGeometry::default()
+        };
+        // Previous printing segment's direction and length, for curvature.
+        let mut prev: Option<([f64; 2], f64)> = None;
+        for m in self.layer_moves(layer) {
+            let kind = segment_kind(self, m);
+            let speed = m.timing.map_or(m.feed_mm_s, |t| t.profile.peak) as f32;
+            let (x0, y0) = (m.from[axis::X], m.from[axis::Y]);
+            let mut points: Vec<[f64; 2]> = Vec::new();
+            match m.kind {
+                MoveKind::Arc(a) if a.plane == Plane::Xy && a.radius.is_finite() => {
+                    let n = (a.sweep.abs().to_degrees() / ARC_CHORD_DEG)
+                        .ceil()
+                        .clamp(1.0, 720.0);
+                    for i in 1..=n as usize {
+                        let o = a.offset_at(i as f64 / n);
+                        points.push([x0 + o[0], y0 + o[1]]);
+                    }
+                }
+                _ => points.push([m.to[axis::X], m.to[axis::Y]]),
+            }
+            let mut start = [x0, y0];
+            for p in points {
+                let d = [p[0] - start[0], p[1] - start[1]];
+                let len = crate::math::hypot(d[0], d[1]);
+                if len < 1e-9 {
+                    continue;
+                }
+                let curvature = match (kind, prev) {
+                    (SegmentKind::Travel, _) | (_, None) => 0.0,
+                    (_, Some((pd, plen))) => {
+                        let cross = pd[0] * d[1] - pd[1] * d[0];
+                        let dot = pd[0] * d[0] + pd[1] * d[1];
+                        let angle = crate::math::atan2(cross, dot).abs();
+                        angle / (0.5 * (len + plen))
+                    }
+                };
+                prev = (kind != SegmentKind::Travel).then_some((d, len));
+                g.xy.extend([start[0] as f32, start[1] as f32, p[0] as f32, p[1] as f32]);
+                g.kind.push(kind as u8);
+                g.speed.push(speed);
+                g.curvature.push(curvature as f32);
+                start = p;
+            }
+        }
+        g
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analyze::AnalyzeOptions;
+
+    #[test]
+    fn square_corners_have_curvature_and_arcs_are_split() {
+        let gcode =
+            b"M83\n;LAYER_CHANGE\n;TYPE:External perimeter\nG1 X10 Y0 E1 F600\nG1 X10 Y10 E1\n\
+G0 X20 Y10\nG3 X20 Y30 I0 J10 E1\n";
+        let p = super::super::extract(gcode, &AnalyzeOptions::default(), true).unwrap();
+        let g = p.layer_geometry(0);
+        // 2 lines + 1 travel + a half circle in 18 chords of 10°.
+        assert_eq!(g.kind.len(), 2 + 1 + 18);
+        assert_eq!(g.xy.len(), 4 * g.kind.len());
+        assert_eq!(g.kind[0], SegmentKind::OuterWall as u8);
+        assert_eq!(g.kind[2], SegmentKind::Travel as u8);
+        // 90° turn between two 10 mm segments: (π/2) / 10.
+        assert!((g.curvature[1] as f64 - std::f64::consts::FRAC_PI_2 / 10.0).abs() < 1e-6);
+        assert_eq!(g.curvature[3], 0.0, "first segment after a travel");
+        // Chords of a radius-10 circle 10° apart: curvature ≈ 1/10.
+        assert!(
+            (g.curvature[5] as f64 - 0.1).abs() < 1e-3,
+            "{}",
+            g.curvature[5]
+        );
+        let end = &g.xy[g.xy.len() - 2..];
+        assert!((end[0] - 20.0).abs() < 1e-4 && (end[1] - 30.0).abs() < 1e-4);
+        assert!(g.speed.iter().all(|&v| v > 0.0 && v <= 10.0 + 1e-3));
+        assert!(p.layer_geometry(5).kind.is_empty());
+    }
+}

@@ -1,0 +1,196 @@
+// ── quietpath result and option types (the serde form of the Rust types; the same JSON as the
+// CLI's --json). Checked against real CLI output by tests/js/types.test.mjs. ──
+
+/** Where a machine limit came from, in order of precedence. */
+export type LimitSource = "command" | "slicer_settings" | "profile" | "option";
+export interface Limit { value: number; source: LimitSource }
+export type JunctionModel = "classic_jerk" | "junction_deviation" | "klipper";
+/** Machine limits; arrays are per axis X, Y, Z, E. */
+export interface Limits {
+  max_feedrate: Limit[];
+  max_acceleration: Limit[];
+  acceleration: Limit;
+  retract_acceleration: Limit;
+  travel_acceleration: Limit;
+  max_jerk: Limit[];
+  junction_deviation: Limit;
+  square_corner_velocity: Limit;
+  minimum_cruise_ratio: Limit;
+  min_feedrate: Limit;
+  min_travel_feedrate: Limit;
+  arc_segment_mm: Limit;
+}
+export interface MachineProfile {
+  name: string;
+  description?: string;
+  junction: JunctionModel;
+  limits: Limits;
+  [key: string]: unknown;
+}
+export type Material = "pla" | "petg" | "abs";
+export interface MaterialProperties {
+  specific_heat_j_gk: number;
+  heat_of_fusion_j_g: number;
+  crystallinity: number;
+  print_temp_c: number;
+  co2_kg_per_kg: number;
+}
+export interface ThesisCoefficients { k_a_mx: number; k_a_my: number; k_c: number; k_h: number }
+/** Energy settings; every field optional (defaults are documented in the README). */
+export interface EnergyOptions {
+  thesis?: Partial<ThesisCoefficients>;
+  servo_model?: "auto" | "thesis" | "physical";
+  servo?: Record<string, unknown>;
+  material?: Material | null;
+  material_properties?: Partial<MaterialProperties> | null;
+  ambient_c?: number;
+  heater_efficiency?: number;
+  aux?: Record<string, number>;
+  grid_kg_co2_per_kwh?: number;
+  material_kg_co2_per_kg?: number | null;
+}
+/** Options of analyze (and of every job that plans a file). */
+export interface AnalyzeOptions {
+  strict?: boolean;
+  filament_diameter_mm?: number | null;
+  density_g_cm3?: number | null;
+  extrusion_mode?: "absolute" | "relative" | null;
+  machine?: string | null;
+  machine_profile?: MachineProfile | null;
+  junction_model?: JunctionModel | null;
+  arc_segment_mm?: number | null;
+  energy?: EnergyOptions | null;
+}
+export interface Warning { line: number; message: string }
+export type FeatureKind =
+  | "outer_wall" | "inner_wall" | "sparse_infill" | "solid_infill" | "bridge"
+  | "gap_fill" | "support" | "adhesion" | "other";
+export interface FeatureSummary {
+  name: string;
+  kind: FeatureKind | null;
+  moves: number;
+  distance_mm: number;
+  filament_mm: number;
+  time_s: number;
+  energy_j: number;
+}
+export interface LayerSummary {
+  index: number;
+  z: number | null;
+  line: number;
+  moves: number;
+  extrude_distance_mm: number;
+  travel_distance_mm: number;
+  filament_mm: number;
+  time_s: number;
+  energy_j: number;
+}
+export type Heater = { hotend: number } | "bed" | "chamber";
+export interface TemperatureEvent { line: number; time_s: number; heater: Heater; target_c: number; wait: boolean }
+export interface FanEvent { line: number; time_s: number; index: number; speed: number }
+export interface ThesisReport {
+  a: number; b: number; c: number; h: number;
+  coefficients: ThesisCoefficients;
+  e_wms: number;
+  accel_decel_s: number;
+  coast_s: number;
+}
+export interface ServoReport { kinetic_j: number; friction_j: number; copper_j: number; standby_j: number; [key: string]: number }
+export interface Energy {
+  thesis_j: number;
+  servo_j: number;
+  servo_model: "auto" | "thesis" | "physical";
+  fuse_j: number;
+  aux_j: number;
+  total_j: number;
+  total_kwh: number;
+  material_g: number;
+  co2_g: number;
+  thesis: ThesisReport;
+  physical_servo: ServoReport | null;
+  fuse: {
+    material: Material;
+    material_source: "option" | "file" | "default";
+    properties: MaterialProperties;
+    print_temp_c: number;
+    ambient_c: number;
+    heater_efficiency: number;
+  };
+  aux: { bed_j: number; hotend_j: number; chamber_j: number; heat_up_j: number; fan_j: number; electronics_j: number };
+  co2: { grid_kg_per_kwh: number; material_kg_per_kg: number; energy_g: number; material_g: number };
+}
+/** Trajectory metrics of the VTG paper (eq. 24–26, 28, 31). */
+export interface ToolpathMetrics {
+  l_total_mm?: number;
+  l_infill_mm?: number;
+  n_total?: number;
+  n_infill?: number;
+  n_turning?: number;
+  mean_turn_deg?: number;
+  mean_chord_error_mm?: number;
+  [key: string]: unknown;
+}
+/** The analysis report (`quietpath analyze --json`). */
+export interface Report {
+  version: string;
+  file: { bytes: number; lines: number; slicer: string | null; flavor: string | null; slicer_time_s: number | null };
+  time_s: number;
+  time_model: string;
+  machine: { profile: string; junction_model: JunctionModel; reason: string; limits: Limits };
+  moves: number;
+  extruding_moves: number;
+  layers: number;
+  layer_source:
+    | { method: "markers"; marker: "layer_change" | "cura_layer" | "simplify3d" | "kis_slicer" | "kiri_moto" }
+    | { method: "z_changes" };
+  distance_mm: number;
+  extrude_distance_mm: number;
+  travel_distance_mm: number;
+  filament_mm: number;
+  filament_volume_mm3: number;
+  material_g: number;
+  retractions: number;
+  extrusion: {
+    mode: "absolute" | "relative";
+    source: "explicit" | "inferred" | "default";
+    filament_diameter_mm: number;
+    density_g_cm3: number;
+  };
+  bounds: { min: number[]; max: number[] } | null;
+  features: FeatureSummary[];
+  layer_list: LayerSummary[];
+  temperatures: TemperatureEvent[];
+  fans: FanEvent[];
+  energy: Energy;
+  toolpath: ToolpathMetrics;
+  warnings: Warning[];
+  warnings_dropped: number;
+}
+/** Drawing data of one layer (Session.layer). Segment i is xy[4i..4i+4] = x0, y0, x1, y1. */
+export interface LayerGeometry {
+  z: number | null;
+  xy: Float32Array;
+  /** 0 travel, 1 outer wall, 2 inner wall, 3 sparse infill, 4 solid infill, 5 bridge,
+   *  6 gap fill, 7 support, 8 adhesion, 9 other. */
+  kind: Uint8Array;
+  speed: Float32Array;
+  curvature: Float32Array;
+}
+/** One calibration row: thesis terms A, B, C, H and the measured energy E (W·ms). */
+export type CalibrationRow = [number, number, number, number, number] | { a: number; b: number; c: number; h: number; e: number };
+export interface CalibrationFit {
+  k_a_mx: number;
+  k_a_my: number;
+  k_c: number;
+  k_h: number;
+  [key: string]: unknown;
+}
+/** An error thrown by the API: a JS Error with the position of the problem. */
+export interface QuietpathError extends Error {
+  line?: number;
+  column?: number;
+  kind?: { kind: string; [key: string]: unknown };
+}
+/** Progress callback: fraction done in [0, 1]; return false to cancel (the job throws a
+ *  `cancelled` error). */
+export type ProgressCallback = (fraction: number) => boolean | void;

@@ -1,0 +1,123 @@
+// The npm package as a user meets it: package.json metadata, the three builds agreeing, the
+// Session API, and the TypeScript declarations checked by tsc against real CLI output.
+// Needs `make pkg` and `make cli` (make test does both).
+
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { execFileSync } from 'node:child_process';
+import { fileURLToPath, pathToFileURL } from 'node:url';
+
+const repoRoot = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+const pkgDir = path.resolve(process.env.QUIETPATH_PKG ?? path.join(repoRoot, 'pkg'));
+const corpusDir = path.resolve(repoRoot, '../shared/corpus');
+const demo = fs.readFileSync(path.join(repoRoot, 'www', 'demo', 'demo.gcode'));
+const cli = path.join(repoRoot, 'target', 'release', 'quietpath');
+const tsc = path.join(repoRoot, 'node_modules', '.bin', 'tsc');
+
+const manifest = JSON.parse(fs.readFileSync(path.join(pkgDir, 'package.json'), 'utf8'));
+const node = await import(pathToFileURL(path.join(pkgDir, 'node', 'quietpath.js')).href);
+const web = await import(pathToFileURL(path.join(pkgDir, 'web', 'quietpath.js')).href);
+web.initSync({ module: fs.readFileSync(path.join(pkgDir, 'web', 'quietpath_bg.wasm')) });
+
+test('package.json: name, licence, repository, keywords, types and conditional exports', () => {
+  assert.equal(manifest.name, 'quietpath');
+  assert.equal(manifest.license, 'MIT OR Apache-2.0');
+  assert.match(manifest.repository.url, /github\.com/);
+  assert.ok(manifest.keywords.includes('gcode'));
+  const cargo = fs.readFileSync(path.join(repoRoot, 'Cargo.toml'), 'utf8');
+  assert.equal(manifest.version, cargo.match(/^version = "([^"]+)"/m)[1]);
+  for (const target of ['web', 'node', 'bundler']) {
+    for (const f of ['quietpath.js', 'quietpath.d.ts', 'quietpath_bg.wasm']) {
+      assert.ok(fs.existsSync(path.join(pkgDir, target, f)), `${target}/${f}`);
+    }
+  }
+  assert.ok(fs.existsSync(path.join(pkgDir, manifest.types)));
+  assert.equal(manifest.exports['.'].node, './node/quietpath.js');
+  assert.equal(manifest.exports['./web'].default, './web/quietpath.js');
+});
+
+test('`import "quietpath"` resolves to the Node build through the exports map', () => {
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'qp-import-'));
+  fs.mkdirSync(path.join(dir, 'node_modules'));
+  fs.symlinkSync(pkgDir, path.join(dir, 'node_modules', 'quietpath'), 'dir');
+  fs.writeFileSync(
+    path.join(dir, 'probe.mjs'),
+    "import { analyze, version } from 'quietpath';\nconsole.log(JSON.stringify({ v: version(), moves: analyze('M83\\nG1 X1 E1 F60\\n').moves }));\n",
+  );
+  fs.writeFileSync(path.join(dir, 'probe.cjs'), "const q = require('quietpath');\nconsole.log(q.analyze('G1 X2 F60\\n').moves);\n");
+  const esm = JSON.parse(execFileSync(process.execPath, ['probe.mjs'], { cwd: dir, encoding: 'utf8' }));
+  assert.deepEqual(esm, { v: manifest.version, moves: 1 });
+  assert.equal(execFileSync(process.execPath, ['probe.cjs'], { cwd: dir, encoding: 'utf8' }).trim(), '1');
+  fs.rmSync(dir, { recursive: true, force: true });
+});
+
+test('the web and Node builds give the same report', () => {
+  assert.deepEqual(web.analyze(demo), node.analyze(demo));
+});
+
+test('Session: layers to draw, as typed arrays that agree with the report', () => {
+  const s = new node.Session(demo);
+  const report = s.analyze();
+  assert.deepEqual(report, node.analyze(demo));
+  assert.equal(s.bytes, demo.length);
+  assert.equal(s.layerCount(), report.layers);
+  let extruded = 0;
+  for (let i = 0; i < s.layerCount(); i++) {
+    const g = s.layer(i);
+    assert.ok(g.xy instanceof Float32Array && g.kind instanceof Uint8Array);
+    assert.equal(g.xy.length, 4 * g.kind.length);
+    assert.equal(g.speed.length, g.kind.length);
+    assert.equal(g.curvature.length, g.kind.length);
+    for (let k = 0; k < g.kind.length; k++) {
+      if (g.kind[k] !== 0) extruded += Math.hypot(g.xy[4 * k + 2] - g.xy[4 * k], g.xy[4 * k + 3] - g.xy[4 * k + 1]);
+    }
+    assert.ok(g.speed.every((v) => v > 0 && v < 1000));
+  }
+  // f32 drawing coordinates and arc chords: within 0.1 % of the report's extrusion length.
+  assert.ok(Math.abs(extruded - report.extrude_distance_mm) / report.extrude_distance_mm < 1e-3, `${extruded} vs ${report.extrude_distance_mm}`);
+  assert.equal(s.layer(1e6).kind.length, 0);
+  s.free();
+});
+
+test('Session: a malformed file fails with a line number (strict)', () => {
+  const s = new node.Session('G1 X1\nG1 Y1.2.3\n', { strict: true });
+  assert.throws(() => s.analyze(), (e) => e instanceof Error && e.line === 2 && e.kind.kind === 'invalid_number');
+  assert.throws(() => s.layerCount(), (e) => e instanceof Error && e.line === 2);
+});
+
+test('TypeScript: declarations compile (tsc --strict) and match real CLI output', () => {
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'qp-types-'));
+  const reports = [path.join(repoRoot, 'www', 'demo', 'demo.gcode'), path.join(corpusDir, 'prusaslicer-2.7.4_screw_arcfit.gcode')].map((f) =>
+    execFileSync(cli, ['analyze', f, '--json'], { encoding: 'utf8', maxBuffer: 64 << 20 }),
+  );
+  const api = path.join(pkgDir, 'web', 'quietpath.js').replaceAll('\\', '/');
+  const src = [
+    `import init, { analyze, calibrate, Session, version } from '${api}';`,
+    `import type { Report, AnalyzeOptions, LayerGeometry, CalibrationFit, QuietpathError } from '${api}';`,
+    'export async function use(bytes: Uint8Array): Promise<number> {',
+    '  await init();',
+    "  const options: AnalyzeOptions = { strict: true, machine: 'prusa-mk3s', junction_model: 'klipper' };",
+    '  const r: Report = analyze(bytes, options, (f: number) => f < 2);',
+    '  const s = new Session(bytes);',
+    '  const g: LayerGeometry = s.layer(0);',
+    "  const fit: CalibrationFit = calibrate([[1, 2, 3, 4, 5]]);",
+    "  try { analyze('G1 X1.2.3'); } catch (e) { const err = e as QuietpathError; return err.line ?? 0; }",
+    '  return r.time_s + g.xy.length + fit.k_c + version().length + s.layerCount();',
+    '}',
+    ...reports.map((json, i) => `export const report${i}: Report = ${json.trim()};`),
+    '',
+  ].join('\n');
+  fs.writeFileSync(path.join(dir, 'check.ts'), src);
+  try {
+    execFileSync(tsc, ['--noEmit', '--strict', '--target', 'es2022', '--lib', 'esnext,dom', '--module', 'nodenext', '--moduleResolution', 'nodenext', '--skipLibCheck', 'false', 'check.ts'], {
+      cwd: dir,
+      encoding: 'utf8',
+    });
+  } catch (e) {
+    assert.fail(`tsc rejected the declarations or a real report:\n${e.stdout}${e.stderr}`);
+  }
+  fs.rmSync(dir, { recursive: true, force: true });
+});
