@@ -8,7 +8,7 @@ export PATH := $(CURDIR)/node_modules/.bin:$(HOME)/.cargo/bin:$(PATH)
 CORPUS ?= $(CURDIR)/../shared/corpus
 LARGE := $(CORPUS)/curaengine-4.13.0_extruder-idler-x2.5_large.gcode
 
-.PHONY: all setup setup-test pkg serve test test-rust test-wasm test-js lint cli bench fuzz clean
+.PHONY: all setup setup-test pkg serve test test-rust test-wasm test-js test-fuzz lint cli bench fuzz clean
 
 all: pkg cli
 
@@ -38,7 +38,7 @@ cli:
 	cargo build --release
 
 ## Everything: formatting, lints, Rust tests, wasm tests in Node, JS API and browser tests.
-test: setup-test lint test-rust test-wasm test-js
+test: setup-test lint test-rust test-wasm test-js test-fuzz
 
 lint:
 	cargo fmt --all -- --check
@@ -60,6 +60,10 @@ bench: cli
 	@echo "sha256sum:"; time -p sha256sum "$(LARGE)" > /dev/null
 	target/release/quietpath bench "$(LARGE)"
 	cargo bench -p quietpath --bench parse
+
+## Short fuzzing smoke run of every cargo-fuzz target (make test); `make fuzz` runs long.
+test-fuzz:
+	crate/fuzz/smoke.sh 10
 
 ## Long fuzzing run of every target (parse_line, analyze, rewrite), 10 minutes each.
 ## Installs nightly and cargo-fuzz if missing. FUZZ_SECONDS=… to change.

@@ -1,7 +1,7 @@
 #![cfg(not(target_arch = "wasm32"))]
 //! Replays every input in `crate/fuzz/regressions/` (crashes found by the fuzzers and hand-made
-//! hostile files) through the checks of the fuzz targets: `parse_line` on every line, `analyze`
-//! lenient and strict, and lossless rewriting. See `crate/fuzz/regressions/README.md`.
+//! hostile files) through the checks of the fuzz targets (`crate/fuzz/checks.rs`): `parse_line` on every line,
+//! `analyze` lenient and strict, lossless rewriting, and the planner on the bytes as motions. See `crate/fuzz/regressions/README.md`.
 
 #![allow(clippy::unwrap_used)]
 
@@ -9,8 +9,11 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
 use quietpath::analyze::{analyze, AnalyzeOptions};
-use quietpath::gcode::{apply_edits, parse_line, Lines};
 use quietpath::ErrorKind;
+
+/// The fuzz targets' own checks (one copy, shared with `crate/fuzz/fuzz_targets/`).
+#[path = "../fuzz/checks.rs"]
+mod checks;
 
 fn regressions_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -30,90 +33,6 @@ fn inputs() -> Vec<PathBuf> {
     files
 }
 
-/// The `parse_line` fuzz target's checks.
-fn check_lines(data: &[u8]) {
-    for raw in Lines::new(data) {
-        match parse_line(raw.text) {
-            Ok(line) => {
-                for (letter, value) in line.params.iter() {
-                    if let Some(v) = value {
-                        assert!(
-                            v.is_finite(),
-                            "line {}: word {} = {v}",
-                            raw.number,
-                            letter as char
-                        );
-                    }
-                }
-            }
-            Err(e) => {
-                assert!(e.column >= 1, "line {}: column 0: {e:?}", raw.number);
-                assert!(
-                    e.column as usize <= raw.text.len() + 1,
-                    "line {}: column past the end: {e:?}",
-                    raw.number
-                );
-            }
-        }
-    }
-}
-
-/// The `analyze` fuzz target's checks: `Ok` or a typed error, never a panic.
-fn check_analyze(data: &[u8]) {
-    let lenient = analyze(data, &AnalyzeOptions::default());
-    let strict = analyze(
-        data,
-        &AnalyzeOptions {
-            strict: true,
-            ..AnalyzeOptions::default()
-        },
-    );
-    match &lenient {
-        Ok(report) => {
-            let json = serde_json::to_string(report).expect("a report always serialises");
-            if let Ok(strict) = &strict {
-                let strict_json =
-                    serde_json::to_string(strict).expect("a report always serialises");
-                assert_eq!(
-                    json, strict_json,
-                    "strict and lenient reports differ on a file strict mode accepts"
-                );
-            }
-        }
-        Err(e) => {
-            assert!(
-                matches!(e.kind, ErrorKind::Utf16),
-                "lenient analysis failed: {e}"
-            );
-            assert!(strict.is_err(), "strict accepted what lenient refused");
-        }
-    }
-    if let Err(e) = &strict {
-        // A typed error with a position inside the file (line 0 / column 0 only for file-level
-        // errors).
-        assert!(
-            e.line as usize <= Lines::new(data).count().max(1),
-            "error line {} past the end",
-            e.line
-        );
-        assert!(!e.to_string().is_empty());
-    }
-}
-
-/// The `rewrite` fuzz target's checks.
-fn check_rewrite(data: &[u8]) {
-    assert!(
-        apply_edits(data, &[]) == data,
-        "rewriting with no edits changed the input"
-    );
-    let mut concat = Vec::with_capacity(data.len());
-    for raw in Lines::new(data) {
-        concat.extend_from_slice(raw.text);
-        concat.extend_from_slice(raw.terminator);
-    }
-    assert!(concat == data, "lines do not concatenate to the input");
-}
-
 #[test]
 fn fuzz_regressions_do_not_panic() {
     let files = inputs();
@@ -128,9 +47,10 @@ fn fuzz_regressions_do_not_panic() {
         let data =
             std::fs::read(path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
         for (what, check) in [
-            ("parse_line", check_lines as fn(&[u8])),
-            ("analyze", check_analyze),
-            ("rewrite", check_rewrite),
+            ("parse_line", checks::parse_line as fn(&[u8])),
+            ("analyze", checks::analyze),
+            ("rewrite", checks::rewrite),
+            ("planner", checks::planner),
         ] {
             if catch_unwind(AssertUnwindSafe(|| check(&data))).is_err() {
                 failures.push(format!("{} ({what})", path.display()));
@@ -204,4 +124,15 @@ fn hand_made_seeds_give_the_expected_outcome() {
     );
     assert_eq!(big.warnings.len(), 1);
     assert_eq!(big.warnings[0].line, 1);
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(400))]
+
+    /// The planner's invariants (see `checks::planner`) on arbitrary motion sequences: every
+    /// junction model and preset, tiny to huge moves, 0.1 to 1000 mm/s.
+    #[test]
+    fn planner_invariants_hold_on_arbitrary_motion(data in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..1500)) {
+        checks::planner(&data);
+    }
 }

@@ -168,6 +168,8 @@ struct Block {
     accel_to_decel: f64,
     nominal_length: bool,
     recalculate: bool,
+    /// The entry speed is the exit speed of an already finalised block and may not change.
+    entry_fixed: bool,
 }
 
 impl Block {
@@ -399,6 +401,7 @@ impl Planner {
             accel_to_decel,
             nominal_length: cruise <= v_allowable,
             recalculate: true,
+            entry_fixed: false,
         };
         self.prev = Some(curr);
         self.blocks.push_back(block);
@@ -430,6 +433,9 @@ impl Planner {
             let (next_entry, next_changed) =
                 (self.blocks[i + 1].entry, self.blocks[i + 1].recalculate);
             let b = &mut self.blocks[i];
+            if b.entry_fixed {
+                continue;
+            }
             if b.entry != b.max_entry || next_changed {
                 // A block of nominal length reaches any junction speed within itself.
                 let entry = if b.nominal_length {
@@ -449,12 +455,17 @@ impl Planner {
         }
         // Forward pass: every block must be reachable from the previous block's entry speed.
         for i in 1..n {
-            let (prev_nominal, prev_entry, prev_accel, prev_distance) = {
+            let (prev_entry, prev_accel, prev_distance) = {
                 let p = &self.blocks[i - 1];
-                (p.nominal_length, p.entry, p.acceleration, p.distance)
+                (p.entry, p.acceleration, p.distance)
             };
             let b = &mut self.blocks[i];
-            if !prev_nominal && prev_entry < b.entry {
+            // Marlin and PrusaSlicer skip this check after a block of "nominal length", but they
+            // set that flag from the block's safe speed, not the minimum planner speed, so the
+            // shortcut can let a block start faster than the previous one can reach: a jump in
+            // speed. Checking every block keeps the speed continuous (proptest in
+            // tests/fuzz_regressions.rs); print times move by well under 0.1 %.
+            if prev_entry < b.entry {
                 let entry = b.entry.min(trapezoid::max_allowable_speed(
                     -prev_accel,
                     prev_entry,
@@ -492,6 +503,15 @@ impl Planner {
             self.elapsed_s += profile.duration();
             self.finalized += 1;
             sink(&pm);
+        }
+        // The machine is already committed to the last finalised block's exit speed: the next
+        // block must start at exactly that speed, whatever later look-ahead would allow (as in
+        // Marlin, where a block's entry is frozen once the block before it is executing).
+        // Later moves only relax constraints, so it can still brake to what follows.
+        if finalize > 0 {
+            if let Some(first) = self.blocks.front_mut() {
+                first.entry_fixed = true;
+            }
         }
     }
 }
