@@ -7,7 +7,7 @@
 //! same units and the matrix exponential is well scaled. State `x = [q̃, q̃̇]`; `q̃[3]` is the
 //! table's deviation from the commanded position, m.
 
-use nalgebra::{DMatrix, SMatrix, SVector};
+use nalgebra::{DMatrix, SVector};
 
 use super::integrate::discretize;
 use super::lumped::{dof, Coefficients, Matrices, Mat6, Vec6};
@@ -21,11 +21,12 @@ pub const TABLE: usize = dof::X4;
 /// Index of the table's deviation velocity in [`State`].
 pub const TABLE_VELOCITY: usize = 6 + dof::X4;
 
-/// `Φ` and `Γ` of one bucket.
+/// `Φ` and `Γ` of one bucket, as plain column-major arrays (the product below unrolls and
+/// vectorises; it is the simulation's inner loop).
 #[derive(Debug, Clone)]
 pub struct Stepper {
-    phi: SMatrix<f64, 12, 12>,
-    gamma: SMatrix<f64, 12, 2>,
+    phi: [[f64; 12]; 12],
+    gamma: [[f64; 12]; 2],
 }
 
 impl Stepper {
@@ -33,7 +34,16 @@ impl Stepper {
     /// acceleration over the period, m/s²).
     #[inline]
     pub fn step(&self, x: &State, v: f64, a: f64) -> State {
-        self.phi * x + self.gamma.column(0) * v + self.gamma.column(1) * a
+        let mut y = [0.0f64; 12];
+        for (r, yr) in y.iter_mut().enumerate() {
+            *yr = self.gamma[0][r] * v + self.gamma[1][r] * a;
+        }
+        for (col, &xc) in self.phi.iter().zip(x.iter()) {
+            for (yr, p) in y.iter_mut().zip(col) {
+                *yr += p * xc;
+            }
+        }
+        State::from(y)
     }
 }
 
@@ -88,8 +98,8 @@ pub fn stepper(drive: &Drive, position_m: f64, ts: f64) -> Option<Stepper> {
     }
     let d = discretize(&a, &b_v, &b_a, ts)?;
     Some(Stepper {
-        phi: SMatrix::from_fn(|r, c| d.phi[(r, c)]),
-        gamma: SMatrix::from_fn(|r, c| d.gamma[(r, c)]),
+        phi: core::array::from_fn(|c| core::array::from_fn(|r| d.phi[(r, c)])),
+        gamma: core::array::from_fn(|c| core::array::from_fn(|r| d.gamma[(r, c)])),
     })
 }
 

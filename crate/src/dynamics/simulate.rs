@@ -198,7 +198,8 @@ pub fn run(
         out.steps += 1;
         let layer = seg.and_then(|i| segs.get(i)).map_or(NO_LAYER, |s| s.layer);
         if seg.is_some() {
-            let dev = (x[0][TABLE].hypot(x[1][TABLE])) * 1e3;
+            let (dx, dy) = (x[0][TABLE], x[1][TABLE]);
+            let dev = (dx * dx + dy * dy).sqrt() * 1e3;
             if dev > out.deviation.max || out.deviation.count == 0 {
                 out.max_at = [next.pos[0], next.pos[1], t1];
             }
