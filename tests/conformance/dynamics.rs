@@ -37,7 +37,11 @@ fn arc_welded_klipper_print_is_sane_on_both_parameter_sets() {
         assert!(r.natural_frequencies_hz.windows(2).all(|w| w[0] <= w[1]));
         assert!(r.natural_frequencies_hz[0] > 10.0 && r.natural_frequencies_hz[0] < 100.0);
         // 25 layers, each with its amplitude.
-        assert!(r.layers.len() >= 24 && r.layers.len() <= 25, "{}", r.layers.len());
+        assert!(
+            r.layers.len() >= 24 && r.layers.len() <= 25,
+            "{}",
+            r.layers.len()
+        );
         for l in &r.layers {
             assert!(l.amplitude >= l.mean && l.amplitude.is_finite());
         }
@@ -62,8 +66,14 @@ fn square(fillet_mm: f64, points: usize) -> Vec<u8> {
         }
         let (px, py) = corners[(i + 3) % 4];
         let (nx, ny) = corners[(i + 1) % 4];
-        let a = (cx - (cx - px) / 40.0 * fillet_mm, cy - (cy - py) / 40.0 * fillet_mm);
-        let b = (cx + (nx - cx) / 40.0 * fillet_mm, cy + (ny - cy) / 40.0 * fillet_mm);
+        let a = (
+            cx - (cx - px) / 40.0 * fillet_mm,
+            cy - (cy - py) / 40.0 * fillet_mm,
+        );
+        let b = (
+            cx + (nx - cx) / 40.0 * fillet_mm,
+            cy + (ny - cy) / 40.0 * fillet_mm,
+        );
         for k in 0..=points {
             let t = k as f64 / points as f64;
             let u = 1.0 - t;
@@ -73,7 +83,8 @@ fn square(fillet_mm: f64, points: usize) -> Vec<u8> {
             ));
         }
     }
-    let mut g = String::from("G21\nG90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2 F600\nG1 X80 Y80 F6000\n");
+    let mut g =
+        String::from("G21\nG90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2 F600\nG1 X80 Y80 F6000\n");
     for _ in 0..20 {
         for (x, y) in &pts {
             g.push_str(&format!("G1 X{x:.4} Y{y:.4} E0.05 F3000\n"));

@@ -95,7 +95,11 @@ pub fn run(args: Args) -> Result<(), String> {
 
 fn print(out: &mut impl Write, file: &std::path::Path, r: &VibrationReport) -> std::io::Result<()> {
     writeln!(out, "{}", file.display())?;
-    writeln!(out, "  machine                {} (dynamics: {})", r.machine, r.dynamics)?;
+    writeln!(
+        out,
+        "  machine                {} (dynamics: {})",
+        r.machine, r.dynamics
+    )?;
     writeln!(
         out,
         "  simulated              {:.0} s of motion, {} steps of {} ms",
@@ -120,7 +124,13 @@ fn print(out: &mut impl Write, file: &std::path::Path, r: &VibrationReport) -> s
             .iter()
             .map(|m| format!("{:.1} ({:.3})", m.frequency_hz, m.damping_ratio))
             .collect();
-        writeln!(out, "  {:<4}  {:>11.1}   {}", a.axis, a.position_mm, modes.join(", "))?;
+        writeln!(
+            out,
+            "  {:<4}  {:>11.1}   {}",
+            a.axis,
+            a.position_mm,
+            modes.join(", ")
+        )?;
     }
     writeln!(out)?;
     let p = &r.psd;
@@ -130,10 +140,17 @@ fn print(out: &mut impl Write, file: &std::path::Path, r: &VibrationReport) -> s
         p.window_kind, p.window, p.fs_hz, p.segments
     )?;
     for peak in &p.peaks {
-        writeln!(out, "    {:>8.2} Hz   {:.4e} (m/s²)²/Hz", peak.hz, peak.power)?;
+        writeln!(
+            out,
+            "    {:>8.2} Hz   {:.4e} (m/s²)²/Hz",
+            peak.hz, peak.power
+        )?;
     }
     writeln!(out)?;
-    writeln!(out, "  layer        z mm   amplitude mm    mean mm   accel rms m/s²")?;
+    writeln!(
+        out,
+        "  layer        z mm   amplitude mm    mean mm   accel rms m/s²"
+    )?;
     let n = r.layers.len();
     let shown: Vec<usize> = if n <= 20 {
         (0..n).collect()

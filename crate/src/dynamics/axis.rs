@@ -10,7 +10,7 @@
 use nalgebra::{DMatrix, SVector};
 
 use super::integrate::discretize;
-use super::lumped::{dof, Coefficients, Matrices, Mat6, Vec6};
+use super::lumped::{dof, Coefficients, Mat6, Matrices, Vec6};
 use super::modal::{self, state_matrix, Mode};
 use super::parameters::Drive;
 
@@ -90,7 +90,7 @@ pub fn stepper(drive: &Drive, position_m: f64, ts: f64) -> Option<Stepper> {
     let mut b_a = DMatrix::zeros(12, 1);
     for i in 0..6 {
         let m = mats.m[(i, i)];
-        if !(m > 0.0) {
+        if m.is_nan() || m <= 0.0 {
             return None;
         }
         b_v[(6 + i, 0)] = f_v[i] / m;
@@ -163,7 +163,10 @@ mod tests {
         assert!(lm.len() >= 4, "{lm:?}");
         assert!(dm.len() >= 4, "{dm:?}");
         // A bed-slinger's first Y mode lies in the 20–80 Hz band input shapers are tuned to.
-        assert!(dm[0].frequency_hz > 20.0 && dm[0].frequency_hz < 80.0, "{dm:?}");
+        assert!(
+            dm[0].frequency_hz > 20.0 && dm[0].frequency_hz < 80.0,
+            "{dm:?}"
+        );
         eprintln!("ldam x {lm:?}\ndesktop y {dm:?}");
         for m in lm.iter().chain(&dm) {
             // The screws' (motor mount's and idler's) antisymmetric mode has no damper: ζ = 0.
@@ -185,8 +188,15 @@ mod tests {
         let c = desk.x.coefficients(0.1 + 0.0025);
         let (mats, _, f_a) = linear_model(&c, &desk.x);
         let static_lag = mats.k.lu().solve(&f_a).unwrap()[TABLE];
-        assert!(static_lag < 0.0, "the table lags behind an accelerating command");
+        assert!(
+            static_lag < 0.0,
+            "the table lags behind an accelerating command"
+        );
         // The velocity ramp inside each period adds a little viscous load.
-        assert!((x[TABLE] - static_lag).abs() < 0.02 * static_lag.abs(), "{} vs {static_lag}", x[TABLE]);
+        assert!(
+            (x[TABLE] - static_lag).abs() < 0.02 * static_lag.abs(),
+            "{} vs {static_lag}",
+            x[TABLE]
+        );
     }
 }

@@ -104,7 +104,9 @@ pub fn rigid_inertia_ball_screw(d: &BallScrew) -> f64 {
 /// Inertia the motor sees when the whole belt axis moves rigidly, kg·m².
 pub fn rigid_inertia_belt(b: &Belt) -> f64 {
     let i = b.pulley_radius_m;
-    b.motor_inertia_kg_m2 + b.pulley_inertia_kg_m2 + i * i * (b.carriage_mass_kg + b.payload_mass_kg)
+    b.motor_inertia_kg_m2
+        + b.pulley_inertia_kg_m2
+        + i * i * (b.carriage_mass_kg + b.payload_mass_kg)
 }
 
 /// Coefficients of a ball-screw drive with the nut `l_n` from the coupling (m).
@@ -120,9 +122,9 @@ pub fn ball_screw(d: &BallScrew, l_n: f64) -> Coefficients {
     Coefficients {
         m: [m1, m1, d.pedestal_mass_kg, d.table_mass_kg],
         j_m: d.motor_inertia_kg_m2,
-        j_s: j_sc + d.coupling_inertia_kg_m2, // eq. 3
-        k_n: series(d.bearing_stiffness_n_m, k_sn),          // eq. 8
-        k_t: series(d.coupling_stiffness_nm_rad, k_st),      // eq. 9
+        j_s: j_sc + d.coupling_inertia_kg_m2,           // eq. 3
+        k_n: series(d.bearing_stiffness_n_m, k_sn),     // eq. 8
+        k_t: series(d.coupling_stiffness_nm_rad, k_st), // eq. 9
         k_mn: nut_contact_stiffness(
             d.nut_reference_stiffness_n_m,
             d.preload_n,

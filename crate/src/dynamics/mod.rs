@@ -126,7 +126,7 @@ pub struct AxisModes {
 pub struct Psd {
     /// Sampling rate, Hz.
     pub fs_hz: f64,
-    /// Segment length, samples.
+    /// Segment length, samples (the option, or the whole signal when it is shorter).
     pub window: usize,
     /// Window function.
     pub window_kind: Window,
@@ -182,7 +182,9 @@ impl VibrationOptions {
             return Err(invalid("fs_hz must be finite and positive"));
         }
         if self.fs_hz * self.ts_ms * 1e-3 > 1.0 + 1e-9 {
-            return Err(invalid("fs_hz must not exceed the simulation rate 1000 / ts_ms"));
+            return Err(invalid(
+                "fs_hz must not exceed the simulation rate 1000 / ts_ms",
+            ));
         }
         if !(4..=1 << 20).contains(&self.window) {
             return Err(invalid("window must be between 4 and 1048576 samples"));
@@ -324,9 +326,9 @@ pub fn vibration_of_path(
         layers,
         psd: Psd {
             fs_hz: fs,
-            window: spectrum.power.len().saturating_sub(1) * 2,
+            window: spectrum.segment_len,
             window_kind: options.window_kind,
-            overlap: options.window / 2,
+            overlap: spectrum.segment_len / 2,
             segments: spectrum.segments,
             freqs: spectrum.freqs,
             power: spectrum.power,
@@ -335,4 +337,116 @@ pub fn vibration_of_path(
         simulated_s: outcome.simulated_s,
         steps: outcome.steps,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SQUARE: &[u8] = b"G21\nG90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2 F600\n\
+G1 X20 Y0 E1 F3000\nG1 X20 Y20 E1\nG1 X0 Y20 E1\nG1 X0 Y0 E1\n\
+;LAYER_CHANGE\n;Z:0.4\nG1 Z0.4\nG4 P10000\nG1 X20 Y0 E1\nG1 X20 Y20 E1\n";
+
+    #[test]
+    fn report_fields_are_consistent() {
+        let r = vibration(SQUARE, &VibrationOptions::default()).unwrap();
+        assert_eq!(r.layers.len(), 2);
+        assert_eq!(r.layers[1].z, Some(0.4));
+        let d = r.deviation_mm;
+        assert!(d.min <= d.mean && d.mean <= d.max && d.max > 0.0);
+        assert!(r.layers.iter().all(|l| l.amplitude <= d.max + 1e-15));
+        assert_eq!(r.psd.fs_hz, 200.0);
+        assert_eq!(r.natural_frequencies_hz.len(), 12);
+        // Most of the 10 s dwell is skipped once the machine is still.
+        assert!(
+            r.simulated_s < r.deviation_mm.samples as f64 * 1e-3 + 5.0,
+            "{}",
+            r.simulated_s
+        );
+        let json = serde_json::to_value(&r).unwrap();
+        for key in [
+            "natural_frequencies_hz",
+            "damping_ratios",
+            "deviation_mm",
+            "layers",
+            "psd",
+        ] {
+            assert!(json.get(key).is_some(), "{key}");
+        }
+        for key in ["max", "min", "mean"] {
+            assert!(json["deviation_mm"].get(key).is_some());
+        }
+        for key in ["fs_hz", "window", "freqs", "power", "peaks"] {
+            assert!(json["psd"].get(key).is_some());
+        }
+        assert!(json["layers"][0].get("amplitude").is_some());
+        // A file against itself changes by nothing.
+        let c = compare(&r, &r);
+        assert_eq!(c.mean_deviation, 0.0);
+        assert!(c.layers.iter().all(|l| l.relative == 0.0));
+    }
+
+    #[test]
+    fn bad_options_are_refused() {
+        let bad = [
+            VibrationOptions {
+                ts_ms: 0.0,
+                ..Default::default()
+            },
+            VibrationOptions {
+                ts_ms: f64::NAN,
+                ..Default::default()
+            },
+            VibrationOptions {
+                fs_hz: 2000.0,
+                ..Default::default()
+            },
+            VibrationOptions {
+                fs_hz: -1.0,
+                ..Default::default()
+            },
+            VibrationOptions {
+                window: 1,
+                ..Default::default()
+            },
+            VibrationOptions {
+                bucket_mm: 0.0,
+                ..Default::default()
+            },
+            VibrationOptions {
+                dynamics: Some("nope".into()),
+                ..Default::default()
+            },
+        ];
+        for o in bad {
+            let e = vibration(SQUARE, &o).unwrap_err();
+            assert!(
+                matches!(e.kind, ErrorKind::InvalidOption { .. }),
+                "{o:?}: {e}"
+            );
+        }
+        let json =
+            r#"{"ts_ms": 2, "analyze": {"machine": "vtg-ldam-servo"}, "window_kind": "hann"}"#;
+        let o: VibrationOptions = serde_json::from_str(json).unwrap();
+        assert_eq!(vibration(SQUARE, &o).unwrap().dynamics, "ldam-ball-screw");
+        assert!(serde_json::from_str::<VibrationOptions>(r#"{"nope": 1}"#).is_err());
+    }
+
+    #[test]
+    fn cancel_and_degenerate_inputs() {
+        let e = vibration_with_progress(SQUARE, &Default::default(), &mut |_| false).unwrap_err();
+        assert_eq!(e.kind, ErrorKind::Cancelled);
+        // No motion at all: an empty but valid report.
+        let r = vibration(b"M104 S200\n; nothing\n", &Default::default()).unwrap();
+        assert_eq!(r.deviation_mm.samples, 0);
+        assert!(r.psd.power.is_empty());
+        // A path without timing is refused, not mis-simulated.
+        let p = crate::path::extract(SQUARE, &Default::default(), false).unwrap();
+        let e = vibration_of_path(&p, &Default::default(), &mut |_| true).unwrap_err();
+        assert!(matches!(e.kind, ErrorKind::InvalidOption { .. }));
+        // Absurdly slow motion is bounded, not simulated for days.
+        let slow = b"G21\nG90\nM83\nG1 X1000 Y0 E1 F0.001\n";
+        let e = vibration(slow, &Default::default()).unwrap_err();
+        assert!(matches!(e.kind, ErrorKind::InvalidOption { .. }));
+    }
 }

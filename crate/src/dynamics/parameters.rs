@@ -189,7 +189,10 @@ impl MachineDynamics {
     /// A built-in parameter set by name (see [`PRESETS`]).
     pub fn preset(name: &str) -> Option<Self> {
         let (x, y) = match name {
-            "ldam-ball-screw" => (ldam_axis(1.2, 2.0, 8.0, 2.6e-5), ldam_axis(1.0, 3.0, 22.0, 8.7e-5)),
+            "ldam-ball-screw" => (
+                ldam_axis(1.2, 2.0, 8.0, 2.6e-5),
+                ldam_axis(1.0, 3.0, 22.0, 8.7e-5),
+            ),
             "desktop-belt" => (desktop_axis(0.15, 0.35, 0.42), desktop_axis(0.3, 1.2, 0.47)),
             _ => return None,
         };

@@ -116,7 +116,10 @@ fn geometry(m: &PathMove) -> Geometry {
     let dx = m.to[axis::X] - m.from[axis::X];
     let dy = m.to[axis::Y] - m.from[axis::Y];
     let len = m.length_mm;
-    if !(len > 1e-9) || !len.is_finite() || (dx.abs() < 1e-12 && dy.abs() < 1e-12 && !matches!(m.kind, MoveKind::Arc(_))) {
+    let usable = len.is_finite() && len > 1e-9;
+    if !usable
+        || (dx.abs() < 1e-12 && dy.abs() < 1e-12 && !matches!(m.kind, MoveKind::Arc(_)))
+    {
         return Geometry::Still;
     }
     match m.kind {
@@ -151,14 +154,17 @@ pub fn segments(path: &PrintPath) -> Option<Vec<Segment>> {
                 .map_or(0.0, |s| s.profile.exit);
             let a = t.profile.acceleration;
             let cruise = m.feed_mm_s.max(t.profile.peak);
-            (cursor, Profile::new(m.length_mm, entry, cruise, t.profile.exit, a))
+            (
+                cursor,
+                Profile::new(m.length_mm, entry, cruise, t.profile.exit, a),
+            )
         } else {
             let gap = (t.start_s - planned_end).max(0.0);
             (cursor + gap, t.profile)
         };
         planned_end = planned_end.max(t.start_s + duration);
         let duration = profile.duration();
-        if !(duration > 0.0) || !duration.is_finite() {
+        if !(duration.is_finite() && duration > 0.0) {
             continue;
         }
         let seg = Segment {
@@ -201,7 +207,10 @@ mod tests {
         let segs = segments(&path).unwrap();
         let arc = segs.last().unwrap();
         let end = arc.command(arc.duration_s);
-        assert!(end.pos[0].abs() < 1e-9 && (end.pos[1] - 10.0).abs() < 1e-9, "{end:?}");
+        assert!(
+            end.pos[0].abs() < 1e-9 && (end.pos[1] - 10.0).abs() < 1e-9,
+            "{end:?}"
+        );
         let mid = arc.command(0.5 * arc.duration_s);
         assert!((mid.pos[0].hypot(mid.pos[1]) - 10.0).abs() < 1e-9);
     }

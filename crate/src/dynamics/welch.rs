@@ -89,6 +89,8 @@ pub struct Spectrum {
     pub power: Vec<f64>,
     /// Segments averaged.
     pub segments: usize,
+    /// Segment length, samples.
+    pub segment_len: usize,
 }
 
 impl Welch {
@@ -135,7 +137,16 @@ impl Welch {
             for ch in 0..self.channels {
                 let ring = &self.buffer[ch * n..(ch + 1) * n];
                 let seg: Vec<f64> = (0..n).map(|i| ring[(start + i) % n]).collect();
-                accumulate(&seg, &window, fs, &*self.fft, &mut self.input, &mut self.spectrum, &mut self.scratch, &mut sum);
+                accumulate(
+                    &seg,
+                    &window,
+                    fs,
+                    &*self.fft,
+                    &mut self.input,
+                    &mut self.spectrum,
+                    &mut self.scratch,
+                    &mut sum,
+                );
             }
             self.window = window;
             self.sum = sum;
@@ -152,6 +163,7 @@ impl Welch {
                 freqs: freqs(self.n, self.fs),
                 power: self.sum.iter().map(|p| p / self.segments as f64).collect(),
                 segments: self.segments,
+                segment_len: self.n,
             };
         }
         if self.pushed < 2 {
@@ -262,7 +274,11 @@ mod tests {
         let sw: f64 = w.iter().sum();
         let sw2: f64 = w.iter().map(|v| v * v).sum();
         let expected = a * a * sw * sw / (2.0 * fs * sw2);
-        assert!((p[0].power - expected).abs() < 1e-9 * expected, "{} vs {expected}", p[0].power);
+        assert!(
+            (p[0].power - expected).abs() < 1e-9 * expected,
+            "{} vs {expected}",
+            p[0].power
+        );
         // Parseval: Σ P Δf is the variance A²/2.
         let df = fs / n as f64;
         let total: f64 = s.power.iter().sum::<f64>() * df;
