@@ -1,1 +1,114 @@
-//! Conformance of `dynamics` on the real corpus (filled in with the capability).
+//! Conformance of `dynamics` on the real corpus: the simulated vibration of real prints is
+//! finite, ordered and of the size printers show, and smoothing corners lowers it.
+
+use quietpath::dynamics::{vibration, VibrationOptions};
+use quietpath_conformance::corpus_dir;
+
+fn options(machine: &str) -> VibrationOptions {
+    let mut o = VibrationOptions::default();
+    o.analyze.machine = Some(machine.to_string());
+    o
+}
+
+fn read(name: &str) -> Vec<u8> {
+    let path = corpus_dir().join(name);
+    std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+#[test]
+fn arc_welded_klipper_print_is_sane_on_both_parameter_sets() {
+    // 7 minutes of SuperSlicer output with 248 arcs.
+    let input = read("superslicer-2.3.56_klipper_arcwelder.gcode");
+    for (machine, dynamics) in [
+        ("voron-klipper", "desktop-belt"),
+        ("vtg-ldam-servo", "ldam-ball-screw"),
+    ] {
+        let r = vibration(&input, &options(machine)).expect("vibration");
+        assert_eq!(r.dynamics, dynamics);
+        let d = r.deviation_mm;
+        assert!(d.min <= d.mean && d.mean <= d.max, "{d:?}");
+        // Micrometres to a fraction of a millimetre, as measured on printers (the VTG paper's
+        // LDAM: mean 0.087 mm, max 0.168 mm).
+        assert!(d.mean > 1e-4 && d.mean < 0.2, "{machine}: {d:?}");
+        assert!(d.max < 2.0, "{machine}: {d:?}");
+        // About one sample per millisecond of motion (rests skipped).
+        assert!(r.steps as f64 > 0.5 * r.simulated_s * 1000.0);
+        assert_eq!(r.natural_frequencies_hz.len(), r.damping_ratios.len());
+        assert!(r.natural_frequencies_hz.windows(2).all(|w| w[0] <= w[1]));
+        assert!(r.natural_frequencies_hz[0] > 10.0 && r.natural_frequencies_hz[0] < 100.0);
+        // 25 layers, each with its amplitude.
+        assert!(
+            r.layers.len() >= 24 && r.layers.len() <= 25,
+            "{}",
+            r.layers.len()
+        );
+        for l in &r.layers {
+            assert!(l.amplitude >= l.mean && l.amplitude.is_finite());
+        }
+        // The paper's PSD settings: 200 Hz, Hamming 512 → 257 bins up to 100 Hz.
+        assert_eq!(r.psd.freqs.len(), 257);
+        assert!((r.psd.freqs[256] - 100.0).abs() < 1e-9);
+        assert!(r.psd.segments > 100);
+        assert!(!r.psd.peaks.is_empty());
+        assert!(r.psd.power.iter().all(|p| p.is_finite() && *p >= 0.0));
+    }
+}
+
+fn square(fillet_mm: f64, points: usize) -> Vec<u8> {
+    // 20 laps of a 40 mm square; corners replaced by quadratic Bézier fillets when asked.
+    let corners = [(80.0, 80.0), (120.0, 80.0), (120.0, 120.0), (80.0, 120.0)];
+    let mut pts = Vec::new();
+    for i in 0..4 {
+        let (cx, cy): (f64, f64) = corners[i];
+        if fillet_mm == 0.0 {
+            pts.push((cx, cy));
+            continue;
+        }
+        let (px, py) = corners[(i + 3) % 4];
+        let (nx, ny) = corners[(i + 1) % 4];
+        let a = (
+            cx - (cx - px) / 40.0 * fillet_mm,
+            cy - (cy - py) / 40.0 * fillet_mm,
+        );
+        let b = (
+            cx + (nx - cx) / 40.0 * fillet_mm,
+            cy + (ny - cy) / 40.0 * fillet_mm,
+        );
+        for k in 0..=points {
+            let t = k as f64 / points as f64;
+            let u = 1.0 - t;
+            pts.push((
+                u * u * a.0 + 2.0 * u * t * cx + t * t * b.0,
+                u * u * a.1 + 2.0 * u * t * cy + t * t * b.1,
+            ));
+        }
+    }
+    let mut g =
+        String::from("G21\nG90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2 F600\nG1 X80 Y80 F6000\n");
+    for _ in 0..20 {
+        for (x, y) in &pts {
+            g.push_str(&format!("G1 X{x:.4} Y{y:.4} E0.05 F3000\n"));
+        }
+    }
+    g.into_bytes()
+}
+
+#[test]
+fn smoothed_corners_vibrate_less_than_sharp_ones() {
+    // Junction-deviation and Klipper firmware slow down for a sharp corner and accelerate
+    // again; a finely filleted corner keeps the speed with small direction changes.
+    let sharp = square(0.0, 0);
+    let smooth = square(8.0, 48);
+    for machine in ["creality-ender3", "voron-klipper", "vtg-ldam-servo"] {
+        let a = vibration(&sharp, &options(machine)).expect("sharp");
+        let b = vibration(&smooth, &options(machine)).expect("smooth");
+        let change = quietpath::dynamics::compare(&a, &b);
+        assert!(
+            change.mean_deviation < 0.0,
+            "{machine}: mean {} → {}",
+            a.deviation_mm.mean,
+            b.deviation_mm.mean
+        );
+        assert_eq!(change.layers.len(), 1);
+    }
+}

@@ -1,2 +1,452 @@
 //! Machine dynamics: the lumped-mass model of an axis drive (VTG paper eq. 1–15), its response
 //! to the planned trajectory, trajectory deviation and acceleration spectra.
+//!
+//! The pipeline of [`vibration`]:
+//! 1. read the file's moves with the planner's timing ([`crate::path::extract`]);
+//! 2. build each axis's `M`, `C`, `K` ([`lumped`], eq. 1–14) from a physical parameter set
+//!    ([`parameters`]), close the position loop, and take its modes ([`modal`]);
+//! 3. sample the commanded X and Y motion every `T_s` ([`trajectory`]) and integrate the model
+//!    exactly ([`integrate`]: matrix exponential per nut-position bucket, [`axis`]);
+//! 4. trajectory deviation `dev = ‖C − C_p‖` (eq. 15) between commanded and simulated table
+//!    position, over the print and per layer; the table's acceleration, averaged to the
+//!    accelerometer rate `f_s`, and its Welch PSD ([`welch`]) with the top peaks.
+//!
+//! ```
+//! let gcode = b"G21\nG90\nM83\n;LAYER_CHANGE\nG1 Z0.2 F600\nG1 X20 Y0 E1 F3000\nG1 X20 Y20 E1\n";
+//! let report = quietpath::dynamics::vibration(gcode, &Default::default()).unwrap();
+//! assert!(report.deviation_mm.max > 0.0);
+//! assert!(!report.natural_frequencies_hz.is_empty());
+//! ```
+
+pub mod axis;
+pub mod compare;
+pub mod integrate;
+pub mod lumped;
+pub mod modal;
+pub mod parameters;
+pub mod simulate;
+pub mod trajectory;
+pub mod welch;
+
+use serde::{Deserialize, Serialize};
+
+use crate::analyze::{AnalyzeOptions, Progress};
+use crate::error::{Error, ErrorKind};
+use crate::path::PrintPath;
+pub use compare::{compare, VibrationComparison};
+pub use modal::Mode;
+pub use parameters::{Drive, MachineDynamics};
+pub use welch::{Peak, Window};
+
+/// Options of [`vibration`]. Every field is optional in JSON.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VibrationOptions {
+    /// How the file is read and planned (machine preset, junction model...).
+    pub analyze: AnalyzeOptions,
+    /// Interpolation period `T_s`, ms (default 1).
+    pub ts_ms: f64,
+    /// Accelerometer sampling rate `f_s` for the spectrum, Hz (default 200, the VTG paper's);
+    /// at most `1000 / ts_ms`. The rate used is `1 / (round(1/(f_s T_s)) T_s)`.
+    pub fs_hz: f64,
+    /// Welch segment length, samples (default 512, the paper's Hamming window size).
+    pub window: usize,
+    /// Window function (default Hamming, as in the paper).
+    pub window_kind: Window,
+    /// Built-in dynamics parameter set (`ldam-ball-screw`, `desktop-belt`); default: the one
+    /// that goes with the machine preset ([`parameters::preset_for_machine`]).
+    pub dynamics: Option<String>,
+    /// A whole parameter set (wins over `dynamics`).
+    pub dynamics_parameters: Option<MachineDynamics>,
+    /// Travel over which the position-dependent stiffness is held constant, mm (default 5).
+    pub bucket_mm: f64,
+    /// Spectral peaks reported (default 5).
+    pub peaks: usize,
+}
+
+impl Default for VibrationOptions {
+    fn default() -> Self {
+        Self {
+            analyze: AnalyzeOptions::default(),
+            ts_ms: 1.0,
+            fs_hz: 200.0,
+            window: 512,
+            window_kind: Window::Hamming,
+            dynamics: None,
+            dynamics_parameters: None,
+            bucket_mm: 5.0,
+            peaks: 5,
+        }
+    }
+}
+
+/// Trajectory deviation statistics (eq. 15), mm.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Deviation {
+    /// Largest deviation.
+    pub max: f64,
+    /// Smallest deviation.
+    pub min: f64,
+    /// Mean deviation.
+    pub mean: f64,
+    /// Commanded X, Y (mm) and time (s) of the largest deviation.
+    pub max_at: [f64; 3],
+    /// Samples (one per `T_s` while the machine runs a move).
+    pub samples: u64,
+}
+
+/// Vibration of one layer (the paper's Fig. 9c).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LayerVibration {
+    /// 0-based layer index.
+    pub layer: usize,
+    /// Layer height, mm.
+    pub z: Option<f64>,
+    /// Vibration amplitude: the largest trajectory deviation in the layer, mm.
+    pub amplitude: f64,
+    /// Mean deviation in the layer, mm.
+    pub mean: f64,
+    /// RMS of the table's acceleration in the layer, m/s².
+    pub acceleration_rms: f64,
+}
+
+/// Modes of one axis.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisModes {
+    /// `x` or `y`.
+    pub axis: &'static str,
+    /// Axis position the modes are taken at (the middle of the printed area), mm.
+    pub position_mm: f64,
+    /// Modes by increasing frequency.
+    pub modes: Vec<Mode>,
+}
+
+/// Welch PSD of the table's acceleration (X and Y spectra summed), (m/s²)²/Hz.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Psd {
+    /// Sampling rate, Hz.
+    pub fs_hz: f64,
+    /// Segment length, samples (the option, or the whole signal when it is shorter).
+    pub window: usize,
+    /// Window function.
+    pub window_kind: Window,
+    /// Overlap between segments, samples.
+    pub overlap: usize,
+    /// Segments averaged.
+    pub segments: usize,
+    /// Bin frequencies, Hz.
+    pub freqs: Vec<f64>,
+    /// Power spectral density per bin.
+    pub power: Vec<f64>,
+    /// Highest local maxima, highest first.
+    pub peaks: Vec<Peak>,
+}
+
+/// Result of [`vibration`].
+#[derive(Debug, Clone, Serialize)]
+pub struct VibrationReport {
+    /// Machine profile the file was planned with.
+    pub machine: String,
+    /// Dynamics parameter set.
+    pub dynamics: String,
+    /// Interpolation period, ms.
+    pub ts_ms: f64,
+    /// Natural frequencies of both axes (mechanism with its position loop), Hz, ascending.
+    pub natural_frequencies_hz: Vec<f64>,
+    /// Damping ratios of the same modes.
+    pub damping_ratios: Vec<f64>,
+    /// Modes per axis.
+    pub axes: Vec<AxisModes>,
+    /// Trajectory deviation over the print, mm.
+    pub deviation_mm: Deviation,
+    /// Per-layer vibration.
+    pub layers: Vec<LayerVibration>,
+    /// Acceleration spectrum.
+    pub psd: Psd,
+    /// Motion time simulated, s (rests are skipped once the machine is still).
+    pub simulated_s: f64,
+    /// Simulation steps.
+    pub steps: u64,
+}
+
+fn invalid(reason: &'static str) -> Error {
+    Error::new(0, 0, ErrorKind::InvalidOption { reason })
+}
+
+impl VibrationOptions {
+    fn validate(&self) -> Result<(), Error> {
+        if !(self.ts_ms.is_finite() && self.ts_ms >= 1e-3 && self.ts_ms <= 1000.0) {
+            return Err(invalid("ts_ms must be between 0.001 and 1000"));
+        }
+        if !(self.fs_hz.is_finite() && self.fs_hz > 0.0) {
+            return Err(invalid("fs_hz must be finite and positive"));
+        }
+        if self.fs_hz * self.ts_ms * 1e-3 > 1.0 + 1e-9 {
+            return Err(invalid(
+                "fs_hz must not exceed the simulation rate 1000 / ts_ms",
+            ));
+        }
+        if !(4..=1 << 20).contains(&self.window) {
+            return Err(invalid("window must be between 4 and 1048576 samples"));
+        }
+        if !(self.bucket_mm.is_finite() && self.bucket_mm > 0.0) {
+            return Err(invalid("bucket_mm must be finite and positive"));
+        }
+        if self.peaks > 1000 {
+            return Err(invalid("peaks must be at most 1000"));
+        }
+        Ok(())
+    }
+
+    /// The parameter set these options ask for, given the machine profile's name.
+    pub fn machine_dynamics(&self, machine: &str) -> Result<MachineDynamics, Error> {
+        if let Some(p) = &self.dynamics_parameters {
+            return Ok(p.clone());
+        }
+        let name = self
+            .dynamics
+            .as_deref()
+            .unwrap_or_else(|| parameters::preset_for_machine(machine));
+        MachineDynamics::preset(name)
+            .ok_or_else(|| invalid("unknown dynamics preset (ldam-ball-screw, desktop-belt)"))
+    }
+}
+
+/// Simulates the machine's dynamics over a G-code file.
+pub fn vibration(input: &[u8], options: &VibrationOptions) -> Result<VibrationReport, Error> {
+    vibration_with_progress(input, options, &mut |_| true)
+}
+
+/// [`vibration`] with a progress callback (reading is the first 10 %).
+pub fn vibration_with_progress(
+    input: &[u8],
+    options: &VibrationOptions,
+    progress: Progress<'_>,
+) -> Result<VibrationReport, Error> {
+    options.validate()?;
+    let path = crate::path::extract(input, &options.analyze, true)?;
+    if !progress(0.1) {
+        return Err(Error::new(0, 0, ErrorKind::Cancelled));
+    }
+    vibration_of_path(&path, options, &mut |f| progress(0.1 + 0.9 * f))
+}
+
+/// Simulates an already extracted, planned path (for optimisers that compare their output's
+/// deviation with the original's). `options.analyze` is not used.
+pub fn vibration_of_path(
+    path: &PrintPath,
+    options: &VibrationOptions,
+    progress: Progress<'_>,
+) -> Result<VibrationReport, Error> {
+    options.validate()?;
+    let machine = options.machine_dynamics(&path.profile.name)?;
+    let segs = trajectory::segments(path)
+        .ok_or_else(|| invalid("the path has no planned timing (extract it with plan = true)"))?;
+    let ts = options.ts_ms * 1e-3;
+    let decimation = ((1.0 / (options.fs_hz * ts)).round() as u64).max(1);
+    let fs = 1.0 / (decimation as f64 * ts);
+    let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
+    let outcome = simulate::run(
+        &segs,
+        path.layers.len(),
+        &machine,
+        simulate::Settings {
+            ts,
+            decimation,
+            bucket_m: options.bucket_mm * 1e-3,
+        },
+        &mut welch,
+        progress,
+    )?;
+
+    // Modes in the middle of the printed area.
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for s in &segs {
+        for p in [s.from, s.to] {
+            for ax in 0..2 {
+                lo[ax] = lo[ax].min(p[ax]);
+                hi[ax] = hi[ax].max(p[ax]);
+            }
+        }
+    }
+    let mid = |ax: usize| {
+        let m = 0.5 * (lo[ax] + hi[ax]);
+        if m.is_finite() {
+            m
+        } else {
+            0.0
+        }
+    };
+    let axes: Vec<AxisModes> = [("x", &machine.x), ("y", &machine.y)]
+        .into_iter()
+        .enumerate()
+        .map(|(ax, (name, drive))| AxisModes {
+            axis: name,
+            position_mm: mid(ax),
+            modes: axis::modes(drive, mid(ax) * 1e-3),
+        })
+        .collect();
+    let mut all: Vec<Mode> = axes.iter().flat_map(|a| a.modes.iter().copied()).collect();
+    all.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+
+    let spectrum = welch.finish();
+    let peaks = welch::peaks(&spectrum.freqs, &spectrum.power, options.peaks);
+    let d = &outcome.deviation;
+    let layers = outcome
+        .layers
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.deviation.count > 0)
+        .map(|(i, l)| LayerVibration {
+            layer: i,
+            z: path.layers.get(i).and_then(|l| l.z),
+            amplitude: l.deviation.max,
+            mean: l.deviation.mean(),
+            acceleration_rms: if l.accel_count > 0 {
+                (l.accel_sq / l.accel_count as f64).sqrt()
+            } else {
+                0.0
+            },
+        })
+        .collect();
+    Ok(VibrationReport {
+        machine: path.profile.name.clone(),
+        dynamics: machine.name.clone(),
+        ts_ms: options.ts_ms,
+        natural_frequencies_hz: all.iter().map(|m| m.frequency_hz).collect(),
+        damping_ratios: all.iter().map(|m| m.damping_ratio).collect(),
+        axes,
+        deviation_mm: Deviation {
+            max: d.max,
+            min: d.min_or_zero(),
+            mean: d.mean(),
+            max_at: outcome.max_at,
+            samples: d.count,
+        },
+        layers,
+        psd: Psd {
+            fs_hz: fs,
+            window: spectrum.segment_len,
+            window_kind: options.window_kind,
+            overlap: spectrum.segment_len / 2,
+            segments: spectrum.segments,
+            freqs: spectrum.freqs,
+            power: spectrum.power,
+            peaks,
+        },
+        simulated_s: outcome.simulated_s,
+        steps: outcome.steps,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SQUARE: &[u8] = b"G21\nG90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2 F600\n\
+G1 X20 Y0 E1 F3000\nG1 X20 Y20 E1\nG1 X0 Y20 E1\nG1 X0 Y0 E1\n\
+;LAYER_CHANGE\n;Z:0.4\nG1 Z0.4\nG4 P10000\nG1 X20 Y0 E1\nG1 X20 Y20 E1\n";
+
+    #[test]
+    fn report_fields_are_consistent() {
+        let r = vibration(SQUARE, &VibrationOptions::default()).unwrap();
+        assert_eq!(r.layers.len(), 2);
+        assert_eq!(r.layers[1].z, Some(0.4));
+        let d = r.deviation_mm;
+        assert!(d.min <= d.mean && d.mean <= d.max && d.max > 0.0);
+        assert!(r.layers.iter().all(|l| l.amplitude <= d.max + 1e-15));
+        assert_eq!(r.psd.fs_hz, 200.0);
+        assert_eq!(r.natural_frequencies_hz.len(), 12);
+        // Most of the 10 s dwell is skipped once the machine is still.
+        assert!(
+            r.simulated_s < r.deviation_mm.samples as f64 * 1e-3 + 5.0,
+            "{}",
+            r.simulated_s
+        );
+        let json = serde_json::to_value(&r).unwrap();
+        for key in [
+            "natural_frequencies_hz",
+            "damping_ratios",
+            "deviation_mm",
+            "layers",
+            "psd",
+        ] {
+            assert!(json.get(key).is_some(), "{key}");
+        }
+        for key in ["max", "min", "mean"] {
+            assert!(json["deviation_mm"].get(key).is_some());
+        }
+        for key in ["fs_hz", "window", "freqs", "power", "peaks"] {
+            assert!(json["psd"].get(key).is_some());
+        }
+        assert!(json["layers"][0].get("amplitude").is_some());
+        // A file against itself changes by nothing.
+        let c = compare(&r, &r);
+        assert_eq!(c.mean_deviation, 0.0);
+        assert!(c.layers.iter().all(|l| l.relative == 0.0));
+    }
+
+    #[test]
+    fn bad_options_are_refused() {
+        let bad = [
+            VibrationOptions {
+                ts_ms: 0.0,
+                ..Default::default()
+            },
+            VibrationOptions {
+                ts_ms: f64::NAN,
+                ..Default::default()
+            },
+            VibrationOptions {
+                fs_hz: 2000.0,
+                ..Default::default()
+            },
+            VibrationOptions {
+                fs_hz: -1.0,
+                ..Default::default()
+            },
+            VibrationOptions {
+                window: 1,
+                ..Default::default()
+            },
+            VibrationOptions {
+                bucket_mm: 0.0,
+                ..Default::default()
+            },
+            VibrationOptions {
+                dynamics: Some("nope".into()),
+                ..Default::default()
+            },
+        ];
+        for o in bad {
+            let e = vibration(SQUARE, &o).unwrap_err();
+            assert!(
+                matches!(e.kind, ErrorKind::InvalidOption { .. }),
+                "{o:?}: {e}"
+            );
+        }
+        let json =
+            r#"{"ts_ms": 2, "analyze": {"machine": "vtg-ldam-servo"}, "window_kind": "hann"}"#;
+        let o: VibrationOptions = serde_json::from_str(json).unwrap();
+        assert_eq!(vibration(SQUARE, &o).unwrap().dynamics, "ldam-ball-screw");
+        assert!(serde_json::from_str::<VibrationOptions>(r#"{"nope": 1}"#).is_err());
+    }
+
+    #[test]
+    fn cancel_and_degenerate_inputs() {
+        let e = vibration_with_progress(SQUARE, &Default::default(), &mut |_| false).unwrap_err();
+        assert_eq!(e.kind, ErrorKind::Cancelled);
+        // No motion at all: an empty but valid report.
+        let r = vibration(b"M104 S200\n; nothing\n", &Default::default()).unwrap();
+        assert_eq!(r.deviation_mm.samples, 0);
+        assert!(r.psd.power.is_empty());
+        // A path without timing is refused, not mis-simulated.
+        let p = crate::path::extract(SQUARE, &Default::default(), false).unwrap();
+        let e = vibration_of_path(&p, &Default::default(), &mut |_| true).unwrap_err();
+        assert!(matches!(e.kind, ErrorKind::InvalidOption { .. }));
+        // Absurdly slow motion is bounded, not simulated for days.
+        let slow = b"G21\nG90\nM83\nG1 X1000 Y0 E1 F0.001\n";
+        let e = vibration(slow, &Default::default()).unwrap_err();
+        assert!(matches!(e.kind, ErrorKind::InvalidOption { .. }));
+    }
+}

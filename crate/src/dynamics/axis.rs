@@ -1,0 +1,202 @@
+//! One axis ready to simulate: the closed-loop model in linear units, discretised per
+//! nut-position bucket.
+//!
+//! Simulation coordinates are those of [`lumped`](super::lumped) measured from the commanded
+//! motion (so the numbers stay small over a metre of travel), with the angles turned into the
+//! table travel they correspond to (`i_s θ`, m) so that every entry of the state matrix has the
+//! same units and the matrix exponential is well scaled. State `x = [q̃, q̃̇]`; `q̃[3]` is the
+//! table's deviation from the commanded position, m.
+
+use nalgebra::{DMatrix, SVector};
+
+use super::integrate::discretize;
+use super::lumped::{dof, Coefficients, Mat6, Matrices, Vec6};
+use super::modal::{self, state_matrix, Mode};
+use super::parameters::Drive;
+
+/// Simulation state of one axis.
+pub type State = SVector<f64, 12>;
+/// Index of the table deviation in [`State`].
+pub const TABLE: usize = dof::X4;
+/// Index of the table's deviation velocity in [`State`].
+pub const TABLE_VELOCITY: usize = 6 + dof::X4;
+
+/// `Φ` and `Γ` of one bucket, as plain column-major arrays (the product below unrolls and
+/// vectorises; it is the simulation's inner loop).
+#[derive(Debug, Clone)]
+pub struct Stepper {
+    phi: [[f64; 12]; 12],
+    gamma: [[f64; 12]; 2],
+}
+
+impl Stepper {
+    /// One period: `x ← Φ x + Γ [v, a]` (commanded velocity at the start, m/s, and
+    /// acceleration over the period, m/s²).
+    #[inline]
+    pub fn step(&self, x: &State, v: f64, a: f64) -> State {
+        let mut y = [0.0f64; 12];
+        for (r, yr) in y.iter_mut().enumerate() {
+            *yr = self.gamma[0][r] * v + self.gamma[1][r] * a;
+        }
+        for (col, &xc) in self.phi.iter().zip(x.iter()) {
+            for (yr, p) in y.iter_mut().zip(col) {
+                *yr += p * xc;
+            }
+        }
+        State::from(y)
+    }
+}
+
+/// `TᵀXT` with `T = diag(1, 1, 1, 1, 1/i_s, 1/i_s)`: angles become travel.
+fn to_linear(x: &Mat6, i_s: f64) -> Mat6 {
+    let t = Vec6::new(1.0, 1.0, 1.0, 1.0, 1.0 / i_s, 1.0 / i_s);
+    Mat6::from_fn(|r, c| x[(r, c)] * t[r] * t[c])
+}
+
+/// The closed-loop matrices in linear units and the command loads (`Tᵀ F`).
+pub fn linear_model(c: &Coefficients, drive: &Drive) -> (Matrices, Vec6, Vec6) {
+    let mats = c.closed_loop(drive.servo());
+    let (f_v, f_a) = c.command_loads(drive.servo());
+    let t = Vec6::new(1.0, 1.0, 1.0, 1.0, 1.0 / c.i_s, 1.0 / c.i_s);
+    (
+        Matrices {
+            m: to_linear(&mats.m, c.i_s),
+            c: to_linear(&mats.c, c.i_s),
+            k: to_linear(&mats.k, c.i_s),
+        },
+        f_v.component_mul(&t),
+        f_a.component_mul(&t),
+    )
+}
+
+fn dyn6(m: &Mat6) -> DMatrix<f64> {
+    DMatrix::from_fn(6, 6, |r, c| m[(r, c)])
+}
+
+/// Modes of the machine as it runs (mechanism and position loop) with the axis at
+/// `position_m`.
+pub fn modes(drive: &Drive, position_m: f64) -> Vec<Mode> {
+    let c = drive.coefficients(position_m);
+    let (mats, _, _) = linear_model(&c, drive);
+    modal::modes(&dyn6(&mats.m), &dyn6(&mats.c), &dyn6(&mats.k))
+}
+
+/// Discretises the axis at `position_m` over `ts` seconds.
+pub fn stepper(drive: &Drive, position_m: f64, ts: f64) -> Option<Stepper> {
+    let c = drive.coefficients(position_m);
+    let (mats, f_v, f_a) = linear_model(&c, drive);
+    let a = state_matrix(&dyn6(&mats.m), &dyn6(&mats.c), &dyn6(&mats.k))?;
+    let mut b_v = DMatrix::zeros(12, 1);
+    let mut b_a = DMatrix::zeros(12, 1);
+    for i in 0..6 {
+        let m = mats.m[(i, i)];
+        if m.is_nan() || m <= 0.0 {
+            return None;
+        }
+        b_v[(6 + i, 0)] = f_v[i] / m;
+        b_a[(6 + i, 0)] = f_a[i] / m;
+    }
+    let d = discretize(&a, &b_v, &b_a, ts)?;
+    Some(Stepper {
+        phi: core::array::from_fn(|c| core::array::from_fn(|r| d.phi[(r, c)])),
+        gamma: core::array::from_fn(|c| core::array::from_fn(|r| d.gamma[(r, c)])),
+    })
+}
+
+/// An axis with its steppers cached per bucket of nut positions.
+#[derive(Debug)]
+pub struct Axis {
+    drive: Drive,
+    ts: f64,
+    bucket_m: f64,
+    cache: Vec<Option<Box<Stepper>>>,
+}
+
+impl Axis {
+    /// Most buckets per axis.
+    pub const MAX_BUCKETS: usize = 4096;
+
+    /// An axis simulated every `ts` seconds, with the stiffness held constant over
+    /// `bucket_m` of travel.
+    pub fn new(drive: Drive, ts: f64, bucket_m: f64) -> Self {
+        let travel = drive.travel_m();
+        let bucket_m = bucket_m.max(travel / Self::MAX_BUCKETS as f64);
+        let count = ((travel / bucket_m).ceil() as usize).clamp(1, Self::MAX_BUCKETS) + 1;
+        Self {
+            drive,
+            ts,
+            bucket_m,
+            cache: vec![None; count],
+        }
+    }
+
+    /// The stepper for the axis at `position_m` (computed on first use), `None` if the model
+    /// cannot be discretised.
+    #[inline]
+    pub fn at(&mut self, position_m: f64) -> Option<&Stepper> {
+        let last = self.cache.len() - 1;
+        let idx = if position_m > 0.0 {
+            ((position_m / self.bucket_m) as usize).min(last)
+        } else {
+            0
+        };
+        let slot = self.cache.get_mut(idx)?;
+        if slot.is_none() {
+            let centre = (idx as f64 + 0.5) * self.bucket_m;
+            *slot = Some(Box::new(stepper(&self.drive, centre, self.ts)?));
+        }
+        slot.as_deref()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::parameters::MachineDynamics;
+
+    #[test]
+    fn preset_modes_are_plausible() {
+        let ldam = MachineDynamics::preset("ldam-ball-screw").unwrap();
+        let desk = MachineDynamics::preset("desktop-belt").unwrap();
+        let lm = modes(&ldam.x, 0.5);
+        let dm = modes(&desk.y, 0.1);
+        assert!(lm.len() >= 4, "{lm:?}");
+        assert!(dm.len() >= 4, "{dm:?}");
+        // A bed-slinger's first Y mode lies in the 20–80 Hz band input shapers are tuned to.
+        assert!(
+            dm[0].frequency_hz > 20.0 && dm[0].frequency_hz < 80.0,
+            "{dm:?}"
+        );
+        eprintln!("ldam x {lm:?}\ndesktop y {dm:?}");
+        for m in lm.iter().chain(&dm) {
+            // The screws' (motor mount's and idler's) antisymmetric mode has no damper: ζ = 0.
+            assert!(m.damping_ratio >= 0.0 && m.damping_ratio < 1.0, "{m:?}");
+        }
+    }
+
+    #[test]
+    fn constant_acceleration_settles_to_the_static_lag() {
+        // Belt axis under a steady commanded acceleration (no feed-forward): the deviation
+        // settles where the springs carry the inertia loads, x = K̃⁻¹ F̃_a a.
+        let desk = MachineDynamics::preset("desktop-belt").unwrap();
+        let mut axis = Axis::new(desk.x, 1e-3, 0.005);
+        let st = axis.at(0.1).unwrap().clone();
+        let mut x = State::zeros();
+        for _ in 0..20_000 {
+            x = st.step(&x, 0.0, 1.0);
+        }
+        let c = desk.x.coefficients(0.1 + 0.0025);
+        let (mats, _, f_a) = linear_model(&c, &desk.x);
+        let static_lag = mats.k.lu().solve(&f_a).unwrap()[TABLE];
+        assert!(
+            static_lag < 0.0,
+            "the table lags behind an accelerating command"
+        );
+        // The velocity ramp inside each period adds a little viscous load.
+        assert!(
+            (x[TABLE] - static_lag).abs() < 0.02 * static_lag.abs(),
+            "{} vs {static_lag}",
+            x[TABLE]
+        );
+    }
+}

@@ -1,0 +1,266 @@
+//! Runs both axes over the sampled trajectory: trajectory deviation (eq. 15), per-layer
+//! statistics and the table's acceleration signal.
+
+use super::axis::{Axis, State, TABLE, TABLE_VELOCITY};
+use super::parameters::MachineDynamics;
+use super::trajectory::{Command, Segment};
+use super::welch::Welch;
+use crate::analyze::Progress;
+use crate::error::{Error, ErrorKind};
+use crate::path::NO_LAYER;
+
+/// Most simulation steps one run may take (about 55 hours of motion at 1 ms).
+pub const MAX_STEPS: f64 = 2e8;
+/// Steps between two progress callbacks.
+const PROGRESS_STEPS: u64 = 1 << 20;
+/// Deviations (m) and deviation velocities (m/s) below which a resting machine is taken as
+/// still: 1 nm, and the speed of a 1 nm vibration at 1.6 kHz. Some modes are all but undamped
+/// (the idler's), so waiting for exact zero could take minutes of simulated rest.
+const STILL_M: f64 = 1e-9;
+const STILL_M_S: f64 = 1e-5;
+
+fn still(x: &State) -> bool {
+    x.iter().take(6).all(|v| v.abs() < STILL_M) && x.iter().skip(6).all(|v| v.abs() < STILL_M_S)
+}
+
+/// Running statistics of a quantity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stats {
+    /// Samples.
+    pub count: u64,
+    /// Sum.
+    pub sum: f64,
+    /// Smallest.
+    pub min: f64,
+    /// Largest.
+    pub max: f64,
+}
+
+impl Default for Stats {
+    fn default() -> Self {
+        Self {
+            count: 0,
+            sum: 0.0,
+            min: f64::INFINITY,
+            max: 0.0,
+        }
+    }
+}
+
+impl Stats {
+    #[inline]
+    fn add(&mut self, v: f64) {
+        self.count += 1;
+        self.sum += v;
+        self.min = self.min.min(v);
+        self.max = self.max.max(v);
+    }
+
+    /// Mean (0 without samples).
+    pub fn mean(&self) -> f64 {
+        if self.count > 0 {
+            self.sum / self.count as f64
+        } else {
+            0.0
+        }
+    }
+
+    /// Smallest (0 without samples).
+    pub fn min_or_zero(&self) -> f64 {
+        if self.count > 0 {
+            self.min
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Per-layer sums.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LayerSums {
+    /// Deviation, mm.
+    pub deviation: Stats,
+    /// Sum of squared acceleration samples, (m/s²)².
+    pub accel_sq: f64,
+    /// Acceleration samples.
+    pub accel_count: u64,
+}
+
+/// What a simulation gives.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// Deviation over every sample taken during a move, mm.
+    pub deviation: Stats,
+    /// Where and when the largest deviation happened: X, Y (mm), time (s).
+    pub max_at: [f64; 3],
+    /// Per-layer sums, by layer index.
+    pub layers: Vec<LayerSums>,
+    /// Steps simulated.
+    pub steps: u64,
+    /// Time simulated (rests skipped once the machine is still), s.
+    pub simulated_s: f64,
+}
+
+/// Settings of one run.
+#[derive(Debug, Clone, Copy)]
+pub struct Settings {
+    /// Interpolation period, s.
+    pub ts: f64,
+    /// Steps per acceleration sample.
+    pub decimation: u64,
+    /// Bucket of nut positions, m.
+    pub bucket_m: f64,
+}
+
+struct Cursor<'a> {
+    segs: &'a [Segment],
+    j: usize,
+}
+
+impl Cursor<'_> {
+    /// Command at `t` (non-decreasing between calls) and the index of the segment it is in.
+    fn at(&mut self, t: f64) -> (Command, Option<usize>) {
+        while self.j < self.segs.len() && self.segs[self.j].end_s() <= t {
+            self.j += 1;
+        }
+        match self.segs.get(self.j) {
+            Some(s) if t >= s.start_s => (s.command(t - s.start_s), Some(self.j)),
+            _ => {
+                let pos = match self.j.checked_sub(1).and_then(|i| self.segs.get(i)) {
+                    Some(prev) => prev.to,
+                    None => self.segs.first().map_or([0.0; 2], |s| s.from),
+                };
+                (Command { pos, vel: [0.0; 2] }, None)
+            }
+        }
+    }
+}
+
+fn cancelled() -> Error {
+    Error::new(0, 0, ErrorKind::Cancelled)
+}
+
+fn model_error() -> Error {
+    Error::new(
+        0,
+        0,
+        ErrorKind::InvalidOption {
+            reason:
+                "dynamics parameters give no usable model (masses must be positive, values finite)",
+        },
+    )
+}
+
+/// Simulates X and Y over `segs`, pushing the table's acceleration (m/s², X and Y) into
+/// `welch` every `decimation` steps.
+pub fn run(
+    segs: &[Segment],
+    layers: usize,
+    machine: &MachineDynamics,
+    settings: Settings,
+    welch: &mut Welch,
+    progress: Progress<'_>,
+) -> Result<Outcome, Error> {
+    let ts = settings.ts;
+    let end = segs.last().map_or(0.0, |s| s.end_s());
+    let total = (end / ts).ceil();
+    if !total.is_finite() || total > MAX_STEPS {
+        return Err(Error::new(
+            0,
+            0,
+            ErrorKind::InvalidOption {
+                reason:
+                    "print too long to simulate at this period (over 2e8 steps); use a longer ts",
+            },
+        ));
+    }
+    let total = total as u64;
+    let mut axes = [
+        Axis::new(machine.x, ts, settings.bucket_m),
+        Axis::new(machine.y, ts, settings.bucket_m),
+    ];
+    let mut x = [State::zeros(); 2];
+    let mut out = Outcome {
+        deviation: Stats::default(),
+        max_at: [0.0; 3],
+        layers: vec![LayerSums::default(); layers],
+        steps: 0,
+        simulated_s: 0.0,
+    };
+    let mut cursor = Cursor { segs, j: 0 };
+    let (mut prev, _) = cursor.at(0.0);
+    // Table velocity (m/s) at the last acceleration sample, and steps since.
+    let mut last_v = [0.0f64; 2];
+    let mut since = 0u64;
+    let mut k = 0u64;
+    let mut next_progress = PROGRESS_STEPS;
+    while k < total {
+        let t1 = (k + 1) as f64 * ts;
+        let (next, seg) = cursor.at(t1);
+        for ax in 0..2 {
+            let v0 = prev.vel[ax] * 1e-3;
+            let a = (next.vel[ax] - prev.vel[ax]) * 1e-3 / ts;
+            let st = axes[ax].at(prev.pos[ax] * 1e-3).ok_or_else(model_error)?;
+            x[ax] = st.step(&x[ax], v0, a);
+        }
+        k += 1;
+        out.steps += 1;
+        let layer = seg.and_then(|i| segs.get(i)).map_or(NO_LAYER, |s| s.layer);
+        if seg.is_some() {
+            let (dx, dy) = (x[0][TABLE], x[1][TABLE]);
+            let dev = (dx * dx + dy * dy).sqrt() * 1e3;
+            if dev > out.deviation.max || out.deviation.count == 0 {
+                out.max_at = [next.pos[0], next.pos[1], t1];
+            }
+            out.deviation.add(dev);
+            if let Some(l) = out.layers.get_mut(layer as usize) {
+                l.deviation.add(dev);
+            }
+        }
+        since += 1;
+        if since >= settings.decimation {
+            let dt = since as f64 * ts;
+            let mut acc = [0.0; 2];
+            for ax in 0..2 {
+                let v = next.vel[ax] * 1e-3 + x[ax][TABLE_VELOCITY];
+                acc[ax] = (v - last_v[ax]) / dt;
+                last_v[ax] = v;
+            }
+            welch.push(&acc);
+            if let Some(l) = out.layers.get_mut(layer as usize) {
+                l.accel_sq += acc[0] * acc[0] + acc[1] * acc[1];
+                l.accel_count += 1;
+            }
+            since = 0;
+        }
+        let mut jumped = false;
+        if seg.is_none() && x.iter().all(still) {
+            // At rest and still: jump to the next move (nothing changes meanwhile).
+            if let Some(s) = segs.get(cursor.j) {
+                let resume = ((s.start_s / ts).floor() as u64).saturating_sub(1);
+                if resume > k {
+                    k = resume;
+                    x = [State::zeros(); 2];
+                    last_v = [0.0; 2];
+                    since = 0;
+                    jumped = true;
+                }
+            } else {
+                break;
+            }
+        }
+        if k >= next_progress {
+            next_progress = k + PROGRESS_STEPS;
+            if !progress(k as f64 / total.max(1) as f64) {
+                return Err(cancelled());
+            }
+        }
+        prev = if jumped {
+            cursor.at(k as f64 * ts).0
+        } else {
+            next
+        };
+    }
+    out.simulated_s = out.steps as f64 * ts;
+    Ok(out)
+}
