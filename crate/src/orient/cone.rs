@@ -36,6 +36,9 @@ pub fn correct(b: V3, smoothed: V3, half_angle: f64) -> Corrected {
     }
     // Eq. 5 (sign and normalisation: see the module documentation).
     let h = vec3::normalize(vec3::cross(b, smoothed)).unwrap_or_else(|| vec3::any_perpendicular(b));
+    // Aim a hair (1e-12 rad) inside the edge so that a caller re-normalising the vector, or
+    // measuring the angle another way, still finds it inside.
+    let half_angle = (half_angle - 1e-12 * half_angle.max(1.0)).max(0.0);
     let mut theta = half_angle;
     let mut t = b;
     for _ in 0..64 {

@@ -116,7 +116,7 @@ pub(super) fn run(
                 dt: orig.dt,
             };
         }
-        if let Some(e) = program::edit_for(input, line, kin, &pose, &offsets, decimals) {
+        if let Some(e) = program::edit_for(input, line, kin, &m.to, &pose, &offsets, decimals) {
             edits.push(e);
         }
     }

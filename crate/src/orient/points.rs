@@ -101,8 +101,9 @@ pub fn write_csv(points: &[PointVector]) -> Vec<u8> {
             out.push('\n');
             last = Some(p.path);
         }
+        // Shortest round-trip form: the vectors read back are bit for bit the ones written.
         out.push_str(&format!(
-            "{:.6},{:.6},{:.6},{:.9},{:.9},{:.9}\n",
+            "{},{},{},{},{},{}\n",
             p.x, p.y, p.z, p.i, p.j, p.k
         ));
     }

@@ -178,12 +178,13 @@ impl Offsets {
     }
 }
 
-/// The edit of one motion line for its new pose, or `None` when the written values would not
-/// change.
+/// The edit of one motion line (which moved to `old_to`) for its new pose, or `None` when the
+/// written values would not change. A changed line gets all five axis words.
 pub(super) fn edit_for(
     input: &[u8],
     line: &MotionLine,
     kin: &Kinematics,
+    old_to: &Pos,
     new: &Pose,
     offsets: &Offsets,
     decimals: usize,
@@ -200,9 +201,9 @@ pub(super) fn edit_for(
     let mut changed = false;
     for (letter, ax, v) in targets {
         let text = words::format_value(v + offsets.of(ax), decimals);
-        let k = AXIS_INDEX.iter().position(|(l, _)| *l == letter);
-        let old = k.and_then(|k| line.words.get(k).copied().flatten());
-        if old.is_none_or(|o| words::format_value(o, decimals) != text) {
+        // What the line means now: its word, or the modal position it leaves unchanged.
+        let old = old_to.get(ax).copied().unwrap_or(0.0) + offsets.of(ax);
+        if words::format_value(old, decimals) != text {
             changed = true;
         }
         values.push((letter, text));
