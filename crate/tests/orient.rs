@@ -90,7 +90,11 @@ fn square_tube_roughness_falls_by_a_third_with_a_60_degree_cone() {
         report.corrected,
         report.max_angle_to_original_deg
     );
-    assert!(report.roughness_reduction >= 0.3, "{}", report.roughness_reduction);
+    assert!(
+        report.roughness_reduction >= 0.3,
+        "{}",
+        report.roughness_reduction
+    );
 }
 
 #[test]
@@ -106,7 +110,11 @@ fn torus_reaches_the_cone_at_60_degrees_and_less_at_90() {
     let (r90, _) = smooth_points(&torus, &paper_options(90.0)).expect("smooth");
     println!(
         "torus: 60° corrected {} roughness {:.5} -> {:.5}; 90° corrected {} roughness -> {:.5}",
-        r60.corrected, r60.before.roughness, r60.after.roughness, r90.corrected, r90.after.roughness
+        r60.corrected,
+        r60.before.roughness,
+        r60.after.roughness,
+        r90.corrected,
+        r90.after.roughness
     );
     assert!(r60.corrected > r90.corrected);
     assert!(r90.after.roughness <= r60.after.roughness);
@@ -135,7 +143,10 @@ fn palindrome(n: usize) -> Vec<PointVector> {
 #[test]
 fn zero_phase_has_no_lag_symmetric_in_symmetric_out() {
     let input = palindrome(121);
-    for filter in [FilterKind::ZeroPhaseMovingAverage, FilterKind::ZeroPhaseMedian] {
+    for filter in [
+        FilterKind::ZeroPhaseMovingAverage,
+        FilterKind::ZeroPhaseMedian,
+    ] {
         for window in [Window::Points(9), Window::Millimetres(6.0)] {
             let options = SmoothOptions {
                 filter,
@@ -181,17 +192,17 @@ fn spiral_gcode() -> (Vec<u8>, Kinematics) {
         let p = [20.0 * ang.cos(), 20.0 * ang.sin(), 5.0 + 10.0 * s];
         let kink = if (i / 30) % 2 == 0 { 8.0 } else { -8.0 };
         let tilt = vec3::rad(20.0 + kink);
-        let v = [
-            tilt.sin() * ang.cos(),
-            tilt.sin() * ang.sin(),
-            tilt.cos(),
-        ];
+        let v = [tilt.sin() * ang.cos(), tilt.sin() * ang.sin(), tilt.cos()];
         let rot = kin.rotary_for(v, prev);
         prev = rot;
         let m = kin.machine_xyz(p, rot);
         e += 0.05;
         let cmd = if i == 0 { "G0" } else { "G1" };
-        let ew = if i == 0 { String::new() } else { format!(" E{e:.4}") };
+        let ew = if i == 0 {
+            String::new()
+        } else {
+            format!(" E{e:.4}")
+        };
         g.push_str(&format!(
             "{cmd} X{:.3} Y{:.3} Z{:.3} B{:.3} C{:.3}{ew}\n",
             m[0], m[1], m[2], rot[0], rot[1]
@@ -230,7 +241,11 @@ fn gcode_keeps_lines_and_tool_tip_path_and_stays_in_the_cone() {
     assert!(report.points > 300 && report.changed > 300);
     assert!(report.max_angle_to_original_deg <= 10.0);
     // The ±10° cone caps what the filter may do at the ±8° kinks.
-    assert!(report.roughness_reduction >= 0.2, "{}", report.roughness_reduction);
+    assert!(
+        report.roughness_reduction >= 0.2,
+        "{}",
+        report.roughness_reduction
+    );
     let out = &report.output;
     let (a_lines, b_lines): (Vec<&[u8]>, Vec<&[u8]>) = (
         input.split(|&b| b == b'\n').collect(),
@@ -253,7 +268,10 @@ fn gcode_keeps_lines_and_tool_tip_path_and_stays_in_the_cone() {
         let d = vec3::norm(vec3::sub(kin.tip(pa), kin.tip(pb)));
         assert!(d < 2e-3, "line {la}: tip moved {d} mm");
         // Within the cone, exactly, on the written values.
-        let ang = vec3::deg(vec3::angle(kin.tool_vector(pa.rot), kin.tool_vector(pb.rot)));
+        let ang = vec3::deg(vec3::angle(
+            kin.tool_vector(pa.rot),
+            kin.tool_vector(pb.rot),
+        ));
         assert!(ang <= 10.0, "line {la}: {ang}");
         // Unwrapped: C never jumps by half a turn or more.
         if *ext {
@@ -277,7 +295,10 @@ fn csv_and_json_round_trip_through_smooth() {
     });
     let csv = orient::points::write_csv(&pts);
     let json = orient::points::write_json(&pts);
-    for (bytes, fmt) in [(csv, orient::InputFormat::Csv), (json, orient::InputFormat::Json)] {
+    for (bytes, fmt) in [
+        (csv, orient::InputFormat::Csv),
+        (json, orient::InputFormat::Json),
+    ] {
         assert_eq!(orient::detect(&bytes), fmt);
         let r = orient::smooth(&bytes, &SmoothOptions::default()).expect("smooth");
         assert_eq!(r.format, fmt);
@@ -295,16 +316,42 @@ fn csv_and_json_round_trip_through_smooth() {
 #[test]
 fn bad_options_are_errors_not_panics() {
     for o in [
-        SmoothOptions { cone_deg: f64::NAN, ..SmoothOptions::default() },
-        SmoothOptions { cone_deg: 0.0, ..SmoothOptions::default() },
-        SmoothOptions { window: Window::Points(0), ..SmoothOptions::default() },
-        SmoothOptions { window: Window::Millimetres(-1.0), ..SmoothOptions::default() },
-        SmoothOptions { decimals: 0, ..SmoothOptions::default() },
-        SmoothOptions { feed_mm_s: 0.0, ..SmoothOptions::default() },
+        SmoothOptions {
+            cone_deg: f64::NAN,
+            ..SmoothOptions::default()
+        },
+        SmoothOptions {
+            cone_deg: 0.0,
+            ..SmoothOptions::default()
+        },
+        SmoothOptions {
+            window: Window::Points(0),
+            ..SmoothOptions::default()
+        },
+        SmoothOptions {
+            window: Window::Millimetres(-1.0),
+            ..SmoothOptions::default()
+        },
+        SmoothOptions {
+            decimals: 0,
+            ..SmoothOptions::default()
+        },
+        SmoothOptions {
+            feed_mm_s: 0.0,
+            ..SmoothOptions::default()
+        },
     ] {
         assert!(orient::smooth(b"G1 X1 B2 C3 E1\n", &o).is_err());
     }
-    let bad = [PointVector { x: 0.0, y: 0.0, z: 0.0, i: 0.0, j: 0.0, k: 0.0, path: 0 }];
+    let bad = [PointVector {
+        x: 0.0,
+        y: 0.0,
+        z: 0.0,
+        i: 0.0,
+        j: 0.0,
+        k: 0.0,
+        path: 0,
+    }];
     assert!(smooth_points(&bad, &SmoothOptions::default()).is_err());
     // Plain 3-axis G-code: nothing to smooth, a warning, output identical.
     let plain = b"G90\nG1 X1 Y1 E1 F600\nG1 X2 Y1 E2\n";

@@ -143,7 +143,8 @@ pub fn run(args: Args) -> Result<(), String> {
         analyze: args.opts.options()?,
     };
     let mut bar = output::ProgressBar::new(
-        input.len() >= super::PROGRESS_MIN_BYTES && std::io::IsTerminal::is_terminal(&std::io::stderr()),
+        input.len() >= super::PROGRESS_MIN_BYTES
+            && std::io::IsTerminal::is_terminal(&std::io::stderr()),
     );
     let report = smooth_with_progress(&input, &options, &mut |f| bar.update(f))
         .map_err(|e| format!("{}:{}", args.file.display(), e))?;
@@ -182,7 +183,12 @@ fn print(out: &mut impl Write, args: &Args, r: &SmoothReport) -> std::io::Result
     let row = |out: &mut dyn Write, name: &str, a: f64, b: f64| {
         writeln!(out, "  {name:<34} {a:>14.4} {b:>14.4}")
     };
-    row(out, "roughness (mean |d2 T|)", r.before.roughness, r.after.roughness)?;
+    row(
+        out,
+        "roughness (mean |d2 T|)",
+        r.before.roughness,
+        r.after.roughness,
+    )?;
     row(
         out,
         "angle change per point, mean deg",
@@ -202,10 +208,34 @@ fn print(out: &mut impl Write, args: &Args, r: &SmoothReport) -> std::io::Result
         r.after.mean_angle_change_per_mm_deg,
     )?;
     for (b, a) in r.before.rotary.iter().zip(&r.after.rotary) {
-        row(out, &format!("{} velocity rms, deg/s", b.axis), b.rms_velocity_deg_s, a.rms_velocity_deg_s)?;
-        row(out, &format!("{} acceleration rms, deg/s2", b.axis), b.rms_acceleration_deg_s2, a.rms_acceleration_deg_s2)?;
-        row(out, &format!("{} jerk rms, deg/s3", b.axis), b.rms_jerk_deg_s3, a.rms_jerk_deg_s3)?;
-        row(out, &format!("{} travel, deg", b.axis), b.travel_deg, a.travel_deg)?;
+        row(
+            out,
+            &format!("{} velocity rms, deg/s", b.axis),
+            b.rms_velocity_deg_s,
+            a.rms_velocity_deg_s,
+        )?;
+        row(
+            out,
+            &format!("{} acceleration rms, deg/s2", b.axis),
+            b.rms_acceleration_deg_s2,
+            a.rms_acceleration_deg_s2,
+        )?;
+        row(
+            out,
+            &format!("{} jerk rms, deg/s3", b.axis),
+            b.rms_jerk_deg_s3,
+            a.rms_jerk_deg_s3,
+        )?;
+        row(
+            out,
+            &format!("{} travel, deg", b.axis),
+            b.travel_deg,
+            a.travel_deg,
+        )?;
     }
-    writeln!(out, "  roughness reduction {:.1}%", 100.0 * r.roughness_reduction)
+    writeln!(
+        out,
+        "  roughness reduction {:.1}%",
+        100.0 * r.roughness_reduction
+    )
 }

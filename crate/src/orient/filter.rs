@@ -193,7 +193,10 @@ fn pad_len(s: &[f64], window: Window, from_end: bool) -> usize {
     match window {
         Window::Points(w) => w.saturating_sub(1).min(n - 1),
         Window::Millimetres(w) => {
-            let (first, last) = (s.first().copied().unwrap_or(0.0), s.last().copied().unwrap_or(0.0));
+            let (first, last) = (
+                s.first().copied().unwrap_or(0.0),
+                s.last().copied().unwrap_or(0.0),
+            );
             let mut k = 0usize;
             while k < n - 1 {
                 let d = if from_end {
@@ -223,7 +226,10 @@ fn zero_phase_average(v: &[V3], s: &[f64], window: Window) -> Vec<V3> {
     let mut pv = Vec::with_capacity(n + pl + pr);
     let mut ps = Vec::with_capacity(n + pl + pr);
     for k in (1..=pl).rev() {
-        let (vk, sk) = (v.get(k).copied().unwrap_or(v0), s.get(k).copied().unwrap_or(s0));
+        let (vk, sk) = (
+            v.get(k).copied().unwrap_or(v0),
+            s.get(k).copied().unwrap_or(s0),
+        );
         pv.push(vec3::sub(vec3::scale(v0, 2.0), vk));
         ps.push(2.0 * s0 - sk);
     }
@@ -231,7 +237,10 @@ fn zero_phase_average(v: &[V3], s: &[f64], window: Window) -> Vec<V3> {
     ps.extend_from_slice(s);
     for k in 1..=pr {
         let i = n - 1 - k;
-        let (vk, sk) = (v.get(i).copied().unwrap_or(vn), s.get(i).copied().unwrap_or(sn));
+        let (vk, sk) = (
+            v.get(i).copied().unwrap_or(vn),
+            s.get(i).copied().unwrap_or(sn),
+        );
         pv.push(vec3::sub(vec3::scale(vn, 2.0), vk));
         ps.push(2.0 * sn - sk);
     }
@@ -309,7 +318,12 @@ mod tests {
     fn causal_average_lags_zero_phase_does_not() {
         let (v, s) = step(200);
         let causal = smooth(&v, &s, FilterKind::MovingAverage, Window::Points(21));
-        let zero = smooth(&v, &s, FilterKind::ZeroPhaseMovingAverage, Window::Points(21));
+        let zero = smooth(
+            &v,
+            &s,
+            FilterKind::ZeroPhaseMovingAverage,
+            Window::Points(21),
+        );
         let midpoint = |out: &[V3]| {
             out.iter()
                 .position(|o| libm::atan2(o[0], o[2]) >= 0.3)
@@ -323,8 +337,18 @@ mod tests {
     #[test]
     fn window_in_millimetres_matches_points_on_even_spacing() {
         let (v, s) = step(100);
-        let a = smooth(&v, &s, FilterKind::ZeroPhaseMovingAverage, Window::Points(11));
-        let b = smooth(&v, &s, FilterKind::ZeroPhaseMovingAverage, Window::Millimetres(2.0 + 1e-9));
+        let a = smooth(
+            &v,
+            &s,
+            FilterKind::ZeroPhaseMovingAverage,
+            Window::Points(11),
+        );
+        let b = smooth(
+            &v,
+            &s,
+            FilterKind::ZeroPhaseMovingAverage,
+            Window::Millimetres(2.0 + 1e-9),
+        );
         for (x, y) in a.iter().zip(&b) {
             assert!(vec3::norm(vec3::sub(*x, *y)) < 1e-12);
         }

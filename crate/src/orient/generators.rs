@@ -47,11 +47,7 @@ pub fn torus_surface(t: f64, v: f64) -> V3 {
     let (st, ct) = (math::sin(t), math::cos(t));
     let (sv, cv) = (math::sin(v), math::cos(v));
     // G(t) + ρ (cos v e₁ + sin v e₂), e₁ = (cos t, 0, sin t) (away from the torus axis), e₂ = ŷ.
-    [
-        R * ct - R + RHO * cv * ct,
-        RHO * sv,
-        R * st + RHO * cv * st,
-    ]
+    [R * ct - R + RHO * cv * ct, RHO * sv, R * st + RHO * cv * st]
 }
 
 /// Eq. 2: guide curve the Z axis, `ρ(t, v) = 15 (1 + t²/400) / (√(1 + sin 2v) + √(1 − sin 2v))`
@@ -172,7 +168,8 @@ fn build_direction(surface: &dyn Fn(f64, f64) -> V3, t: f64, v: f64, tau: V3, t_
     let st = vec3::sub(surface(t1, v), surface(t0, v));
     let sv = vec3::sub(surface(t, v + 1e-5), surface(t, v - 1e-5));
     let normal = vec3::normalize(vec3::cross(st, sv)).unwrap_or([1.0, 0.0, 0.0]);
-    let b = vec3::normalize(vec3::cross(normal, tau)).unwrap_or_else(|| vec3::normalize(st).unwrap_or([0.0, 0.0, 1.0]));
+    let b = vec3::normalize(vec3::cross(normal, tau))
+        .unwrap_or_else(|| vec3::normalize(st).unwrap_or([0.0, 0.0, 1.0]));
     if vec3::dot(b, st) < 0.0 {
         vec3::scale(b, -1.0)
     } else {

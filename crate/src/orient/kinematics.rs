@@ -212,7 +212,11 @@ impl Kinematics {
                 let b1 = vec3::deg(math::atan2(n[0], math::hypot(n[1], n[2])));
                 let singular = math::hypot(n[1], n[2]) < 1e-12;
                 let a1 = vec3::deg(math::atan2(-n[1], n[2]));
-                ([a1, b1], [wrap180(a1 + 180.0), wrap180(180.0 - b1)], singular)
+                (
+                    [a1, b1],
+                    [wrap180(a1 + 180.0), wrap180(180.0 - b1)],
+                    singular,
+                )
             }
         }
     }
@@ -324,7 +328,11 @@ mod tests {
                 pivot_length_mm: 120.0,
             };
             // Table C is multi-turn; head angles are principal values.
-            let last = if model == KinematicModel::TableBc { [5.0, 720.5] } else { [5.0, 80.5] };
+            let last = if model == KinematicModel::TableBc {
+                [5.0, 720.5]
+            } else {
+                [5.0, 80.5]
+            };
             for (i, rot) in [[-20.0, 33.0], [45.0, -170.0], last].iter().enumerate() {
                 let p = [i as f64 * 3.0 - 4.0, 12.5, 30.0 + i as f64];
                 let m = k.machine_xyz(p, *rot);
@@ -332,8 +340,14 @@ mod tests {
                 assert!(close(back, p, 1e-9), "{model:?} {rot:?}");
                 let n = k.tool_vector(*rot);
                 let r = k.rotary_for(n, *rot);
-                assert!(close(k.tool_vector(r), n, 1e-12), "{model:?} {rot:?} -> {r:?}");
-                assert!((r[0] - rot[0]).abs() < 1e-9 && (r[1] - rot[1]).abs() < 1e-9, "{model:?} {rot:?} {r:?}");
+                assert!(
+                    close(k.tool_vector(r), n, 1e-12),
+                    "{model:?} {rot:?} -> {r:?}"
+                );
+                assert!(
+                    (r[0] - rot[0]).abs() < 1e-9 && (r[1] - rot[1]).abs() < 1e-9,
+                    "{model:?} {rot:?} {r:?}"
+                );
             }
         }
     }

@@ -97,7 +97,10 @@ impl Acc {
 }
 
 /// Metrics of `runs` (each a continuous path; its first sample is where it starts).
-pub fn measure<'a>(runs: impl Iterator<Item = &'a [Sample]>, letters: [char; 2]) -> OrientationMetrics {
+pub fn measure<'a>(
+    runs: impl Iterator<Item = &'a [Sample]>,
+    letters: [char; 2],
+) -> OrientationMetrics {
     let mut second = Acc::default();
     let mut turn = Acc::default();
     let mut per_mm = Acc::default();
@@ -108,7 +111,10 @@ pub fn measure<'a>(runs: impl Iterator<Item = &'a [Sample]>, letters: [char; 2])
     for run in runs {
         for w in run.windows(3) {
             if let [a, b, c] = w {
-                second.push(vec3::norm(vec3::add(vec3::sub(a.v, vec3::scale(b.v, 2.0)), c.v)));
+                second.push(vec3::norm(vec3::add(
+                    vec3::sub(a.v, vec3::scale(b.v, 2.0)),
+                    c.v,
+                )));
             }
         }
         for w in run.windows(2) {

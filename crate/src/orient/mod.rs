@@ -115,7 +115,7 @@ impl SmoothOptions {
         if !(self.singular_deg.is_finite() && (0.0..=90.0).contains(&self.singular_deg)) {
             return bad("singular_deg must be in [0, 90]");
         }
-        if !(self.max_gap_mm > 0.0) || self.max_gap_mm.is_nan() {
+        if self.max_gap_mm.is_nan() || self.max_gap_mm <= 0.0 {
             return bad("max_gap_mm must be positive (may be infinite)");
         }
         if !(1..=9).contains(&self.decimals) {
@@ -262,9 +262,9 @@ pub fn detect(input: &[u8]) -> InputFormat {
     let first = text.split(|&b| b == b'\n').next().unwrap_or(&[]);
     let first = String::from_utf8_lossy(first);
     let fields: Vec<&str> = first.split(',').map(str::trim).collect();
-    let header = fields.first().is_some_and(|f| f.eq_ignore_ascii_case("x"))
-        && fields.len() >= 6;
-    let numbers = (6..=7).contains(&fields.len()) && fields.iter().all(|f| f.parse::<f64>().is_ok());
+    let header = fields.first().is_some_and(|f| f.eq_ignore_ascii_case("x")) && fields.len() >= 6;
+    let numbers =
+        (6..=7).contains(&fields.len()) && fields.iter().all(|f| f.parse::<f64>().is_ok());
     if header || numbers {
         InputFormat::Csv
     } else {

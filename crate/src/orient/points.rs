@@ -74,7 +74,15 @@ pub fn parse_csv(input: &[u8]) -> Result<Vec<PointVector>, Error> {
             Some(_) => return Err(invalid(number, "CSV path column must be a whole number")),
             None => path,
         };
-        out.push(PointVector { x, y, z, i, j, k, path: p });
+        out.push(PointVector {
+            x,
+            y,
+            z,
+            i,
+            j,
+            k,
+            path: p,
+        });
         if out.len() > MAX_POINTS {
             return Err(invalid(number, "too many points (more than 10 000 000)"));
         }
@@ -84,8 +92,12 @@ pub fn parse_csv(input: &[u8]) -> Result<Vec<PointVector>, Error> {
 
 /// Parses JSON point-vector data.
 pub fn parse_json(input: &[u8]) -> Result<Vec<PointVector>, Error> {
-    let points: Vec<PointVector> = serde_json::from_slice(input)
-        .map_err(|_| invalid(0, "JSON must be an array of {x, y, z, i, j, k, path?} objects"))?;
+    let points: Vec<PointVector> = serde_json::from_slice(input).map_err(|_| {
+        invalid(
+            0,
+            "JSON must be an array of {x, y, z, i, j, k, path?} objects",
+        )
+    })?;
     if points.len() > MAX_POINTS {
         return Err(invalid(0, "too many points (more than 10 000 000)"));
     }
@@ -121,7 +133,8 @@ mod tests {
 
     #[test]
     fn csv_with_header_and_paths() {
-        let pts = parse_csv(b"x,y,z,i,j,k\n0,0,0,0,0,1\n1,0,0,0,0,1\n\n2,0,0,0,0,1\n").unwrap_or_default();
+        let pts = parse_csv(b"x,y,z,i,j,k\n0,0,0,0,0,1\n1,0,0,0,0,1\n\n2,0,0,0,0,1\n")
+            .unwrap_or_default();
         assert_eq!(pts.len(), 3);
         assert_eq!((pts[0].path, pts[1].path, pts[2].path), (0, 0, 1));
         assert!(parse_csv(b"0,0,0,0,0\n").is_err());

@@ -86,7 +86,10 @@ fn eligible(m: &PathMove, line: Option<&MotionLine>, max_gap_mm: f64) -> bool {
 }
 
 /// The motion line of each move (`None` for moves from other commands).
-pub(super) fn line_of_moves<'l>(moves: &[PathMove], lines: &'l [MotionLine]) -> Vec<Option<&'l MotionLine>> {
+pub(super) fn line_of_moves<'l>(
+    moves: &[PathMove],
+    lines: &'l [MotionLine],
+) -> Vec<Option<&'l MotionLine>> {
     let mut j = 0usize;
     moves
         .iter()
@@ -100,11 +103,7 @@ pub(super) fn line_of_moves<'l>(moves: &[PathMove], lines: &'l [MotionLine]) -> 
 }
 
 /// Splits the moves into runs of consecutive eligible moves.
-pub(super) fn runs(
-    moves: &[PathMove],
-    lines: &[Option<&MotionLine>],
-    max_gap_mm: f64,
-) -> Vec<Run> {
+pub(super) fn runs(moves: &[PathMove], lines: &[Option<&MotionLine>], max_gap_mm: f64) -> Vec<Run> {
     let mut out = Vec::new();
     let mut cur: Run = Vec::new();
     for (i, m) in moves.iter().enumerate() {
@@ -219,5 +218,8 @@ pub(super) fn edit_for(
 }
 
 fn rot_letter(ax: usize) -> u8 {
-    crate::machine::AXIS_LETTERS.get(ax).copied().unwrap_or(b'B')
+    crate::machine::AXIS_LETTERS
+        .get(ax)
+        .copied()
+        .unwrap_or(b'B')
 }

@@ -126,7 +126,11 @@ mod tests {
 
     #[test]
     fn rodrigues_quarter_turn_about_z() {
-        let r = rotate([1.0, 0.0, 0.0], [0.0, 0.0, 1.0], std::f64::consts::FRAC_PI_2);
+        let r = rotate(
+            [1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0],
+            std::f64::consts::FRAC_PI_2,
+        );
         assert!(norm(sub(r, [0.0, 1.0, 0.0])) < 1e-15);
     }
 
