@@ -1,0 +1,173 @@
+//! Smoothing multi-axis G-code.
+
+use super::core::{self, RunSettings};
+use super::kinematics::Pose;
+use super::metrics::Sample;
+use super::program::{self, Offsets};
+use super::summary::{self, Counts};
+use super::vec3;
+use super::words;
+use super::{InputFormat, SmoothOptions, SmoothReport};
+use crate::analyze::Progress;
+use crate::error::{Error, Warning};
+use crate::gcode::{self, Edit};
+use crate::path;
+
+pub(super) fn run(
+    input: &[u8],
+    options: &SmoothOptions,
+    progress: Progress<'_>,
+) -> Result<SmoothReport, Error> {
+    let kin = &options.kinematics;
+    summary::tick(progress, 0.0)?;
+    let read = path::extract(input, &options.analyze, true)?;
+    let moves = &read.moves;
+    let mut warnings = read.warnings.clone();
+    summary::tick(progress, 0.3)?;
+    let lines = program::motion_lines(input, options.analyze.strict)?;
+    let line_of = program::line_of_moves(moves, &lines);
+    let runs = program::runs(moves, &line_of, options.max_gap_mm);
+    let [r0, r1] = kin.model.rotary_axes();
+    let has_rotary = moves
+        .iter()
+        .any(|m| m.to[r0] != 0.0 || m.to[r1] != 0.0 || m.from[r0] != 0.0 || m.from[r1] != 0.0);
+    if !has_rotary {
+        let [a, b] = kin.model.rotary_letters();
+        warnings.push(Warning {
+            line: 0,
+            message: format!(
+                "no {a}/{b} rotary motion in the file: the tool vector is constant, nothing to smooth"
+            ),
+        });
+    }
+
+    let decimals = usize::from(options.decimals);
+    let half = vec3::rad(0.5 * options.cone_deg);
+    // Writing the angles with `decimals` places moves each by at most half a unit of the last
+    // place; aiming that much inside the cone keeps the written vector inside it.
+    let margin = vec3::rad(libm::pow(10.0, -(decimals as f64)));
+    let settings = RunSettings {
+        filter: options.filter,
+        window: options.window,
+        half_angle: (half - margin).max(0.0),
+        singular_angle: vec3::rad(options.singular_deg),
+    };
+    let before: Vec<Vec<Sample>> = runs
+        .iter()
+        .map(|r| program::samples(kin, moves, r))
+        .collect();
+    let mut smoothed = Vec::with_capacity(runs.len());
+    let mut corrected = 0usize;
+    for (i, run) in before.iter().enumerate() {
+        if i % 256 == 0 {
+            summary::tick(progress, 0.3 + 0.3 * i as f64 / before.len().max(1) as f64)?;
+        }
+        let out = core::smooth_run(run, kin, &settings, true);
+        corrected += out.corrected;
+        smoothed.push(out.samples);
+    }
+
+    // Where each move's new pose is: (run, sample index).
+    let mut slot: Vec<Option<(usize, usize)>> = vec![None; moves.len()];
+    for (r, run) in runs.iter().enumerate() {
+        for (k, &mi) in run.iter().enumerate() {
+            if let Some(s) = slot.get_mut(mi) {
+                *s = Some((r, k + 1));
+            }
+        }
+    }
+    let mut offsets = Offsets::default();
+    let mut edits: Vec<Edit> = Vec::new();
+    let mut after_est: Vec<Vec<Sample>> = before.clone();
+    for (mi, m) in moves.iter().enumerate() {
+        let Some(line) = line_of.get(mi).copied().flatten() else {
+            continue;
+        };
+        offsets.learn(m, line);
+        let Some((r, k)) = slot.get(mi).copied().flatten() else {
+            continue;
+        };
+        let (Some(orig), Some(new)) = (
+            before.get(r).and_then(|x| x.get(k)),
+            smoothed.get(r).and_then(|x| x.get(k)),
+        ) else {
+            continue;
+        };
+        let q = |v: f64, ax: usize| words::rounded(v + offsets.of(ax), decimals) - offsets.of(ax);
+        let mut rot = [q(new.rot[0], r0), q(new.rot[1], r1)];
+        let mut v = kin.tool_vector(rot);
+        if vec3::angle(v, orig.v) > half {
+            // Rounding pushed it out after all: keep the original orientation here.
+            rot = orig.rot;
+            v = orig.v;
+        }
+        let xyz = kin.machine_xyz(orig.p, rot);
+        let xyz = [
+            q(xyz[0], crate::machine::axis::X),
+            q(xyz[1], crate::machine::axis::Y),
+            q(xyz[2], crate::machine::axis::Z),
+        ];
+        let pose = Pose { xyz, rot };
+        if let Some(s) = after_est.get_mut(r).and_then(|x| x.get_mut(k)) {
+            *s = Sample {
+                p: kin.tip(&pose),
+                v,
+                rot,
+                dt: orig.dt,
+            };
+        }
+        if let Some(e) = program::edit_for(input, line, kin, &m.to, &pose, &offsets, decimals) {
+            edits.push(e);
+        }
+    }
+    summary::tick(progress, 0.65)?;
+    let output = gcode::apply_edits(input, &edits);
+
+    // Read the output back: the "after" metrics are measured on what was written. The rotary
+    // rates use the input's schedule for both (see `SmoothReport::planned_time_after_s`).
+    let mut planned_time_after_s = read.time_s;
+    let after = match path::extract(&output, &options.analyze, true) {
+        Ok(back)
+            if back.moves.len() == moves.len()
+                && back.moves.iter().zip(moves).all(|(a, b)| a.line == b.line) =>
+        {
+            planned_time_after_s = back.time_s;
+            runs.iter()
+                .zip(&before)
+                .map(|(r, b)| {
+                    let mut s = program::samples(kin, &back.moves, r);
+                    for (x, y) in s.iter_mut().zip(b) {
+                        x.dt = y.dt;
+                    }
+                    s
+                })
+                .collect()
+        }
+        _ => {
+            warnings.push(Warning {
+                line: 0,
+                message: "the output could not be re-read move for move; after-metrics use the input's timing".into(),
+            });
+            after_est
+        }
+    };
+    summary::tick(progress, 0.95)?;
+    let mut report = summary::assemble(
+        options,
+        Counts {
+            format: InputFormat::Gcode,
+            motion_lines: lines.len(),
+            corrected,
+            changed: edits.len(),
+            skip_first: true,
+        },
+        &before,
+        &after,
+        warnings,
+        output,
+    );
+    report.planned_time_before_s = read.time_s;
+    report.planned_time_after_s = planned_time_after_s;
+    summary::tick(progress, 1.0)?;
+    Ok(report)
+}

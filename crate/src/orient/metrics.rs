@@ -1,0 +1,203 @@
+//! Orientation-variation metrics (what the smoothing is for): angle change per point and per
+//! millimetre, roughness, and the rotary axes' angular velocity, acceleration and jerk under
+//! the move timing (the planner's for G-code, a constant feed for point-vector data).
+
+use serde::Serialize;
+
+use super::vec3::{self, V3};
+
+/// One path point as the metrics see it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Tool-tip position in the workpiece frame, mm.
+    pub p: V3,
+    /// Unit tool vector in the workpiece frame.
+    pub v: V3,
+    /// Rotary axes, degrees.
+    pub rot: [f64; 2],
+    /// Duration of the move ending here, s (unused for a run's first sample).
+    pub dt: f64,
+}
+
+/// Motion of one rotary axis.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct RotaryMetrics {
+    /// Axis letter.
+    pub axis: String,
+    /// Total angle travelled, degrees.
+    pub travel_deg: f64,
+    /// Largest angular velocity (per-move average), °/s.
+    pub max_velocity_deg_s: f64,
+    /// Root-mean-square angular velocity, °/s.
+    pub rms_velocity_deg_s: f64,
+    /// Largest angular acceleration between consecutive moves, °/s².
+    pub max_acceleration_deg_s2: f64,
+    /// Root-mean-square angular acceleration, °/s².
+    pub rms_acceleration_deg_s2: f64,
+    /// Largest angular jerk, °/s³.
+    pub max_jerk_deg_s3: f64,
+    /// Root-mean-square angular jerk, °/s³.
+    pub rms_jerk_deg_s3: f64,
+}
+
+/// Orientation metrics of a set of runs.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct OrientationMetrics {
+    /// Mean norm of the second difference of the unit tool vector,
+    /// `‖T_{m+1} − 2 T_m + T_{m−1}‖`, over interior points of every run.
+    pub roughness: f64,
+    /// Largest second-difference norm.
+    pub max_second_difference: f64,
+    /// Mean angle between consecutive tool vectors, degrees.
+    pub mean_angle_change_deg: f64,
+    /// Largest angle between consecutive tool vectors, degrees.
+    pub max_angle_change_deg: f64,
+    /// Mean angle change per millimetre of tool-tip path, °/mm (segments longer than 1 µm).
+    pub mean_angle_change_per_mm_deg: f64,
+    /// Largest angle change per millimetre, °/mm.
+    pub max_angle_change_per_mm_deg: f64,
+    /// The two rotary axes.
+    pub rotary: Vec<RotaryMetrics>,
+}
+
+/// Shortest move duration the rates are computed with, s (guards zero-time moves).
+const MIN_DT_S: f64 = 1e-4;
+
+#[derive(Default)]
+struct Acc {
+    sum: f64,
+    sq: f64,
+    max: f64,
+    n: usize,
+}
+
+impl Acc {
+    fn push(&mut self, x: f64) {
+        if x.is_finite() {
+            self.sum += x.abs();
+            self.sq += x * x;
+            self.max = self.max.max(x.abs());
+            self.n += 1;
+        }
+    }
+    fn mean(&self) -> f64 {
+        if self.n == 0 {
+            0.0
+        } else {
+            self.sum / self.n as f64
+        }
+    }
+    fn rms(&self) -> f64 {
+        if self.n == 0 {
+            0.0
+        } else {
+            (self.sq / self.n as f64).sqrt()
+        }
+    }
+}
+
+/// Metrics of `runs` (each a continuous path; its first sample is where it starts).
+pub fn measure<'a>(
+    runs: impl Iterator<Item = &'a [Sample]>,
+    letters: [char; 2],
+) -> OrientationMetrics {
+    let mut second = Acc::default();
+    let mut turn = Acc::default();
+    let mut per_mm = Acc::default();
+    let mut travel = [0.0f64; 2];
+    let mut vel: [Acc; 2] = Default::default();
+    let mut acc: [Acc; 2] = Default::default();
+    let mut jerk: [Acc; 2] = Default::default();
+    for run in runs {
+        for w in run.windows(3) {
+            if let [a, b, c] = w {
+                second.push(vec3::norm(vec3::add(
+                    vec3::sub(a.v, vec3::scale(b.v, 2.0)),
+                    c.v,
+                )));
+            }
+        }
+        for w in run.windows(2) {
+            if let [a, b] = w {
+                let ang = vec3::deg(vec3::angle(a.v, b.v));
+                turn.push(ang);
+                let len = vec3::norm(vec3::sub(b.p, a.p));
+                if len > 1e-3 {
+                    per_mm.push(ang / len);
+                }
+            }
+        }
+        for k in 0..2 {
+            // Per-move average velocity, then differences at the move boundaries.
+            let mut prev_v: Option<(f64, f64)> = None;
+            let mut prev_a: Option<(f64, f64)> = None;
+            for w in run.windows(2) {
+                let [a, b] = w else { continue };
+                let d = b.rot[k] - a.rot[k];
+                travel[k] += d.abs();
+                let dt = b.dt.max(MIN_DT_S);
+                let v = d / dt;
+                vel[k].push(v);
+                if let Some((pv, pdt)) = prev_v {
+                    let h = 0.5 * (dt + pdt);
+                    let a_now = (v - pv) / h;
+                    acc[k].push(a_now);
+                    if let Some((pa, ph)) = prev_a {
+                        jerk[k].push((a_now - pa) / (0.5 * (h + ph)));
+                    }
+                    prev_a = Some((a_now, h));
+                }
+                prev_v = Some((v, dt));
+            }
+        }
+    }
+    OrientationMetrics {
+        roughness: second.mean(),
+        max_second_difference: second.max,
+        mean_angle_change_deg: turn.mean(),
+        max_angle_change_deg: turn.max,
+        mean_angle_change_per_mm_deg: per_mm.mean(),
+        max_angle_change_per_mm_deg: per_mm.max,
+        rotary: (0..2)
+            .map(|k| RotaryMetrics {
+                axis: letters[k].to_string(),
+                travel_deg: travel[k],
+                max_velocity_deg_s: vel[k].max,
+                rms_velocity_deg_s: vel[k].rms(),
+                max_acceleration_deg_s2: acc[k].max,
+                rms_acceleration_deg_s2: acc[k].rms(),
+                max_jerk_deg_s3: jerk[k].max,
+                rms_jerk_deg_s3: jerk[k].rms(),
+            })
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn constant_rotation_rate_has_no_acceleration() {
+        let run: Vec<Sample> = (0..10)
+            .map(|i| {
+                let a = vec3::rad(i as f64);
+                Sample {
+                    p: [i as f64, 0.0, 0.0],
+                    v: [a.sin(), 0.0, a.cos()],
+                    rot: [0.0, 2.0 * i as f64],
+                    dt: 0.5,
+                }
+            })
+            .collect();
+        let m = measure(std::iter::once(&run[..]), ['B', 'C']);
+        assert!((m.mean_angle_change_deg - 1.0).abs() < 1e-9);
+        assert!((m.mean_angle_change_per_mm_deg - 1.0).abs() < 1e-9);
+        assert!((m.rotary[1].max_velocity_deg_s - 4.0).abs() < 1e-12);
+        assert!(m.rotary[1].max_acceleration_deg_s2 < 1e-9);
+        assert!((m.rotary[1].travel_deg - 18.0).abs() < 1e-12);
+        // Second difference of a uniform rotation by δ: 2 (1 − cos δ) = 4 sin²(δ/2).
+        let d = vec3::rad(1.0);
+        assert!((m.roughness - 4.0 * (d / 2.0).sin().powi(2)).abs() < 1e-12);
+    }
+}

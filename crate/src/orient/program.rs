@@ -1,0 +1,225 @@
+//! Multi-axis G-code in and out: every extruding `G1` becomes a path point (tool tip in the
+//! workpiece frame and tool vector through the kinematic model), consecutive extruding moves
+//! form a run, and smoothed runs are written back as the same lines with new rotary angles and
+//! the machine XYZ that keeps the tool tip where it was.
+//!
+//! Travel moves, arcs, moves in relative positioning (`G91`) and every other line stay
+//! byte-identical. A run starts at the end of the move before it, which is not changed.
+
+use crate::error::{Error, Warnings};
+use crate::gcode::{self, Code, Edit};
+use crate::machine::{axis, MoveKind, Pos};
+use crate::path::PathMove;
+
+use super::kinematics::{Kinematics, Pose};
+use super::metrics::Sample;
+use super::words;
+
+/// Word letters the rewriting can change: X, Y, Z and the rotary axes.
+const AXIS_INDEX: [(u8, usize); 6] = [
+    (b'X', axis::X),
+    (b'Y', axis::Y),
+    (b'Z', axis::Z),
+    (b'A', axis::A),
+    (b'B', axis::B),
+    (b'C', axis::C),
+];
+
+/// A `G0`/`G1` line as the rewriting needs it.
+#[derive(Debug, Clone)]
+pub(super) struct MotionLine {
+    /// 1-based line number.
+    pub number: u32,
+    /// Byte range of the line's text in the input.
+    pub range: std::ops::Range<usize>,
+    /// Whether `G91` was in force.
+    pub relative: bool,
+    /// Values written for X, Y, Z, A, B, C (in [`AXIS_INDEX`] order).
+    pub words: [Option<f64>; 6],
+}
+
+/// Every `G0`/`G1` line of the input, in order.
+pub(super) fn motion_lines(input: &[u8], strict: bool) -> Result<Vec<MotionLine>, Error> {
+    let mut out = Vec::new();
+    let mut relative = false;
+    let mut warnings = Warnings::default();
+    let strictness = if strict {
+        gcode::Strictness::Strict
+    } else {
+        gcode::Strictness::Lenient
+    };
+    gcode::for_each_line(input, strictness, &mut warnings, |raw, line, _| {
+        let Some(line) = line else { return Ok(()) };
+        let Some(code) = line.code() else {
+            return Ok(());
+        };
+        let Code { letter, number, .. } = code;
+        if letter == b'G' && number == 90 {
+            relative = false;
+        } else if letter == b'G' && number == 91 {
+            relative = true;
+        } else if letter == b'G' && (number == 0 || number == 1) {
+            out.push(MotionLine {
+                number: raw.number,
+                range: raw.offset..raw.offset + raw.text.len(),
+                relative,
+                words: AXIS_INDEX.map(|(l, _)| line.params.get(l)),
+            });
+        }
+        Ok(())
+    })?;
+    Ok(out)
+}
+
+/// One run: indexes of its moves in the path.
+pub(super) type Run = Vec<usize>;
+
+/// Whether a move can be smoothed: an extruding straight `G1` in absolute positioning, no
+/// longer than `max_gap_mm` (a longer extruding move is a jump between sections of the path,
+/// whose orientations have nothing to do with each other; it stays as written and separates
+/// the runs).
+fn eligible(m: &PathMove, line: Option<&MotionLine>, max_gap_mm: f64) -> bool {
+    matches!(m.kind, MoveKind::Linear)
+        && m.is_extruding()
+        && m.length_mm <= max_gap_mm
+        && line.is_some_and(|l| !l.relative)
+}
+
+/// The motion line of each move (`None` for moves from other commands).
+pub(super) fn line_of_moves<'l>(
+    moves: &[PathMove],
+    lines: &'l [MotionLine],
+) -> Vec<Option<&'l MotionLine>> {
+    let mut j = 0usize;
+    moves
+        .iter()
+        .map(|m| {
+            while lines.get(j).is_some_and(|l| l.number < m.line) {
+                j += 1;
+            }
+            lines.get(j).filter(|l| l.number == m.line)
+        })
+        .collect()
+}
+
+/// Splits the moves into runs of consecutive eligible moves.
+pub(super) fn runs(moves: &[PathMove], lines: &[Option<&MotionLine>], max_gap_mm: f64) -> Vec<Run> {
+    let mut out = Vec::new();
+    let mut cur: Run = Vec::new();
+    for (i, m) in moves.iter().enumerate() {
+        if eligible(m, lines.get(i).copied().flatten(), max_gap_mm) {
+            cur.push(i);
+        } else if !cur.is_empty() {
+            out.push(std::mem::take(&mut cur));
+        }
+    }
+    if !cur.is_empty() {
+        out.push(cur);
+    }
+    out
+}
+
+/// Pose of a machine position.
+pub(super) fn pose(kin: &Kinematics, pos: &Pos) -> Pose {
+    let [r0, r1] = kin.model.rotary_axes();
+    Pose {
+        xyz: [pos[axis::X], pos[axis::Y], pos[axis::Z]],
+        rot: [pos[r0], pos[r1]],
+    }
+}
+
+/// The samples of a run: where it starts, then the end of each move.
+pub(super) fn samples(kin: &Kinematics, moves: &[PathMove], run: &Run) -> Vec<Sample> {
+    let mut out = Vec::with_capacity(run.len() + 1);
+    let mut push = |pos: &Pos, dt: f64| {
+        let pose = pose(kin, pos);
+        out.push(Sample {
+            p: kin.tip(&pose),
+            v: kin.tool_vector(pose.rot),
+            rot: pose.rot,
+            dt,
+        });
+    };
+    if let Some(first) = run.first().and_then(|&i| moves.get(i)) {
+        push(&first.from, 0.0);
+    }
+    for m in run.iter().filter_map(|&i| moves.get(i)) {
+        push(&m.to, m.timing.map_or(0.0, |t| t.profile.duration()));
+    }
+    out
+}
+
+/// Offsets between written words and machine positions (G92 shifts), tracked along the file:
+/// `word = position + offset`.
+#[derive(Debug, Default)]
+pub(super) struct Offsets([f64; 6]);
+
+impl Offsets {
+    /// Learns the offsets from a move and its line.
+    pub fn learn(&mut self, m: &PathMove, line: &MotionLine) {
+        for (k, (_, ax)) in AXIS_INDEX.iter().enumerate() {
+            if let (Some(w), Some(o)) = (line.words.get(k).copied().flatten(), self.0.get_mut(k)) {
+                let d = w - m.to[*ax];
+                if d.is_finite() {
+                    *o = d;
+                }
+            }
+        }
+    }
+
+    /// Offset of an axis index.
+    pub fn of(&self, ax: usize) -> f64 {
+        AXIS_INDEX
+            .iter()
+            .position(|(_, a)| *a == ax)
+            .and_then(|k| self.0.get(k).copied())
+            .unwrap_or(0.0)
+    }
+}
+
+/// The edit of one motion line (which moved to `old_to`) for its new pose, or `None` when the
+/// written values would not change. A changed line gets all five axis words.
+pub(super) fn edit_for(
+    input: &[u8],
+    line: &MotionLine,
+    kin: &Kinematics,
+    old_to: &Pos,
+    new: &Pose,
+    offsets: &Offsets,
+    decimals: usize,
+) -> Option<Edit> {
+    let [r0, r1] = kin.model.rotary_axes();
+    let targets = [
+        (b'X', axis::X, new.xyz[0]),
+        (b'Y', axis::Y, new.xyz[1]),
+        (b'Z', axis::Z, new.xyz[2]),
+        (rot_letter(r0), r0, new.rot[0]),
+        (rot_letter(r1), r1, new.rot[1]),
+    ];
+    let mut values = Vec::with_capacity(5);
+    let mut changed = false;
+    for (letter, ax, v) in targets {
+        let text = words::format_value(v + offsets.of(ax), decimals);
+        // What the line means now: its word, or the modal position it leaves unchanged.
+        let old = old_to.get(ax).copied().unwrap_or(0.0) + offsets.of(ax);
+        if words::format_value(old, decimals) != text {
+            changed = true;
+        }
+        values.push((letter, text));
+    }
+    if !changed {
+        return None;
+    }
+    let text = input.get(line.range.clone())?;
+    Some(Edit {
+        line: line.number,
+        replacement: words::rewrite_line(text, &values),
+    })
+}
+
+fn rot_letter(ax: usize) -> u8 {
+    crate::machine::AXIS_LETTERS
+        .get(ax)
+        .copied()
+        .unwrap_or(b'B')
+}
