@@ -93,10 +93,15 @@ test('TypeScript: declarations compile (tsc --strict) and match real CLI output'
   const reports = [path.join(repoRoot, 'www', 'demo', 'demo.gcode'), path.join(corpusDir, 'prusaslicer-2.7.4_screw_arcfit.gcode')].map((f) =>
     execFileSync(cli, ['analyze', f, '--json'], { encoding: 'utf8', maxBuffer: 64 << 20 }),
   );
+  const json = (args) => execFileSync(cli, args, { encoding: 'utf8', maxBuffer: 64 << 20, stdio: ['ignore', 'pipe', 'ignore'] }).trim();
+  const typed = [
+    ['VibrationReport', json(['vibration', path.join(repoRoot, 'www', 'demo', 'demo.gcode'), '--json'])],
+    ['SmoothReport', json(['smooth', path.join(corpusDir, 'multiaxis-xyzbc_zhang-ral2021_model1.gcode'), '-o', path.join(dir, 'smooth.gcode'), '--kinematics', 'table-bc', '--json'])],
+  ];
   const api = path.join(pkgDir, 'web', 'quietpath.js').replaceAll('\\', '/');
   const src = [
-    `import init, { analyze, calibrate, Session, version } from '${api}';`,
-    `import type { Report, AnalyzeOptions, LayerGeometry, CalibrationFit, QuietpathError } from '${api}';`,
+    `import init, { analyze, calibrate, Session, version, vibration, smooth } from '${api}';`,
+    `import type { Report, AnalyzeOptions, LayerGeometry, CalibrationFit, QuietpathError, ${typed.map(([t]) => t).join(', ')} } from '${api}';`,
     'export async function use(bytes: Uint8Array): Promise<number> {',
     '  await init();',
     "  const options: AnalyzeOptions = { strict: true, machine: 'prusa-mk3s', junction_model: 'klipper' };",
@@ -104,10 +109,15 @@ test('TypeScript: declarations compile (tsc --strict) and match real CLI output'
     '  const s = new Session(bytes);',
     '  const g: LayerGeometry = s.layer(0);',
     "  const fit: CalibrationFit = calibrate([[1, 2, 3, 4, 5]]);",
+    "  const vr: VibrationReport = vibration(bytes, { ts_ms: 1, window: 256 }, () => true);",
+    "  const sr = smooth(bytes, { cone_deg: 60, window: { millimetres: 5 } });",
+    "  const smoothed: Uint8Array = sr.output;",
+    "  const sv: VibrationReport = s.vibration({ analyze: { machine: 'vtg-ldam-servo' } });",
     "  try { analyze('G1 X1.2.3'); } catch (e) { const err = e as QuietpathError; return err.line ?? 0; }",
-    '  return r.time_s + g.xy.length + fit.k_c + version().length + s.layerCount();',
+    '  return r.time_s + g.xy.length + fit.k_c + version().length + s.layerCount() + vr.psd.freqs.length + smoothed.length + sv.steps + sr.corrected;',
     '}',
     ...reports.map((json, i) => `export const report${i}: Report = ${json.trim()};`),
+    ...typed.map(([t, json], i) => `export const typed${i}: ${t} = ${json};`),
     '',
   ].join('\n');
   fs.writeFileSync(path.join(dir, 'check.ts'), src);

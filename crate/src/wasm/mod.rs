@@ -4,8 +4,10 @@
 //! parsed by the JS engine), so a report from the browser, Node and the CLI is identical.
 //! Errors become JS `Error` objects carrying `line`, `column` and `kind` properties.
 
+mod jobs;
 mod session;
 
+pub use jobs::{smooth, vibration};
 pub use session::Session;
 
 use js_sys::{Function, Reflect, Uint8Array};
@@ -83,8 +85,13 @@ fn options<T: serde::de::DeserializeOwned + Default>(
     let Some(value) = value.filter(|v| !v.is_undefined() && !v.is_null()) else {
         return Ok(T::default());
     };
-    serde_wasm_bindgen::from_value(value.clone())
-        .map_err(|e| message_error(&format!("invalid options: {e}")))
+    // Through JSON rather than serde-wasm-bindgen: the options then read exactly like the
+    // CLI's JSON files, and unknown fields (typos) are refused instead of silently ignored.
+    let text = js_sys::JSON::stringify(value)
+        .ok()
+        .and_then(|s| s.as_string())
+        .ok_or_else(|| message_error("invalid options: not JSON-serialisable"))?;
+    serde_json::from_str(&text).map_err(|e| message_error(&format!("invalid options: {e}")))
 }
 
 fn to_js<T: serde::Serialize>(value: &T) -> Result<JsValue, JsValue> {

@@ -77,6 +77,16 @@ impl Session {
 }
 
 impl Session {
+    /// The file, for the job methods.
+    pub(super) fn input_ref(&self) -> &[u8] {
+        &self.bytes
+    }
+
+    /// The session's analyze options, for the job methods.
+    pub(super) fn analyze_options(&self) -> &AnalyzeOptions {
+        &self.options
+    }
+
     fn layers(&mut self) -> Result<&Vec<LayerGeometry>, JsValue> {
         if self.layers.is_none() {
             // The move list is large; keep only the compact drawing arrays.

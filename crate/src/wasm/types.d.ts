@@ -194,3 +194,111 @@ export interface QuietpathError extends Error {
 /** Progress callback: fraction done in [0, 1]; return false to cancel (the job throws a
  *  `cancelled` error). */
 export type ProgressCallback = (fraction: number) => boolean | void;
+
+// ── vibration (`quietpath vibration --json`) ──
+export interface VibrationOptions {
+  analyze?: AnalyzeOptions;
+  /** Interpolation period T_s, ms (default 1). */
+  ts_ms?: number;
+  /** Accelerometer sampling rate for the spectrum, Hz (default 200). */
+  fs_hz?: number;
+  /** Welch segment length, samples (default 512). */
+  window?: number;
+  window_kind?: "hamming" | "hann" | "rectangular";
+  /** Built-in dynamics parameter set: "ldam-ball-screw" | "desktop-belt" (default: from the machine). */
+  dynamics?: string | null;
+  dynamics_parameters?: Record<string, unknown> | null;
+  bucket_mm?: number;
+  peaks?: number;
+}
+export interface Mode { frequency_hz: number; damping_ratio: number }
+export interface VibrationReport {
+  machine: string;
+  dynamics: string;
+  ts_ms: number;
+  natural_frequencies_hz: number[];
+  damping_ratios: number[];
+  axes: { axis: string; position_mm: number; modes: Mode[] }[];
+  deviation_mm: { max: number; min: number; mean: number; max_at: number[]; samples: number };
+  layers: { layer: number; z: number | null; amplitude: number; mean: number; acceleration_rms: number }[];
+  psd: {
+    fs_hz: number;
+    window: number;
+    window_kind: "hamming" | "hann" | "rectangular";
+    overlap: number;
+    segments: number;
+    freqs: number[];
+    power: number[];
+    peaks: { hz: number; power: number }[];
+  };
+  simulated_s: number;
+  steps: number;
+}
+
+// ── smooth (`quietpath smooth --json`) ──
+export type FilterKind = "zero-phase-moving-average" | "zero-phase-median" | "moving-average" | "median";
+export interface SmoothOptions {
+  kinematics?: { model?: "table-bc" | "head-ab"; b_axis_point_mm?: number[]; c_axis_point_mm?: number[]; pivot_length_mm?: number };
+  filter?: FilterKind;
+  /** Window by point count or by path length. */
+  window?: { points: number } | { millimetres: number };
+  /** Tolerance cone opening γ, degrees (default 60): every vector stays within γ/2. */
+  cone_deg?: number;
+  singular_deg?: number;
+  max_gap_mm?: number;
+  decimals?: number;
+  format?: "auto" | "gcode" | "csv" | "json";
+  feed_mm_s?: number;
+  analyze?: AnalyzeOptions;
+}
+export interface RotaryMetrics {
+  axis: string;
+  travel_deg: number;
+  max_velocity_deg_s: number;
+  rms_velocity_deg_s: number;
+  max_acceleration_deg_s2: number;
+  rms_acceleration_deg_s2: number;
+  max_jerk_deg_s3: number;
+  rms_jerk_deg_s3: number;
+}
+export interface OrientationMetrics {
+  roughness: number;
+  max_second_difference: number;
+  mean_angle_change_deg: number;
+  max_angle_change_deg: number;
+  mean_angle_change_per_mm_deg: number;
+  max_angle_change_per_mm_deg: number;
+  rotary: RotaryMetrics[];
+}
+export interface SmoothReport {
+  format: string;
+  kinematics: string;
+  filter: FilterKind;
+  window: { points: number } | { millimetres: number };
+  cone_deg: number;
+  motion_lines: number;
+  points: number;
+  runs: number;
+  corrected: number;
+  changed: number;
+  max_angle_to_original_deg: number;
+  mean_angle_to_original_deg: number;
+  before: OrientationMetrics;
+  after: OrientationMetrics;
+  roughness_reduction: number;
+  max_tip_deviation_mm: number;
+  planned_time_before_s: number;
+  planned_time_after_s: number;
+  series: {
+    axes: string[];
+    point: number[];
+    first_before: number[];
+    first_after: number[];
+    second_before: number[];
+    second_after: number[];
+    angle_to_original_deg: number[];
+  };
+  warnings: Warning[];
+}
+/** smooth() result: the report plus the smoothed file. */
+export interface SmoothResult extends SmoothReport { output: Uint8Array }

@@ -1,0 +1,85 @@
+// The optimisers and the dynamics report through the npm package (Node build) against the
+// native CLI on the same files: the JSON must be identical, and the rewritten file byte for
+// byte the file the CLI writes. Needs `make pkg` and `make cli`.
+
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { execFileSync } from 'node:child_process';
+import { fileURLToPath, pathToFileURL } from 'node:url';
+
+const repoRoot = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+const pkgDir = path.resolve(process.env.QUIETPATH_PKG ?? path.join(repoRoot, 'pkg'));
+const corpusDir = path.resolve(repoRoot, '../shared/corpus');
+const cli = path.join(repoRoot, 'target', 'release', 'quietpath');
+const qp = await import(pathToFileURL(path.join(pkgDir, 'node', 'quietpath.js')).href);
+const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'qp-jobs-'));
+
+const DEMO = path.join(repoRoot, 'www', 'demo', 'demo.gcode');
+const FIVE_AXIS = path.join(corpusDir, 'multiaxis-xyzbc_zhang-ral2021_model1.gcode');
+
+function runCli(args) {
+  return JSON.parse(execFileSync(cli, args, { encoding: 'utf8', maxBuffer: 256 << 20, stdio: ['ignore', 'pipe', 'ignore'] }));
+}
+
+// The JS result without the output bytes, as plain JSON.
+function reportOf(result) {
+  const { output, ...report } = result;
+  return { report: JSON.parse(JSON.stringify(report)), output };
+}
+
+// Paths where `a` and `b` differ: structure exactly, numbers within `rel` relative error.
+function diffs(a, b, rel, at = '$', out = []) {
+  if (typeof a === 'number' && typeof b === 'number') {
+    if (Math.abs(a - b) > rel * Math.max(Math.abs(a), Math.abs(b), 1e-300)) out.push(`${at}: ${a} vs ${b}`);
+  } else if (a && b && typeof a === 'object' && typeof b === 'object') {
+    const keys = new Set([...Object.keys(a), ...Object.keys(b)]);
+    for (const k of keys) diffs(a[k], b[k], rel, `${at}.${k}`, out);
+  } else if (a !== b) {
+    out.push(`${at}: ${JSON.stringify(a)} vs ${JSON.stringify(b)}`);
+  }
+  return out;
+}
+
+test('vibration: wasm report equals `quietpath vibration --json` (numbers to 1e-9)', () => {
+  const fromCli = runCli(['vibration', DEMO, '--json']);
+  const fromWasm = JSON.parse(JSON.stringify(qp.vibration(fs.readFileSync(DEMO))));
+  // Not bit for bit: nalgebra's eigenvalue solver and matrix exponential and rustfft's twiddle
+  // factors call the platform's libm (glibc natively, Rust's libm in wasm), which differ in the
+  // last bit; the simulation carries that to about 1e-13.
+  assert.deepEqual(diffs(fromWasm, fromCli, 1e-9), []);
+  assert.ok(fromWasm.psd.freqs.length > 100 && fromWasm.deviation_mm.mean > 0);
+});
+
+test('smooth: wasm report and output equal the CLI on the 5-axis corpus file', () => {
+  const out = path.join(tmp, 'smooth.gcode');
+  const fromCli = runCli(['smooth', FIVE_AXIS, '-o', out, '--kinematics', 'table-bc', '--json']);
+  const { report, output } = reportOf(qp.smooth(fs.readFileSync(FIVE_AXIS), { filter: 'zero-phase-moving-average' }));
+  assert.deepEqual(report, fromCli);
+  assert.ok(output instanceof Uint8Array);
+  assert.ok(Buffer.from(output).equals(fs.readFileSync(out)), 'smoothed file differs from the CLI output');
+  assert.ok(report.max_angle_to_original_deg <= report.cone_deg / 2);
+});
+
+test('Session jobs use the session analyze options unless the job names its own', () => {
+  const bytes = fs.readFileSync(DEMO);
+  const s = new qp.Session(bytes, { machine: 'vtg-ldam-servo' });
+  assert.equal(s.vibration().machine, 'vtg-ldam-servo');
+  assert.equal(s.vibration({ analyze: { machine: 'creality-ender3' } }).machine, 'creality-ender3');
+  s.free();
+});
+
+test('job errors are Errors with a kind; bad options are refused', () => {
+  assert.throws(() => qp.vibration('G1 X1\n', { ts_ms: -1 }), (e) => e instanceof Error && /ts_ms|option/i.test(e.message));
+  assert.throws(() => qp.smooth('G1 X1\n', { nonsense: 1 }), (e) => e instanceof Error && /nonsense|unknown field/i.test(e.message));
+  assert.throws(() => qp.vibration('G1 X1.2.3\n', { analyze: { strict: true } }), (e) => e instanceof Error && e.line === 1);
+});
+
+test('cancelling a job through the progress callback throws a cancelled error', () => {
+  assert.throws(
+    () => qp.vibration(fs.readFileSync(DEMO), {}, () => false),
+    (e) => e instanceof Error && e.kind?.kind === 'cancelled',
+  );
+});
