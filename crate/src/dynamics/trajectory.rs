@@ -117,9 +117,7 @@ fn geometry(m: &PathMove) -> Geometry {
     let dy = m.to[axis::Y] - m.from[axis::Y];
     let len = m.length_mm;
     let usable = len.is_finite() && len > 1e-9;
-    if !usable
-        || (dx.abs() < 1e-12 && dy.abs() < 1e-12 && !matches!(m.kind, MoveKind::Arc(_)))
-    {
+    if !usable || (dx.abs() < 1e-12 && dy.abs() < 1e-12 && !matches!(m.kind, MoveKind::Arc(_))) {
         return Geometry::Still;
     }
     match m.kind {
