@@ -444,9 +444,50 @@ G1 X20 Y0 E1 F3000\nG1 X20 Y20 E1\nG1 X0 Y20 E1\nG1 X0 Y0 E1\n\
         let p = crate::path::extract(SQUARE, &Default::default(), false).unwrap();
         let e = vibration_of_path(&p, &Default::default(), &mut |_| true).unwrap_err();
         assert!(matches!(e.kind, ErrorKind::InvalidOption { .. }));
+        // A day-long dwell costs nothing once the machine is still.
+        let dwell = b"G21\nG90\nM83\nG1 X10 Y0 E1 F3000\nG4 S86400\nG1 X0 Y0 E1\n";
+        let r = vibration(dwell, &Default::default()).unwrap();
+        assert!(r.simulated_s < 100.0, "{}", r.simulated_s);
         // Absurdly slow motion is bounded, not simulated for days.
         let slow = b"G21\nG90\nM83\nG1 X1000 Y0 E1 F0.001\n";
         let e = vibration(slow, &Default::default()).unwrap_err();
         assert!(matches!(e.kind, ErrorKind::InvalidOption { .. }));
+    }
+}
+
+#[cfg(all(test, not(target_arch = "wasm32")))]
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+
+        /// Any short sequence of moves, arcs and dwells gives a finite, ordered report.
+        #[test]
+        fn random_moves_give_finite_ordered_reports(
+            moves in proptest::collection::vec(
+                (0u8..4, -200.0f64..200.0, -200.0f64..200.0, 1200.0f64..20_000.0),
+                1..12,
+            )
+        ) {
+            let mut g = String::from("G21\nG90\nM83\n;LAYER_CHANGE\n");
+            for (kind, x, y, f) in moves {
+                let line = match kind {
+                    0 => format!("G1 X{x:.3} Y{y:.3} E0.1 F{f:.1}\n"),
+                    1 => format!("G0 X{x:.3} Y{y:.3} F{f:.1}\n"),
+                    2 => format!("G2 X{x:.3} Y{y:.3} R{:.3} E0.1 F{f:.1}\n", x.abs() + y.abs() + 1.0),
+                    _ => "G4 P50\n".to_string(),
+                };
+                g.push_str(&line);
+            }
+            let options = VibrationOptions { ts_ms: 5.0, ..Default::default() };
+            if let Ok(r) = vibration(g.as_bytes(), &options) {
+                let d = r.deviation_mm;
+                prop_assert!(d.max.is_finite() && d.mean.is_finite() && d.min.is_finite());
+                prop_assert!(d.min <= d.mean + 1e-12 && d.mean <= d.max + 1e-12);
+                prop_assert!(r.psd.power.iter().all(|p| p.is_finite() && *p >= 0.0));
+            }
+        }
     }
 }

@@ -163,18 +163,23 @@ pub fn run(
 ) -> Result<Outcome, Error> {
     let ts = settings.ts;
     let end = segs.last().map_or(0.0, |s| s.end_s());
-    let total = (end / ts).ceil();
-    if !total.is_finite() || total > MAX_STEPS {
-        return Err(Error::new(
+    // Motion time bounds the work (rests are skipped once the machine is still).
+    let motion: f64 = segs.iter().map(|s| s.duration_s).sum();
+    let too_long = || {
+        Error::new(
             0,
             0,
             ErrorKind::InvalidOption {
                 reason:
                     "print too long to simulate at this period (over 2e8 steps); use a longer ts",
             },
-        ));
+        )
+    };
+    let steps = motion / ts;
+    if steps.is_nan() || steps > MAX_STEPS || !end.is_finite() || end / ts > u64::MAX as f64 / 2.0 {
+        return Err(too_long());
     }
-    let total = total as u64;
+    let total = (end / ts).ceil() as u64;
     let mut axes = [
         Axis::new(machine.x, ts, settings.bucket_m),
         Axis::new(machine.y, ts, settings.bucket_m),
@@ -248,6 +253,10 @@ pub fn run(
             } else {
                 break;
             }
+        }
+        if out.steps as f64 > 2.0 * MAX_STEPS {
+            // Rests that never settle (an undamped mode excited): still bounded.
+            return Err(too_long());
         }
         if k >= next_progress {
             next_progress = k + PROGRESS_STEPS;
