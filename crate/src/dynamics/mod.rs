@@ -157,8 +157,10 @@ pub struct VibrationReport {
     pub damping_ratios: Vec<f64>,
     /// Modes per axis.
     pub axes: Vec<AxisModes>,
-    /// Trajectory deviation over the print, mm.
+    /// Trajectory deviation over the print (every sample of every move), mm.
     pub deviation_mm: Deviation,
+    /// Trajectory deviation while extruding only (what the part sees; travel left out), mm.
+    pub printing_deviation_mm: Deviation,
     /// Per-layer vibration.
     pub layers: Vec<LayerVibration>,
     /// Acceleration spectrum.
@@ -322,6 +324,13 @@ pub fn vibration_of_path(
             mean: d.mean(),
             max_at: outcome.max_at,
             samples: d.count,
+        },
+        printing_deviation_mm: Deviation {
+            max: outcome.printing.max,
+            min: outcome.printing.min_or_zero(),
+            mean: outcome.printing.mean(),
+            max_at: outcome.printing_max_at,
+            samples: outcome.printing.count,
         },
         layers,
         psd: Psd {

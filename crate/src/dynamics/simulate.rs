@@ -93,6 +93,10 @@ pub struct Outcome {
     pub deviation: Stats,
     /// Where and when the largest deviation happened: X, Y (mm), time (s).
     pub max_at: [f64; 3],
+    /// Deviation over the samples of extruding moves only, mm.
+    pub printing: Stats,
+    /// Where and when the largest deviation while extruding happened.
+    pub printing_max_at: [f64; 3],
     /// Per-layer sums, by layer index.
     pub layers: Vec<LayerSums>,
     /// Steps simulated.
@@ -188,6 +192,8 @@ pub fn run(
     let mut out = Outcome {
         deviation: Stats::default(),
         max_at: [0.0; 3],
+        printing: Stats::default(),
+        printing_max_at: [0.0; 3],
         layers: vec![LayerSums::default(); layers],
         steps: 0,
         simulated_s: 0.0,
@@ -218,6 +224,12 @@ pub fn run(
                 out.max_at = [next.pos[0], next.pos[1], t1];
             }
             out.deviation.add(dev);
+            if seg.and_then(|i| segs.get(i)).is_some_and(|s| s.extruding) {
+                if dev > out.printing.max || out.printing.count == 0 {
+                    out.printing_max_at = [next.pos[0], next.pos[1], t1];
+                }
+                out.printing.add(dev);
+            }
             if let Some(l) = out.layers.get_mut(layer as usize) {
                 l.deviation.add(dev);
             }

@@ -14,6 +14,8 @@ fn report_fields_are_consistent() {
     let d = r.deviation_mm;
     assert!(d.min <= d.mean && d.mean <= d.max && d.max > 0.0);
     assert!(r.layers.iter().all(|l| l.amplitude <= d.max + 1e-15));
+    let p = r.printing_deviation_mm;
+    assert!(p.samples > 0 && p.samples < d.samples && p.max <= d.max);
     assert_eq!(r.psd.fs_hz, 200.0);
     assert_eq!(r.natural_frequencies_hz.len(), 12);
     // Most of the 10 s dwell is skipped once the machine is still.

@@ -48,6 +48,8 @@ pub struct Segment {
     geometry: Geometry,
     /// Layer index (or `path::NO_LAYER`).
     pub layer: u32,
+    /// Whether the move lays down material.
+    pub extruding: bool,
 }
 
 /// Commanded state of X and Y at one instant.
@@ -183,6 +185,7 @@ pub fn segments(path: &PrintPath) -> Option<Vec<Segment>> {
             to: [m.to[axis::X], m.to[axis::Y]],
             geometry: geometry(m),
             layer: m.layer,
+            extruding: m.is_extruding(),
         };
         cursor = seg.end_s();
         out.push(seg);
