@@ -34,6 +34,10 @@ pub struct Args {
     /// Spectral peaks to report.
     #[arg(long, default_value_t = 5)]
     pub peaks: usize,
+    /// A second file (e.g. the optimised toolpath) to compare with: both are simulated and the
+    /// relative change of the deviation is reported (JSON: `{before, after, change}`).
+    #[arg(long, value_name = "FILE")]
+    pub compare: Option<PathBuf>,
     /// Print the report as JSON (the same object the JS API returns).
     #[arg(long)]
     pub json: bool,
@@ -85,6 +89,31 @@ pub fn run(args: Args) -> Result<(), String> {
         .map_err(|e| format!("{}:{}", args.file.display(), e))?;
     bar.finish();
     let mut stdout = std::io::stdout().lock();
+    if let Some(other) = &args.compare {
+        let after = dynamics::vibration(&read(other)?, &options)
+            .map_err(|e| format!("{}:{}", other.display(), e))?;
+        let change = dynamics::compare(&report, &after);
+        if args.json {
+            output::write_json(
+                &mut stdout,
+                &serde_json::json!({ "before": report, "after": after, "change": change }),
+            )?;
+        } else {
+            print(&mut stdout, &args.file, &report).map_err(|e| e.to_string())?;
+            writeln!(stdout).map_err(|e| e.to_string())?;
+            print(&mut stdout, other, &after).map_err(|e| e.to_string())?;
+            let pct = |x: f64| format!("{:+.2}%", 100.0 * x);
+            writeln!(
+                stdout,
+                "\nchange: max {}, mean {}, min {}",
+                pct(change.max_deviation),
+                pct(change.mean_deviation),
+                pct(change.min_deviation)
+            )
+            .map_err(|e| e.to_string())?;
+        }
+        return stdout.flush().map_err(|e| e.to_string());
+    }
     if args.json {
         output::write_json(&mut stdout, &report)?;
     } else {

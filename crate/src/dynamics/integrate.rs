@@ -163,3 +163,44 @@ mod tests {
         assert!(discretize(&a, &DMatrix::zeros(2, 1), &b, 1e-3).is_none());
     }
 }
+
+#[cfg(all(test, not(target_arch = "wasm32")))]
+mod properties {
+    use super::*;
+    use crate::dynamics::modal::{modes, state_matrix};
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Any damped oscillator: the modal frequency and damping are the closed forms, and the
+        /// discrete step is a contraction (spectral radius e^{−ζωₙT} < 1) whatever `T`.
+        #[test]
+        fn damped_oscillators_are_stable_at_any_period(
+            m in 1e-3f64..100.0,
+            k in 1.0f64..1e9,
+            zeta in 0.001f64..0.9,
+            dt in 1e-5f64..1e-1,
+        ) {
+            let c = 2.0 * zeta * (k * m).sqrt();
+            let (mm, cc, kk) = (
+                DMatrix::from_element(1, 1, m),
+                DMatrix::from_element(1, 1, c),
+                DMatrix::from_element(1, 1, k),
+            );
+            let found = modes(&mm, &cc, &kk);
+            prop_assert_eq!(found.len(), 1);
+            let wn = (k / m).sqrt();
+            prop_assert!((found[0].frequency_hz * 2.0 * core::f64::consts::PI - wn).abs() < 1e-6 * wn);
+            prop_assert!((found[0].damping_ratio - zeta).abs() < 1e-6);
+            let a = state_matrix(&mm, &cc, &kk).unwrap();
+            let zero = DMatrix::zeros(2, 1);
+            let d = discretize(&a, &zero, &zero, dt).unwrap();
+            // |det Φ| = e^{tr(A) T} = e^{−2ζωₙT}; both eigenvalues have modulus e^{−ζωₙT}.
+            let det = d.phi.determinant();
+            let expected = (-2.0 * zeta * wn * dt).exp();
+            prop_assert!((det - expected).abs() < 1e-6 * expected.max(1e-300) + 1e-12);
+            prop_assert!(d.phi.iter().all(|v| v.is_finite()));
+        }
+    }
+}

@@ -157,8 +157,10 @@ pub struct VibrationReport {
     pub damping_ratios: Vec<f64>,
     /// Modes per axis.
     pub axes: Vec<AxisModes>,
-    /// Trajectory deviation over the print, mm.
+    /// Trajectory deviation over the print (every sample of every move), mm.
     pub deviation_mm: Deviation,
+    /// Trajectory deviation while extruding only (what the part sees; travel left out), mm.
+    pub printing_deviation_mm: Deviation,
     /// Per-layer vibration.
     pub layers: Vec<LayerVibration>,
     /// Acceleration spectrum.
@@ -323,6 +325,13 @@ pub fn vibration_of_path(
             max_at: outcome.max_at,
             samples: d.count,
         },
+        printing_deviation_mm: Deviation {
+            max: outcome.printing.max,
+            min: outcome.printing.min_or_zero(),
+            mean: outcome.printing.mean(),
+            max_at: outcome.printing_max_at,
+            samples: outcome.printing.count,
+        },
         layers,
         psd: Psd {
             fs_hz: fs,
@@ -340,113 +349,4 @@ pub fn vibration_of_path(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    const SQUARE: &[u8] = b"G21\nG90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2 F600\n\
-G1 X20 Y0 E1 F3000\nG1 X20 Y20 E1\nG1 X0 Y20 E1\nG1 X0 Y0 E1\n\
-;LAYER_CHANGE\n;Z:0.4\nG1 Z0.4\nG4 P10000\nG1 X20 Y0 E1\nG1 X20 Y20 E1\n";
-
-    #[test]
-    fn report_fields_are_consistent() {
-        let r = vibration(SQUARE, &VibrationOptions::default()).unwrap();
-        assert_eq!(r.layers.len(), 2);
-        assert_eq!(r.layers[1].z, Some(0.4));
-        let d = r.deviation_mm;
-        assert!(d.min <= d.mean && d.mean <= d.max && d.max > 0.0);
-        assert!(r.layers.iter().all(|l| l.amplitude <= d.max + 1e-15));
-        assert_eq!(r.psd.fs_hz, 200.0);
-        assert_eq!(r.natural_frequencies_hz.len(), 12);
-        // Most of the 10 s dwell is skipped once the machine is still.
-        assert!(
-            r.simulated_s < r.deviation_mm.samples as f64 * 1e-3 + 5.0,
-            "{}",
-            r.simulated_s
-        );
-        let json = serde_json::to_value(&r).unwrap();
-        for key in [
-            "natural_frequencies_hz",
-            "damping_ratios",
-            "deviation_mm",
-            "layers",
-            "psd",
-        ] {
-            assert!(json.get(key).is_some(), "{key}");
-        }
-        for key in ["max", "min", "mean"] {
-            assert!(json["deviation_mm"].get(key).is_some());
-        }
-        for key in ["fs_hz", "window", "freqs", "power", "peaks"] {
-            assert!(json["psd"].get(key).is_some());
-        }
-        assert!(json["layers"][0].get("amplitude").is_some());
-        // A file against itself changes by nothing.
-        let c = compare(&r, &r);
-        assert_eq!(c.mean_deviation, 0.0);
-        assert!(c.layers.iter().all(|l| l.relative == 0.0));
-    }
-
-    #[test]
-    fn bad_options_are_refused() {
-        let bad = [
-            VibrationOptions {
-                ts_ms: 0.0,
-                ..Default::default()
-            },
-            VibrationOptions {
-                ts_ms: f64::NAN,
-                ..Default::default()
-            },
-            VibrationOptions {
-                fs_hz: 2000.0,
-                ..Default::default()
-            },
-            VibrationOptions {
-                fs_hz: -1.0,
-                ..Default::default()
-            },
-            VibrationOptions {
-                window: 1,
-                ..Default::default()
-            },
-            VibrationOptions {
-                bucket_mm: 0.0,
-                ..Default::default()
-            },
-            VibrationOptions {
-                dynamics: Some("nope".into()),
-                ..Default::default()
-            },
-        ];
-        for o in bad {
-            let e = vibration(SQUARE, &o).unwrap_err();
-            assert!(
-                matches!(e.kind, ErrorKind::InvalidOption { .. }),
-                "{o:?}: {e}"
-            );
-        }
-        let json =
-            r#"{"ts_ms": 2, "analyze": {"machine": "vtg-ldam-servo"}, "window_kind": "hann"}"#;
-        let o: VibrationOptions = serde_json::from_str(json).unwrap();
-        assert_eq!(vibration(SQUARE, &o).unwrap().dynamics, "ldam-ball-screw");
-        assert!(serde_json::from_str::<VibrationOptions>(r#"{"nope": 1}"#).is_err());
-    }
-
-    #[test]
-    fn cancel_and_degenerate_inputs() {
-        let e = vibration_with_progress(SQUARE, &Default::default(), &mut |_| false).unwrap_err();
-        assert_eq!(e.kind, ErrorKind::Cancelled);
-        // No motion at all: an empty but valid report.
-        let r = vibration(b"M104 S200\n; nothing\n", &Default::default()).unwrap();
-        assert_eq!(r.deviation_mm.samples, 0);
-        assert!(r.psd.power.is_empty());
-        // A path without timing is refused, not mis-simulated.
-        let p = crate::path::extract(SQUARE, &Default::default(), false).unwrap();
-        let e = vibration_of_path(&p, &Default::default(), &mut |_| true).unwrap_err();
-        assert!(matches!(e.kind, ErrorKind::InvalidOption { .. }));
-        // Absurdly slow motion is bounded, not simulated for days.
-        let slow = b"G21\nG90\nM83\nG1 X1000 Y0 E1 F0.001\n";
-        let e = vibration(slow, &Default::default()).unwrap_err();
-        assert!(matches!(e.kind, ErrorKind::InvalidOption { .. }));
-    }
-}
+mod tests;

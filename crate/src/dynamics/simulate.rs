@@ -93,6 +93,10 @@ pub struct Outcome {
     pub deviation: Stats,
     /// Where and when the largest deviation happened: X, Y (mm), time (s).
     pub max_at: [f64; 3],
+    /// Deviation over the samples of extruding moves only, mm.
+    pub printing: Stats,
+    /// Where and when the largest deviation while extruding happened.
+    pub printing_max_at: [f64; 3],
     /// Per-layer sums, by layer index.
     pub layers: Vec<LayerSums>,
     /// Steps simulated.
@@ -163,18 +167,23 @@ pub fn run(
 ) -> Result<Outcome, Error> {
     let ts = settings.ts;
     let end = segs.last().map_or(0.0, |s| s.end_s());
-    let total = (end / ts).ceil();
-    if !total.is_finite() || total > MAX_STEPS {
-        return Err(Error::new(
+    // Motion time bounds the work (rests are skipped once the machine is still).
+    let motion: f64 = segs.iter().map(|s| s.duration_s).sum();
+    let too_long = || {
+        Error::new(
             0,
             0,
             ErrorKind::InvalidOption {
                 reason:
                     "print too long to simulate at this period (over 2e8 steps); use a longer ts",
             },
-        ));
+        )
+    };
+    let steps = motion / ts;
+    if steps.is_nan() || steps > MAX_STEPS || !end.is_finite() || end / ts > u64::MAX as f64 / 2.0 {
+        return Err(too_long());
     }
-    let total = total as u64;
+    let total = (end / ts).ceil() as u64;
     let mut axes = [
         Axis::new(machine.x, ts, settings.bucket_m),
         Axis::new(machine.y, ts, settings.bucket_m),
@@ -183,6 +192,8 @@ pub fn run(
     let mut out = Outcome {
         deviation: Stats::default(),
         max_at: [0.0; 3],
+        printing: Stats::default(),
+        printing_max_at: [0.0; 3],
         layers: vec![LayerSums::default(); layers],
         steps: 0,
         simulated_s: 0.0,
@@ -213,6 +224,12 @@ pub fn run(
                 out.max_at = [next.pos[0], next.pos[1], t1];
             }
             out.deviation.add(dev);
+            if seg.and_then(|i| segs.get(i)).is_some_and(|s| s.extruding) {
+                if dev > out.printing.max || out.printing.count == 0 {
+                    out.printing_max_at = [next.pos[0], next.pos[1], t1];
+                }
+                out.printing.add(dev);
+            }
             if let Some(l) = out.layers.get_mut(layer as usize) {
                 l.deviation.add(dev);
             }
@@ -248,6 +265,10 @@ pub fn run(
             } else {
                 break;
             }
+        }
+        if out.steps as f64 > 2.0 * MAX_STEPS {
+            // Rests that never settle (an undamped mode excited): still bounded.
+            return Err(too_long());
         }
         if k >= next_progress {
             next_progress = k + PROGRESS_STEPS;

@@ -8,7 +8,8 @@
 //! The path extraction keeps one timing per source move; an arc is planned as many short
 //! segments, and its stored timing is the last segment's. An arc's start is therefore taken
 //! from the end of the move before it, and the arc is travelled with a trapezoid from that
-//! move's exit speed to the last segment's exit speed at the requested feed rate.
+//! move's exit speed to the last segment's exit speed at the requested feed rate (within the
+//! X/Y speed limits).
 
 use crate::machine::{axis, MoveKind};
 use crate::path::{PathMove, PrintPath};
@@ -47,6 +48,8 @@ pub struct Segment {
     geometry: Geometry,
     /// Layer index (or `path::NO_LAYER`).
     pub layer: u32,
+    /// Whether the move lays down material.
+    pub extruding: bool,
 }
 
 /// Commanded state of X and Y at one instant.
@@ -151,7 +154,16 @@ pub fn segments(path: &PrintPath) -> Option<Vec<Segment>> {
                 .filter(|s| (s.end_s() - cursor).abs() < 1e-12)
                 .map_or(0.0, |s| s.profile.exit);
             let a = t.profile.acceleration;
-            let cruise = m.feed_mm_s.max(t.profile.peak);
+            // The requested feed within the machine's X/Y speed limits (an arc's direction
+            // turns, so the lower of the two bounds it).
+            let limits = &path.print_limits.max_feedrate;
+            let axis_max = limits[axis::X].value.min(limits[axis::Y].value);
+            let feed = if axis_max > 0.0 {
+                m.feed_mm_s.min(axis_max)
+            } else {
+                m.feed_mm_s
+            };
+            let cruise = feed.max(t.profile.peak);
             (
                 cursor,
                 Profile::new(m.length_mm, entry, cruise, t.profile.exit, a),
@@ -173,6 +185,7 @@ pub fn segments(path: &PrintPath) -> Option<Vec<Segment>> {
             to: [m.to[axis::X], m.to[axis::Y]],
             geometry: geometry(m),
             layer: m.layer,
+            extruding: m.is_extruding(),
         };
         cursor = seg.end_s();
         out.push(seg);
