@@ -180,7 +180,7 @@ fn zero_phase_has_no_lag_symmetric_in_symmetric_out() {
 }
 
 /// A table-BC spiral: the tool leans 20° and turns with the path, C goes round three turns,
-/// with a kink of the build direction every 30 points.
+/// with a kink of the build direction (±4° of tilt) every 30 points.
 fn spiral_gcode() -> (Vec<u8>, Kinematics) {
     let kin = Kinematics::default();
     let mut g = String::from("; spiral\nG90\nM82\nG92 E0\nG1 F1200\n");
@@ -190,7 +190,7 @@ fn spiral_gcode() -> (Vec<u8>, Kinematics) {
         let s = i as f64 / 360.0;
         let ang = s * 6.0 * std::f64::consts::PI;
         let p = [20.0 * ang.cos(), 20.0 * ang.sin(), 5.0 + 10.0 * s];
-        let kink = if (i / 30) % 2 == 0 { 8.0 } else { -8.0 };
+        let kink = if (i / 30) % 2 == 0 { 4.0 } else { -4.0 };
         let tilt = vec3::rad(20.0 + kink);
         let v = [tilt.sin() * ang.cos(), tilt.sin() * ang.sin(), tilt.cos()];
         let rot = kin.rotary_for(v, prev);
