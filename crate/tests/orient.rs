@@ -109,12 +109,16 @@ fn torus_reaches_the_cone_at_60_degrees_and_less_at_90() {
     let (r60, _) = smooth_points(&torus, &paper_options(60.0)).expect("smooth");
     let (r90, _) = smooth_points(&torus, &paper_options(90.0)).expect("smooth");
     println!(
-        "torus: 60° corrected {} roughness {:.5} -> {:.5}; 90° corrected {} roughness -> {:.5}",
+        "torus: {} points; 60°: corrected {} roughness {:.5} -> {:.5} max angle {:.3}; \
+         90°: corrected {} roughness -> {:.5} max angle {:.3}",
+        r60.points,
         r60.corrected,
         r60.before.roughness,
         r60.after.roughness,
+        r60.max_angle_to_original_deg,
         r90.corrected,
-        r90.after.roughness
+        r90.after.roughness,
+        r90.max_angle_to_original_deg
     );
     assert!(r60.corrected > r90.corrected);
     assert!(r90.after.roughness <= r60.after.roughness);
