@@ -136,10 +136,15 @@ pub(super) fn run(
                 continue;
             }
         };
-        match program::edit_for(input, line, kin, &m.to, &pose, &offsets, decimals, force) {
+        let fmt = program::WordFormat {
+            kin,
+            offsets: &offsets,
+            decimals,
+        };
+        match program::edit_for(input, line, &fmt, &m.to, &pose, force) {
             Some(e) => {
                 edits.push(e);
-                dirty = program::differs(kin, &m.to, &pose, &offsets, decimals);
+                dirty = program::differs(&fmt, &m.to, &pose);
             }
             None => {
                 for (d, o) in dirty.iter_mut().zip(&omits) {

@@ -184,14 +184,24 @@ pub(super) fn omitted(line: &MotionLine, kin: &Kinematics) -> [bool; 5] {
     })
 }
 
+/// How axis words are written: the model, the G92 offsets in force, the decimals.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct WordFormat<'a> {
+    /// Kinematic model (which rotary letters).
+    pub kin: &'a Kinematics,
+    /// `word = position + offset`.
+    pub offsets: &'a Offsets,
+    /// Decimals written.
+    pub decimals: usize,
+}
+
 /// Which of the five axes the new pose writes differently from the original position.
-pub(super) fn differs(
-    kin: &Kinematics,
-    old_to: &Pos,
-    new: &Pose,
-    offsets: &Offsets,
-    decimals: usize,
-) -> [bool; 5] {
+pub(super) fn differs(fmt: &WordFormat<'_>, old_to: &Pos, new: &Pose) -> [bool; 5] {
+    let WordFormat {
+        kin,
+        offsets,
+        decimals,
+    } = *fmt;
     let values = [new.xyz[0], new.xyz[1], new.xyz[2], new.rot[0], new.rot[1]];
     let axes = five_axes(kin);
     std::array::from_fn(|k| {
@@ -237,13 +247,16 @@ impl Offsets {
 pub(super) fn edit_for(
     input: &[u8],
     line: &MotionLine,
-    kin: &Kinematics,
+    fmt: &WordFormat<'_>,
     old_to: &Pos,
     new: &Pose,
-    offsets: &Offsets,
-    decimals: usize,
     force: bool,
 ) -> Option<Edit> {
+    let WordFormat {
+        kin,
+        offsets,
+        decimals,
+    } = *fmt;
     let [r0, r1] = kin.model.rotary_axes();
     let targets = [
         (b'X', axis::X, new.xyz[0]),
