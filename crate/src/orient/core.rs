@@ -48,28 +48,36 @@ pub fn arc_length(p: &[V3]) -> Vec<f64> {
     s
 }
 
-/// Smooths one run. With `fixed_first` its first sample is where the run starts (the end of the
-/// move before it, in G-code) and stays as it is; it still takes part in the filter so the run
-/// begins continuously.
+/// Smooths one run. With `fixed_ends` its first sample (where the run starts: the end of the
+/// move before it, in G-code) and its last stay as they are: the lines after the run then mean
+/// what they meant (a following line that omits an axis word inherits the run's last values),
+/// and the smoothing ramps in and out ([`anchor_weights`]). Fixed samples still take part in the
+/// filter.
 pub fn smooth_run(
     run: &[Sample],
     kin: &Kinematics,
     settings: &RunSettings,
-    fixed_first: bool,
+    fixed_ends: bool,
 ) -> RunOutput {
     let p: Vec<V3> = run.iter().map(|s| s.p).collect();
     let b: Vec<V3> = run.iter().map(|s| s.v).collect();
     let s = arc_length(&p);
     let smoothed = filter::smooth(&b, &s, settings.filter, settings.window);
-    let mut out = Vec::with_capacity(run.len());
+    let fixed: Vec<bool> = run
+        .iter()
+        .enumerate()
+        .map(|(i, x)| {
+            (fixed_ends && (i == 0 || i + 1 == run.len()))
+                || in_singular_zone(kin, x.v, settings.singular_angle)
+        })
+        .collect();
+    let weights = anchor_weights(&fixed, &s, settings.window);
+    // The new tool vectors (fixed points keep theirs).
+    let mut vectors = Vec::with_capacity(run.len());
     let mut corrected = 0usize;
-    let mut prev_rot = run.first().map_or([0.0; 2], |s| s.rot);
-    let mut prev_orig = prev_rot;
     for (i, (sample, ts)) in run.iter().zip(&smoothed).enumerate() {
-        if (i == 0 && fixed_first) || in_singular_zone(kin, sample.v, settings.singular_angle) {
-            out.push(*sample);
-            prev_rot = sample.rot;
-            prev_orig = sample.rot;
+        if fixed.get(i).copied().unwrap_or(true) {
+            vectors.push(None);
             continue;
         }
         let c = cone::correct(sample.v, *ts, settings.half_angle);
@@ -81,19 +89,145 @@ pub fn smooth_run(
             settings.singular_angle,
             settings.half_angle,
         );
-        let rot = kin.rotary_following(vector, prev_rot, sample.rot, prev_orig);
-        prev_orig = sample.rot;
-        prev_rot = rot;
-        out.push(Sample {
-            v: vector,
-            rot,
-            ..*sample
-        });
+        vectors.push(Some(blend(
+            sample.v,
+            vector,
+            weights.get(i).copied().unwrap_or(1.0),
+        )));
     }
-    RunOutput {
-        samples: out,
-        corrected,
+    let rots = choose_rotary(kin, run, &vectors);
+    let samples = run
+        .iter()
+        .zip(&vectors)
+        .zip(&rots)
+        .map(|((sample, v), rot)| match v {
+            Some(v) => Sample {
+                v: *v,
+                rot: *rot,
+                ..*sample
+            },
+            None => *sample,
+        })
+        .collect();
+    RunOutput { samples, corrected }
+}
+
+/// Rotary angles for the new vectors of a run (`None`: the point keeps its original angles),
+/// chosen over the whole run at once: among both inverse-kinematics branches and the nearest
+/// turns of the table (see [`Kinematics::candidates`]), the sequence with the least total axis
+/// motion (dynamic programming, Viterbi-style). A greedy point-by-point choice can drift a whole
+/// turn (or onto the other branch) away from the original and then has to jump back at the next
+/// point that is kept as written; the path-wide choice never steps by a turn when a continuous
+/// sequence exists, and it meets kept points and the run's ends on the file's own branch.
+pub fn choose_rotary(kin: &Kinematics, run: &[Sample], vectors: &[Option<V3>]) -> Vec<[f64; 2]> {
+    let cands: Vec<Vec<[f64; 2]>> = run
+        .iter()
+        .zip(vectors)
+        .map(|(s, v)| match v {
+            Some(v) => kin.candidates(*v, s.rot),
+            None => vec![s.rot],
+        })
+        .collect();
+    // cost[i][j]: least motion to reach candidate j of point i; back[i][j]: predecessor.
+    let mut cost: Vec<f64> = cands.first().map_or(Vec::new(), |c| vec![0.0; c.len()]);
+    let mut back: Vec<Vec<usize>> = Vec::with_capacity(cands.len());
+    back.push(vec![0; cost.len()]);
+    for w in cands.windows(2) {
+        let [prev, cur] = w else { continue };
+        let mut next_cost = Vec::with_capacity(cur.len());
+        let mut next_back = Vec::with_capacity(cur.len());
+        for c in cur {
+            let mut best = (f64::INFINITY, 0usize);
+            for (k, p) in prev.iter().enumerate() {
+                let total =
+                    cost.get(k).copied().unwrap_or(f64::INFINITY) + transition_cost(kin, *p, *c);
+                if total < best.0 {
+                    best = (total, k);
+                }
+            }
+            next_cost.push(best.0);
+            next_back.push(best.1);
+        }
+        cost = next_cost;
+        back.push(next_back);
     }
+    // Backtrack from the cheapest end.
+    let mut j = cost
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(b.1))
+        .map_or(0, |(j, _)| j);
+    let mut out = vec![[0.0; 2]; cands.len()];
+    for i in (0..cands.len()).rev() {
+        if let (Some(o), Some(c)) = (out.get_mut(i), cands.get(i).and_then(|c| c.get(j))) {
+            *o = *c;
+        }
+        j = back.get(i).and_then(|b| b.get(j)).copied().unwrap_or(0);
+    }
+    out
+}
+
+/// Cost of moving the rotary axes from `a` to `b` in one move: the axis motion, plus a penalty
+/// that makes a step of half a turn or more of the second axis the last resort.
+fn transition_cost(kin: &Kinematics, a: [f64; 2], b: [f64; 2]) -> f64 {
+    let step = kin.step(a, b);
+    if (a[1] - b[1]).abs() >= 180.0 {
+        step + 1e6
+    } else {
+        step
+    }
+}
+
+/// Weight of the smoothing at each point: 0 at points kept as written (anchors), rising linearly
+/// to 1 over half a window away from the nearest anchor (in points or millimetres, as the
+/// window is counted). Without it the smoothed vectors would meet a kept point with a step.
+pub fn anchor_weights(fixed: &[bool], s: &[f64], window: Window) -> Vec<f64> {
+    let n = fixed.len();
+    let ramp = match window {
+        Window::Points(w) => (w as f64 / 2.0).max(1.0),
+        Window::Millimetres(mm) => (mm / 2.0).max(1e-9),
+    };
+    let pos = |i: usize| match window {
+        Window::Points(_) => i as f64,
+        Window::Millimetres(_) => s.get(i).copied().unwrap_or(0.0),
+    };
+    let mut dist = vec![f64::INFINITY; n];
+    let mut last: Option<f64> = None;
+    for i in 0..n {
+        if fixed.get(i).copied().unwrap_or(false) {
+            last = Some(pos(i));
+        }
+        if let (Some(a), Some(d)) = (last, dist.get_mut(i)) {
+            *d = pos(i) - a;
+        }
+    }
+    let mut next: Option<f64> = None;
+    for i in (0..n).rev() {
+        if fixed.get(i).copied().unwrap_or(false) {
+            next = Some(pos(i));
+        }
+        if let (Some(a), Some(d)) = (next, dist.get_mut(i)) {
+            *d = d.min(a - pos(i));
+        }
+    }
+    dist.into_iter()
+        .map(|d| (d / ramp).clamp(0.0, 1.0))
+        .collect()
+}
+
+/// The vector a fraction `w` of the way from `b` to `t` along the great circle (slerp). Its
+/// angle to `b` is `w` times that of `t`, so it stays inside any cone `t` is inside.
+pub fn blend(b: V3, t: V3, w: f64) -> V3 {
+    if w >= 1.0 {
+        return t;
+    }
+    if w <= 0.0 {
+        return b;
+    }
+    let Some(h) = vec3::normalize(vec3::cross(b, t)) else {
+        return if w < 0.5 { b } else { t };
+    };
+    vec3::normalize(vec3::rotate(b, h, w * vec3::angle(b, t))).unwrap_or(b)
 }
 
 /// Whether the original vector `b` is within `keep_out` of the singular direction.
@@ -147,5 +281,33 @@ pub fn keep_out_of_singularity(t: V3, b: V3, axis: V3, keep_out: f64, half_angle
     match vec3::normalize(moved) {
         Some(m) if vec3::angle(m, b) <= half_angle => m,
         _ => b,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weights_ramp_from_anchors() {
+        let fixed = [
+            true, false, false, false, false, false, false, false, false, true,
+        ];
+        let s: Vec<f64> = (0..10).map(f64::from).collect();
+        let w = anchor_weights(&fixed, &s, Window::Points(4));
+        assert_eq!(w, vec![0.0, 0.5, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.5, 0.0]);
+        let w = anchor_weights(&fixed, &s, Window::Millimetres(8.0));
+        assert_eq!(w[1], 0.25);
+        assert_eq!(w[4], 1.0);
+        let none = anchor_weights(&[false; 5], &s[..5], Window::Points(4));
+        assert!(none.iter().all(|&x| x == 1.0));
+    }
+
+    #[test]
+    fn blend_scales_the_angle() {
+        let b = [0.0, 0.0, 1.0];
+        let t = [0.6f64.sin(), 0.0, 0.6f64.cos()];
+        let m = blend(b, t, 0.25);
+        assert!((vec3::angle(m, b) - 0.15).abs() < 1e-12);
     }
 }

@@ -26,7 +26,7 @@ pub(super) fn run(
     summary::tick(progress, 0.3)?;
     let lines = program::motion_lines(input, options.analyze.strict)?;
     let line_of = program::line_of_moves(moves, &lines);
-    let runs = program::runs(moves, &line_of, options.max_gap_mm);
+    let runs = program::runs(kin, moves, &line_of, options.max_gap_mm);
     let [r0, r1] = kin.model.rotary_axes();
     let has_rotary = moves
         .iter()
@@ -79,45 +79,78 @@ pub(super) fn run(
     let mut offsets = Offsets::default();
     let mut edits: Vec<Edit> = Vec::new();
     let mut after_est: Vec<Vec<Sample>> = before.clone();
+    // Axes whose modal value in the output differs from the input's (X, Y, Z, rotary ×2): a
+    // later line that leaves such a word out would inherit the wrong value, so it gets all its
+    // words written out.
+    let mut dirty = [false; 5];
+    let xyz_axes = [
+        crate::machine::axis::X,
+        crate::machine::axis::Y,
+        crate::machine::axis::Z,
+    ];
     for (mi, m) in moves.iter().enumerate() {
         let Some(line) = line_of.get(mi).copied().flatten() else {
             continue;
         };
         offsets.learn(m, line);
-        let Some((r, k)) = slot.get(mi).copied().flatten() else {
-            continue;
+        let omits = program::omitted(line, kin);
+        let force = omits.iter().zip(&dirty).any(|(o, d)| *o && *d);
+        let slot_here = slot.get(mi).copied().flatten();
+        let pose = match slot_here
+            .and_then(|(r, k)| Some((r, k, before.get(r)?.get(k)?, smoothed.get(r)?.get(k)?)))
+        {
+            Some((r, k, orig, new)) => {
+                let q = |v: f64, ax: usize| {
+                    words::rounded(v + offsets.of(ax), decimals) - offsets.of(ax)
+                };
+                let mut rot = [q(new.rot[0], r0), q(new.rot[1], r1)];
+                let mut v = kin.tool_vector(rot);
+                if vec3::angle(v, orig.v) > half {
+                    // Rounding pushed it out after all: keep the original orientation here.
+                    rot = orig.rot;
+                    v = orig.v;
+                }
+                let xyz = kin.machine_xyz(orig.p, rot);
+                let xyz = [0, 1, 2].map(|k| {
+                    q(
+                        xyz.get(k).copied().unwrap_or(0.0),
+                        xyz_axes.get(k).copied().unwrap_or(0),
+                    )
+                });
+                let pose = Pose { xyz, rot };
+                if let Some(s) = after_est.get_mut(r).and_then(|x| x.get_mut(k)) {
+                    *s = Sample {
+                        p: kin.tip(&pose),
+                        v,
+                        rot,
+                        dt: orig.dt,
+                    };
+                }
+                pose
+            }
+            None if force => program::pose(kin, &m.to),
+            None => {
+                for (d, o) in dirty.iter_mut().zip(&omits) {
+                    *d &= *o;
+                }
+                continue;
+            }
         };
-        let (Some(orig), Some(new)) = (
-            before.get(r).and_then(|x| x.get(k)),
-            smoothed.get(r).and_then(|x| x.get(k)),
-        ) else {
-            continue;
+        let fmt = program::WordFormat {
+            kin,
+            offsets: &offsets,
+            decimals,
         };
-        let q = |v: f64, ax: usize| words::rounded(v + offsets.of(ax), decimals) - offsets.of(ax);
-        let mut rot = [q(new.rot[0], r0), q(new.rot[1], r1)];
-        let mut v = kin.tool_vector(rot);
-        if vec3::angle(v, orig.v) > half {
-            // Rounding pushed it out after all: keep the original orientation here.
-            rot = orig.rot;
-            v = orig.v;
-        }
-        let xyz = kin.machine_xyz(orig.p, rot);
-        let xyz = [
-            q(xyz[0], crate::machine::axis::X),
-            q(xyz[1], crate::machine::axis::Y),
-            q(xyz[2], crate::machine::axis::Z),
-        ];
-        let pose = Pose { xyz, rot };
-        if let Some(s) = after_est.get_mut(r).and_then(|x| x.get_mut(k)) {
-            *s = Sample {
-                p: kin.tip(&pose),
-                v,
-                rot,
-                dt: orig.dt,
-            };
-        }
-        if let Some(e) = program::edit_for(input, line, kin, &m.to, &pose, &offsets, decimals) {
-            edits.push(e);
+        match program::edit_for(input, line, &fmt, &m.to, &pose, force) {
+            Some(e) => {
+                edits.push(e);
+                dirty = program::differs(&fmt, &m.to, &pose);
+            }
+            None => {
+                for (d, o) in dirty.iter_mut().zip(&omits) {
+                    *d &= *o;
+                }
+            }
         }
     }
     summary::tick(progress, 0.65)?;

@@ -261,31 +261,42 @@ impl Kinematics {
 }
 
 impl Kinematics {
-    /// Inverse kinematics along a path being re-oriented: the solution on the original pose's
-    /// branch and turn (nearest to `orig`, the rotary angles the point had before), unless that
-    /// costs a step from `prev` more than 45° larger than both the continuous choice
-    /// ([`Kinematics::rotary_for`] from `prev`) and the original step `orig − orig_prev`.
-    ///
-    /// Following the original branch keeps each run ending on the same B sign and C turn count
-    /// as the file had, so the unchanged travel move after it does not have to spin the table
-    /// round by 360° or flip B; the continuity fallback keeps the new angles from ever stepping
-    /// by half a turn inside a run.
-    pub fn rotary_following(
-        &self,
-        n: V3,
-        prev: [f64; 2],
-        orig: [f64; 2],
-        orig_prev: [f64; 2],
-    ) -> [f64; 2] {
-        let on_branch = self.rotary_for(n, orig);
-        let continuous = self.rotary_for(n, prev);
-        let dist = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).abs() + (p[1] - q[1]).abs();
-        let allowed = dist(continuous, prev).max(dist(orig, orig_prev)) + 45.0;
-        if dist(on_branch, prev) <= allowed {
-            on_branch
-        } else {
-            continuous
+    /// Every rotary solution for unit tool vector `n` worth considering near the original
+    /// angles `orig`: both inverse-kinematics branches, and for the turntable (table C) the turn
+    /// nearest `orig` and one either side. At the singularity the free angle takes its original
+    /// value. Used by the path-wide choice in [`super::core`].
+    pub fn candidates(&self, n: V3, orig: [f64; 2]) -> Vec<[f64; 2]> {
+        let (s1, s2, singular) = self.solutions(n);
+        let mut out = Vec::with_capacity(6);
+        for s in [s1, s2] {
+            match self.model {
+                KinematicModel::TableBc => {
+                    let c0 = if singular {
+                        orig[1]
+                    } else {
+                        orig[1] + wrap180(s[1] - orig[1])
+                    };
+                    for turn in [0.0, -360.0, 360.0] {
+                        out.push([s[0], c0 + turn]);
+                    }
+                }
+                KinematicModel::HeadAb => {
+                    let a = if singular { orig[0] } else { s[0] };
+                    out.push([a, s[1]]);
+                }
+            }
         }
+        out
+    }
+
+    /// Joint-space distance between two rotary poses (sum of the axis moves, degrees; the head's
+    /// A is compared modulo a turn).
+    pub fn step(&self, a: [f64; 2], b: [f64; 2]) -> f64 {
+        let d0 = match self.model {
+            KinematicModel::TableBc => (a[0] - b[0]).abs(),
+            KinematicModel::HeadAb => wrap180(a[0] - b[0]).abs(),
+        };
+        d0 + (a[1] - b[1]).abs()
     }
 }
 

@@ -74,15 +74,28 @@ pub(super) fn motion_lines(input: &[u8], strict: bool) -> Result<Vec<MotionLine>
 /// One run: indexes of its moves in the path.
 pub(super) type Run = Vec<usize>;
 
-/// Whether a move can be smoothed: an extruding straight `G1` in absolute positioning, no
-/// longer than `max_gap_mm` (a longer extruding move is a jump between sections of the path,
+/// Whether a move can be smoothed: an extruding straight `G1` in absolute positioning whose
+/// tool tip, and whose machine XYZ, move no more than `max_gap_mm`. A longer tip move is a jump
+/// to another section of the part; a long machine move for a short tip move is the table
+/// swinging round (a change of inverse-kinematics branch, as the corpus file does at every
+/// section change). Either way the orientations on both sides have nothing to average (a longer extruding move is a jump between sections of the path,
 /// whose orientations have nothing to do with each other; it stays as written and separates
 /// the runs).
-fn eligible(m: &PathMove, line: Option<&MotionLine>, max_gap_mm: f64) -> bool {
+fn eligible(kin: &Kinematics, m: &PathMove, line: Option<&MotionLine>, max_gap_mm: f64) -> bool {
     matches!(m.kind, MoveKind::Linear)
         && m.is_extruding()
-        && m.length_mm <= max_gap_mm
         && line.is_some_and(|l| !l.relative)
+        && tip_length(kin, m) <= max_gap_mm
+        && m.length_mm <= max_gap_mm
+}
+
+/// Length of a move's tool-tip path in the workpiece frame (chord), mm. The machine XYZ length
+/// is no measure of it: turning the table moves the machine axes a long way for a short step of
+/// the tip.
+pub(super) fn tip_length(kin: &Kinematics, m: &PathMove) -> f64 {
+    let a = kin.tip(&pose(kin, &m.from));
+    let b = kin.tip(&pose(kin, &m.to));
+    super::vec3::norm(super::vec3::sub(b, a))
 }
 
 /// The motion line of each move (`None` for moves from other commands).
@@ -103,11 +116,16 @@ pub(super) fn line_of_moves<'l>(
 }
 
 /// Splits the moves into runs of consecutive eligible moves.
-pub(super) fn runs(moves: &[PathMove], lines: &[Option<&MotionLine>], max_gap_mm: f64) -> Vec<Run> {
+pub(super) fn runs(
+    kin: &Kinematics,
+    moves: &[PathMove],
+    lines: &[Option<&MotionLine>],
+    max_gap_mm: f64,
+) -> Vec<Run> {
     let mut out = Vec::new();
     let mut cur: Run = Vec::new();
     for (i, m) in moves.iter().enumerate() {
-        if eligible(m, lines.get(i).copied().flatten(), max_gap_mm) {
+        if eligible(kin, m, lines.get(i).copied().flatten(), max_gap_mm) {
             cur.push(i);
         } else if !cur.is_empty() {
             out.push(std::mem::take(&mut cur));
@@ -149,6 +167,53 @@ pub(super) fn samples(kin: &Kinematics, moves: &[PathMove], run: &Run) -> Vec<Sa
     out
 }
 
+/// The five axes a rewritten line carries: X, Y, Z and the two rotary axes.
+fn five_axes(kin: &Kinematics) -> [usize; 5] {
+    let [r0, r1] = kin.model.rotary_axes();
+    [axis::X, axis::Y, axis::Z, r0, r1]
+}
+
+/// Which of the five axes the line leaves out (it then inherits them from the line before).
+pub(super) fn omitted(line: &MotionLine, kin: &Kinematics) -> [bool; 5] {
+    five_axes(kin).map(|ax| {
+        AXIS_INDEX
+            .iter()
+            .position(|(_, a)| *a == ax)
+            .and_then(|k| line.words.get(k).copied().flatten())
+            .is_none()
+    })
+}
+
+/// How axis words are written: the model, the G92 offsets in force, the decimals.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct WordFormat<'a> {
+    /// Kinematic model (which rotary letters).
+    pub kin: &'a Kinematics,
+    /// `word = position + offset`.
+    pub offsets: &'a Offsets,
+    /// Decimals written.
+    pub decimals: usize,
+}
+
+/// Which of the five axes the new pose writes differently from the original position.
+pub(super) fn differs(fmt: &WordFormat<'_>, old_to: &Pos, new: &Pose) -> [bool; 5] {
+    let WordFormat {
+        kin,
+        offsets,
+        decimals,
+    } = *fmt;
+    let values = [new.xyz[0], new.xyz[1], new.xyz[2], new.rot[0], new.rot[1]];
+    let axes = five_axes(kin);
+    std::array::from_fn(|k| {
+        let (ax, v) = (
+            axes.get(k).copied().unwrap_or(0),
+            values.get(k).copied().unwrap_or(0.0),
+        );
+        let old = old_to.get(ax).copied().unwrap_or(0.0) + offsets.of(ax);
+        words::format_value(v + offsets.of(ax), decimals) != words::format_value(old, decimals)
+    })
+}
+
 /// Offsets between written words and machine positions (G92 shifts), tracked along the file:
 /// `word = position + offset`.
 #[derive(Debug, Default)]
@@ -178,16 +243,20 @@ impl Offsets {
 }
 
 /// The edit of one motion line (which moved to `old_to`) for its new pose, or `None` when the
-/// written values would not change. A changed line gets all five axis words.
+/// written values would not change (and not `force`d). A changed line gets all five axis words.
 pub(super) fn edit_for(
     input: &[u8],
     line: &MotionLine,
-    kin: &Kinematics,
+    fmt: &WordFormat<'_>,
     old_to: &Pos,
     new: &Pose,
-    offsets: &Offsets,
-    decimals: usize,
+    force: bool,
 ) -> Option<Edit> {
+    let WordFormat {
+        kin,
+        offsets,
+        decimals,
+    } = *fmt;
     let [r0, r1] = kin.model.rotary_axes();
     let targets = [
         (b'X', axis::X, new.xyz[0]),
@@ -197,7 +266,7 @@ pub(super) fn edit_for(
         (rot_letter(r1), r1, new.rot[1]),
     ];
     let mut values = Vec::with_capacity(5);
-    let mut changed = false;
+    let mut changed = force;
     for (letter, ax, v) in targets {
         let text = words::format_value(v + offsets.of(ax), decimals);
         // What the line means now: its word, or the modal position it leaves unchanged.
