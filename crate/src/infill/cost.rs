@@ -40,6 +40,13 @@ impl Rotation {
     }
 }
 
+/// New motions for a block, and where the nozzle ends (X, Y, Z as the machine holds them).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Replacement {
+    pub motions: Vec<Motion>,
+    pub end: [f64; 3],
+}
+
 /// The numbers of one candidate, for the whole file.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct Costs {
@@ -129,7 +136,7 @@ fn motion_length(m: &Motion) -> f64 {
 /// Replays `prog` with block `b` replaced by `replace[b]` (when `Some`) and the rotation.
 pub(crate) fn replay(
     prog: &Program,
-    replace: &[Option<Vec<Motion>>],
+    replace: &[Option<Replacement>],
     rotation: Option<&Rotation>,
     base: &Baseline,
 ) -> Costs {
@@ -140,7 +147,7 @@ pub(crate) fn replay(
 /// `per_block` (indexed like `prog.blocks`).
 pub(crate) fn replay_blocks(
     prog: &Program,
-    replace: &[Option<Vec<Motion>>],
+    replace: &[Option<Replacement>],
     rotation: Option<&Rotation>,
     base: &Baseline,
     per_block: Option<&mut Vec<[f64; 2]>>,
@@ -176,6 +183,7 @@ pub(crate) fn replay_blocks(
     starts.sort_unstable();
     let mut next_start = 0usize;
     let mut skip_until = 0usize;
+    let mut resume_from: Option<[f64; 3]> = None;
 
     macro_rules! push {
         ($m:expr, $owner:expr) => {{
@@ -206,9 +214,12 @@ pub(crate) fn replay_blocks(
                             .get(blk.first..blk.end)
                             .map_or(0.0, |ms| ms.iter().map(|m| m.m.extrusion()).sum::<f64>());
                         filament -= orig;
-                        for m in replace[b].iter().flatten() {
-                            filament += m.delta[3];
-                            push!(*m, b as u32);
+                        if let Some(r) = &replace[b] {
+                            for m in &r.motions {
+                                filament += m.delta[3];
+                                push!(*m, b as u32);
+                            }
+                            resume_from = Some(r.end);
                         }
                         continue;
                     }
@@ -228,6 +239,25 @@ pub(crate) fn replay_blocks(
                             a.start_angle += crate::math::atan2(r.cs.1, r.cs.0);
                         }
                     }
+                }
+                // Moves after new infill start where the new infill ended: the axes a line
+                // does not name stay there (a Z lift or a retraction stays put; a rotated
+                // line names both).
+                if let Some(end) = resume_from {
+                    let rotated = rotation.is_some_and(|r| r.covers(i));
+                    let to = [mv.m.to[axis::X], mv.m.to[axis::Y]];
+                    let moves_xy = to != [mv.m.from[axis::X], mv.m.from[axis::Y]];
+                    let names = if rotated && moves_xy { [true; 2] } else { mv.names };
+                    let t = match rotation {
+                        Some(r) if rotated => r.apply(to),
+                        _ => to,
+                    };
+                    let x = if names[0] { t[0] } else { end[0] };
+                    let y = if names[1] { t[1] } else { end[1] };
+                    m.delta[0] = x - end[0];
+                    m.delta[1] = y - end[1];
+                    m.delta[2] = mv.m.to[axis::Z] - end[2];
+                    resume_from = (!names[0] || !names[1]).then_some([x, y, mv.m.to[axis::Z]]);
                 }
                 push!(m, u32::MAX);
             }

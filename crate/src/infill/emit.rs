@@ -6,6 +6,7 @@
 
 use std::fmt::Write as _;
 
+use super::cost::Replacement;
 use super::geom::{dist, Path, P2};
 use super::program::{Block, Program};
 use crate::error::Warnings;
@@ -187,7 +188,8 @@ impl Writer<'_> {
 }
 
 /// The new text of `block` (without a final newline): `strokes` (machine frame), then back to
-/// `end` (machine frame), with the filament state and absolute E the original left behind.
+/// `end` (machine frame) unless the file travels on from there anyway, with the filament state
+/// and absolute E the original left behind.
 pub(crate) fn block_text(block: &Block, strokes: &[Path], start: P2, end: P2, habit: &Habit) -> String {
     let absolute = block.machine.extrusion_mode() == ExtrusionMode::Absolute;
     let mut w = Writer {
@@ -201,7 +203,9 @@ pub(crate) fn block_text(block: &Block, strokes: &[Path], start: P2, end: P2, ha
     for s in strokes {
         w.stroke(s);
     }
-    w.travel(end);
+    if !block.free_end {
+        w.travel(end);
+    }
     w.retract(block.retracted_end);
     if absolute {
         let _ = writeln!(w.out, "G92 E{:.5}", block.end_logical[3]);
@@ -210,19 +214,23 @@ pub(crate) fn block_text(block: &Block, strokes: &[Path], start: P2, end: P2, ha
     w.out
 }
 
-/// The motions `text` makes when run from the machine state before `block`; net filament.
-pub(crate) fn motions(block: &Block, text: &str, out: &mut Vec<Motion>) -> f64 {
+/// The motions `text` makes when run from the machine state before `block`, and where the
+/// nozzle ends.
+pub(crate) fn motions(block: &Block, text: &str) -> Replacement {
     let mut machine = block.machine.clone();
     let mut warnings = Warnings::default();
-    let mut net = 0.0;
+    let mut motions = Vec::new();
     for l in text.lines() {
         let Ok(line) = parse_line(l.as_bytes()) else { continue };
         if let Some(Event::Move(m)) = machine.apply(block.first_line, &line, &mut warnings) {
-            net += m.extrusion();
-            out.push(Motion::from(&m));
+            motions.push(Motion::from(&m));
         }
     }
-    net
+    let p = machine.position();
+    Replacement {
+        motions,
+        end: [p[axis::X], p[axis::Y], p[axis::Z]],
+    }
 }
 
 #[cfg(test)]

@@ -20,6 +20,19 @@ pub(crate) fn link(
 ) -> Vec<Path> {
     let mut strokes: Vec<Path> = Vec::new();
     let mut cur = start;
+    // Sweep from the end of the pattern nearer the nozzle.
+    let near = |row: Option<&Vec<Path>>| {
+        row.map_or(f64::INFINITY, |r| {
+            r.iter()
+                .flat_map(|p| p.first().into_iter().chain(p.last()))
+                .map(|&q| dist(q, start))
+                .fold(f64::INFINITY, f64::min)
+        })
+    };
+    let mut rows = rows;
+    if near(rows.last()) < near(rows.first()) {
+        rows.reverse();
+    }
     let mut open: Option<Path> = None;
     for (r, mut row) in rows.into_iter().enumerate() {
         if r % 2 == 1 {

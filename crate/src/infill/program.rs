@@ -38,6 +38,8 @@ pub(crate) enum Op {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Mv {
     pub m: Move,
+    /// Whether the line names X, and Y.
+    pub names: [bool; 2],
     pub kind: Option<FeatureKind>,
     pub layer: u32,
 }
@@ -59,6 +61,9 @@ pub(crate) struct Block {
     pub end_logical: [f64; 4],
     pub end_physical: [f64; 4],
     pub end_feed_mm_s: f64,
+    /// Whether the next move that goes somewhere after the block is a travel (so new infill
+    /// may end anywhere: that travel starts from wherever it ends).
+    pub free_end: bool,
     /// Whether the filament is retracted at the start and at the end of the block.
     pub retracted_start: bool,
     pub retracted_end: bool,
@@ -182,6 +187,7 @@ pub(crate) fn read(input: &[u8], options: &AnalyzeOptions) -> Result<Program, Er
                 ops.push(Op::Move(moves.len()));
                 moves.push(Mv {
                     m,
+                    names: [line.params.has(b'X'), line.params.has(b'Y')],
                     kind,
                     layer: u32::MAX,
                 });
@@ -249,6 +255,10 @@ pub(crate) fn read(input: &[u8], options: &AnalyzeOptions) -> Result<Program, Er
             end_feed_mm_s: end_feed,
             retracted_start: retract_marks.get(first).copied().unwrap_or(false),
             retracted_end: retract_marks.get(end).copied().unwrap_or(false),
+            free_end: moves
+                .get(end..)
+                .and_then(|rest| rest.iter().find(|m| m.m.length_mm > 1e-9))
+                .is_some_and(|m| !m.m.is_extruding() && !matches!(m.m.kind, MoveKind::Arc(_))),
         });
     }
     Ok(Program {

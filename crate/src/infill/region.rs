@@ -203,6 +203,7 @@ mod tests {
                 length_mm: dist(a, b),
             },
             kind: Some(kind),
+            names: [true, true],
             layer: 0,
         }
     }

@@ -8,7 +8,7 @@
 
 use std::collections::HashMap;
 
-use super::cost::{replay, Baseline, Costs, Rotation};
+use super::cost::{replay, Baseline, Costs, Replacement, Rotation};
 use super::emit::{self, Habit};
 use super::geom::{bbox, path_len, Path, P2};
 use super::program::{self, Program};
@@ -21,7 +21,6 @@ use crate::analyze::{analyze, Progress, Report};
 use crate::error::{Error, ErrorKind};
 use crate::gcode::FeatureKind;
 use crate::machine::axis;
-use crate::plan::Motion;
 
 /// Clearance used when the file gives no evidence of its own, mm (a 0.45 mm line with 10 %
 /// overlap).
@@ -232,10 +231,10 @@ impl Prepared<'_> {
         &self,
         plans: &[&Vec<Path>],
         rotation: Option<&Rotation>,
-    ) -> (Vec<Option<String>>, Vec<Option<Vec<Motion>>>) {
+    ) -> (Vec<Option<String>>, Vec<Option<Replacement>>) {
         let n = self.prog.blocks.len();
         let mut texts: Vec<Option<String>> = vec![None; n];
-        let mut motions: Vec<Option<Vec<Motion>>> = vec![None; n];
+        let mut motions: Vec<Option<Replacement>> = vec![None; n];
         let tf = |p: P2| rotation.map_or(p, |r| r.apply(p));
         for (w, plan) in self.work.iter().zip(plans) {
             let habit = Habit {
@@ -250,10 +249,8 @@ impl Prepared<'_> {
                 let end = tf([blk.end_physical[0], blk.end_physical[1]]);
                 let strokes: &[Path] = if k == 0 { &moved } else { &[] };
                 let text = emit::block_text(blk, strokes, start, end, &habit);
-                let mut m = Vec::new();
-                emit::motions(blk, &text, &mut m);
+                motions[b] = Some(emit::motions(blk, &text));
                 texts[b] = Some(text);
-                motions[b] = Some(m);
             }
         }
         (texts, motions)

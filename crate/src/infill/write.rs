@@ -2,9 +2,9 @@
 //! so every line the candidate does not change stays byte for byte.
 //!
 //! - Each replaced block: its first line becomes the new text, its other lines go.
-//! - A part rotation: every move line of the print gets its X and Y rewritten to the rotated
-//!   target (both words, even where the original gave one), arc offsets `I`/`J` turned with it;
-//!   the other words are written back as parsed, the comment kept.
+//! - A part rotation: every move line of the print that moves in XY gets its X and Y rewritten
+//!   to the rotated target (both words, even where the original gave one), arc offsets `I`/`J`
+//!   turned with it; the other words are written back as parsed, the comment kept.
 
 use std::fmt::Write as _;
 
@@ -29,7 +29,10 @@ pub(crate) fn edits(
     let mut rotated = std::collections::BTreeMap::new();
     if let Some(r) = rotation {
         for (i, mv) in prog.moves.iter().enumerate().take(r.last + 1).skip(r.first) {
-            if matches!(mv.m.kind, MoveKind::FirmwareRetract | MoveKind::Home) {
+            // Moves that stay in XY (lifts, retractions) keep their words: they stay wherever
+            // the nozzle is, which after new infill is where the new infill ended.
+            let still = mv.m.to[axis::X] == mv.m.from[axis::X] && mv.m.to[axis::Y] == mv.m.from[axis::Y];
+            if still || matches!(mv.m.kind, MoveKind::FirmwareRetract | MoveKind::Home) {
                 continue;
             }
             let to = r.apply([mv.m.to[axis::X], mv.m.to[axis::Y]]);
