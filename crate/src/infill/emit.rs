@@ -214,22 +214,35 @@ pub(crate) fn block_text(block: &Block, strokes: &[Path], start: P2, end: P2, ha
     w.out
 }
 
-/// The motions `text` makes when run from the machine state before `block`, and where the
-/// nozzle ends.
-pub(crate) fn motions(block: &Block, text: &str) -> Replacement {
+/// The motions `text` makes when run from the machine state before `block`, with the nozzle
+/// at `start` (the block's start in the candidate's frame: a rotated part starts elsewhere
+/// than the machine copy believes), and where the nozzle ends.
+pub(crate) fn motions(block: &Block, text: &str, start: P2) -> Replacement {
     let mut machine = block.machine.clone();
     let mut warnings = Warnings::default();
     let mut motions = Vec::new();
+    let p0 = *machine.position();
+    let start = [r3(start[0]), r3(start[1])];
+    let mut moved = false;
     for l in text.lines() {
         let Ok(line) = parse_line(l.as_bytes()) else { continue };
         if let Some(Event::Move(m)) = machine.apply(block.first_line, &line, &mut warnings) {
-            motions.push(Motion::from(&m));
+            let mut motion = Motion::from(&m);
+            if !moved && line.params.has(b'X') {
+                // Every XY line written here names X and Y: the first one's displacement is
+                // from the true start.
+                motion.delta[0] += p0[axis::X] - start[0];
+                motion.delta[1] += p0[axis::Y] - start[1];
+                moved = true;
+            }
+            motions.push(motion);
         }
     }
     let p = machine.position();
+    let end = if moved { [p[axis::X], p[axis::Y]] } else { start };
     Replacement {
         motions,
-        end: [p[axis::X], p[axis::Y], p[axis::Z]],
+        end: [end[0], end[1], p[axis::Z]],
     }
 }
 

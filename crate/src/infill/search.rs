@@ -249,7 +249,7 @@ impl Prepared<'_> {
                 let end = tf([blk.end_physical[0], blk.end_physical[1]]);
                 let strokes: &[Path] = if k == 0 { &moved } else { &[] };
                 let text = emit::block_text(blk, strokes, start, end, &habit);
-                motions[b] = Some(emit::motions(blk, &text));
+                motions[b] = Some(emit::motions(blk, &text, start));
                 texts[b] = Some(text);
             }
         }
