@@ -104,6 +104,44 @@ pub fn path_len(p: &[P2]) -> f64 {
     p.windows(2).map(|w| dist(w[0], w[1])).sum()
 }
 
+/// Douglas–Peucker simplification of a closed contour to within `tol` (keeps at least 3
+/// points). Regions rebuilt from strokes carry many near-collinear points; fewer points make
+/// every later offset and clip cheaper.
+pub fn simplify_closed(c: &[P2], tol: f64) -> Path {
+    if c.len() <= 4 {
+        return c.to_vec();
+    }
+    let mut keep = vec![false; c.len()];
+    keep[0] = true;
+    // Split at the point farthest from the first, so the closed contour is two open chains.
+    let far = (1..c.len())
+        .max_by(|&a, &b| dist(c[a], c[0]).total_cmp(&dist(c[b], c[0])))
+        .unwrap_or(c.len() / 2);
+    keep[far] = true;
+    let mut stack = vec![(0usize, far), (far, c.len())];
+    while let Some((a, b)) = stack.pop() {
+        let pb = c[b % c.len()];
+        let mut best = (0.0, 0usize);
+        for (i, &p) in c.iter().enumerate().take(b).skip(a + 1) {
+            let d = seg_dist(p, c[a], pb);
+            if d > best.0 {
+                best = (d, i);
+            }
+        }
+        if best.0 > tol {
+            keep[best.1] = true;
+            stack.push((a, best.1));
+            stack.push((best.1, b));
+        }
+    }
+    let out: Path = c.iter().zip(&keep).filter(|(_, k)| **k).map(|(p, _)| *p).collect();
+    if out.len() >= 3 {
+        out
+    } else {
+        c.to_vec()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -119,6 +157,11 @@ mod tests {
         assert!(!inside(&r, [5.0, 5.0]));
         assert!(!inside(&r, [11.0, 5.0]));
         assert!(inside_tol(&r, [10.01, 5.0], 0.02));
+        let dense: Path = (0..=100)
+            .map(|i| [0.1 * i as f64, 0.0])
+            .chain([[10.0, 10.0], [0.0, 10.0]])
+            .collect();
+        assert_eq!(simplify_closed(&dense, 0.01).len(), 4);
         let q = rotate([1.0, 0.0], [0.0, 0.0], cos_sin_deg(90.0));
         assert!(q[0].abs() < 1e-12 && (q[1] - 1.0).abs() < 1e-12);
     }

@@ -24,7 +24,7 @@ use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::stroke::offset::StrokeOffset;
 use i_overlay::mesh::float::style::{LineCap, OutlineStyle, StrokeStyle};
 
-use super::geom::{dist, path_len, region_area, seg_dist, Path, Region, P2};
+use super::geom::{dist, path_len, region_area, seg_dist, simplify_closed, Path, Region, P2};
 use super::program::{Mv, Program};
 use crate::gcode::FeatureKind;
 use crate::machine::axis;
@@ -162,7 +162,10 @@ pub(crate) fn extract(moves: &[Mv], d: f64) -> Option<LayerRegion> {
     let r = flatten(part.overlay(&taken, OverlayRule::Difference, FillRule::EvenOdd));
     // Opening: drop slivers narrower than about d.
     let r = flatten(r.outline(&OutlineStyle::new(-0.5 * d)));
-    let region = flatten(r.outline(&OutlineStyle::new(0.5 * d)));
+    let region: Region = flatten(r.outline(&OutlineStyle::new(0.5 * d)))
+        .iter()
+        .map(|c| simplify_closed(c, 0.01))
+        .collect();
     let area_mm2 = region_area(&region);
     (area_mm2 > 1e-6).then_some(LayerRegion {
         region,

@@ -308,7 +308,9 @@ pub fn infill_with_progress(
                 }
                 done += 1;
                 let beta = angle - rot_deg;
-                let plans = cache.entry(angle_key(beta)).or_insert_with(|| {
+                // Concentric loops do not depend on the angle.
+                let key = if pattern == Pattern::Concentric { 0 } else { angle_key(beta) };
+                let plans = cache.entry(key).or_insert_with(|| {
                     prep.work.iter().map(|w| prep.plan_layer(w, pattern, beta)).collect()
                 });
                 let refs: Vec<&Vec<Path>> = plans.iter().collect();

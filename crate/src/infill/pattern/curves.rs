@@ -8,7 +8,7 @@ use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::OutlineStyle;
 use i_overlay::string::clip::ClipRule;
 
-use super::super::geom::{bbox, Path, Region, P2};
+use super::super::geom::{bbox, region_area, signed_area, Path, Region, P2};
 use super::super::region::flatten;
 
 /// Most points of one generated curve (hostile-input bound).
@@ -29,8 +29,14 @@ pub(crate) fn clip(paths: &[Path], region: &Region) -> Vec<Path> {
 pub(crate) fn concentric(region: &Region, spacing: f64) -> Vec<Path> {
     let mut out = Vec::new();
     let mut current = region.clone();
-    while !current.is_empty() && out.len() < MAX_LOOPS {
+    // Stop when what is left is smaller than a line's footprint (offsets of slivers can leave
+    // specks that never vanish).
+    let min_area = 0.25 * spacing * spacing;
+    while region_area(&current) > min_area && out.len() < MAX_LOOPS {
         for c in &current {
+            if signed_area(c).abs() < min_area {
+                continue;
+            }
             let mut p = c.clone();
             if let Some(&f) = p.first() {
                 p.push(f);

@@ -145,7 +145,13 @@ pub(crate) fn generate(
                 .map(|c| c.iter().map(|&p| rotate(p, o, fwd)).collect())
                 .collect();
             let pieces = match pattern {
-                Pattern::Concentric => curves::concentric(&turned, pitch),
+                // Loops follow the outline whatever the angle.
+                Pattern::Concentric => {
+                    return curves::concentric(region, pitch)
+                        .into_iter()
+                        .map(|p| vec![p])
+                        .collect()
+                }
                 Pattern::Hilbert => curves::hilbert(&turned, pitch),
                 Pattern::ArchimedeanChords => curves::archimedean(&turned, pitch),
                 _ => curves::octagram(&turned, pitch),
