@@ -213,17 +213,25 @@ impl Prepared<'_> {
             let rows = pattern::generate(&w.region.region, pattern, beta, s, w.layer);
             link::link(rows, w.start, &w.region.region, 3.0 * s, 0.25 * self.clearance.max(0.05))
         };
-        let strokes = make(self.spacing);
-        let len: f64 = strokes.iter().map(|s| path_len(s)).sum();
-        let ratio = len / w.target_mm;
-        if len > 0.0 && (ratio - 1.0).abs() > 0.03 {
-            let s = self.spacing * ratio.clamp(0.5, 2.0);
-            let again = make(s);
-            if !again.is_empty() {
-                return again;
+        // Up to three corrections of the spacing by the length ratio (rows are discrete, so one
+        // is not always enough); keep the closest.
+        let mut s = self.spacing;
+        let mut best: Option<(f64, Vec<Path>)> = None;
+        for _ in 0..3 {
+            let strokes = make(s);
+            let len: f64 = strokes.iter().map(|s| path_len(s)).sum();
+            let ratio = len / w.target_mm;
+            let err = (ratio - 1.0).abs();
+            let better = best.as_ref().is_none_or(|b| err < b.0);
+            if better && !strokes.is_empty() {
+                best = Some((err, strokes));
             }
+            if !(len > 0.0) || err <= 0.03 {
+                break;
+            }
+            s *= ratio.clamp(0.5, 2.0);
         }
-        strokes
+        best.map(|b| b.1).unwrap_or_default()
     }
 
     /// The texts and motions of every replaced block for per-work-item strokes.
