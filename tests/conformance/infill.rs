@@ -7,12 +7,14 @@
 use std::path::PathBuf;
 
 use quietpath::analyze::{analyze, AnalyzeOptions, Report};
-use quietpath::infill::{infill, InfillOptions, InfillReport, Pattern};
 use quietpath::gcode::FeatureKind;
+use quietpath::infill::{infill, InfillOptions, InfillReport, Pattern};
 use quietpath::path::extract;
 
 fn data(name: &str) -> Vec<u8> {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../crate/tests/data").join(name);
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../crate/tests/data")
+        .join(name);
     std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
@@ -34,7 +36,12 @@ fn pct(a: f64, b: f64) -> f64 {
 fn check_candidate_is_analyze(r: &InfillReport) {
     let after: &Report = &r.after;
     let b = &r.best;
-    assert!(pct(b.time_s, after.time_s).abs() < 1e-6, "{} vs {}", b.time_s, after.time_s);
+    assert!(
+        pct(b.time_s, after.time_s).abs() < 1e-6,
+        "{} vs {}",
+        b.time_s,
+        after.time_s
+    );
     assert!(pct(b.thesis_j, after.energy.thesis_j).abs() < 1e-6);
     assert!(pct(b.total_j, after.energy.total_j).abs() < 1e-6);
 }
@@ -47,8 +54,11 @@ fn regenerated_rectilinear_agrees_with_prusaslicer() {
     println!("| target | PrusaSlicer thesis J | regenerated thesis J | Δ | PrusaSlicer total J | regenerated total J | Δ | PrusaSlicer time s | regenerated time s | Δ |");
     println!("|---|---|---|---|---|---|---|---|---|---|");
     for angle in [0u32, 90] {
-        let slicer = analyze(&data(&format!("rect_infill_{angle}.gcode")), &AnalyzeOptions::default())
-            .unwrap();
+        let slicer = analyze(
+            &data(&format!("rect_infill_{angle}.gcode")),
+            &AnalyzeOptions::default(),
+        )
+        .unwrap();
         let r = run(&at45, &[Pattern::Rectilinear], &[f64::from(angle)], &[0.0]);
         check_candidate_is_analyze(&r);
         let c = &r.candidates[0];
@@ -69,7 +79,10 @@ fn regenerated_rectilinear_agrees_with_prusaslicer() {
 
 /// The moves of layer `i` (by each move's own layer index: `PrintPath::layer_moves` gives empty
 /// ranges when moves come before the first layer, as the start G-code's do).
-fn layer_moves(p: &quietpath::path::PrintPath, i: usize) -> impl Iterator<Item = &quietpath::path::PathMove> {
+fn layer_moves(
+    p: &quietpath::path::PrintPath,
+    i: usize,
+) -> impl Iterator<Item = &quietpath::path::PathMove> {
     p.moves.iter().filter(move |m| m.layer as usize == i)
 }
 
@@ -80,7 +93,11 @@ fn outer_loops(p: &quietpath::path::PrintPath, layer: usize) -> Vec<Vec<[f64; 2]
     for m in layer_moves(p, layer) {
         let outer = p.feature_kind(m) == Some(FeatureKind::OuterWall) && m.is_extruding();
         let from = [m.from[0], m.from[1]];
-        if outer && cur.last().is_some_and(|l| (l[0] - from[0]).abs() + (l[1] - from[1]).abs() < 1e-9) {
+        if outer
+            && cur
+                .last()
+                .is_some_and(|l| (l[0] - from[0]).abs() + (l[1] - from[1]).abs() < 1e-9)
+        {
             cur.push([m.to[0], m.to[1]]);
         } else {
             if cur.len() > 2 {
@@ -105,13 +122,20 @@ fn inside(loops: &[Vec<[f64; 2]>], p: [f64; 2], tol: f64) -> bool {
     for c in loops {
         for i in 0..c.len() {
             let (a, b) = (c[i], c[(i + 1) % c.len()]);
-            if (a[1] > p[1]) != (b[1] > p[1]) && a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]) > p[0] {
+            if (a[1] > p[1]) != (b[1] > p[1])
+                && a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]) > p[0]
+            {
                 odd = !odd;
             }
             let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
             let l2 = dx * dx + dy * dy;
-            let t = if l2 > 0.0 { (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0) } else { 0.0 };
-            near = near.min(((p[0] - a[0] - t * dx).powi(2) + (p[1] - a[1] - t * dy).powi(2)).sqrt());
+            let t = if l2 > 0.0 {
+                (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            near =
+                near.min(((p[0] - a[0] - t * dx).powi(2) + (p[1] - a[1] - t * dy).powi(2)).sqrt());
         }
     }
     odd || near <= tol
@@ -132,19 +156,29 @@ fn new_infill_stays_inside_and_keeps_the_material() {
     };
     for pattern in Pattern::ALL {
         let r = run(&input, &[pattern], &[30.0], &[0.0]);
-        assert!(r.after.warnings.is_empty(), "{pattern:?}: {:?}", r.after.warnings);
+        assert!(
+            r.after.warnings.is_empty(),
+            "{pattern:?}: {:?}",
+            r.after.warnings
+        );
         let after = extract(&r.output, &AnalyzeOptions::default(), false).unwrap();
         assert_eq!(before.layers.len(), after.layers.len());
         let mut worst: f64 = 0.0;
         for i in 0..before.layers.len() {
             let (fb, fa) = (sparse(&before, i), sparse(&after, i));
             if fb <= 0.0 {
-                assert!(fa.abs() < 1e-9, "{pattern:?} layer {i}: new infill where there was none");
+                assert!(
+                    fa.abs() < 1e-9,
+                    "{pattern:?} layer {i}: new infill where there was none"
+                );
                 continue;
             }
             worst = worst.max(pct(fa, fb).abs());
 
-            assert!(pct(fa, fb).abs() < 10.0, "{pattern:?} layer {i}: {fa} vs {fb}");
+            assert!(
+                pct(fa, fb).abs() < 10.0,
+                "{pattern:?} layer {i}: {fa} vs {fb}"
+            );
             let loops = outer_loops(&before, i);
             assert!(!loops.is_empty());
             for m in layer_moves(&after, i).filter(|m| m.is_extruding()) {
@@ -153,7 +187,10 @@ fn new_infill_stays_inside_and_keeps_the_material() {
                 }
                 let mid = [0.5 * (m.from[0] + m.to[0]), 0.5 * (m.from[1] + m.to[1])];
                 for p in [[m.from[0], m.from[1]], [m.to[0], m.to[1]], mid] {
-                    assert!(inside(&loops, p, 1e-3), "{pattern:?} layer {i}: {p:?} outside the part");
+                    assert!(
+                        inside(&loops, p, 1e-3),
+                        "{pattern:?} layer {i}: {p:?} outside the part"
+                    );
                 }
             }
         }
@@ -162,7 +199,9 @@ fn new_infill_stays_inside_and_keeps_the_material() {
 }
 
 fn fixture(name: &str) -> Vec<u8> {
-    let p = quietpath_conformance::fixtures_dir().join("gcode").join(name);
+    let p = quietpath_conformance::fixtures_dir()
+        .join("gcode")
+        .join(name);
     std::fs::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
@@ -188,7 +227,11 @@ fn thesis_findings_on_its_geometries() {
                 .unwrap()
         };
         let mean = |p: Pattern| (j(p, 0.0) + j(p, 45.0) + j(p, 90.0)) / 3.0;
-        let rect = [j(Pattern::Rectilinear, 0.0), j(Pattern::Rectilinear, 45.0), j(Pattern::Rectilinear, 90.0)];
+        let rect = [
+            j(Pattern::Rectilinear, 0.0),
+            j(Pattern::Rectilinear, 45.0),
+            j(Pattern::Rectilinear, 90.0),
+        ];
         println!(
             "| {shape} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} |",
             rect[0],
@@ -199,9 +242,19 @@ fn thesis_findings_on_its_geometries() {
             mean(Pattern::ArchimedeanChords),
             mean(Pattern::OctagramSpiral)
         );
-        assert!(rect[1] > rect[0] && rect[1] > rect[2], "{shape}: 45° must cost most: {rect:?}");
-        for p in [Pattern::Hilbert, Pattern::ArchimedeanChords, Pattern::OctagramSpiral] {
-            assert!(mean(Pattern::Rectilinear) < mean(p), "{shape}: rectilinear vs {p:?}");
+        assert!(
+            rect[1] > rect[0] && rect[1] > rect[2],
+            "{shape}: 45° must cost most: {rect:?}"
+        );
+        for p in [
+            Pattern::Hilbert,
+            Pattern::ArchimedeanChords,
+            Pattern::OctagramSpiral,
+        ] {
+            assert!(
+                mean(Pattern::Rectilinear) < mean(p),
+                "{shape}: rectilinear vs {p:?}"
+            );
         }
     }
 }

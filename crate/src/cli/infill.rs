@@ -4,7 +4,9 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use quietpath::infill::{infill_with_progress, InfillOptions, InfillReport, Objective, Pattern, Weights};
+use quietpath::infill::{
+    infill_with_progress, InfillOptions, InfillReport, Objective, Pattern, Weights,
+};
 
 use super::output::{write_atomically, write_json, ProgressBar};
 
@@ -59,8 +61,14 @@ fn parse_list(s: &str, what: &str) -> Result<Vec<f64>, String> {
     let num = |t: &str| t.trim().parse::<f64>().ok().filter(|v| v.is_finite());
     if s.contains(':') {
         let parts: Vec<&str> = s.split(':').collect();
-        let [a, b, step] = parts.as_slice() else { return Err(bad()) };
-        let (a, b, step) = (num(a).ok_or_else(bad)?, num(b).ok_or_else(bad)?, num(step).ok_or_else(bad)?);
+        let [a, b, step] = parts.as_slice() else {
+            return Err(bad());
+        };
+        let (a, b, step) = (
+            num(a).ok_or_else(bad)?,
+            num(b).ok_or_else(bad)?,
+            num(step).ok_or_else(bad)?,
+        );
         if step <= 0.0 || (b - a) / step > 10_000.0 {
             return Err(bad());
         }
@@ -93,7 +101,11 @@ fn options(args: &Args) -> Result<InfillOptions, String> {
         "time" => Objective::Time,
         "length" => Objective::Length,
         "weighted" => Objective::Weighted,
-        o => return Err(format!("--objective: expected energy, time, length or weighted, got '{o}'")),
+        o => {
+            return Err(format!(
+                "--objective: expected energy, time, length or weighted, got '{o}'"
+            ))
+        }
     };
     let w = parse_list(&args.weights, "weights")?;
     let [energy, time, length] = w.as_slice() else {
@@ -115,7 +127,12 @@ fn options(args: &Args) -> Result<InfillOptions, String> {
     })
 }
 
-fn print(out: &mut impl Write, file: &std::path::Path, r: &InfillReport, secs: f64) -> std::io::Result<()> {
+fn print(
+    out: &mut impl Write,
+    file: &std::path::Path,
+    r: &InfillReport,
+    secs: f64,
+) -> std::io::Result<()> {
     let (b, a) = (&r.before, &r.after);
     writeln!(out, "{}", file.display())?;
     let m = &r.measured;
@@ -130,9 +147,17 @@ fn print(out: &mut impl Write, file: &std::path::Path, r: &InfillReport, secs: f
         r.best.pattern.name(),
         r.best.angle_deg,
         r.best.rotation_deg,
-        if r.best.layers.is_some() { " (per-layer hybrid)" } else { "" }
+        if r.best.layers.is_some() {
+            " (per-layer hybrid)"
+        } else {
+            ""
+        }
     )?;
-    writeln!(out, "  {:<12} {:>12} {:>12} {:>10} {:>12}", "", "thesis J", "total J", "time s", "filament mm")?;
+    writeln!(
+        out,
+        "  {:<12} {:>12} {:>12} {:>10} {:>12}",
+        "", "thesis J", "total J", "time s", "filament mm"
+    )?;
     for (name, rep) in [("before", b), ("after", a)] {
         writeln!(
             out,
@@ -140,10 +165,18 @@ fn print(out: &mut impl Write, file: &std::path::Path, r: &InfillReport, secs: f
             rep.energy.thesis_j, rep.energy.total_j, rep.time_s, rep.filament_mm
         )?;
     }
-    writeln!(out, "  saving {:.1} J ({:.2} %)", r.best.saving_j, r.best.saving_pct)?;
+    writeln!(
+        out,
+        "  saving {:.1} J ({:.2} %)",
+        r.best.saving_j, r.best.saving_pct
+    )?;
     let mut sorted: Vec<_> = r.candidates.iter().collect();
     sorted.sort_by(|x, y| x.total_j.total_cmp(&y.total_j));
-    writeln!(out, "  {} candidates in {secs:.2} s; cheapest:", r.candidates.len())?;
+    writeln!(
+        out,
+        "  {} candidates in {secs:.2} s; cheapest:",
+        r.candidates.len()
+    )?;
     for c in sorted.iter().take(8) {
         writeln!(
             out,
@@ -157,7 +190,11 @@ fn print(out: &mut impl Write, file: &std::path::Path, r: &InfillReport, secs: f
         )?;
     }
     if !r.rotations_skipped.is_empty() {
-        writeln!(out, "  rotations skipped (off the bed): {:?}", r.rotations_skipped)?;
+        writeln!(
+            out,
+            "  rotations skipped (off the bed): {:?}",
+            r.rotations_skipped
+        )?;
     }
     Ok(())
 }
@@ -182,13 +219,17 @@ pub fn run(args: Args) -> Result<(), String> {
     let mut out = stdout.lock();
     for file in &args.files {
         let input = super::read(file)?;
-        let mut bar = ProgressBar::new(!args.json && std::io::IsTerminal::is_terminal(&std::io::stderr()));
+        let mut bar =
+            ProgressBar::new(!args.json && std::io::IsTerminal::is_terminal(&std::io::stderr()));
         let t0 = Instant::now();
         let report = infill_with_progress(&input, &options, &mut |f| bar.update(f))
             .map_err(|e| format!("{}: {e}", file.display()))?;
         let secs = t0.elapsed().as_secs_f64();
         bar.finish();
-        let name = file.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+        let name = file
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
         for c in &report.candidates {
             csv.push_str(&format!(
                 "{name},{},{},{},{:.3},{:.3},{:.3},{:.3},{:.3}\n",
@@ -229,7 +270,10 @@ mod tests {
 
     #[test]
     fn lists_and_ranges() {
-        assert_eq!(parse_list("0:180:45", "a").unwrap(), vec![0.0, 45.0, 90.0, 135.0]);
+        assert_eq!(
+            parse_list("0:180:45", "a").unwrap(),
+            vec![0.0, 45.0, 90.0, 135.0]
+        );
         assert_eq!(parse_list("0,30", "a").unwrap(), vec![0.0, 30.0]);
         assert!(parse_list("0:1:0", "a").is_err());
         assert!(parse_list("x", "a").is_err());

@@ -38,7 +38,10 @@ impl Rotation {
     /// [`Rotation::apply`] rounded to 0.001 mm, as the rewritten lines give it.
     pub fn apply_r3(&self, p: P2) -> P2 {
         let q = self.apply(p);
-        [(q[0] * 1000.0).round() / 1000.0, (q[1] * 1000.0).round() / 1000.0]
+        [
+            (q[0] * 1000.0).round() / 1000.0,
+            (q[1] * 1000.0).round() / 1000.0,
+        ]
     }
 
     fn covers(&self, i: usize) -> bool {
@@ -230,13 +233,19 @@ pub(crate) fn replay_blocks(
                         continue;
                     }
                 }
-                let Some(mv) = prog.moves.get(i) else { continue };
+                let Some(mv) = prog.moves.get(i) else {
+                    continue;
+                };
                 let mut m = Motion::from(&mv.m);
                 if let Some(r) = rotation {
                     let from = [mv.m.from[axis::X], mv.m.from[axis::Y]];
                     let to = [mv.m.to[axis::X], mv.m.to[axis::Y]];
                     // As the rewritten lines give them (0.001 mm).
-                    let f = if i > r.first && i <= r.last + 1 { r.apply_r3(from) } else { from };
+                    let f = if i > r.first && i <= r.last + 1 {
+                        r.apply_r3(from)
+                    } else {
+                        from
+                    };
                     let t = if r.covers(i) { r.apply_r3(to) } else { to };
                     m.delta[0] = t[0] - f[0];
                     m.delta[1] = t[1] - f[1];
@@ -254,7 +263,11 @@ pub(crate) fn replay_blocks(
                     let rotated = rotation.is_some_and(|r| r.covers(i));
                     let to = [mv.m.to[axis::X], mv.m.to[axis::Y]];
                     let moves_xy = to != [mv.m.from[axis::X], mv.m.from[axis::Y]];
-                    let names = if rotated && moves_xy { [true; 2] } else { mv.names };
+                    let names = if rotated && moves_xy {
+                        [true; 2]
+                    } else {
+                        mv.names
+                    };
                     let t = match rotation {
                         Some(r) if rotated => r.apply_r3(to),
                         _ => to,

@@ -58,7 +58,9 @@ pub(crate) fn habit(prog: &Program) -> Option<Habit> {
             .flat_map(|b| prog.moves.get(b.first..b.end).unwrap_or(&[]))
             .filter(|m| m.m.is_extruding())
     };
-    let (e, l) = sparse().fold((0.0, 0.0), |(e, l), m| (e + m.m.extrusion(), l + m.m.length_mm));
+    let (e, l) = sparse().fold((0.0, 0.0), |(e, l), m| {
+        (e + m.m.extrusion(), l + m.m.length_mm)
+    });
     if !(l > 0.0 && e > 0.0) {
         return None;
     }
@@ -67,29 +69,45 @@ pub(crate) fn habit(prog: &Program) -> Option<Habit> {
         .moves
         .iter()
         .filter(|m| m.m.length_mm > 1e-9 && m.m.extrusion().abs() < 1e-12);
-    let travel_f =
-        mode_by_weight(travels.clone().map(|m| (m.m.feed_mm_s, m.m.length_mm))).unwrap_or(print_f / 60.0) * 60.0;
+    let travel_f = mode_by_weight(travels.clone().map(|m| (m.m.feed_mm_s, m.m.length_mm)))
+        .unwrap_or(print_f / 60.0)
+        * 60.0;
     let pure_e = |sign: f64| {
         prog.moves.iter().filter(move |m| {
-            m.m.length_mm <= 1e-9 && m.m.extrusion() * sign > 1e-9 && !matches!(m.m.kind, MoveKind::Home)
+            m.m.length_mm <= 1e-9
+                && m.m.extrusion() * sign > 1e-9
+                && !matches!(m.m.kind, MoveKind::Home)
         })
     };
     let firmware = prog
         .moves
         .iter()
         .any(|m| matches!(m.m.kind, MoveKind::FirmwareRetract));
-    let retract_mm = mode_by_weight(pure_e(-1.0).map(|m| ((-m.m.extrusion() * 1e5).round() / 1e5, 1.0))).unwrap_or(0.0);
-    let retract_f = mode_by_weight(pure_e(-1.0).map(|m| (m.m.feed_mm_s, 1.0))).unwrap_or(35.0) * 60.0;
-    let unretract_f = mode_by_weight(pure_e(1.0).map(|m| (m.m.feed_mm_s, 1.0))).unwrap_or(retract_f / 60.0) * 60.0;
+    let retract_mm =
+        mode_by_weight(pure_e(-1.0).map(|m| ((-m.m.extrusion() * 1e5).round() / 1e5, 1.0)))
+            .unwrap_or(0.0);
+    let retract_f =
+        mode_by_weight(pure_e(-1.0).map(|m| (m.m.feed_mm_s, 1.0))).unwrap_or(35.0) * 60.0;
+    let unretract_f = mode_by_weight(pure_e(1.0).map(|m| (m.m.feed_mm_s, 1.0)))
+        .unwrap_or(retract_f / 60.0)
+        * 60.0;
     // Shortest travel that follows a retraction.
     let mut min_travel: f64 = f64::INFINITY;
     for w in prog.moves.windows(2) {
         let (a, b) = (&w[0].m, &w[1].m);
-        if a.length_mm <= 1e-9 && a.extrusion() < -1e-9 && b.length_mm > 1e-9 && b.extrusion().abs() < 1e-12 {
+        if a.length_mm <= 1e-9
+            && a.extrusion() < -1e-9
+            && b.length_mm > 1e-9
+            && b.extrusion().abs() < 1e-12
+        {
             min_travel = min_travel.min(b.length_mm);
         }
     }
-    let min_travel_mm = if min_travel.is_finite() { min_travel.clamp(0.5, 20.0) } else { 2.0 };
+    let min_travel_mm = if min_travel.is_finite() {
+        min_travel.clamp(0.5, 20.0)
+    } else {
+        2.0
+    };
     Some(Habit {
         e_per_mm: e / l,
         print_f,
@@ -154,7 +172,11 @@ impl Writer<'_> {
         if d >= self.habit.min_travel_mm {
             self.retract(true);
         }
-        let _ = writeln!(self.out, "G1 X{:.3} Y{:.3} F{:.0}", to[0], to[1], self.habit.travel_f);
+        let _ = writeln!(
+            self.out,
+            "G1 X{:.3} Y{:.3} F{:.0}",
+            to[0], to[1], self.habit.travel_f
+        );
         self.pos = to;
     }
 
@@ -190,7 +212,13 @@ impl Writer<'_> {
 /// The new text of `block` (without a final newline): `strokes` (machine frame), then back to
 /// `end` (machine frame) unless the file travels on from there anyway, with the filament state
 /// and absolute E the original left behind.
-pub(crate) fn block_text(block: &Block, strokes: &[Path], start: P2, end: P2, habit: &Habit) -> String {
+pub(crate) fn block_text(
+    block: &Block,
+    strokes: &[Path],
+    start: P2,
+    end: P2,
+    habit: &Habit,
+) -> String {
     let absolute = block.machine.extrusion_mode() == ExtrusionMode::Absolute;
     let mut w = Writer {
         out: String::with_capacity(strokes.iter().map(|s| s.len() * 34).sum::<usize>() + 64),
@@ -225,7 +253,9 @@ pub(crate) fn motions(block: &Block, text: &str, start: P2) -> Replacement {
     let start = [r3(start[0]), r3(start[1])];
     let mut moved = false;
     for l in text.lines() {
-        let Ok(line) = parse_line(l.as_bytes()) else { continue };
+        let Ok(line) = parse_line(l.as_bytes()) else {
+            continue;
+        };
         if let Some(Event::Move(m)) = machine.apply(block.first_line, &line, &mut warnings) {
             let mut motion = Motion::from(&m);
             if !moved && line.params.has(b'X') {
@@ -239,7 +269,11 @@ pub(crate) fn motions(block: &Block, text: &str, start: P2) -> Replacement {
         }
     }
     let p = machine.position();
-    let end = if moved { [p[axis::X], p[axis::Y]] } else { start };
+    let end = if moved {
+        [p[axis::X], p[axis::Y]]
+    } else {
+        start
+    };
     Replacement {
         motions,
         end: [end[0], end[1], p[axis::Z]],
@@ -252,7 +286,10 @@ mod tests {
 
     #[test]
     fn weighted_mode() {
-        assert_eq!(mode_by_weight([(1.0, 1.0), (2.0, 3.0), (1.0, 1.0)].into_iter()), Some(2.0));
+        assert_eq!(
+            mode_by_weight([(1.0, 1.0), (2.0, 3.0), (1.0, 1.0)].into_iter()),
+            Some(2.0)
+        );
         assert_eq!(mode_by_weight(std::iter::empty()), None);
     }
 }

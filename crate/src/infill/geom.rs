@@ -92,9 +92,19 @@ pub fn inside_tol(r: &Region, p: P2, tol: f64) -> bool {
 
 /// Bounding box `[x0, y0, x1, y1]` of some points (None when empty or not finite).
 pub fn bbox<'a>(points: impl IntoIterator<Item = &'a P2>) -> Option<[f64; 4]> {
-    let mut b = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+    let mut b = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
     for p in points {
-        b = [b[0].min(p[0]), b[1].min(p[1]), b[2].max(p[0]), b[3].max(p[1])];
+        b = [
+            b[0].min(p[0]),
+            b[1].min(p[1]),
+            b[2].max(p[0]),
+            b[3].max(p[1]),
+        ];
     }
     (b.iter().all(|v| v.is_finite()) && b[2] >= b[0] && b[3] >= b[1]).then_some(b)
 }
@@ -134,7 +144,12 @@ pub fn simplify_closed(c: &[P2], tol: f64) -> Path {
             stack.push((best.1, b));
         }
     }
-    let out: Path = c.iter().zip(&keep).filter(|(_, k)| **k).map(|(p, _)| *p).collect();
+    let out: Path = c
+        .iter()
+        .zip(&keep)
+        .filter(|(_, k)| **k)
+        .map(|(p, _)| *p)
+        .collect();
     if out.len() >= 3 {
         out
     } else {

@@ -12,6 +12,9 @@ use super::geom::Path;
 use super::search::Prepared;
 use super::{Candidate, InfillOptions, LayerChoice, Pattern};
 
+/// A layer's best so far: cost, pattern, angle, strokes.
+type Choice = (f64, Pattern, f64, Vec<Path>);
+
 /// The per-layer plans, choices and whole-file costs of the hybrid.
 pub(crate) fn per_layer(
     prep: &Prepared<'_>,
@@ -26,7 +29,7 @@ pub(crate) fn per_layer(
     };
     let n = prep.work.len();
     // (cost, pattern, angle, plan) per work item.
-    let mut best: Vec<Option<(f64, Pattern, f64, Vec<Path>)>> = vec![None; n];
+    let mut best: Vec<Option<Choice>> = vec![None; n];
     let mut per_block = Vec::new();
     for &pattern in &options.patterns {
         for &angle in &options.angles_deg {
@@ -38,7 +41,13 @@ pub(crate) fn per_layer(
                 .collect();
             let refs: Vec<&Vec<Path>> = plans.iter().collect();
             let (_, motions) = prep.candidate(&refs, rotation);
-            replay_blocks(&prep.prog, &motions, rotation, &prep.base, Some(&mut per_block));
+            replay_blocks(
+                &prep.prog,
+                &motions,
+                rotation,
+                &prep.base,
+                Some(&mut per_block),
+            );
             for ((w, plan), slot) in prep.work.iter().zip(plans).zip(best.iter_mut()) {
                 let cost: f64 = w
                     .blocks

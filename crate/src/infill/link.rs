@@ -66,7 +66,10 @@ pub(crate) fn link(
                     || [0.25, 0.5, 0.75].iter().all(|&t| {
                         inside_tol(
                             region,
-                            [cur[0] + t * (head[0] - cur[0]), cur[1] + t * (head[1] - cur[1])],
+                            [
+                                cur[0] + t * (head[0] - cur[0]),
+                                cur[1] + t * (head[1] - cur[1]),
+                            ],
                             tol,
                         )
                     }));
@@ -98,7 +101,12 @@ mod tests {
     fn zigzag_rows_become_one_stroke() {
         let sq: Region = vec![vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]];
         let rows: Vec<Vec<Path>> = (0..5)
-            .map(|k| vec![vec![[0.0, 1.0 + 2.0 * k as f64], [10.0, 1.0 + 2.0 * k as f64]]])
+            .map(|k| {
+                vec![vec![
+                    [0.0, 1.0 + 2.0 * k as f64],
+                    [10.0, 1.0 + 2.0 * k as f64],
+                ]]
+            })
             .collect();
         let s = link(rows, [0.0, 0.0], &sq, 3.0, 0.05);
         assert_eq!(s.len(), 1);

@@ -1,13 +1,13 @@
 //! Infill regeneration and the energy-driven search over pattern, infill angle and part
 //! orientation about Z (Somade 2023, "toolpath strategy": DOE of Table 4 and the case study).
 //!
-//! 1. [`program`]: the file as the planner sees it, with its sparse-infill blocks.
-//! 2. [`region`]: per layer, where sparse infill may go (from the walls, holes included).
-//! 3. [`pattern`] + [`link`]: new infill with the original's spacing and extrusion per mm.
-//! 4. [`emit`]: G-code for it in the file's own habits; [`cost`]: every candidate costed with
+//! 1. `program`: the file as the planner sees it, with its sparse-infill blocks.
+//! 2. `region`: per layer, where sparse infill may go (from the walls, holes included).
+//! 3. [`pattern`] + `link`: new infill with the original's spacing and extrusion per mm.
+//! 4. `emit`: G-code for it in the file's own habits; `cost`: every candidate costed with
 //!    the real planner and energy model (the thesis stepper model, eq. 24–28, and the whole
 //!    `total_j`), as `analyze` would cost the rewritten file.
-//! 5. [`search`]: angles × rotations × patterns (and per-layer hybrids); [`write`]: the output.
+//! 5. `search`: angles × rotations × patterns (and per-layer hybrids); `write`: the output.
 
 pub(crate) mod cost;
 pub(crate) mod emit;
@@ -112,7 +112,12 @@ impl InfillOptions {
         if self.angles_deg.is_empty() || self.rotations_deg.is_empty() || self.patterns.is_empty() {
             return bad("angles, rotations and patterns must each list at least one value");
         }
-        if self.angles_deg.iter().chain(&self.rotations_deg).any(|v| !v.is_finite()) {
+        if self
+            .angles_deg
+            .iter()
+            .chain(&self.rotations_deg)
+            .any(|v| !v.is_finite())
+        {
             return bad("angles and rotations must be finite numbers of degrees");
         }
         let n = self.angles_deg.len() * self.rotations_deg.len() * self.patterns.len();
@@ -120,7 +125,10 @@ impl InfillOptions {
             return bad("too many candidates (angles × rotations × patterns > 20000)");
         }
         let w = self.weights;
-        if [w.energy, w.time, w.length].iter().any(|v| !v.is_finite() || *v < 0.0) {
+        if [w.energy, w.time, w.length]
+            .iter()
+            .any(|v| !v.is_finite() || *v < 0.0)
+        {
             return bad("weights must be finite and not negative");
         }
         if let Some(s) = self.spacing_mm {

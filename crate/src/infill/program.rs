@@ -112,8 +112,7 @@ pub(crate) fn read(input: &[u8], options: &AnalyzeOptions) -> Result<Program, Er
     let mut relative_now = false;
     let mut bed = None;
     // Block candidates: (first move, first line, machine before), open while sparse moves come.
-    let mut raw_blocks: Vec<(usize, usize, u32, u32, Box<Machine>, [f64; 4], [f64; 4], f64)> =
-        Vec::new();
+    let mut raw_blocks: Vec<RawBlock> = Vec::new();
     let mut open: Option<(usize, u32, Box<Machine>)> = None;
     let mut retracted = false;
     let mut retract_marks: Vec<bool> = Vec::new();
@@ -148,7 +147,8 @@ pub(crate) fn read(input: &[u8], options: &AnalyzeOptions) -> Result<Program, Er
                 relative_now = false;
             }
         }
-        let is_motion_code = matches!(code, Some(c) if c.letter == b'G' && c.number <= 3 && c.sub.is_none());
+        let is_motion_code =
+            matches!(code, Some(c) if c.letter == b'G' && c.number <= 3 && c.sub.is_none());
         let harmless = matches!(line.command, Command::None)
             || is_motion_code
             || matches!(code, Some(c) if c.letter == b'M' && c.number == 73);
@@ -229,7 +229,9 @@ pub(crate) fn read(input: &[u8], options: &AnalyzeOptions) -> Result<Program, Er
     for (first, end, first_line, last_line, machine, end_logical, end_physical, end_feed) in
         raw_blocks
     {
-        let Some(head) = moves.get(first) else { continue };
+        let Some(head) = moves.get(first) else {
+            continue;
+        };
         let layer = head.layer;
         // Split at layer boundaries (a marker closes blocks, but Z-counted layers do not).
         if layer == u32::MAX || moves[first..end].iter().any(|m| m.layer != layer) {
@@ -274,7 +276,16 @@ pub(crate) fn read(input: &[u8], options: &AnalyzeOptions) -> Result<Program, Er
     })
 }
 
-type RawBlock = (usize, usize, u32, u32, Box<Machine>, [f64; 4], [f64; 4], f64);
+type RawBlock = (
+    usize,
+    usize,
+    u32,
+    u32,
+    Box<Machine>,
+    [f64; 4],
+    [f64; 4],
+    f64,
+);
 
 /// Ends the open block (if any) after the moves read so far; `after` is the machine state
 /// after the block's last line.
@@ -311,7 +322,12 @@ fn parse_bed(comment: &[u8]) -> Option<[f64; 4]> {
         .strip_prefix("bed_shape")
         .or_else(|| text.strip_prefix("printable_area"))?;
     let rest = rest.trim_start().strip_prefix('=')?.trim();
-    let mut b = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+    let mut b = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
     for pair in rest.split(',') {
         let (x, y) = pair.trim().split_once('x')?;
         let (x, y): (f64, f64) = (x.trim().parse().ok()?, y.trim().parse().ok()?);

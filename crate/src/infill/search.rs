@@ -14,8 +14,8 @@ use super::geom::{bbox, path_len, Path, P2};
 use super::program::{self, Program};
 use super::region::{self, LayerRegion};
 use super::{
-    link, pattern, write, Best, Candidate, InfillOptions, InfillReport, Measured,
-    Objective, Pattern,
+    link, pattern, write, Best, Candidate, InfillOptions, InfillReport, Measured, Objective,
+    Pattern,
 };
 use crate::analyze::{analyze, Progress, Report};
 use crate::error::{Error, ErrorKind};
@@ -87,16 +87,27 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
     let mut work = Vec::new();
     for layer in layers {
         let blocks = blocks_of.remove(&layer).unwrap_or_default();
-        let Some(idx) = by_layer.get(layer) else { continue };
-        let moves: Vec<_> = idx.iter().filter_map(|&i| prog.moves.get(i).copied()).collect();
-        let Some(region) = region::extract(&moves, clearance) else { continue };
+        let Some(idx) = by_layer.get(layer) else {
+            continue;
+        };
+        let moves: Vec<_> = idx
+            .iter()
+            .filter_map(|&i| prog.moves.get(i).copied())
+            .collect();
+        let Some(region) = region::extract(&moves, clearance) else {
+            continue;
+        };
         let (e, l) = blocks
             .iter()
             .filter_map(|&b| prog.blocks.get(b))
             .flat_map(|b| prog.moves.get(b.first..b.end).unwrap_or(&[]))
             .filter(|m| m.m.is_extruding())
-            .fold((0.0, 0.0), |(e, l), m| (e + m.m.extrusion(), l + m.m.length_mm));
-        let Some(first) = blocks.first().and_then(|&b| prog.blocks.get(b)) else { continue };
+            .fold((0.0, 0.0), |(e, l), m| {
+                (e + m.m.extrusion(), l + m.m.length_mm)
+            });
+        let Some(first) = blocks.first().and_then(|&b| prog.blocks.get(b)) else {
+            continue;
+        };
         let p = first.machine.position();
         if l > 0.0 {
             work.push(Work {
@@ -110,7 +121,9 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
         }
     }
     if work.is_empty() {
-        return Err(invalid("no layer has a sparse-infill region inside closed walls"));
+        return Err(invalid(
+            "no layer has a sparse-infill region inside closed walls",
+        ));
     }
     let spacing = options.spacing_mm.unwrap_or_else(|| {
         let a: f64 = work.iter().map(|w| w.region.area_mm2).sum();
@@ -118,7 +131,9 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
         a / l
     });
     if !(spacing.is_finite() && spacing > 0.05) {
-        return Err(invalid("could not measure a line spacing from the file's infill"));
+        return Err(invalid(
+            "could not measure a line spacing from the file's infill",
+        ));
     }
     // The print: from the first to the last move of a printed feature.
     let printed = |i: &usize| {
@@ -141,9 +156,20 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
     let b = bbox(&pts).unwrap_or([0.0; 4]);
     let centre = [0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3])];
     let bed = prog.bed.unwrap_or_else(|| {
-        let all = bbox(prog.moves.iter().map(|m| [m.m.to[0], m.m.to[1]]).collect::<Vec<_>>().iter())
-            .unwrap_or([0.0; 4]);
-        [all[0].min(0.0), all[1].min(0.0), all[2].max(200.0), all[3].max(200.0)]
+        let all = bbox(
+            prog.moves
+                .iter()
+                .map(|m| [m.m.to[0], m.m.to[1]])
+                .collect::<Vec<_>>()
+                .iter(),
+        )
+        .unwrap_or([0.0; 4]);
+        [
+            all[0].min(0.0),
+            all[1].min(0.0),
+            all[2].max(200.0),
+            all[3].max(200.0),
+        ]
     });
     let base = Baseline::new(&before, options.analyze.energy.clone().unwrap_or_default());
     Ok(Prepared {
@@ -211,7 +237,13 @@ impl Prepared<'_> {
     pub(crate) fn plan_layer(&self, w: &Work, pattern: Pattern, beta: f64) -> Vec<Path> {
         let make = |s: f64| {
             let rows = pattern::generate(&w.region.region, pattern, beta, s, w.layer);
-            link::link(rows, w.start, &w.region.region, 3.0 * s, 0.25 * self.clearance.max(0.05))
+            link::link(
+                rows,
+                w.start,
+                &w.region.region,
+                3.0 * s,
+                0.25 * self.clearance.max(0.05),
+            )
         };
         // Up to three corrections of the spacing by the length ratio (rows are discrete, so one
         // is not always enough); keep the closest.
@@ -226,7 +258,7 @@ impl Prepared<'_> {
             if better && !strokes.is_empty() {
                 best = Some((err, strokes));
             }
-            if !(len > 0.0) || err <= 0.03 {
+            if len.is_nan() || len <= 0.0 || err <= 0.03 {
                 break;
             }
             s *= ratio.clamp(0.5, 2.0);
@@ -249,9 +281,14 @@ impl Prepared<'_> {
                 e_per_mm: w.e_per_mm,
                 ..self.habit
             };
-            let moved: Vec<Path> = plan.iter().map(|s| s.iter().map(|&p| tf(p)).collect()).collect();
+            let moved: Vec<Path> = plan
+                .iter()
+                .map(|s| s.iter().map(|&p| tf(p)).collect())
+                .collect();
             for (k, &b) in w.blocks.iter().enumerate() {
-                let Some(blk) = self.prog.blocks.get(b) else { continue };
+                let Some(blk) = self.prog.blocks.get(b) else {
+                    continue;
+                };
                 let p = blk.machine.position();
                 let start = tf([p[axis::X], p[axis::Y]]);
                 let end = tf([blk.end_physical[0], blk.end_physical[1]]);
@@ -317,9 +354,16 @@ pub fn infill_with_progress(
                 done += 1;
                 let beta = angle - rot_deg;
                 // Concentric loops do not depend on the angle.
-                let key = if pattern == Pattern::Concentric { 0 } else { angle_key(beta) };
+                let key = if pattern == Pattern::Concentric {
+                    0
+                } else {
+                    angle_key(beta)
+                };
                 let plans = cache.entry(key).or_insert_with(|| {
-                    prep.work.iter().map(|w| prep.plan_layer(w, pattern, beta)).collect()
+                    prep.work
+                        .iter()
+                        .map(|w| prep.plan_layer(w, pattern, beta))
+                        .collect()
                 });
                 let refs: Vec<&Vec<Path>> = plans.iter().collect();
                 let (_, motions) = prep.candidate(&refs, rotation.as_ref());
@@ -436,7 +480,12 @@ pub(crate) mod tests {
         let prep = prepare(&input, &InfillOptions::default()).expect("prepare");
         let c = replay(&prep.prog, &[], None, &prep.base);
         let r = &prep.before;
-        assert!((c.time_s - r.time_s).abs() < 1e-9 * r.time_s, "{} vs {}", c.time_s, r.time_s);
+        assert!(
+            (c.time_s - r.time_s).abs() < 1e-9 * r.time_s,
+            "{} vs {}",
+            c.time_s,
+            r.time_s
+        );
         assert!((c.thesis_j - r.energy.thesis_j).abs() < 1e-9 * r.energy.thesis_j);
         assert!((c.total_j - r.energy.total_j).abs() < 1e-9 * r.energy.total_j);
         assert!((c.filament_mm - r.filament_mm).abs() < 1e-9);

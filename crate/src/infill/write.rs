@@ -23,7 +23,9 @@ pub(crate) fn edits(
     let mut edits: Vec<Edit> = Vec::new();
     let mut replaced = std::collections::BTreeMap::new();
     for (b, text) in texts.iter().enumerate() {
-        let (Some(text), Some(blk)) = (text, prog.blocks.get(b)) else { continue };
+        let (Some(text), Some(blk)) = (text, prog.blocks.get(b)) else {
+            continue;
+        };
         replaced.insert(blk.first_line, (blk.last_line, text.as_str()));
     }
     let mut rotated = std::collections::BTreeMap::new();
@@ -31,7 +33,8 @@ pub(crate) fn edits(
         for (i, mv) in prog.moves.iter().enumerate().take(r.last + 1).skip(r.first) {
             // Moves that stay in XY (lifts, retractions) keep their words: they stay wherever
             // the nozzle is, which after new infill is where the new infill ended.
-            let still = mv.m.to[axis::X] == mv.m.from[axis::X] && mv.m.to[axis::Y] == mv.m.from[axis::Y];
+            let still =
+                mv.m.to[axis::X] == mv.m.from[axis::X] && mv.m.to[axis::Y] == mv.m.from[axis::Y];
             if still || matches!(mv.m.kind, MoveKind::FirmwareRetract | MoveKind::Home) {
                 continue;
             }
@@ -57,8 +60,12 @@ pub(crate) fn edits(
             });
             continue;
         }
-        let (Some(&(_, to)), Some(r)) = (rotated.get(&n), rotation) else { continue };
-        let Ok(line) = parse_line(raw.text) else { continue };
+        let (Some(&(_, to)), Some(r)) = (rotated.get(&n), rotation) else {
+            continue;
+        };
+        let Ok(line) = parse_line(raw.text) else {
+            continue;
+        };
         let Some(code) = line.code() else { continue };
         if code.letter != b'G' || code.number > 3 || line.params.has_bare_word() {
             continue;

@@ -89,7 +89,10 @@ pub(crate) fn hilbert(region: &Region, spacing: f64) -> Vec<Path> {
     let path: Path = (0..count)
         .map(|d| {
             let (x, y) = hilbert_xy(n, d);
-            [x0 + (x as f64 + 0.5) * spacing, y0 + (y as f64 + 0.5) * spacing]
+            [
+                x0 + (x as f64 + 0.5) * spacing,
+                y0 + (y as f64 + 0.5) * spacing,
+            ]
         })
         .collect();
     clip(&[path], region)
@@ -112,9 +115,16 @@ fn spiral(region: &Region, spacing: f64, per_turn: usize, star: f64) -> Vec<Path
         .map(|i| {
             let t = i as f64 / per_turn as f64;
             let a = t * std::f64::consts::TAU;
-            let k = if star > 0.0 && i % 2 == 1 { 1.0 - star } else { 1.0 };
+            let k = if star > 0.0 && i % 2 == 1 {
+                1.0 - star
+            } else {
+                1.0
+            };
             let r = spacing * t * k;
-            [c[0] + r * crate::math::cos(a), c[1] + r * crate::math::sin(a)]
+            [
+                c[0] + r * crate::math::cos(a),
+                c[1] + r * crate::math::sin(a),
+            ]
         })
         .collect();
     clip(&[path], region)

@@ -14,7 +14,12 @@ const MAX_ROWS: usize = 20_000;
 
 /// Segments of the family at `angle_deg` with spacing `spacing` and offset `offset` (mm,
 /// across the lines), clipped to `region`, grouped by row in sweep order.
-pub(crate) fn family(region: &Region, angle_deg: f64, spacing: f64, offset: f64) -> Vec<Vec<[P2; 2]>> {
+pub(crate) fn family(
+    region: &Region,
+    angle_deg: f64,
+    spacing: f64,
+    offset: f64,
+) -> Vec<Vec<[P2; 2]>> {
     let (c, s) = cos_sin_deg(angle_deg);
     // Turn the region by -angle: the lines become horizontal (v = y').
     let to_local = |p: P2| [c * p[0] + s * p[1], -s * p[0] + c * p[1]];
@@ -27,15 +32,17 @@ pub(crate) fn family(region: &Region, angle_deg: f64, spacing: f64, offset: f64)
         })
         .map(|(a, b)| (to_local(a), to_local(b)))
         .collect();
-    let (lo, hi) = edges.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (a, b)| {
-        (lo.min(a[1]).min(b[1]), hi.max(a[1]).max(b[1]))
-    });
-    if !(spacing > 0.0) || !lo.is_finite() || !hi.is_finite() {
+    let (lo, hi) = edges
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (a, b)| {
+            (lo.min(a[1]).min(b[1]), hi.max(a[1]).max(b[1]))
+        });
+    if spacing.is_nan() || spacing <= 0.0 || !lo.is_finite() || !hi.is_finite() {
         return Vec::new();
     }
     let k0 = ((lo - offset) / spacing).ceil();
     let k1 = ((hi - offset) / spacing).floor();
-    if !(k1 >= k0) || (k1 - k0) as usize > MAX_ROWS {
+    if k1.is_nan() || k0.is_nan() || k1 < k0 || (k1 - k0) as usize > MAX_ROWS {
         return Vec::new();
     }
     let mut rows = Vec::new();
@@ -72,10 +79,18 @@ mod tests {
         let sq: Region = vec![vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]];
         let rows = family(&sq, 0.0, 1.0, 0.5);
         assert_eq!(rows.len(), 10);
-        let len: f64 = rows.iter().flatten().map(|s| super::super::super::geom::dist(s[0], s[1])).sum();
+        let len: f64 = rows
+            .iter()
+            .flatten()
+            .map(|s| super::super::super::geom::dist(s[0], s[1]))
+            .sum();
         assert!((len - 100.0).abs() < 1e-9);
         let rows = family(&sq, 45.0, 1.0, 0.0);
-        let len: f64 = rows.iter().flatten().map(|s| super::super::super::geom::dist(s[0], s[1])).sum();
+        let len: f64 = rows
+            .iter()
+            .flatten()
+            .map(|s| super::super::super::geom::dist(s[0], s[1]))
+            .sum();
         // Area / spacing, up to the ends.
         assert!((len - 100.0).abs() < 3.0, "{len}");
     }

@@ -114,7 +114,7 @@ pub(crate) fn generate(
     layer: usize,
 ) -> Vec<Vec<Path>> {
     let pitch = pattern.pitch() * spacing;
-    if !(pitch > 1e-3) || !angle_deg.is_finite() {
+    if pitch.is_nan() || pitch <= 1e-3 || !angle_deg.is_finite() {
         return Vec::new();
     }
     let rows = |angles: &[(f64, f64)]| -> Vec<Vec<Path>> {
