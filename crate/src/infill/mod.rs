@@ -1,1 +1,239 @@
-//! Infill regeneration and the energy-driven search over pattern, infill angle and orientation.
+//! Infill regeneration and the energy-driven search over pattern, infill angle and part
+//! orientation about Z (Somade 2023, "toolpath strategy": DOE of Table 4 and the case study).
+//!
+//! 1. `program`: the file as the planner sees it, with its sparse-infill blocks.
+//! 2. `region`: per layer, where sparse infill may go (from the walls, holes included).
+//! 3. [`pattern`] + `link`: new infill with the original's spacing and extrusion per mm.
+//! 4. `emit`: G-code for it in the file's own habits; `cost`: every candidate costed with
+//!    the real planner and energy model (the thesis stepper model, eq. 24–28, and the whole
+//!    `total_j`), as `analyze` would cost the rewritten file.
+//! 5. `search`: angles × rotations × patterns (and per-layer hybrids); `write`: the output.
+
+pub(crate) mod cost;
+pub(crate) mod emit;
+pub(crate) mod geom;
+mod hybrid;
+pub(crate) mod link;
+pub mod pattern;
+pub(crate) mod program;
+pub(crate) mod region;
+mod search;
+pub(crate) mod write;
+
+use serde::{Deserialize, Serialize};
+
+use crate::analyze::{AnalyzeOptions, Report};
+use crate::error::{Error, ErrorKind};
+pub use pattern::Pattern;
+pub use search::{infill, infill_with_progress};
+
+/// What the search minimises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Objective {
+    /// `total_j` of the whole file (servo + fuse + auxiliary).
+    #[default]
+    Energy,
+    /// Print time.
+    Time,
+    /// Toolpath length (printing and travel).
+    Length,
+    /// `w_e·E/E₀ + w_t·t/t₀ + w_l·L/L₀` with [`InfillOptions::weights`].
+    Weighted,
+}
+
+/// Weights of [`Objective::Weighted`] (each of energy, time, length relative to the original).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Weights {
+    /// Weight of `total_j / before`.
+    pub energy: f64,
+    /// Weight of `time_s / before`.
+    pub time: f64,
+    /// Weight of `length_mm / before`.
+    pub length: f64,
+}
+
+impl Default for Weights {
+    fn default() -> Self {
+        Self {
+            energy: 1.0,
+            time: 1.0,
+            length: 0.0,
+        }
+    }
+}
+
+/// Options of [`infill`]. Every field is optional in JSON.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct InfillOptions {
+    /// How the file is read and costed (machine, junction model, energy).
+    pub analyze: AnalyzeOptions,
+    /// Infill angles to try, degrees in the machine frame (default 0, 15, …, 165).
+    pub angles_deg: Vec<f64>,
+    /// Part rotations about Z to try, degrees (default 0 only: the part stays where it is).
+    pub rotations_deg: Vec<f64>,
+    /// Patterns to try (default: the thesis's five, Table 4).
+    pub patterns: Vec<Pattern>,
+    /// What to minimise.
+    pub objective: Objective,
+    /// Weights of [`Objective::Weighted`].
+    pub weights: Weights,
+    /// After the search, pick pattern and angle layer by layer (the thesis's hybrid), keeping
+    /// the best rotation.
+    pub per_layer: bool,
+    /// Rectilinear-equivalent line spacing, mm (default: measured from the file).
+    pub spacing_mm: Option<f64>,
+}
+
+impl Default for InfillOptions {
+    fn default() -> Self {
+        Self {
+            analyze: AnalyzeOptions::default(),
+            angles_deg: (0..12).map(|k| 15.0 * k as f64).collect(),
+            rotations_deg: vec![0.0],
+            patterns: Pattern::THESIS.to_vec(),
+            objective: Objective::Energy,
+            weights: Weights::default(),
+            per_layer: false,
+            spacing_mm: None,
+        }
+    }
+}
+
+/// Most candidates one search may cost.
+pub const MAX_CANDIDATES: usize = 20_000;
+
+impl InfillOptions {
+    /// Checks the options.
+    pub fn validate(&self) -> Result<(), Error> {
+        let bad = |reason| Err(Error::new(0, 0, ErrorKind::InvalidOption { reason }));
+        if self.angles_deg.is_empty() || self.rotations_deg.is_empty() || self.patterns.is_empty() {
+            return bad("angles, rotations and patterns must each list at least one value");
+        }
+        if self
+            .angles_deg
+            .iter()
+            .chain(&self.rotations_deg)
+            .any(|v| !v.is_finite())
+        {
+            return bad("angles and rotations must be finite numbers of degrees");
+        }
+        let n = self.angles_deg.len() * self.rotations_deg.len() * self.patterns.len();
+        if n > MAX_CANDIDATES {
+            return bad("too many candidates (angles × rotations × patterns > 20000)");
+        }
+        let w = self.weights;
+        if [w.energy, w.time, w.length]
+            .iter()
+            .any(|v| !v.is_finite() || *v < 0.0)
+        {
+            return bad("weights must be finite and not negative");
+        }
+        if let Some(s) = self.spacing_mm {
+            if !(s.is_finite() && (0.1..=100.0).contains(&s)) {
+                return bad("spacing_mm must be between 0.1 and 100 mm");
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One candidate: the whole file with this pattern, angle and rotation.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Candidate {
+    /// Pattern.
+    pub pattern: Pattern,
+    /// Infill angle, degrees (machine frame).
+    pub angle_deg: f64,
+    /// Part rotation about Z, degrees.
+    pub rotation_deg: f64,
+    /// Thesis stepper energy of the whole file (eq. 28), J.
+    pub thesis_j: f64,
+    /// Total energy of the whole file, J.
+    pub total_j: f64,
+    /// Print time, s.
+    pub time_s: f64,
+    /// Toolpath length (printing and travel), mm.
+    pub length_mm: f64,
+    /// Filament, mm.
+    pub filament_mm: f64,
+}
+
+/// A layer's choice in a per-layer (hybrid) result.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LayerChoice {
+    /// Layer index.
+    pub layer: usize,
+    /// Pattern.
+    pub pattern: Pattern,
+    /// Infill angle, degrees.
+    pub angle_deg: f64,
+}
+
+/// The chosen result.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Best {
+    /// Pattern (the most used one for a per-layer result).
+    pub pattern: Pattern,
+    /// Infill angle, degrees.
+    pub angle_deg: f64,
+    /// Part rotation, degrees.
+    pub rotation_deg: f64,
+    /// Thesis stepper energy, J.
+    pub thesis_j: f64,
+    /// Total energy, J.
+    pub total_j: f64,
+    /// Print time, s.
+    pub time_s: f64,
+    /// Toolpath length, mm.
+    pub length_mm: f64,
+    /// `before.total_j − total_j`, J.
+    pub saving_j: f64,
+    /// Saving in percent of `before.total_j`.
+    pub saving_pct: f64,
+    /// Per-layer choices when `per_layer` was asked and beat the single best.
+    pub layers: Option<Vec<LayerChoice>>,
+}
+
+/// What the method measured from the file.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Measured {
+    /// Rectilinear-equivalent line spacing, mm.
+    pub spacing_mm: f64,
+    /// Distance from the innermost wall's centre line to the infill line ends, mm.
+    pub clearance_mm: f64,
+    /// Filament per mm of infill line.
+    pub e_per_mm: f64,
+    /// Layers whose sparse infill is regenerated.
+    pub layers_regenerated: usize,
+    /// Sparse-infill blocks replaced.
+    pub blocks: usize,
+    /// Infill print feed, mm/s.
+    pub print_feed_mm_s: f64,
+    /// Travel feed, mm/s.
+    pub travel_feed_mm_s: f64,
+    /// Retraction length, mm (0: none).
+    pub retract_mm: f64,
+}
+
+/// Result of [`infill`].
+#[derive(Debug, Clone, Serialize)]
+pub struct InfillReport {
+    /// `analyze` of the input.
+    pub before: Report,
+    /// `analyze` of the output.
+    pub after: Report,
+    /// The chosen candidate.
+    pub best: Best,
+    /// Every candidate costed, in search order.
+    pub candidates: Vec<Candidate>,
+    /// What was measured from the file.
+    pub measured: Measured,
+    /// Rotations skipped (the part would not fit on the bed), degrees.
+    pub rotations_skipped: Vec<f64>,
+    /// The rewritten G-code.
+    #[serde(skip)]
+    pub output: Vec<u8>,
+}

@@ -1,0 +1,340 @@
+//! Costing a candidate with the real planner and energy model, without writing its G-code.
+//!
+//! The file's [`Program`] is replayed through a fresh [`Planner`] and energy
+//! [`Accumulator`] exactly as `analyze` drives them (limits where they change, dwells and
+//! heater waits flushing the queue, temperature and fan events stamped at the start of the next
+//! planned move), with the sparse-infill blocks swapped for the candidate's motions (parsed back
+//! from the candidate's own text, see [`super::emit`]) and, for a part rotation, every move of
+//! the print turned about the part centre. So a candidate's `time_s`, `thesis_j` and `total_j`
+//! are those `analyze` gives for the written file: exactly without rotation; with a rotation up
+//! to the 0.001 mm rounding of the rewritten coordinates (the test suite checks both).
+//! Replaying skips the parser and the machine, so it costs a fraction of an `analyze` pass.
+
+use super::geom::{rotate, P2};
+use super::program::{Op, Program};
+use crate::analyze::{FanEvent, Report, TemperatureEvent};
+use crate::energy::{Accumulator, EnergyOptions, MaterialSource};
+use crate::machine::axis;
+use crate::plan::{Motion, Planner};
+
+/// A part rotation about Z: `p' = R(p − centre) + centre + shift`, applied to moves
+/// `first..=last` (the print, without start and end code).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Rotation {
+    pub cs: (f64, f64),
+    pub centre: P2,
+    pub shift: P2,
+    pub first: usize,
+    pub last: usize,
+}
+
+impl Rotation {
+    /// Where `p` goes.
+    pub fn apply(&self, p: P2) -> P2 {
+        let q = rotate(p, self.centre, self.cs);
+        [q[0] + self.shift[0], q[1] + self.shift[1]]
+    }
+
+    /// [`Rotation::apply`] rounded to 0.001 mm, as the rewritten lines give it.
+    pub fn apply_r3(&self, p: P2) -> P2 {
+        let q = self.apply(p);
+        [
+            (q[0] * 1000.0).round() / 1000.0,
+            (q[1] * 1000.0).round() / 1000.0,
+        ]
+    }
+
+    fn covers(&self, i: usize) -> bool {
+        (self.first..=self.last).contains(&i)
+    }
+}
+
+/// New motions for a block, and where the nozzle ends (X, Y, Z as the machine holds them).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Replacement {
+    pub motions: Vec<Motion>,
+    pub end: [f64; 3],
+}
+
+/// The numbers of one candidate, for the whole file.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Costs {
+    pub time_s: f64,
+    pub thesis_j: f64,
+    pub total_j: f64,
+    pub length_mm: f64,
+    pub filament_mm: f64,
+}
+
+/// What replay needs from the original analysis.
+#[derive(Debug, Clone)]
+pub(crate) struct Baseline {
+    pub energy: EnergyOptions,
+    pub material_from_file: Option<crate::energy::Material>,
+    pub filament_mm: f64,
+    pub material_g: f64,
+}
+
+impl Baseline {
+    pub fn new(report: &Report, energy: EnergyOptions) -> Self {
+        Self {
+            energy,
+            material_from_file: (report.energy.fuse.material_source == MaterialSource::File)
+                .then_some(report.energy.fuse.material),
+            filament_mm: report.filament_mm,
+            material_g: report.material_g,
+        }
+    }
+}
+
+enum Pending {
+    T(TemperatureEvent),
+    F(FanEvent),
+}
+
+/// The timing side's bookkeeping during a replay (as `analyze`'s `TimeBook`).
+struct Book<'a> {
+    energy: Accumulator,
+    temperatures: Vec<TemperatureEvent>,
+    fans: Vec<FanEvent>,
+    pending: std::collections::VecDeque<(u64, Pending)>,
+    owner: Vec<u32>,
+    per_block: Option<&'a mut Vec<[f64; 2]>>,
+}
+
+impl Book<'_> {
+    fn planned(&mut self, pm: &crate::plan::PlannedMove) {
+        let j = self.energy.planned(pm);
+        self.stamp(pm.tag, pm.start_s);
+        if let Some(pb) = self.per_block.as_deref_mut() {
+            let b = self.owner.get(pm.tag as usize).copied().unwrap_or(u32::MAX);
+            if let Some(acc) = pb.get_mut(b as usize) {
+                acc[0] += j;
+                acc[1] += pm.duration();
+            }
+        }
+    }
+
+    /// Stamps events that come before move `upto` with `t`.
+    fn stamp(&mut self, upto: u64, t: f64) {
+        while self.pending.front().is_some_and(|p| p.0 <= upto) {
+            if let Some((_, p)) = self.pending.pop_front() {
+                match p {
+                    Pending::T(mut e) => {
+                        e.time_s = t;
+                        self.temperatures.push(e);
+                    }
+                    Pending::F(mut e) => {
+                        e.time_s = t;
+                        self.fans.push(e);
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn motion_length(m: &Motion) -> f64 {
+    let [dx, dy, dz, _] = m.delta;
+    match &m.arc {
+        Some(a) => crate::math::hypot(a.radius * a.sweep.abs(), dz),
+        None => crate::math::hypot(crate::math::hypot(dx, dy), dz),
+    }
+}
+
+/// Replays `prog` with block `b` replaced by `replace[b]` (when `Some`) and the rotation.
+pub(crate) fn replay(
+    prog: &Program,
+    replace: &[Option<Replacement>],
+    rotation: Option<&Rotation>,
+    base: &Baseline,
+) -> Costs {
+    replay_blocks(prog, replace, rotation, base, None)
+}
+
+/// [`replay`], also summing `[servo J, s]` of each replaced block's planned moves into
+/// `per_block` (indexed like `prog.blocks`).
+pub(crate) fn replay_blocks(
+    prog: &Program,
+    replace: &[Option<Replacement>],
+    rotation: Option<&Rotation>,
+    base: &Baseline,
+    per_block: Option<&mut Vec<[f64; 2]>>,
+) -> Costs {
+    let mut planner = Planner::new(prog.limits.clone(), prog.model);
+    let mut book = Book {
+        energy: Accumulator::new(&base.energy, &prog.profile.name),
+        temperatures: Vec::new(),
+        fans: Vec::new(),
+        pending: Default::default(),
+        owner: Vec::new(),
+        per_block,
+    };
+    if let Some(pb) = book.per_block.as_deref_mut() {
+        pb.clear();
+        pb.resize(prog.blocks.len(), [0.0; 2]);
+    }
+    if let Some(m) = base.material_from_file {
+        book.energy.set_material_from_file(m);
+    }
+    let track = book.per_block.is_some();
+    let mut seq: u64 = 0;
+    let mut length = 0.0;
+    let mut filament = base.filament_mm;
+    // Block starts: move index -> block index.
+    let mut starts: Vec<(usize, usize)> = prog
+        .blocks
+        .iter()
+        .enumerate()
+        .filter(|(b, _)| replace.get(*b).is_some_and(|r| r.is_some()))
+        .map(|(b, blk)| (blk.first, b))
+        .collect();
+    starts.sort_unstable();
+    let mut next_start = 0usize;
+    let mut skip_until = 0usize;
+    let mut resume_from: Option<[f64; 3]> = None;
+
+    macro_rules! push {
+        ($m:expr, $owner:expr) => {{
+            let m: Motion = $m;
+            length += motion_length(&m);
+            if track {
+                book.owner.push($owner);
+            }
+            planner.push(&m, seq, &mut |pm| book.planned(pm));
+            seq += 1;
+        }};
+    }
+
+    for op in &prog.ops {
+        match op {
+            Op::Move(i) => {
+                let i = *i;
+                if i < skip_until {
+                    continue;
+                }
+                if let Some(&(first, b)) = starts.get(next_start) {
+                    if first == i {
+                        next_start += 1;
+                        let blk = &prog.blocks[b];
+                        skip_until = blk.end;
+                        let orig = prog
+                            .moves
+                            .get(blk.first..blk.end)
+                            .map_or(0.0, |ms| ms.iter().map(|m| m.m.extrusion()).sum::<f64>());
+                        filament -= orig;
+                        if let Some(r) = &replace[b] {
+                            for m in &r.motions {
+                                filament += m.delta[3];
+                                push!(*m, b as u32);
+                            }
+                            resume_from = Some(r.end);
+                        }
+                        continue;
+                    }
+                }
+                let Some(mv) = prog.moves.get(i) else {
+                    continue;
+                };
+                let mut m = Motion::from(&mv.m);
+                if let Some(r) = rotation {
+                    let from = [mv.m.from[axis::X], mv.m.from[axis::Y]];
+                    let to = [mv.m.to[axis::X], mv.m.to[axis::Y]];
+                    // As the rewritten lines give them (0.001 mm).
+                    let f = if i > r.first && i <= r.last + 1 {
+                        r.apply_r3(from)
+                    } else {
+                        from
+                    };
+                    let t = if r.covers(i) { r.apply_r3(to) } else { to };
+                    m.delta[0] = t[0] - f[0];
+                    m.delta[1] = t[1] - f[1];
+                    if r.covers(i) {
+                        if let Some(a) = m.arc.as_mut() {
+                            a.center = r.apply(a.center);
+                            a.start_angle += crate::math::atan2(r.cs.1, r.cs.0);
+                        }
+                    }
+                }
+                // Moves after new infill start where the new infill ended: the axes a line
+                // does not name stay there (a Z lift or a retraction stays put; a rotated
+                // line names both).
+                if let Some(end) = resume_from {
+                    let rotated = rotation.is_some_and(|r| r.covers(i));
+                    let to = [mv.m.to[axis::X], mv.m.to[axis::Y]];
+                    let moves_xy = to != [mv.m.from[axis::X], mv.m.from[axis::Y]];
+                    let names = if rotated && moves_xy {
+                        [true; 2]
+                    } else {
+                        mv.names
+                    };
+                    let t = match rotation {
+                        Some(r) if rotated => r.apply_r3(to),
+                        _ => to,
+                    };
+                    let x = if names[0] { t[0] } else { end[0] };
+                    let y = if names[1] { t[1] } else { end[1] };
+                    m.delta[0] = x - end[0];
+                    m.delta[1] = y - end[1];
+                    m.delta[2] = mv.m.to[axis::Z] - end[2];
+                    resume_from = (!names[0] || !names[1]).then_some([x, y, mv.m.to[axis::Z]]);
+                }
+                push!(m, u32::MAX);
+            }
+            Op::Dwell(secs) => {
+                planner.flush(&mut |pm| book.planned(pm));
+                book.stamp(u64::MAX, planner.elapsed_s());
+                planner.dwell(*secs, &mut |pm| book.planned(pm));
+                book.energy.dwell(*secs);
+            }
+            Op::Flush => planner.flush(&mut |pm| book.planned(pm)),
+            Op::Limits(l) => *planner.limits_mut() = (**l).clone(),
+            Op::Temperature {
+                line,
+                heater,
+                target_c,
+                wait,
+            } => book.pending.push_back((
+                seq,
+                Pending::T(TemperatureEvent {
+                    line: *line,
+                    time_s: 0.0,
+                    heater: *heater,
+                    target_c: *target_c,
+                    wait: *wait,
+                }),
+            )),
+            Op::Fan { line, index, speed } => book.pending.push_back((
+                seq,
+                Pending::F(FanEvent {
+                    line: *line,
+                    time_s: 0.0,
+                    index: *index,
+                    speed: *speed,
+                }),
+            )),
+        }
+    }
+    planner.flush(&mut |pm| book.planned(pm));
+    let time_s = planner.elapsed_s();
+    book.stamp(u64::MAX, time_s);
+    let Book {
+        energy,
+        temperatures,
+        fans,
+        ..
+    } = book;
+    let material_g = if base.filament_mm > 0.0 {
+        base.material_g * filament / base.filament_mm
+    } else {
+        base.material_g
+    };
+    let e = energy.finish(time_s, material_g, &temperatures, &fans);
+    Costs {
+        time_s,
+        thesis_j: e.thesis_j,
+        total_j: e.total_j,
+        length_mm: length,
+        filament_mm: filament,
+    }
+}

@@ -1,0 +1,295 @@
+//! G-code for new infill, written with the file's own habits, and the planner's view of it.
+//!
+//! A block's new text is parsed back through a copy of the machine as it stood before the
+//! block, so the motions a candidate is costed with are exactly those `analyze` will read from
+//! the written file (same rounding, same extrusion mode, same firmware retraction).
+
+use std::fmt::Write as _;
+
+use super::cost::Replacement;
+use super::geom::{dist, Path, P2};
+use super::program::{Block, Program};
+use crate::error::Warnings;
+use crate::gcode::parse_line;
+use crate::machine::{axis, Event, ExtrusionMode, MoveKind};
+use crate::plan::Motion;
+
+/// How the file prints its infill and travels (measured from the file).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Habit {
+    /// Filament per mm of sparse infill.
+    pub e_per_mm: f64,
+    /// Feed rates, mm/min.
+    pub print_f: f64,
+    pub travel_f: f64,
+    pub retract_f: f64,
+    pub unretract_f: f64,
+    /// Retraction length, mm of filament (0: the file does not retract).
+    pub retract_mm: f64,
+    /// Travels at least this long are retracted, mm.
+    pub min_travel_mm: f64,
+    /// `G10`/`G11` instead of E moves.
+    pub firmware: bool,
+}
+
+/// The value that most of `items`' weight sits at (ties: the first).
+fn mode_by_weight(items: impl Iterator<Item = (f64, f64)>) -> Option<f64> {
+    let mut bins: Vec<(f64, f64)> = Vec::new();
+    for (v, w) in items {
+        if !v.is_finite() || !w.is_finite() {
+            continue;
+        }
+        if let Some(b) = bins.iter_mut().find(|b| (b.0 - v).abs() < 1e-6) {
+            b.1 += w;
+        } else if bins.len() < 4096 {
+            bins.push((v, w));
+        }
+    }
+    bins.into_iter()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|b| b.0)
+}
+
+/// Measures the habit from the file's moves.
+pub(crate) fn habit(prog: &Program) -> Option<Habit> {
+    let sparse = || {
+        prog.blocks
+            .iter()
+            .flat_map(|b| prog.moves.get(b.first..b.end).unwrap_or(&[]))
+            .filter(|m| m.m.is_extruding())
+    };
+    let (e, l) = sparse().fold((0.0, 0.0), |(e, l), m| {
+        (e + m.m.extrusion(), l + m.m.length_mm)
+    });
+    if !(l > 0.0 && e > 0.0) {
+        return None;
+    }
+    let print_f = mode_by_weight(sparse().map(|m| (m.m.feed_mm_s, m.m.length_mm)))? * 60.0;
+    let travels = prog
+        .moves
+        .iter()
+        .filter(|m| m.m.length_mm > 1e-9 && m.m.extrusion().abs() < 1e-12);
+    let travel_f = mode_by_weight(travels.clone().map(|m| (m.m.feed_mm_s, m.m.length_mm)))
+        .unwrap_or(print_f / 60.0)
+        * 60.0;
+    let pure_e = |sign: f64| {
+        prog.moves.iter().filter(move |m| {
+            m.m.length_mm <= 1e-9
+                && m.m.extrusion() * sign > 1e-9
+                && !matches!(m.m.kind, MoveKind::Home)
+        })
+    };
+    let firmware = prog
+        .moves
+        .iter()
+        .any(|m| matches!(m.m.kind, MoveKind::FirmwareRetract));
+    let retract_mm =
+        mode_by_weight(pure_e(-1.0).map(|m| ((-m.m.extrusion() * 1e5).round() / 1e5, 1.0)))
+            .unwrap_or(0.0);
+    let retract_f =
+        mode_by_weight(pure_e(-1.0).map(|m| (m.m.feed_mm_s, 1.0))).unwrap_or(35.0) * 60.0;
+    let unretract_f = mode_by_weight(pure_e(1.0).map(|m| (m.m.feed_mm_s, 1.0)))
+        .unwrap_or(retract_f / 60.0)
+        * 60.0;
+    // Shortest travel that follows a retraction.
+    let mut min_travel: f64 = f64::INFINITY;
+    for w in prog.moves.windows(2) {
+        let (a, b) = (&w[0].m, &w[1].m);
+        if a.length_mm <= 1e-9
+            && a.extrusion() < -1e-9
+            && b.length_mm > 1e-9
+            && b.extrusion().abs() < 1e-12
+        {
+            min_travel = min_travel.min(b.length_mm);
+        }
+    }
+    let min_travel_mm = if min_travel.is_finite() {
+        min_travel.clamp(0.5, 20.0)
+    } else {
+        2.0
+    };
+    Some(Habit {
+        e_per_mm: e / l,
+        print_f,
+        travel_f,
+        retract_f,
+        unretract_f,
+        retract_mm,
+        min_travel_mm,
+        firmware,
+    })
+}
+
+fn r3(v: f64) -> f64 {
+    (v * 1000.0).round() / 1000.0
+}
+fn r5(v: f64) -> f64 {
+    (v * 1e5).round() / 1e5
+}
+
+/// Writes text for a block whose new strokes (machine frame) are `strokes`, from the block's
+/// start to `end` (machine frame), leaving the filament as the original left it.
+struct Writer<'a> {
+    out: String,
+    habit: &'a Habit,
+    pos: P2,
+    retracted: bool,
+    absolute: bool,
+    e: f64,
+}
+
+impl Writer<'_> {
+    fn retract(&mut self, on: bool) {
+        if self.retracted == on || (self.habit.retract_mm <= 0.0 && !self.habit.firmware) {
+            self.retracted = on;
+            return;
+        }
+        self.retracted = on;
+        if self.habit.firmware {
+            self.out.push_str(if on { "G10\n" } else { "G11\n" });
+            return;
+        }
+        let (d, f) = if on {
+            (-self.habit.retract_mm, self.habit.retract_f)
+        } else {
+            (self.habit.retract_mm, self.habit.unretract_f)
+        };
+        let v = if self.absolute {
+            self.e = r5(self.e + d);
+            self.e
+        } else {
+            r5(d)
+        };
+        let _ = writeln!(self.out, "G1 E{v:.5} F{f:.0}");
+    }
+
+    fn travel(&mut self, to: P2) {
+        let to = [r3(to[0]), r3(to[1])];
+        let d = dist(self.pos, to);
+        if d < 1e-9 {
+            return;
+        }
+        if d >= self.habit.min_travel_mm {
+            self.retract(true);
+        }
+        let _ = writeln!(
+            self.out,
+            "G1 X{:.3} Y{:.3} F{:.0}",
+            to[0], to[1], self.habit.travel_f
+        );
+        self.pos = to;
+    }
+
+    fn stroke(&mut self, s: &[P2]) {
+        let Some(&head) = s.first() else { return };
+        self.travel(head);
+        self.retract(false);
+        let mut first = true;
+        for &q in s.iter().skip(1) {
+            let q = [r3(q[0]), r3(q[1])];
+            let d = dist(self.pos, q);
+            if d < 1e-9 {
+                continue;
+            }
+            let inc = self.habit.e_per_mm * d;
+            let v = if self.absolute {
+                self.e = r5(self.e + inc);
+                self.e
+            } else {
+                r5(inc)
+            };
+            let _ = write!(self.out, "G1 X{:.3} Y{:.3} E{v:.5}", q[0], q[1]);
+            if first {
+                let _ = write!(self.out, " F{:.0}", self.habit.print_f);
+                first = false;
+            }
+            self.out.push('\n');
+            self.pos = q;
+        }
+    }
+}
+
+/// The new text of `block` (without a final newline): `strokes` (machine frame), then back to
+/// `end` (machine frame) unless the file travels on from there anyway, with the filament state
+/// and absolute E the original left behind.
+pub(crate) fn block_text(
+    block: &Block,
+    strokes: &[Path],
+    start: P2,
+    end: P2,
+    habit: &Habit,
+) -> String {
+    let absolute = block.machine.extrusion_mode() == ExtrusionMode::Absolute;
+    let mut w = Writer {
+        out: String::with_capacity(strokes.iter().map(|s| s.len() * 34).sum::<usize>() + 64),
+        habit,
+        pos: [r3(start[0]), r3(start[1])],
+        retracted: block.retracted_start,
+        absolute,
+        e: block.machine.logical_position()[axis::E],
+    };
+    for s in strokes {
+        w.stroke(s);
+    }
+    if !block.free_end {
+        w.travel(end);
+    }
+    w.retract(block.retracted_end);
+    if absolute {
+        let _ = writeln!(w.out, "G92 E{:.5}", block.end_logical[3]);
+    }
+    let _ = write!(w.out, "G1 F{:.3}", block.end_feed_mm_s * 60.0);
+    w.out
+}
+
+/// The motions `text` makes when run from the machine state before `block`, with the nozzle
+/// at `start` (the block's start in the candidate's frame: a rotated part starts elsewhere
+/// than the machine copy believes), and where the nozzle ends.
+pub(crate) fn motions(block: &Block, text: &str, start: P2) -> Replacement {
+    let mut machine = block.machine.clone();
+    let mut warnings = Warnings::default();
+    let mut motions = Vec::new();
+    let p0 = *machine.position();
+    let start = [r3(start[0]), r3(start[1])];
+    let mut moved = false;
+    for l in text.lines() {
+        let Ok(line) = parse_line(l.as_bytes()) else {
+            continue;
+        };
+        if let Some(Event::Move(m)) = machine.apply(block.first_line, &line, &mut warnings) {
+            let mut motion = Motion::from(&m);
+            if !moved && line.params.has(b'X') {
+                // Every XY line written here names X and Y: the first one's displacement is
+                // from the true start.
+                motion.delta[0] += p0[axis::X] - start[0];
+                motion.delta[1] += p0[axis::Y] - start[1];
+                moved = true;
+            }
+            motions.push(motion);
+        }
+    }
+    let p = machine.position();
+    let end = if moved {
+        [p[axis::X], p[axis::Y]]
+    } else {
+        start
+    };
+    Replacement {
+        motions,
+        end: [end[0], end[1], p[axis::Z]],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weighted_mode() {
+        assert_eq!(
+            mode_by_weight([(1.0, 1.0), (2.0, 3.0), (1.0, 1.0)].into_iter()),
+            Some(2.0)
+        );
+        assert_eq!(mode_by_weight(std::iter::empty()), None);
+    }
+}

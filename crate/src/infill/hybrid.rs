@@ -1,0 +1,79 @@
+//! The thesis's hybrid: a pattern and angle chosen layer by layer.
+//!
+//! Each (pattern, angle) is replayed once at the chosen rotation with the planner and energy
+//! model, summing per replaced block its servo energy and its time; a layer's cost is
+//! `servo J + (auxiliary power) × time`, the auxiliary power being the original file's average
+//! (`aux_j / time_s`). Each layer takes its cheapest option, and the assembled hybrid is replayed
+//! as a whole for its true numbers (junction coupling between layers and the fuse energy of the
+//! material included); the caller keeps it only if it beats the single best.
+
+use super::cost::{replay, replay_blocks, Costs, Rotation};
+use super::geom::Path;
+use super::search::Prepared;
+use super::{Candidate, InfillOptions, LayerChoice, Pattern};
+
+/// A layer's best so far: cost, pattern, angle, strokes.
+type Choice = (f64, Pattern, f64, Vec<Path>);
+
+/// The per-layer plans, choices and whole-file costs of the hybrid.
+pub(crate) fn per_layer(
+    prep: &Prepared<'_>,
+    options: &InfillOptions,
+    chosen: &Candidate,
+    rotation: Option<&Rotation>,
+) -> Option<(Vec<Vec<Path>>, Vec<LayerChoice>, Costs)> {
+    let aux_w = if prep.before.time_s > 0.0 {
+        prep.before.energy.aux_j / prep.before.time_s
+    } else {
+        0.0
+    };
+    let n = prep.work.len();
+    // (cost, pattern, angle, plan) per work item.
+    let mut best: Vec<Option<Choice>> = vec![None; n];
+    let mut per_block = Vec::new();
+    for &pattern in &options.patterns {
+        for &angle in &options.angles_deg {
+            let beta = angle - chosen.rotation_deg;
+            let plans: Vec<Vec<Path>> = prep
+                .work
+                .iter()
+                .map(|w| prep.plan_layer(w, pattern, beta))
+                .collect();
+            let refs: Vec<&Vec<Path>> = plans.iter().collect();
+            let (_, motions) = prep.candidate(&refs, rotation);
+            replay_blocks(
+                &prep.prog,
+                &motions,
+                rotation,
+                &prep.base,
+                Some(&mut per_block),
+            );
+            for ((w, plan), slot) in prep.work.iter().zip(plans).zip(best.iter_mut()) {
+                let cost: f64 = w
+                    .blocks
+                    .iter()
+                    .filter_map(|&b| per_block.get(b))
+                    .map(|[j, t]| j + aux_w * t)
+                    .sum();
+                if slot.as_ref().is_none_or(|s| cost < s.0) {
+                    *slot = Some((cost, pattern, angle, plan));
+                }
+            }
+        }
+    }
+    let mut plans = Vec::with_capacity(n);
+    let mut choices = Vec::with_capacity(n);
+    for (w, slot) in prep.work.iter().zip(best) {
+        let (_, pattern, angle_deg, plan) = slot?;
+        plans.push(plan);
+        choices.push(LayerChoice {
+            layer: w.layer,
+            pattern,
+            angle_deg,
+        });
+    }
+    let refs: Vec<&Vec<Path>> = plans.iter().collect();
+    let (_, motions) = prep.candidate(&refs, rotation);
+    let costs = replay(&prep.prog, &motions, rotation, &prep.base);
+    Some((plans, choices, costs))
+}

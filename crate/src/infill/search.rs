@@ -1,0 +1,496 @@
+//! The search: every (pattern, infill angle, part rotation) is written as G-code for the
+//! replaced blocks, parsed back and replayed through the planner and energy model for the
+//! whole file ([`super::cost`]); the best by the objective is written out and analysed again.
+//!
+//! Infill angles are in the machine frame, as a slicer's `fill_angle`: a part turned by `θ`
+//! with infill at `α` gets the pattern at `α − θ` in the part's own frame, so the generated
+//! geometry is shared by every (α, θ) with the same difference (a cache keyed by it).
+
+use std::collections::HashMap;
+
+use super::cost::{replay, Baseline, Costs, Replacement, Rotation};
+use super::emit::{self, Habit};
+use super::geom::{bbox, path_len, Path, P2};
+use super::program::{self, Program};
+use super::region::{self, LayerRegion};
+use super::{
+    link, pattern, write, Best, Candidate, InfillOptions, InfillReport, Measured, Objective,
+    Pattern,
+};
+use crate::analyze::{analyze, Progress, Report};
+use crate::error::{Error, ErrorKind};
+use crate::gcode::FeatureKind;
+use crate::machine::axis;
+
+/// Clearance used when the file gives no evidence of its own, mm (a 0.45 mm line with 10 %
+/// overlap).
+const DEFAULT_CLEARANCE_MM: f64 = 0.2;
+/// Margin kept from the bed edges when a rotated part is moved back onto the bed, mm.
+const BED_MARGIN_MM: f64 = 1.0;
+
+/// Regenerates the sparse infill of `input` with the best pattern, angle and rotation.
+pub fn infill(input: &[u8], options: &InfillOptions) -> Result<InfillReport, Error> {
+    infill_with_progress(input, options, &mut |_| true)
+}
+
+/// A layer whose infill is regenerated.
+pub(crate) struct Work {
+    pub layer: usize,
+    /// Blocks of the layer (the first gets all the new infill).
+    pub blocks: Vec<usize>,
+    pub region: LayerRegion,
+    /// Extruded length of the original sparse infill, mm.
+    pub target_mm: f64,
+    /// Filament per mm of the original sparse infill of this layer.
+    pub e_per_mm: f64,
+    /// Nozzle position at the first block (part frame).
+    pub start: P2,
+}
+
+pub(crate) struct Prepared<'a> {
+    pub input: &'a [u8],
+    pub prog: Program,
+    pub before: Report,
+    pub base: Baseline,
+    pub habit: Habit,
+    pub spacing: f64,
+    pub clearance: f64,
+    pub work: Vec<Work>,
+    pub zone: Option<(usize, usize)>,
+    pub centre: P2,
+    pub bed: [f64; 4],
+}
+
+fn invalid(reason: &'static str) -> Error {
+    Error::new(0, 0, ErrorKind::InvalidOption { reason })
+}
+
+fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>, Error> {
+    options.validate()?;
+    let before = analyze(input, &options.analyze)?;
+    let prog = program::read(input, &options.analyze)?;
+    let habit = emit::habit(&prog)
+        .ok_or_else(|| invalid("the file marks no sparse infill to regenerate"))?;
+    let mut by_layer: Vec<Vec<usize>> = vec![Vec::new(); prog.layer_count];
+    for (i, mv) in prog.moves.iter().enumerate() {
+        if let Some(l) = by_layer.get_mut(mv.layer as usize) {
+            l.push(i);
+        }
+    }
+    let clearance = region::clearance(&prog, &by_layer).unwrap_or(DEFAULT_CLEARANCE_MM);
+    let mut blocks_of: HashMap<usize, Vec<usize>> = HashMap::new();
+    for (b, blk) in prog.blocks.iter().enumerate() {
+        blocks_of.entry(blk.layer).or_default().push(b);
+    }
+    let mut layers: Vec<usize> = blocks_of.keys().copied().collect();
+    layers.sort_unstable();
+    let mut work = Vec::new();
+    for layer in layers {
+        let blocks = blocks_of.remove(&layer).unwrap_or_default();
+        let Some(idx) = by_layer.get(layer) else {
+            continue;
+        };
+        let moves: Vec<_> = idx
+            .iter()
+            .filter_map(|&i| prog.moves.get(i).copied())
+            .collect();
+        let Some(region) = region::extract(&moves, clearance) else {
+            continue;
+        };
+        let (e, l) = blocks
+            .iter()
+            .filter_map(|&b| prog.blocks.get(b))
+            .flat_map(|b| prog.moves.get(b.first..b.end).unwrap_or(&[]))
+            .filter(|m| m.m.is_extruding())
+            .fold((0.0, 0.0), |(e, l), m| {
+                (e + m.m.extrusion(), l + m.m.length_mm)
+            });
+        let Some(first) = blocks.first().and_then(|&b| prog.blocks.get(b)) else {
+            continue;
+        };
+        let p = first.machine.position();
+        if l > 0.0 {
+            work.push(Work {
+                layer,
+                start: [p[axis::X], p[axis::Y]],
+                blocks,
+                region,
+                target_mm: l,
+                e_per_mm: e / l,
+            });
+        }
+    }
+    if work.is_empty() {
+        return Err(invalid(
+            "no layer has a sparse-infill region inside closed walls",
+        ));
+    }
+    let spacing = options.spacing_mm.unwrap_or_else(|| {
+        let a: f64 = work.iter().map(|w| w.region.area_mm2).sum();
+        let l: f64 = work.iter().map(|w| w.target_mm).sum();
+        a / l
+    });
+    if !(spacing.is_finite() && spacing > 0.05) {
+        return Err(invalid(
+            "could not measure a line spacing from the file's infill",
+        ));
+    }
+    // The print: from the first to the last move of a printed feature.
+    let printed = |i: &usize| {
+        prog.moves.get(*i).is_some_and(|m| {
+            m.layer != u32::MAX && !matches!(m.kind, None | Some(FeatureKind::Other))
+        })
+    };
+    let first = (0..prog.moves.len()).find(printed);
+    let last = (0..prog.moves.len()).rev().find(printed);
+    let zone = first.zip(last);
+    let pts: Vec<P2> = zone
+        .map(|(a, b)| {
+            prog.moves[a..=b]
+                .iter()
+                .filter(|m| m.m.is_extruding())
+                .flat_map(|m| [[m.m.from[0], m.m.from[1]], [m.m.to[0], m.m.to[1]]])
+                .collect()
+        })
+        .unwrap_or_default();
+    let b = bbox(&pts).unwrap_or([0.0; 4]);
+    let centre = [0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3])];
+    let bed = prog.bed.unwrap_or_else(|| {
+        let all = bbox(
+            prog.moves
+                .iter()
+                .map(|m| [m.m.to[0], m.m.to[1]])
+                .collect::<Vec<_>>()
+                .iter(),
+        )
+        .unwrap_or([0.0; 4]);
+        [
+            all[0].min(0.0),
+            all[1].min(0.0),
+            all[2].max(200.0),
+            all[3].max(200.0),
+        ]
+    });
+    let base = Baseline::new(&before, options.analyze.energy.clone().unwrap_or_default());
+    Ok(Prepared {
+        input,
+        prog,
+        before,
+        base,
+        habit,
+        spacing,
+        clearance,
+        work,
+        zone,
+        centre,
+        bed,
+    })
+}
+
+impl Prepared<'_> {
+    /// The rotation by `deg` that keeps the print on the bed, or `None` if it cannot fit.
+    fn rotation(&self, deg: f64) -> Option<Option<Rotation>> {
+        let turns = deg.rem_euclid(360.0);
+        if turns.abs() < 1e-9 || (turns - 360.0).abs() < 1e-9 {
+            return Some(None);
+        }
+        if self.prog.relative_xy {
+            return None;
+        }
+        let (first, last) = self.zone?;
+        let mut r = Rotation {
+            cs: super::geom::cos_sin_deg(deg),
+            centre: self.centre,
+            shift: [0.0, 0.0],
+            first,
+            last,
+        };
+        let pts: Vec<P2> = self.prog.moves[first..=last]
+            .iter()
+            .map(|m| r.apply([m.m.to[0], m.m.to[1]]))
+            .collect();
+        let b = bbox(&pts)?;
+        let bed = [
+            self.bed[0] + BED_MARGIN_MM,
+            self.bed[1] + BED_MARGIN_MM,
+            self.bed[2] - BED_MARGIN_MM,
+            self.bed[3] - BED_MARGIN_MM,
+        ];
+        for k in 0..2 {
+            let (lo, hi) = (b[k], b[k + 2]);
+            if hi - lo > bed[k + 2] - bed[k] {
+                return None;
+            }
+            r.shift[k] = if lo < bed[k] {
+                bed[k] - lo
+            } else if hi > bed[k + 2] {
+                bed[k + 2] - hi
+            } else {
+                0.0
+            };
+        }
+        Some(Some(r))
+    }
+
+    /// New strokes of work item `w` (part frame), `pattern` at `beta` degrees in the part
+    /// frame, with the spacing corrected once so the layer's extruded length matches.
+    pub(crate) fn plan_layer(&self, w: &Work, pattern: Pattern, beta: f64) -> Vec<Path> {
+        let make = |s: f64| {
+            let rows = pattern::generate(&w.region.region, pattern, beta, s, w.layer);
+            link::link(
+                rows,
+                w.start,
+                &w.region.region,
+                3.0 * s,
+                0.25 * self.clearance.max(0.05),
+            )
+        };
+        // Up to three corrections of the spacing by the length ratio (rows are discrete, so one
+        // is not always enough); keep the closest.
+        let mut s = self.spacing;
+        let mut best: Option<(f64, Vec<Path>)> = None;
+        for _ in 0..3 {
+            let strokes = make(s);
+            let len: f64 = strokes.iter().map(|s| path_len(s)).sum();
+            let ratio = len / w.target_mm;
+            let err = (ratio - 1.0).abs();
+            let better = best.as_ref().is_none_or(|b| err < b.0);
+            if better && !strokes.is_empty() {
+                best = Some((err, strokes));
+            }
+            if len.is_nan() || len <= 0.0 || err <= 0.03 {
+                break;
+            }
+            s *= ratio.clamp(0.5, 2.0);
+        }
+        best.map(|b| b.1).unwrap_or_default()
+    }
+
+    /// The texts and motions of every replaced block for per-work-item strokes.
+    pub(crate) fn candidate(
+        &self,
+        plans: &[&Vec<Path>],
+        rotation: Option<&Rotation>,
+    ) -> (Vec<Option<String>>, Vec<Option<Replacement>>) {
+        let n = self.prog.blocks.len();
+        let mut texts: Vec<Option<String>> = vec![None; n];
+        let mut motions: Vec<Option<Replacement>> = vec![None; n];
+        let tf = |p: P2| rotation.map_or(p, |r| r.apply(p));
+        for (w, plan) in self.work.iter().zip(plans) {
+            let habit = Habit {
+                e_per_mm: w.e_per_mm,
+                ..self.habit
+            };
+            let moved: Vec<Path> = plan
+                .iter()
+                .map(|s| s.iter().map(|&p| tf(p)).collect())
+                .collect();
+            for (k, &b) in w.blocks.iter().enumerate() {
+                let Some(blk) = self.prog.blocks.get(b) else {
+                    continue;
+                };
+                let p = blk.machine.position();
+                let start = tf([p[axis::X], p[axis::Y]]);
+                let end = tf([blk.end_physical[0], blk.end_physical[1]]);
+                let strokes: &[Path] = if k == 0 { &moved } else { &[] };
+                let text = emit::block_text(blk, strokes, start, end, &habit);
+                motions[b] = Some(emit::motions(blk, &text, start));
+                texts[b] = Some(text);
+            }
+        }
+        (texts, motions)
+    }
+}
+
+fn score(objective: Objective, w: &super::Weights, c: &Costs, base: &Costs) -> f64 {
+    let rel = |a: f64, b: f64| if b > 0.0 { a / b } else { a };
+    match objective {
+        Objective::Energy => c.total_j,
+        Objective::Time => c.time_s,
+        Objective::Length => c.length_mm,
+        Objective::Weighted => {
+            w.energy * rel(c.total_j, base.total_j)
+                + w.time * rel(c.time_s, base.time_s)
+                + w.length * rel(c.length_mm, base.length_mm)
+        }
+    }
+}
+
+/// Key of a part-frame angle for the geometry cache (millidegrees in [0, 360)).
+fn angle_key(beta: f64) -> i64 {
+    (beta.rem_euclid(360.0) * 1000.0).round() as i64 % 360_000
+}
+
+/// [`infill`] with a progress callback (fraction of candidates costed; `false` cancels).
+pub fn infill_with_progress(
+    input: &[u8],
+    options: &InfillOptions,
+    progress: Progress<'_>,
+) -> Result<InfillReport, Error> {
+    let prep = prepare(input, options)?;
+    let base_costs = replay(&prep.prog, &[], None, &prep.base);
+    let mut rotations = Vec::new();
+    let mut rotations_skipped = Vec::new();
+    for &deg in &options.rotations_deg {
+        match prep.rotation(deg) {
+            Some(r) => rotations.push((deg, r)),
+            None => rotations_skipped.push(deg),
+        }
+    }
+    if rotations.is_empty() {
+        return Err(invalid("no rotation keeps the part on the bed"));
+    }
+    let total = options.patterns.len() * options.angles_deg.len() * rotations.len();
+    let mut done = 0usize;
+    let mut candidates: Vec<Candidate> = Vec::with_capacity(total);
+    let mut best: Option<(f64, usize)> = None;
+    for &pattern in &options.patterns {
+        let mut cache: HashMap<i64, Vec<Vec<Path>>> = HashMap::new();
+        for &angle in &options.angles_deg {
+            for (rot_deg, rotation) in &rotations {
+                if !progress(done as f64 / total as f64) {
+                    return Err(Error::new(0, 0, ErrorKind::Cancelled));
+                }
+                done += 1;
+                let beta = angle - rot_deg;
+                // Concentric loops do not depend on the angle.
+                let key = if pattern == Pattern::Concentric {
+                    0
+                } else {
+                    angle_key(beta)
+                };
+                let plans = cache.entry(key).or_insert_with(|| {
+                    prep.work
+                        .iter()
+                        .map(|w| prep.plan_layer(w, pattern, beta))
+                        .collect()
+                });
+                let refs: Vec<&Vec<Path>> = plans.iter().collect();
+                let (_, motions) = prep.candidate(&refs, rotation.as_ref());
+                let c = replay(&prep.prog, &motions, rotation.as_ref(), &prep.base);
+                let s = score(options.objective, &options.weights, &c, &base_costs);
+                if best.is_none_or(|(b, _)| s < b) {
+                    best = Some((s, candidates.len()));
+                }
+                candidates.push(Candidate {
+                    pattern,
+                    angle_deg: angle,
+                    rotation_deg: *rot_deg,
+                    thesis_j: c.thesis_j,
+                    total_j: c.total_j,
+                    time_s: c.time_s,
+                    length_mm: c.length_mm,
+                    filament_mm: c.filament_mm,
+                });
+            }
+        }
+    }
+    let Some((best_score, bi)) = best else {
+        return Err(invalid("no candidate"));
+    };
+    let chosen = candidates[bi].clone();
+    let rotation = rotations
+        .iter()
+        .find(|(d, _)| *d == chosen.rotation_deg)
+        .and_then(|(_, r)| *r);
+    let beta = chosen.angle_deg - chosen.rotation_deg;
+    let mut plans: Vec<Vec<Path>> = prep
+        .work
+        .iter()
+        .map(|w| prep.plan_layer(w, chosen.pattern, beta))
+        .collect();
+    let mut layers = None;
+    let mut result = Costs {
+        time_s: chosen.time_s,
+        thesis_j: chosen.thesis_j,
+        total_j: chosen.total_j,
+        length_mm: chosen.length_mm,
+        filament_mm: chosen.filament_mm,
+    };
+    if options.per_layer {
+        if let Some((hybrid, choices, costs)) =
+            super::hybrid::per_layer(&prep, options, &chosen, rotation.as_ref())
+        {
+            if score(options.objective, &options.weights, &costs, &base_costs) < best_score {
+                plans = hybrid;
+                layers = Some(choices);
+                result = costs;
+            }
+        }
+    }
+    let refs: Vec<&Vec<Path>> = plans.iter().collect();
+    let (texts, _) = prep.candidate(&refs, rotation.as_ref());
+    let edits = write::edits(prep.input, &prep.prog, &texts, rotation.as_ref());
+    let output = crate::gcode::apply_edits(prep.input, &edits);
+    let after = analyze(&output, &options.analyze)?;
+    progress(1.0);
+    let before_j = prep.before.energy.total_j;
+    let best = Best {
+        pattern: chosen.pattern,
+        angle_deg: chosen.angle_deg,
+        rotation_deg: chosen.rotation_deg,
+        thesis_j: result.thesis_j,
+        total_j: result.total_j,
+        time_s: result.time_s,
+        length_mm: result.length_mm,
+        saving_j: before_j - result.total_j,
+        saving_pct: if before_j > 0.0 {
+            100.0 * (before_j - result.total_j) / before_j
+        } else {
+            0.0
+        },
+        layers,
+    };
+    let measured = Measured {
+        spacing_mm: prep.spacing,
+        clearance_mm: prep.clearance,
+        e_per_mm: prep.habit.e_per_mm,
+        layers_regenerated: prep.work.len(),
+        blocks: prep.work.iter().map(|w| w.blocks.len()).sum(),
+        print_feed_mm_s: prep.habit.print_f / 60.0,
+        travel_feed_mm_s: prep.habit.travel_f / 60.0,
+        retract_mm: prep.habit.retract_mm,
+    };
+    Ok(InfillReport {
+        before: prep.before,
+        after,
+        best,
+        candidates,
+        measured,
+        rotations_skipped,
+        output,
+    })
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    pub(crate) fn rect(angle: u32) -> Vec<u8> {
+        let path = format!(
+            "{}/tests/data/rect_infill_{angle}.gcode",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        std::fs::read(path).expect("fixture")
+    }
+
+    #[test]
+    fn replay_of_the_original_is_analyze() {
+        let input = rect(45);
+        let prep = prepare(&input, &InfillOptions::default()).expect("prepare");
+        let c = replay(&prep.prog, &[], None, &prep.base);
+        let r = &prep.before;
+        assert!(
+            (c.time_s - r.time_s).abs() < 1e-9 * r.time_s,
+            "{} vs {}",
+            c.time_s,
+            r.time_s
+        );
+        assert!((c.thesis_j - r.energy.thesis_j).abs() < 1e-9 * r.energy.thesis_j);
+        assert!((c.total_j - r.energy.total_j).abs() < 1e-9 * r.energy.total_j);
+        assert!((c.filament_mm - r.filament_mm).abs() < 1e-9);
+        assert_eq!(prep.work.len(), 25);
+        // PrusaSlicer's 20 % of a 0.45 mm line: about 2 mm.
+        assert!((prep.spacing - 2.0).abs() < 0.3, "{}", prep.spacing);
+    }
+}
