@@ -30,10 +30,11 @@ function reportOf(result) {
   return { report: JSON.parse(JSON.stringify(report)), output };
 }
 
-// Paths where `a` and `b` differ: structure exactly, numbers within `rel` relative error.
+// Paths where `a` and `b` differ: structure exactly, numbers within `rel` relative error (or
+// 1e-12 absolute, for values that are zero up to rounding, such as a minimum deviation).
 function diffs(a, b, rel, at = '$', out = []) {
   if (typeof a === 'number' && typeof b === 'number') {
-    if (Math.abs(a - b) > rel * Math.max(Math.abs(a), Math.abs(b), 1e-300)) out.push(`${at}: ${a} vs ${b}`);
+    if (Math.abs(a - b) > rel * Math.max(Math.abs(a), Math.abs(b)) + 1e-12) out.push(`${at}: ${a} vs ${b}`);
   } else if (a && b && typeof a === 'object' && typeof b === 'object') {
     const keys = new Set([...Object.keys(a), ...Object.keys(b)]);
     for (const k of keys) diffs(a[k], b[k], rel, `${at}.${k}`, out);
@@ -61,6 +62,20 @@ test('smooth: wasm report and output equal the CLI on the 5-axis corpus file', (
   assert.ok(output instanceof Uint8Array);
   assert.ok(Buffer.from(output).equals(fs.readFileSync(out)), 'smoothed file differs from the CLI output');
   assert.ok(report.max_angle_to_original_deg <= report.cone_deg / 2);
+});
+
+test('infill: wasm report and output equal the CLI (angles 0/45/90, two patterns)', () => {
+  const out = path.join(tmp, 'infill.gcode');
+  const fromCli = runCli(['infill', DEMO, '-o', out, '--angles', '0,45,90', '--patterns', 'rectilinear,grid', '--json']);
+  const { report, output } = reportOf(
+    qp.infill(fs.readFileSync(DEMO), { angles_deg: [0, 45, 90], patterns: ['rectilinear', 'grid'] }),
+  );
+  assert.deepEqual(report, fromCli);
+  assert.equal(report.candidates.length, 6);
+  assert.ok(Buffer.from(output).equals(fs.readFileSync(out)), 'rewritten file differs from the CLI output');
+  // The output is a file analyze reads, with the material of the input (±10 %).
+  const after = qp.analyze(output);
+  assert.ok(Math.abs(after.filament_mm / report.before.filament_mm - 1) < 0.1);
 });
 
 test('Session jobs use the session analyze options unless the job names its own', () => {

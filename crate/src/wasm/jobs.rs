@@ -8,10 +8,15 @@ use wasm_bindgen::prelude::*;
 use super::{input_bytes, js_error, options, progress_fn, to_js, JsProgress, Session};
 use crate::analyze::AnalyzeOptions;
 use crate::dynamics::{vibration_with_progress, VibrationOptions};
+use crate::infill::{infill_with_progress, InfillOptions};
 use crate::orient::{smooth_with_progress, SmoothOptions};
 
 #[wasm_bindgen]
 extern "C" {
+    /// `InfillOptions` in TypeScript.
+    #[wasm_bindgen(typescript_type = "InfillOptions")]
+    #[derive(Debug)]
+    pub type JsInfillOptions;
     /// `SmoothOptions` in TypeScript.
     #[wasm_bindgen(typescript_type = "SmoothOptions")]
     #[derive(Debug)]
@@ -54,6 +59,11 @@ where
     Ok(o)
 }
 
+fn run_infill(bytes: &[u8], o: &InfillOptions, p: Option<JsProgress>) -> Result<JsValue, JsValue> {
+    let r = infill_with_progress(bytes, o, &mut progress_fn(p)).map_err(|e| js_error(&e))?;
+    with_output(&r, &r.output)
+}
+
 fn run_smooth(bytes: &[u8], o: &SmoothOptions, p: Option<JsProgress>) -> Result<JsValue, JsValue> {
     let r = smooth_with_progress(bytes, o, &mut progress_fn(p)).map_err(|e| js_error(&e))?;
     with_output(&r, &r.output)
@@ -66,6 +76,22 @@ fn run_vibration(
 ) -> Result<JsValue, JsValue> {
     let r = vibration_with_progress(bytes, o, &mut progress_fn(p)).map_err(|e| js_error(&e))?;
     to_js(&r)
+}
+
+/// Infill regeneration and the search over pattern, angle and orientation
+/// (`quietpath infill --json`, plus `output`).
+#[wasm_bindgen(unchecked_return_type = "InfillResult")]
+pub fn infill(
+    #[wasm_bindgen(unchecked_param_type = "string | Uint8Array | ArrayBuffer")] input: JsValue,
+    options_value: Option<JsInfillOptions>,
+    on_progress: Option<JsProgress>,
+) -> Result<JsValue, JsValue> {
+    let o = job_options(
+        options_value.as_deref(),
+        None,
+        |o: &mut InfillOptions, a| o.analyze = a,
+    )?;
+    run_infill(&input_bytes(&input)?, &o, on_progress)
 }
 
 /// Tool-orientation smoothing of a multi-axis file (`quietpath smooth --json`, plus `output`).
@@ -100,6 +126,21 @@ pub fn vibration(
 
 #[wasm_bindgen]
 impl Session {
+    /// `infill` of the session's file.
+    #[wasm_bindgen(unchecked_return_type = "InfillResult")]
+    pub fn infill(
+        &self,
+        options_value: Option<JsInfillOptions>,
+        on_progress: Option<JsProgress>,
+    ) -> Result<JsValue, JsValue> {
+        let o = job_options(
+            options_value.as_deref(),
+            Some(self),
+            |o: &mut InfillOptions, a| o.analyze = a,
+        )?;
+        run_infill(self.input_ref(), &o, on_progress)
+    }
+
     /// `smooth` of the session's file.
     #[wasm_bindgen(unchecked_return_type = "SmoothResult")]
     pub fn smooth(

@@ -7,7 +7,7 @@
 mod jobs;
 mod session;
 
-pub use jobs::{smooth, vibration};
+pub use jobs::{infill, smooth, vibration};
 pub use session::Session;
 
 use js_sys::{Function, Reflect, Uint8Array};

@@ -211,6 +211,8 @@ export interface VibrationOptions {
   bucket_mm?: number;
   peaks?: number;
 }
+/** Trajectory deviation (eq. 15 of the VTG paper), mm. */
+export interface Deviation { max: number; min: number; mean: number; max_at: number[]; samples: number }
 export interface Mode { frequency_hz: number; damping_ratio: number }
 export interface VibrationReport {
   machine: string;
@@ -219,7 +221,9 @@ export interface VibrationReport {
   natural_frequencies_hz: number[];
   damping_ratios: number[];
   axes: { axis: string; position_mm: number; modes: Mode[] }[];
-  deviation_mm: { max: number; min: number; mean: number; max_at: number[]; samples: number };
+  deviation_mm: Deviation;
+  /** The same over extruding moves only. */
+  printing_deviation_mm: Deviation;
   layers: { layer: number; z: number | null; amplitude: number; mean: number; acceleration_rms: number }[];
   psd: {
     fs_hz: number;
@@ -302,3 +306,62 @@ export interface SmoothReport {
 }
 /** smooth() result: the report plus the smoothed file. */
 export interface SmoothResult extends SmoothReport { output: Uint8Array }
+
+// ── infill (`quietpath infill --json`) ──
+export type InfillPattern =
+  | "rectilinear" | "grid" | "triangles" | "tri_hexagon" | "cross_line" | "concentric"
+  | "hilbert" | "archimedean_chords" | "octagram_spiral";
+export interface InfillOptions {
+  analyze?: AnalyzeOptions;
+  /** Infill angles to try, degrees (default 0 to 165 in steps of 15). */
+  angles_deg?: number[];
+  /** Part rotations about Z to try, degrees (default 0). */
+  rotations_deg?: number[];
+  patterns?: InfillPattern[];
+  objective?: "energy" | "time" | "length" | "weighted";
+  weights?: { energy?: number; time?: number; length?: number };
+  /** Choose pattern and angle per layer (the thesis's hybrid). */
+  per_layer?: boolean;
+  spacing_mm?: number | null;
+}
+export interface InfillCandidate {
+  pattern: InfillPattern;
+  angle_deg: number;
+  rotation_deg: number;
+  thesis_j: number;
+  total_j: number;
+  time_s: number;
+  length_mm: number;
+  filament_mm: number;
+}
+export interface InfillReport {
+  before: Report;
+  after: Report;
+  best: {
+    pattern: InfillPattern;
+    angle_deg: number;
+    rotation_deg: number;
+    thesis_j: number;
+    total_j: number;
+    time_s: number;
+    length_mm: number;
+    saving_j: number;
+    saving_pct: number;
+    layers: { layer: number; pattern: InfillPattern; angle_deg: number; [key: string]: unknown }[] | null;
+  };
+  candidates: InfillCandidate[];
+  measured: {
+    spacing_mm: number;
+    clearance_mm: number;
+    e_per_mm: number;
+    layers_regenerated: number;
+    blocks: number;
+    print_feed_mm_s: number;
+    travel_feed_mm_s: number;
+    retract_mm: number;
+    [key: string]: number;
+  };
+  rotations_skipped: number[];
+}
+/** infill() result: the report plus the rewritten file. */
+export interface InfillResult extends InfillReport { output: Uint8Array }
