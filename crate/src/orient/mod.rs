@@ -10,10 +10,14 @@
 //!
 //! ```
 //! use quietpath::orient::{smooth, SmoothOptions};
-//! let gcode = b"G90\nG1 X10 Y0 Z1 B-10 C0 E1 F600\nG1 X10 Y1 Z1 B-30 C0 E2\nG1 X10 Y2 Z1 B-10 C0 E3\n";
+//! // Table-tilting B / rotary C: a kink of the tool tilt in the middle of a printed line.
+//! let gcode = b"G90\nG0 X10 Y0 Z1 B-10 C0\nG1 X10 Y1 Z1 B-10 C0 E1 F600\n\
+//! G1 X10 Y2 Z1 B-30 C0 E2\nG1 X10 Y3 Z1 B-10 C0 E3\nG1 X10 Y4 Z1 B-10 C0 E4\n";
 //! let report = smooth(gcode, &SmoothOptions::default()).unwrap();
-//! assert_eq!(report.points, 3);
+//! assert_eq!(report.points, 4);
 //! assert!(report.max_angle_to_original_deg <= 30.0);
+//! assert!(report.after.roughness < report.before.roughness);
+//! assert_eq!(report.output.split(|&b| b == b'\n').count(), 7);
 //! ```
 
 pub mod cone;
