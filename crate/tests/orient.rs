@@ -423,3 +423,80 @@ proptest! {
         prop_assert!((r[1] - rot[1]).abs() < 180.0 + 1e-9);
     }
 }
+
+#[test]
+fn cli_smooth_writes_the_same_format_and_json() {
+    let dir = std::env::temp_dir().join(format!("quietpath-orient-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let (gcode, _) = spiral_gcode();
+    let csv = orient::points::write_csv(&square_tube(&PartOptions {
+        layer_height_mm: 5.0,
+        point_spacing_mm: 1.0,
+        height_mm: 15.0,
+    }));
+    for (name, bytes) in [("spiral.gcode", gcode), ("tube.csv", csv)] {
+        let input = dir.join(name);
+        let output = dir.join(format!("out-{name}"));
+        std::fs::write(&input, &bytes).expect("write input");
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_quietpath"))
+            .args(["smooth"])
+            .arg(&input)
+            .arg("-o")
+            .arg(&output)
+            .args([
+                "--kinematics",
+                "table-bc",
+                "--window-mm",
+                "8",
+                "--cone-deg",
+                "40",
+                "--json",
+            ])
+            .output()
+            .expect("run quietpath");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+        assert!(json["max_angle_to_original_deg"].as_f64().unwrap_or(99.0) <= 20.0);
+        assert!(json["points"].as_u64().unwrap_or(0) > 0);
+        assert_eq!(json["window"]["millimetres"].as_f64(), Some(8.0));
+        assert!(json["series"]["first_before"]
+            .as_array()
+            .is_some_and(|a| !a.is_empty()));
+        let written = std::fs::read(&output).expect("output");
+        let lines = |b: &[u8]| b.split(|&c| c == b'\n').count();
+        assert_eq!(lines(&written), lines(&bytes));
+        // Refuses to overwrite its input without --force.
+        let same = std::process::Command::new(env!("CARGO_BIN_EXE_quietpath"))
+            .arg("smooth")
+            .arg(&input)
+            .arg("-o")
+            .arg(&input)
+            .output()
+            .expect("run quietpath");
+        assert!(!same.status.success());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn progress_is_reported_and_cancellation_stops() {
+    let (gcode, _) = spiral_gcode();
+    let mut seen = Vec::new();
+    let r = orient::smooth_with_progress(&gcode, &SmoothOptions::default(), &mut |f| {
+        seen.push(f);
+        true
+    });
+    assert!(r.is_ok());
+    assert!(seen.first() == Some(&0.0) && seen.last() == Some(&1.0));
+    assert!(seen.windows(2).all(|w| w[0] <= w[1]));
+    let cancelled =
+        orient::smooth_with_progress(&gcode, &SmoothOptions::default(), &mut |f| f < 0.5);
+    assert!(matches!(
+        cancelled.map_err(|e| e.kind),
+        Err(quietpath::ErrorKind::Cancelled)
+    ));
+}
