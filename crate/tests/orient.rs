@@ -500,3 +500,66 @@ fn progress_is_reported_and_cancellation_stops() {
         Err(quietpath::ErrorKind::Cancelled)
     ));
 }
+
+#[test]
+fn head_ab_gcode_is_rewritten_with_a_and_b() {
+    // A head machine with a 60 mm pivot: the tool leans about X with a kink every 20 points.
+    let kin = Kinematics {
+        model: KinematicModel::HeadAb,
+        pivot_length_mm: 60.0,
+        ..Kinematics::default()
+    };
+    let mut g = String::from("G90\nM82\n");
+    let mut prev = [0.0, 0.0];
+    for i in 0..=120 {
+        let p = [i as f64 * 0.5, 10.0, 2.0];
+        let a = vec3::rad(if (i / 20) % 2 == 0 { 15.0 } else { 5.0 });
+        let v = [0.1, -a.sin(), a.cos()];
+        let v = vec3::normalize(v).expect("unit");
+        let rot = kin.rotary_for(v, prev);
+        prev = rot;
+        let m = kin.machine_xyz(p, rot);
+        let cmd = if i == 0 { "G0" } else { "G1" };
+        let e = if i == 0 {
+            String::new()
+        } else {
+            format!(" E{:.3}", i as f64 * 0.02)
+        };
+        g.push_str(&format!(
+            "{cmd} X{:.3} Y{:.3} Z{:.3} A{:.3} B{:.3}{e} F900\n",
+            m[0], m[1], m[2], rot[0], rot[1]
+        ));
+    }
+    let options = SmoothOptions {
+        kinematics: kin.clone(),
+        max_gap_mm: 100.0,
+        ..SmoothOptions::default()
+    };
+    let report = orient::smooth(g.as_bytes(), &options).expect("smooth");
+    assert_eq!(report.series.axes, vec!["A".to_string(), "B".to_string()]);
+    assert!(report.changed > 50, "{}", report.changed);
+    assert!(report.max_angle_to_original_deg <= 30.0);
+    assert!(
+        report.max_tip_deviation_mm < 2e-3,
+        "{}",
+        report.max_tip_deviation_mm
+    );
+    assert!(
+        report.roughness_reduction > 0.3,
+        "{}",
+        report.roughness_reduction
+    );
+    let path = quietpath::path::extract(&report.output, &Default::default(), false).expect("read");
+    let before = quietpath::path::extract(g.as_bytes(), &Default::default(), false).expect("read");
+    for (a, b) in before.moves.iter().zip(&path.moves) {
+        let pa = kin.tip(&Pose {
+            xyz: [a.to[0], a.to[1], a.to[2]],
+            rot: [a.to[4], a.to[5]],
+        });
+        let pb = kin.tip(&Pose {
+            xyz: [b.to[0], b.to[1], b.to[2]],
+            rot: [b.to[4], b.to[5]],
+        });
+        assert!(vec3::norm(vec3::sub(pa, pb)) < 2e-3);
+    }
+}
