@@ -563,3 +563,28 @@ fn head_ab_gcode_is_rewritten_with_a_and_b() {
         assert!(vec3::norm(vec3::sub(pa, pb)) < 2e-3);
     }
 }
+
+#[test]
+fn widely_spaced_points_warn_about_the_gap_limit() {
+    let pts: Vec<PointVector> = (0..20)
+        .map(|i| PointVector {
+            x: i as f64 * 10.0,
+            y: 0.0,
+            z: 0.0,
+            i: 0.0,
+            j: (i as f64 * 0.3).sin() * 0.3,
+            k: 1.0,
+            path: 0,
+        })
+        .collect();
+    let (r, _) = smooth_points(&pts, &SmoothOptions::default()).expect("smooth");
+    assert_eq!(r.runs, 20);
+    assert!(r.warnings.iter().any(|w| w.message.contains("max_gap_mm")));
+    let wide = SmoothOptions {
+        max_gap_mm: 50.0,
+        ..SmoothOptions::default()
+    };
+    let (r, _) = smooth_points(&pts, &wide).expect("smooth");
+    assert_eq!(r.runs, 1);
+    assert!(r.warnings.is_empty());
+}

@@ -56,6 +56,7 @@ pub(super) fn run(
         .iter()
         .map(|r| program::samples(kin, moves, r))
         .collect();
+    warnings.extend(summary::short_run_warning(&before, true));
     let mut smoothed = Vec::with_capacity(runs.len());
     let mut corrected = 0usize;
     for (i, run) in before.iter().enumerate() {

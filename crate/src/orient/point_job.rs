@@ -90,7 +90,9 @@ pub(super) fn run(
         },
         &runs,
         &after,
-        Vec::new(),
+        summary::short_run_warning(&runs, false)
+            .into_iter()
+            .collect(),
         Vec::new(),
     );
     summary::tick(progress, 1.0)?;
