@@ -34,7 +34,7 @@ fn paper_options(cone_deg: f64) -> SmoothOptions {
         filter: FilterKind::ZeroPhaseMovingAverage,
         window: Window::Millimetres(20.0),
         cone_deg,
-        singular_deg: 0.0,
+        singular_deg: Some(0.0),
         max_gap_mm: f64::INFINITY,
         ..SmoothOptions::default()
     }
@@ -156,7 +156,7 @@ fn zero_phase_has_no_lag_symmetric_in_symmetric_out() {
                 filter,
                 window,
                 cone_deg: 180.0,
-                singular_deg: 0.0,
+                singular_deg: Some(0.0),
                 ..SmoothOptions::default()
             };
             let (_, out) = smooth_points(&input, &options).expect("smooth");
@@ -175,7 +175,7 @@ fn zero_phase_has_no_lag_symmetric_in_symmetric_out() {
         filter: FilterKind::MovingAverage,
         window: Window::Points(9),
         cone_deg: 180.0,
-        singular_deg: 0.0,
+        singular_deg: Some(0.0),
         ..SmoothOptions::default()
     };
     let (_, out) = smooth_points(&input, &options).expect("smooth");

@@ -50,7 +50,7 @@ pub(super) fn run(
         filter: options.filter,
         window: options.window,
         half_angle: (half - margin).max(0.0),
-        singular_angle: vec3::rad(options.singular_deg),
+        singular_angle: vec3::rad(options.singular_deg.unwrap_or(6.0)),
     };
     let before: Vec<Vec<Sample>> = runs
         .iter()
