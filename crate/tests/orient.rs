@@ -34,7 +34,7 @@ fn paper_options(cone_deg: f64) -> SmoothOptions {
         filter: FilterKind::ZeroPhaseMovingAverage,
         window: Window::Millimetres(20.0),
         cone_deg,
-        singular_deg: 0.0,
+        singular_deg: Some(0.0),
         max_gap_mm: f64::INFINITY,
         ..SmoothOptions::default()
     }
@@ -156,7 +156,7 @@ fn zero_phase_has_no_lag_symmetric_in_symmetric_out() {
                 filter,
                 window,
                 cone_deg: 180.0,
-                singular_deg: 0.0,
+                singular_deg: Some(0.0),
                 ..SmoothOptions::default()
             };
             let (_, out) = smooth_points(&input, &options).expect("smooth");
@@ -175,7 +175,7 @@ fn zero_phase_has_no_lag_symmetric_in_symmetric_out() {
         filter: FilterKind::MovingAverage,
         window: Window::Points(9),
         cone_deg: 180.0,
-        singular_deg: 0.0,
+        singular_deg: Some(0.0),
         ..SmoothOptions::default()
     };
     let (_, out) = smooth_points(&input, &options).expect("smooth");
@@ -422,4 +422,169 @@ proptest! {
         // Never a jump of a whole turn from the previous angles.
         prop_assert!((r[1] - rot[1]).abs() < 180.0 + 1e-9);
     }
+}
+
+#[test]
+fn cli_smooth_writes_the_same_format_and_json() {
+    let dir = std::env::temp_dir().join(format!("quietpath-orient-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let (gcode, _) = spiral_gcode();
+    let csv = orient::points::write_csv(&square_tube(&PartOptions {
+        layer_height_mm: 5.0,
+        point_spacing_mm: 1.0,
+        height_mm: 15.0,
+    }));
+    for (name, bytes) in [("spiral.gcode", gcode), ("tube.csv", csv)] {
+        let input = dir.join(name);
+        let output = dir.join(format!("out-{name}"));
+        std::fs::write(&input, &bytes).expect("write input");
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_quietpath"))
+            .args(["smooth"])
+            .arg(&input)
+            .arg("-o")
+            .arg(&output)
+            .args([
+                "--kinematics",
+                "table-bc",
+                "--window-mm",
+                "8",
+                "--cone-deg",
+                "40",
+                "--json",
+            ])
+            .output()
+            .expect("run quietpath");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+        assert!(json["max_angle_to_original_deg"].as_f64().unwrap_or(99.0) <= 20.0);
+        assert!(json["points"].as_u64().unwrap_or(0) > 0);
+        assert_eq!(json["window"]["millimetres"].as_f64(), Some(8.0));
+        assert!(json["series"]["first_before"]
+            .as_array()
+            .is_some_and(|a| !a.is_empty()));
+        let written = std::fs::read(&output).expect("output");
+        let lines = |b: &[u8]| b.split(|&c| c == b'\n').count();
+        assert_eq!(lines(&written), lines(&bytes));
+        // Refuses to overwrite its input without --force.
+        let same = std::process::Command::new(env!("CARGO_BIN_EXE_quietpath"))
+            .arg("smooth")
+            .arg(&input)
+            .arg("-o")
+            .arg(&input)
+            .output()
+            .expect("run quietpath");
+        assert!(!same.status.success());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn progress_is_reported_and_cancellation_stops() {
+    let (gcode, _) = spiral_gcode();
+    let mut seen = Vec::new();
+    let r = orient::smooth_with_progress(&gcode, &SmoothOptions::default(), &mut |f| {
+        seen.push(f);
+        true
+    });
+    assert!(r.is_ok());
+    assert!(seen.first() == Some(&0.0) && seen.last() == Some(&1.0));
+    assert!(seen.windows(2).all(|w| w[0] <= w[1]));
+    let cancelled =
+        orient::smooth_with_progress(&gcode, &SmoothOptions::default(), &mut |f| f < 0.5);
+    assert!(matches!(
+        cancelled.map_err(|e| e.kind),
+        Err(quietpath::ErrorKind::Cancelled)
+    ));
+}
+
+#[test]
+fn head_ab_gcode_is_rewritten_with_a_and_b() {
+    // A head machine with a 60 mm pivot: the tool leans about X with a kink every 20 points.
+    let kin = Kinematics {
+        model: KinematicModel::HeadAb,
+        pivot_length_mm: 60.0,
+        ..Kinematics::default()
+    };
+    let mut g = String::from("G90\nM82\n");
+    let mut prev = [0.0, 0.0];
+    for i in 0..=120 {
+        let p = [i as f64 * 0.5, 10.0, 2.0];
+        let a = vec3::rad(if (i / 20) % 2 == 0 { 15.0 } else { 5.0 });
+        let v = [0.1, -a.sin(), a.cos()];
+        let v = vec3::normalize(v).expect("unit");
+        let rot = kin.rotary_for(v, prev);
+        prev = rot;
+        let m = kin.machine_xyz(p, rot);
+        let cmd = if i == 0 { "G0" } else { "G1" };
+        let e = if i == 0 {
+            String::new()
+        } else {
+            format!(" E{:.3}", i as f64 * 0.02)
+        };
+        g.push_str(&format!(
+            "{cmd} X{:.3} Y{:.3} Z{:.3} A{:.3} B{:.3}{e} F900\n",
+            m[0], m[1], m[2], rot[0], rot[1]
+        ));
+    }
+    let options = SmoothOptions {
+        kinematics: kin.clone(),
+        max_gap_mm: 100.0,
+        ..SmoothOptions::default()
+    };
+    let report = orient::smooth(g.as_bytes(), &options).expect("smooth");
+    assert_eq!(report.series.axes, vec!["A".to_string(), "B".to_string()]);
+    assert!(report.changed > 50, "{}", report.changed);
+    assert!(report.max_angle_to_original_deg <= 30.0);
+    assert!(
+        report.max_tip_deviation_mm < 2e-3,
+        "{}",
+        report.max_tip_deviation_mm
+    );
+    assert!(
+        report.roughness_reduction > 0.3,
+        "{}",
+        report.roughness_reduction
+    );
+    let path = quietpath::path::extract(&report.output, &Default::default(), false).expect("read");
+    let before = quietpath::path::extract(g.as_bytes(), &Default::default(), false).expect("read");
+    for (a, b) in before.moves.iter().zip(&path.moves) {
+        let pa = kin.tip(&Pose {
+            xyz: [a.to[0], a.to[1], a.to[2]],
+            rot: [a.to[4], a.to[5]],
+        });
+        let pb = kin.tip(&Pose {
+            xyz: [b.to[0], b.to[1], b.to[2]],
+            rot: [b.to[4], b.to[5]],
+        });
+        assert!(vec3::norm(vec3::sub(pa, pb)) < 2e-3);
+    }
+}
+
+#[test]
+fn widely_spaced_points_warn_about_the_gap_limit() {
+    let pts: Vec<PointVector> = (0..20)
+        .map(|i| PointVector {
+            x: i as f64 * 10.0,
+            y: 0.0,
+            z: 0.0,
+            i: 0.0,
+            j: (i as f64 * 0.3).sin() * 0.3,
+            k: 1.0,
+            path: 0,
+        })
+        .collect();
+    let (r, _) = smooth_points(&pts, &SmoothOptions::default()).expect("smooth");
+    assert_eq!(r.runs, 20);
+    assert!(r.warnings.iter().any(|w| w.message.contains("max_gap_mm")));
+    let wide = SmoothOptions {
+        max_gap_mm: 50.0,
+        ..SmoothOptions::default()
+    };
+    let (r, _) = smooth_points(&pts, &wide).expect("smooth");
+    assert_eq!(r.runs, 1);
+    assert!(r.warnings.is_empty());
 }

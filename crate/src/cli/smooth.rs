@@ -44,9 +44,10 @@ pub struct Args {
     /// Opening of the tolerance cone around each original tool vector, degrees.
     #[arg(long, value_name = "DEG", default_value_t = 60.0)]
     pub cone_deg: f64,
-    /// Keep-out angle around the kinematic singularity (table C axis / head B = ±90°), degrees.
-    #[arg(long, value_name = "DEG", default_value_t = 6.0)]
-    pub singular_deg: f64,
+    /// Keep-out angle around the kinematic singularity (table C axis / head B = ±90°), degrees
+    /// (default 6 for G-code, 0 for point-vector data).
+    #[arg(long, value_name = "DEG")]
+    pub singular_deg: Option<f64>,
     /// Longest step inside one continuous path, mm; longer moves are jumps the filter does not
     /// average across.
     #[arg(long, value_name = "MM", default_value_t = 5.0)]

@@ -52,7 +52,7 @@ impl Default for Window {
 }
 
 /// Largest number of points one median window holds (bounds the work on hostile windows).
-pub const MAX_MEDIAN_POINTS: usize = 4001;
+pub const MAX_MEDIAN_POINTS: usize = 1001;
 /// Largest window in points.
 pub const MAX_WINDOW_POINTS: usize = 1_000_000;
 

@@ -50,12 +50,13 @@ pub(super) fn run(
         filter: options.filter,
         window: options.window,
         half_angle: (half - margin).max(0.0),
-        singular_angle: vec3::rad(options.singular_deg),
+        singular_angle: vec3::rad(options.singular_deg.unwrap_or(6.0)),
     };
     let before: Vec<Vec<Sample>> = runs
         .iter()
         .map(|r| program::samples(kin, moves, r))
         .collect();
+    warnings.extend(summary::short_run_warning(&before, true));
     let mut smoothed = Vec::with_capacity(runs.len());
     let mut corrected = 0usize;
     for (i, run) in before.iter().enumerate() {

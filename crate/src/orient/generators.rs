@@ -88,7 +88,7 @@ fn generate(surface: &dyn Fn(f64, f64) -> V3, t_max: f64, o: &PartOptions) -> Ve
             .sum::<f64>()
     };
     let per = perimeter(0.0).max(perimeter(t_max));
-    let nv = ((per / o.point_spacing_mm).ceil() as usize).clamp(16, 20_000);
+    let nv = ((per / o.point_spacing_mm).ceil() as usize).clamp(16, 5_000);
     // Meridian length tables s_j(t).
     const NT: usize = 400;
     let dt = t_max / NT as f64;

@@ -10,10 +10,14 @@
 //!
 //! ```
 //! use quietpath::orient::{smooth, SmoothOptions};
-//! let gcode = b"G90\nG1 X10 Y0 Z1 B-10 C0 E1 F600\nG1 X10 Y1 Z1 B-30 C0 E2\nG1 X10 Y2 Z1 B-10 C0 E3\n";
+//! // Table-tilting B / rotary C: a kink of the tool tilt in the middle of a printed line.
+//! let gcode = b"G90\nG0 X10 Y0 Z1 B-10 C0\nG1 X10 Y1 Z1 B-10 C0 E1 F600\n\
+//! G1 X10 Y2 Z1 B-30 C0 E2\nG1 X10 Y3 Z1 B-10 C0 E3\nG1 X10 Y4 Z1 B-10 C0 E4\n";
 //! let report = smooth(gcode, &SmoothOptions::default()).unwrap();
-//! assert_eq!(report.points, 3);
+//! assert_eq!(report.points, 4);
 //! assert!(report.max_angle_to_original_deg <= 30.0);
+//! assert!(report.after.roughness < report.before.roughness);
+//! assert_eq!(report.output.split(|&b| b == b'\n').count(), 7);
 //! ```
 
 pub mod cone;
@@ -70,9 +74,11 @@ pub struct SmoothOptions {
     /// output vector stays within `γ/2` of its original.
     pub cone_deg: f64,
     /// Keep-out angle around the kinematic singularity (the table's C axis, the head's B = ±90°),
-    /// degrees (default 6, the λ of the corpus file's generator; 0 disables): a smoothed vector is
-    /// kept at least `min(singular_deg, tilt of its original)` away from it.
-    pub singular_deg: f64,
+    /// degrees; 0 disables. Points whose original vector is inside it are kept as written, and a
+    /// smoothed vector is kept at least `min(singular_deg, tilt of its original)` away from it.
+    /// Default (`None`): 6° for G-code (the λ of the corpus file's generator), 0 for point-vector
+    /// data (a robot cell has no turntable singularity; the kinematics only serve the metrics).
+    pub singular_deg: Option<f64>,
     /// Longest step between two points of one continuous path, mm (default 5, the jump length
     /// of the corpus file's generator). A longer step is a jump to another section: the filter
     /// does not average across it (in G-code the jumping move stays as written).
@@ -95,7 +101,7 @@ impl Default for SmoothOptions {
             filter: FilterKind::default(),
             window: Window::default(),
             cone_deg: 60.0,
-            singular_deg: 6.0,
+            singular_deg: None,
             max_gap_mm: 5.0,
             decimals: 3,
             format: InputFormat::Auto,
@@ -112,7 +118,10 @@ impl SmoothOptions {
         if !(self.cone_deg.is_finite() && self.cone_deg > 0.0 && self.cone_deg <= 360.0) {
             return bad("cone_deg must be in (0, 360]");
         }
-        if !(self.singular_deg.is_finite() && (0.0..=90.0).contains(&self.singular_deg)) {
+        if self
+            .singular_deg
+            .is_some_and(|d| !(d.is_finite() && (0.0..=90.0).contains(&d)))
+        {
             return bad("singular_deg must be in [0, 90]");
         }
         if self.max_gap_mm.is_nan() || self.max_gap_mm <= 0.0 {

@@ -57,7 +57,7 @@ pub(super) fn run(
         filter: options.filter,
         window: options.window,
         half_angle: vec3::rad(0.5 * options.cone_deg),
-        singular_angle: vec3::rad(options.singular_deg),
+        singular_angle: vec3::rad(options.singular_deg.unwrap_or(0.0)),
     };
     let mut after = Vec::with_capacity(runs.len());
     let mut corrected = 0usize;
@@ -90,7 +90,9 @@ pub(super) fn run(
         },
         &runs,
         &after,
-        Vec::new(),
+        summary::short_run_warning(&runs, false)
+            .into_iter()
+            .collect(),
         Vec::new(),
     );
     summary::tick(progress, 1.0)?;

@@ -24,6 +24,25 @@ pub(super) struct Counts {
     pub skip_first: bool,
 }
 
+/// A warning when most points sit in runs too short to smooth (the gap limit or the path
+/// numbering cuts every path apart).
+pub(super) fn short_run_warning(runs: &[Vec<Sample>], skip_first: bool) -> Option<Warning> {
+    let skip = usize::from(skip_first);
+    let total: usize = runs.iter().map(|r| r.len().saturating_sub(skip)).sum();
+    let short: usize = runs
+        .iter()
+        .map(|r| r.len().saturating_sub(skip))
+        .filter(|&n| n < 3)
+        .sum();
+    (total > 0 && 2 * short > total).then(|| Warning {
+        line: 0,
+        message: format!(
+            "{short} of {total} points are in runs of fewer than 3 points and cannot be smoothed; \
+             is max_gap_mm (--max-gap) shorter than the point spacing?"
+        ),
+    })
+}
+
 pub(super) fn assemble(
     options: &SmoothOptions,
     counts: Counts,
