@@ -143,12 +143,13 @@ pub fn segments(path: &PrintPath) -> Option<Vec<Segment>> {
     let mut planned_end = 0.0f64; // end of the last move on the planner's timeline
     for m in &path.moves {
         let t = m.timing?;
-        let duration = t.profile.duration();
+        let duration = t.duration_s;
         if !duration.is_finite() || !t.start_s.is_finite() {
             continue;
         }
         let (start, profile) = if matches!(m.kind, MoveKind::Arc(_)) {
-            // Only the last segment's timing is known: start where the previous move ended.
+            // The planner times an arc as straight firmware segments; the simulation follows the
+            // true arc with one trapezoid, starting where the previous move ended.
             let entry = out
                 .last()
                 .filter(|s| (s.end_s() - cursor).abs() < 1e-12)

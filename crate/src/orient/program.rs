@@ -162,7 +162,7 @@ pub(super) fn samples(kin: &Kinematics, moves: &[PathMove], run: &Run) -> Vec<Sa
         push(&first.from, 0.0);
     }
     for m in run.iter().filter_map(|&i| moves.get(i)) {
-        push(&m.to, m.timing.map_or(0.0, |t| t.profile.duration()));
+        push(&m.to, m.timing.map_or(0.0, |t| t.duration_s));
     }
     out
 }

@@ -37,7 +37,10 @@ pub const NO_LAYER: u32 = crate::analyze::layers::NO_LAYER;
 pub struct MoveTiming {
     /// Time the move starts, s from the start of the file.
     pub start_s: f64,
-    /// Speed profile along the path.
+    /// Time the whole move takes, s (for an arc: all the straight segments the firmware splits
+    /// it into).
+    pub duration_s: f64,
+    /// Speed profile along the path (for an arc: its last segment's).
     pub profile: Profile,
 }
 
@@ -167,8 +170,11 @@ pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<Pri
 
     fn set_timing(moves: &mut [PathMove], pm: &PlannedMove) {
         if let Some(m) = moves.get_mut(pm.tag as usize) {
+            let end = pm.start_s + pm.duration();
+            let start_s = m.timing.map_or(pm.start_s, |t| t.start_s);
             m.timing = Some(MoveTiming {
-                start_s: pm.start_s,
+                start_s,
+                duration_s: end - start_s,
                 profile: pm.profile,
             });
         }
@@ -327,16 +333,26 @@ G1 X10 Y0 E0.5 F1200\nG1 X10 Y10 E0.5\n;TYPE:Internal infill\nG1 X0 Y10 E0.5\n\
             p.time_s,
             r.time_s
         );
-        let sum: f64 = p
-            .moves
-            .iter()
-            .map(|m| m.timing.unwrap().profile.duration())
-            .sum();
+        let sum: f64 = p.moves.iter().map(|m| m.timing.unwrap().duration_s).sum();
         assert!((sum - r.time_s).abs() < 1e-9);
         // Consecutive moves start when the previous one ends (no dwell in the sample).
         for w in p.moves.windows(2) {
             let (a, b) = (w[0].timing.unwrap(), w[1].timing.unwrap());
-            assert!((a.start_s + a.profile.duration() - b.start_s).abs() < 1e-9);
+            assert!((a.start_s + a.duration_s - b.start_s).abs() < 1e-9);
         }
+    }
+
+    #[test]
+    fn an_arc_is_timed_from_its_first_segment_to_its_last() {
+        let gcode = b"M83\nG1 X10 Y0 F3000\nG3 X10 Y20 I0 J10 E2 F1200\nG1 X0 Y20 E1\n";
+        let p = extract(gcode, &AnalyzeOptions::default(), true).unwrap();
+        let r = crate::analyze::analyze(gcode, &AnalyzeOptions::default()).unwrap();
+        let t: Vec<MoveTiming> = p.moves.iter().map(|m| m.timing.unwrap()).collect();
+        assert_eq!(t.len(), 3);
+        // Half a circle of radius 10 in 1 mm segments: much longer than its last segment.
+        assert!(t[1].duration_s > 10.0 * t[1].profile.duration());
+        assert!((t[0].start_s + t[0].duration_s - t[1].start_s).abs() < 1e-9);
+        assert!((t[1].start_s + t[1].duration_s - t[2].start_s).abs() < 1e-9);
+        assert!((t[2].start_s + t[2].duration_s - r.time_s).abs() < 1e-9);
     }
 }
