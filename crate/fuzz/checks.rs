@@ -210,3 +210,120 @@ pub fn planner(data: &[u8]) {
         planner.elapsed_s()
     );
 }
+
+/// What every rewriting job must give: a file that re-parses in strict mode where the input
+/// did, with every number finite and every coordinate and feed rate sane, and every
+/// non-motion line of the input kept, in order.
+fn check_rewritten(input: &[u8], output: &[u8], what: &str) {
+    use quietpath::gcode::Command;
+    let sane = |letter: u8, v: f64| match letter {
+        b'F' => v > 0.0 && v < 1e7,
+        b'X' | b'Y' | b'Z' | b'E' | b'A' | b'B' | b'C' | b'I' | b'J' | b'K' | b'R' => {
+            v.abs() <= quietpath::machine::MAX_COORDINATE
+        }
+        _ => true,
+    };
+    let input_ok = run_analyze(
+        input,
+        &AnalyzeOptions {
+            strict: true,
+            ..AnalyzeOptions::default()
+        },
+    )
+    .is_ok();
+    let mut kept_in: Vec<&[u8]> = Vec::new();
+    for raw in Lines::new(input) {
+        if let Ok(l) = parse_one(raw.text) {
+            let motion = matches!(l.command, Command::Code(c) if c.letter == b'G' && c.number <= 3);
+            if !motion && !raw.text.is_empty() {
+                kept_in.push(raw.text);
+            }
+        }
+    }
+    // Lines the job copied unchanged are the input's business (a hostile input may hold
+    // absurd values the job rightly leaves alone); lines it wrote must be sane.
+    let written =
+        |text: &[u8]| !kept_in.contains(&text) && !Lines::new(input).any(|l| l.text == text);
+    let mut kept_out: Vec<&[u8]> = Vec::new();
+    for raw in Lines::new(output) {
+        match parse_one(raw.text) {
+            Ok(l) => {
+                let motion =
+                    matches!(l.command, Command::Code(c) if c.letter == b'G' && c.number <= 3);
+                if motion && written(raw.text) {
+                    for (letter, value) in l.params.iter() {
+                        if let Some(v) = value {
+                            assert!(
+                                v.is_finite() && sane(letter, v),
+                                "{what}: output line {}: {}={v}",
+                                raw.number,
+                                letter as char
+                            );
+                        }
+                    }
+                } else if !raw.text.is_empty() {
+                    kept_out.push(raw.text);
+                }
+            }
+            Err(e) => assert!(
+                !input_ok,
+                "{what}: output line {} does not parse: {e:?}",
+                raw.number
+            ),
+        }
+    }
+    if input_ok {
+        // Non-motion lines are kept in order (an optimiser may add its own comments).
+        let mut it = kept_out.iter();
+        for line in &kept_in {
+            assert!(
+                it.any(|o| o == line),
+                "{what}: lost or reordered line {:?}",
+                String::from_utf8_lossy(line)
+            );
+        }
+    }
+}
+
+/// Infill regeneration on arbitrary input.
+pub fn infill(data: &[u8]) {
+    use quietpath::infill::{infill as run, InfillOptions};
+    if let Ok(r) = run(data, &InfillOptions::default()) {
+        check_rewritten(data, &r.output, "infill");
+    }
+}
+
+/// Orientation smoothing on arbitrary input: the cone invariant always holds.
+pub fn smooth(data: &[u8]) {
+    use quietpath::orient::{smooth as run, SmoothOptions};
+    let o = SmoothOptions::default();
+    if let Ok(r) = run(data, &o) {
+        assert!(
+            r.max_angle_to_original_deg <= o.cone_deg / 2.0 + 1e-9,
+            "smooth: {} over half the cone",
+            r.max_angle_to_original_deg
+        );
+        check_rewritten(data, &r.output, "smooth");
+    }
+}
+
+/// The dynamics report on arbitrary input: finite numbers.
+pub fn vibration(data: &[u8]) {
+    use quietpath::dynamics::{vibration as run, VibrationOptions};
+    if let Ok(r) = run(data, &VibrationOptions::default()) {
+        let json = serde_json::to_string(&r).expect("serialises");
+        let v: serde_json::Value = serde_json::from_str(&json).expect("valid JSON");
+        for key in ["max", "min", "mean"] {
+            assert!(
+                v["deviation_mm"][key].is_number(),
+                "vibration: deviation {key} not finite: {json:.300}"
+            );
+        }
+        assert!(
+            v["psd"]["power"]
+                .as_array()
+                .is_some_and(|p| p.iter().all(|x| x.is_number())),
+            "vibration: PSD not finite"
+        );
+    }
+}

@@ -51,9 +51,20 @@ fn fuzz_regressions_do_not_panic() {
             ("analyze", checks::analyze),
             ("rewrite", checks::rewrite),
             ("planner", checks::planner),
+            ("infill", checks::infill),
+            ("smooth", checks::smooth),
+            ("vibration", checks::vibration),
         ] {
+            let started = std::time::Instant::now();
             if catch_unwind(AssertUnwindSafe(|| check(&data))).is_err() {
                 failures.push(format!("{} ({what})", path.display()));
+            }
+            // Bounded cost on hostile input: seconds per megabyte at most (debug build, with
+            // room for a loaded machine).
+            let limit = 20.0 * (data.len() as f64 / 1e6).max(1.0);
+            let secs = started.elapsed().as_secs_f64();
+            if secs > limit {
+                failures.push(format!("{} ({what}): {secs:.1} s", path.display()));
             }
         }
     }

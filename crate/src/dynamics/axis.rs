@@ -43,6 +43,14 @@ impl Stepper {
                 *yr += p * xc;
             }
         }
+        // A decaying state would otherwise sink into subnormal numbers, which x86 handles a
+        // hundred times slower (a crawl at a vanishing feed rate took minutes); 1e-200 m is
+        // zero for any machine.
+        for yr in &mut y {
+            if yr.abs() < FLUSH_TO_ZERO {
+                *yr = 0.0;
+            }
+        }
         State::from(y)
     }
 }
@@ -102,6 +110,9 @@ pub fn stepper(drive: &Drive, position_m: f64, ts: f64) -> Option<Stepper> {
         gamma: core::array::from_fn(|c| core::array::from_fn(|r| d.gamma[(r, c)])),
     })
 }
+
+/// State components smaller than this are set to zero after each step (see [`Stepper::step`]).
+pub const FLUSH_TO_ZERO: f64 = 1e-200;
 
 /// An axis with its steppers cached per bucket of nut positions.
 #[derive(Debug)]

@@ -11,6 +11,12 @@ use crate::path::NO_LAYER;
 
 /// Most simulation steps one run may take (about 55 hours of motion at 1 ms).
 pub const MAX_STEPS: f64 = 2e8;
+/// Steps allowed per move, and at least [`MIN_STEP_BUDGET`] in all: a real print spends well
+/// under a second per move on average, so a short file that asks for days of motion (a
+/// vanishing feed rate) is refused quickly instead of simulated for minutes.
+pub const STEPS_PER_MOVE: f64 = 2000.0;
+/// The step budget of even the smallest file (about 5.5 hours of motion at 1 ms).
+pub const MIN_STEP_BUDGET: f64 = 2e7;
 /// Steps between two progress callbacks.
 const PROGRESS_STEPS: u64 = 1 << 20;
 /// Deviations (m) and deviation velocities (m/s) below which a resting machine is taken as
@@ -174,13 +180,14 @@ pub fn run(
             0,
             0,
             ErrorKind::InvalidOption {
-                reason:
-                    "print too long to simulate at this period (over 2e8 steps); use a longer ts",
+                reason: "print too long to simulate at this period (over 2e8 steps, or 2000 \
+                         steps a move); use a longer ts",
             },
         )
     };
     let steps = motion / ts;
-    if steps.is_nan() || steps > MAX_STEPS || !end.is_finite() || end / ts > u64::MAX as f64 / 2.0 {
+    let budget = (STEPS_PER_MOVE * segs.len() as f64).clamp(MIN_STEP_BUDGET, MAX_STEPS);
+    if steps.is_nan() || steps > budget || !end.is_finite() || end / ts > u64::MAX as f64 / 2.0 {
         return Err(too_long());
     }
     let total = (end / ts).ceil() as u64;
@@ -266,7 +273,7 @@ pub fn run(
                 break;
             }
         }
-        if out.steps as f64 > 2.0 * MAX_STEPS {
+        if out.steps as f64 > 2.0 * budget {
             // Rests that never settle (an undamped mode excited): still bounded.
             return Err(too_long());
         }
