@@ -33,11 +33,13 @@ pub enum Pattern {
     ArchimedeanChords,
     /// A spiral of eight-pointed stars.
     OctagramSpiral,
+    /// Cross-line: the Sierpiński space-filling curve (what Cura's "cross" infill is built on).
+    CrossLine,
 }
 
 impl Pattern {
     /// Every pattern.
-    pub const ALL: [Pattern; 8] = [
+    pub const ALL: [Pattern; 9] = [
         Pattern::Rectilinear,
         Pattern::Grid,
         Pattern::Triangles,
@@ -46,6 +48,7 @@ impl Pattern {
         Pattern::Hilbert,
         Pattern::ArchimedeanChords,
         Pattern::OctagramSpiral,
+        Pattern::CrossLine,
     ];
     /// The five patterns of the thesis's DOE (Table 4).
     pub const THESIS: [Pattern; 5] = [
@@ -67,6 +70,7 @@ impl Pattern {
             Pattern::Hilbert => "hilbert",
             Pattern::ArchimedeanChords => "archimedean_chords",
             Pattern::OctagramSpiral => "octagram_spiral",
+            Pattern::CrossLine => "cross_line",
         }
     }
 
@@ -78,6 +82,7 @@ impl Pattern {
             "trihexagon" => return Some(Pattern::TriHexagon),
             "archimedean" => return Some(Pattern::ArchimedeanChords),
             "octagram" => return Some(Pattern::OctagramSpiral),
+            "cross" | "crossline" => return Some(Pattern::CrossLine),
             _ => {}
         }
         Pattern::ALL.into_iter().find(|p| p.name() == s)
@@ -135,7 +140,8 @@ pub(crate) fn generate(
         Pattern::Concentric
         | Pattern::Hilbert
         | Pattern::ArchimedeanChords
-        | Pattern::OctagramSpiral => {
+        | Pattern::OctagramSpiral
+        | Pattern::CrossLine => {
             // Build upright in a frame turned by -angle, then turn back.
             let back = super::geom::cos_sin_deg(angle_deg);
             let fwd = (back.0, -back.1);
@@ -154,6 +160,7 @@ pub(crate) fn generate(
                 }
                 Pattern::Hilbert => curves::hilbert(&turned, pitch),
                 Pattern::ArchimedeanChords => curves::archimedean(&turned, pitch),
+                Pattern::CrossLine => curves::sierpinski(&turned, pitch),
                 _ => curves::octagram(&turned, pitch),
             };
             pieces
