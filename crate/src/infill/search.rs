@@ -105,6 +105,28 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
             .fold((0.0, 0.0), |(e, l), m| {
                 (e + m.m.extrusion(), l + m.m.length_mm)
             });
+        // Guard: the file's own sparse infill must lie in the region we found (at least 80 %
+        // of its length, judged by move midpoints); otherwise the walls did not describe the
+        // infill area (open or unmarked walls) and the layer is left as it is.
+        let (inside_mm, all_mm) = blocks
+            .iter()
+            .filter_map(|&b| prog.blocks.get(b))
+            .flat_map(|b| prog.moves.get(b.first..b.end).unwrap_or(&[]))
+            .filter(|m| m.m.is_extruding())
+            .fold((0.0, 0.0), |(i, a), m| {
+                let mid = [
+                    0.5 * (m.m.from[axis::X] + m.m.to[axis::X]),
+                    0.5 * (m.m.from[axis::Y] + m.m.to[axis::Y]),
+                ];
+                let inside = super::geom::inside_tol(&region.region, mid, clearance);
+                (
+                    i + if inside { m.m.length_mm } else { 0.0 },
+                    a + m.m.length_mm,
+                )
+            });
+        if inside_mm < 0.8 * all_mm {
+            continue;
+        }
         let Some(first) = blocks.first().and_then(|&b| prog.blocks.get(b)) else {
             continue;
         };
