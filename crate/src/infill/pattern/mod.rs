@@ -201,3 +201,45 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod props {
+    use super::*;
+    use crate::infill::geom::inside_tol;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+        /// Every point of every pattern lies in the region (a rectangle with a square hole),
+        /// whatever the angle, size and spacing.
+        #[test]
+        fn pieces_stay_in_the_region(
+            w in 8.0f64..60.0,
+            h in 8.0f64..60.0,
+            hole in 0.1f64..0.4,
+            angle in -180.0f64..180.0,
+            spacing in 0.8f64..4.0,
+            k in 0usize..9,
+        ) {
+            let (hx, hy) = (w * hole, h * hole);
+            let region: Region = vec![
+                vec![[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]],
+                vec![
+                    [w / 2.0 - hx, h / 2.0 - hy],
+                    [w / 2.0 - hx, h / 2.0 + hy],
+                    [w / 2.0 + hx, h / 2.0 + hy],
+                    [w / 2.0 + hx, h / 2.0 - hy],
+                ],
+            ];
+            let p = Pattern::ALL[k];
+            for piece in generate(&region, p, angle, spacing, 1).iter().flatten() {
+                for w2 in piece.windows(2) {
+                    let mid = [0.5 * (w2[0][0] + w2[1][0]), 0.5 * (w2[0][1] + w2[1][1])];
+                    for q in [w2[0], w2[1], mid] {
+                        prop_assert!(inside_tol(&region, q, 1e-3), "{p:?} {q:?}");
+                    }
+                }
+            }
+        }
+    }
+}
