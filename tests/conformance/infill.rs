@@ -272,3 +272,26 @@ fn rotated_candidates_cost_what_the_file_costs() {
     assert!(b.min[0] >= 0.0 && b.min[1] >= 0.0 && b.max[0] <= 250.0 && b.max[1] <= 210.0);
     assert!(pct(r.after.filament_mm, r.before.filament_mm).abs() < 10.0);
 }
+
+/// The speed target of the issue: 12 angles × 4 rotations × 5 patterns (240 candidates, each
+/// planned and costed for the whole file) on a 100-layer part in under 10 s. Release only:
+/// `cargo test --release -p quietpath-conformance --test infill -- --ignored --nocapture`.
+#[test]
+#[ignore = "timing: run in release with --ignored"]
+fn speed_240_candidates_on_a_100_layer_part() {
+    let input = fixture("prusaslicer-2.5.0_cube_marlin2_defaults.gcode");
+    let options = InfillOptions {
+        rotations_deg: vec![0.0, 30.0, 60.0, 90.0],
+        ..InfillOptions::default()
+    };
+    let mut best = f64::INFINITY;
+    for _ in 0..3 {
+        let t0 = std::time::Instant::now();
+        let r = infill(&input, &options).unwrap();
+        best = best.min(t0.elapsed().as_secs_f64());
+        assert_eq!(r.candidates.len(), 240);
+        assert_eq!(r.before.layers, 100);
+    }
+    println!("240 candidates on a 100-layer part: {best:.2} s (best of 3)");
+    assert!(best < 10.0, "{best:.2} s");
+}

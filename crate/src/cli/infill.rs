@@ -27,7 +27,8 @@ pub struct Args {
     #[arg(long, default_value = "0")]
     pub rotations: String,
     /// Patterns, comma-separated (rectilinear, grid, triangles, tri_hexagon, concentric,
-    /// hilbert, archimedean_chords, octagram_spiral; `thesis` = the DOE's five, `all`).
+    /// hilbert, archimedean_chords, octagram_spiral, cross_line; `thesis` = the DOE's five,
+    /// `all`).
     #[arg(long, default_value = "thesis")]
     pub patterns: String,
     /// What to minimise: energy, time, length or weighted.

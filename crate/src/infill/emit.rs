@@ -120,6 +120,25 @@ pub(crate) fn habit(prog: &Program) -> Option<Habit> {
     })
 }
 
+/// Appends `v` with `digits` decimals (3 or 5) by integer arithmetic: the same text as
+/// `format!("{v:.3}")` up to trailing zeros, several times faster (emission is a hot path of
+/// the search).
+fn push_fixed(out: &mut String, v: f64, digits: u32) {
+    let scale = 10i64.pow(digits);
+    let n = (v * scale as f64).round();
+    if !n.is_finite() || n.abs() > 9.0e15 {
+        let _ = write!(out, "{v:.0$}", digits as usize);
+        return;
+    }
+    let n = n as i64;
+    if n < 0 {
+        out.push('-');
+    }
+    let a = n.unsigned_abs();
+    let s = scale as u64;
+    let _ = write!(out, "{}.{:0w$}", a / s, a % s, w = digits as usize);
+}
+
 fn r3(v: f64) -> f64 {
     (v * 1000.0).round() / 1000.0
 }
@@ -160,7 +179,9 @@ impl Writer<'_> {
         } else {
             r5(d)
         };
-        let _ = writeln!(self.out, "G1 E{v:.5} F{f:.0}");
+        self.out.push_str("G1 E");
+        push_fixed(&mut self.out, v, 5);
+        let _ = writeln!(self.out, " F{f:.0}");
     }
 
     fn travel(&mut self, to: P2) {
@@ -172,11 +193,11 @@ impl Writer<'_> {
         if d >= self.habit.min_travel_mm {
             self.retract(true);
         }
-        let _ = writeln!(
-            self.out,
-            "G1 X{:.3} Y{:.3} F{:.0}",
-            to[0], to[1], self.habit.travel_f
-        );
+        self.out.push_str("G1 X");
+        push_fixed(&mut self.out, to[0], 3);
+        self.out.push_str(" Y");
+        push_fixed(&mut self.out, to[1], 3);
+        let _ = writeln!(self.out, " F{:.0}", self.habit.travel_f);
         self.pos = to;
     }
 
@@ -198,7 +219,12 @@ impl Writer<'_> {
             } else {
                 r5(inc)
             };
-            let _ = write!(self.out, "G1 X{:.3} Y{:.3} E{v:.5}", q[0], q[1]);
+            self.out.push_str("G1 X");
+            push_fixed(&mut self.out, q[0], 3);
+            self.out.push_str(" Y");
+            push_fixed(&mut self.out, q[1], 3);
+            self.out.push_str(" E");
+            push_fixed(&mut self.out, v, 5);
             if first {
                 let _ = write!(self.out, " F{:.0}", self.habit.print_f);
                 first = false;
@@ -283,6 +309,21 @@ pub(crate) fn motions(block: &Block, text: &str, start: P2) -> Replacement {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fixed_point_text() {
+        for (v, d, want) in [
+            (70.85, 3, "70.850"),
+            (-0.0004, 3, "0.000"),
+            (-2.0, 5, "-2.00000"),
+            (0.123456, 5, "0.12346"),
+            (-12.3456, 3, "-12.346"),
+        ] {
+            let mut s = String::new();
+            push_fixed(&mut s, v, d);
+            assert_eq!(s, want);
+        }
+    }
 
     #[test]
     fn weighted_mode() {

@@ -18,6 +18,7 @@ pub mod pattern;
 pub(crate) mod program;
 pub(crate) mod region;
 mod search;
+pub(crate) mod spacing;
 pub(crate) mod write;
 
 use serde::{Deserialize, Serialize};

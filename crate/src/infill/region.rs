@@ -27,7 +27,7 @@ use i_overlay::mesh::float::style::{LineCap, OutlineStyle, StrokeStyle};
 use super::geom::{dist, path_len, region_area, seg_dist, simplify_closed, Path, Region, P2};
 use super::program::{Mv, Program};
 use crate::gcode::FeatureKind;
-use crate::machine::axis;
+use crate::machine::{axis, MoveKind, Plane};
 
 /// Largest seam gap of a closed loop, mm.
 const SEAM_GAP_MM: f64 = 1.0;
@@ -60,15 +60,33 @@ fn runs(moves: &[Mv]) -> Vec<(Path, Option<FeatureKind>)> {
             }
             continue;
         }
+        // Arcs (G2/G3 in the XY plane) as chords of at most 5°, so arc-fitted walls bound the
+        // region as the nozzle draws them.
+        let mut pts_of_move: Vec<P2> = Vec::new();
+        if let MoveKind::Arc(a) = mv.m.kind {
+            if a.plane == Plane::Xy && a.radius.is_finite() && a.sweep.is_finite() {
+                let n = ((a.sweep.abs() / 5f64.to_radians()).ceil() as usize).clamp(1, 720);
+                for k in 1..n {
+                    let t = a.start_angle + a.sweep * k as f64 / n as f64;
+                    pts_of_move.push([
+                        a.center[0] + a.radius * crate::math::cos(t),
+                        a.center[1] + a.radius * crate::math::sin(t),
+                    ]);
+                }
+            }
+        }
+        pts_of_move.push(to);
         match cur.as_mut() {
             Some((pts, k))
                 if *k == mv.kind && pts.last().is_some_and(|&l| dist(l, from) < 1e-6) =>
             {
-                pts.push(to)
+                pts.extend(pts_of_move)
             }
             _ => {
                 out.extend(cur.take());
-                cur = Some((vec![from, to], mv.kind));
+                let mut pts = vec![from];
+                pts.extend(pts_of_move);
+                cur = Some((pts, mv.kind));
             }
         }
     }

@@ -13,6 +13,7 @@ use super::emit::{self, Habit};
 use super::geom::{bbox, path_len, Path, P2};
 use super::program::{self, Program};
 use super::region::{self, LayerRegion};
+use super::spacing::Line;
 use super::{
     link, pattern, write, Best, Candidate, InfillOptions, InfillReport, Measured, Objective,
     Pattern,
@@ -41,6 +42,8 @@ pub(crate) struct Work {
     pub region: LayerRegion,
     /// Extruded length of the original sparse infill, mm.
     pub target_mm: f64,
+    /// Length of rectilinear lines at the file's spacing over the region, mm.
+    pub nominal_mm: f64,
     /// Filament per mm of the original sparse infill of this layer.
     pub e_per_mm: f64,
     /// Nozzle position at the first block (part frame).
@@ -105,6 +108,28 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
             .fold((0.0, 0.0), |(e, l), m| {
                 (e + m.m.extrusion(), l + m.m.length_mm)
             });
+        // Guard: the file's own sparse infill must lie in the region we found (at least 80 %
+        // of its length, judged by move midpoints); otherwise the walls did not describe the
+        // infill area (open or unmarked walls) and the layer is left as it is.
+        let (inside_mm, all_mm) = blocks
+            .iter()
+            .filter_map(|&b| prog.blocks.get(b))
+            .flat_map(|b| prog.moves.get(b.first..b.end).unwrap_or(&[]))
+            .filter(|m| m.m.is_extruding())
+            .fold((0.0, 0.0), |(i, a), m| {
+                let mid = [
+                    0.5 * (m.m.from[axis::X] + m.m.to[axis::X]),
+                    0.5 * (m.m.from[axis::Y] + m.m.to[axis::Y]),
+                ];
+                let inside = super::geom::inside_tol(&region.region, mid, clearance);
+                (
+                    i + if inside { m.m.length_mm } else { 0.0 },
+                    a + m.m.length_mm,
+                )
+            });
+        if inside_mm < 0.8 * all_mm {
+            continue;
+        }
         let Some(first) = blocks.first().and_then(|&b| prog.blocks.get(b)) else {
             continue;
         };
@@ -116,6 +141,7 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
                 blocks,
                 region,
                 target_mm: l,
+                nominal_mm: 0.0,
                 e_per_mm: e / l,
             });
         }
@@ -128,8 +154,37 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
     let spacing = options.spacing_mm.unwrap_or_else(|| {
         let a: f64 = work.iter().map(|w| w.region.area_mm2).sum();
         let l: f64 = work.iter().map(|w| w.target_mm).sum();
-        a / l
+        let estimate = a / l;
+        let lines: Vec<Line> = work
+            .iter()
+            .flat_map(|w| w.blocks.iter().map(move |&b| (w.layer, b)))
+            .filter_map(|(layer, b)| prog.blocks.get(b).map(|blk| (layer, blk)))
+            .flat_map(|(layer, blk)| {
+                prog.moves
+                    .get(blk.first..blk.end)
+                    .unwrap_or(&[])
+                    .iter()
+                    .map(move |m| (layer, m))
+            })
+            .filter(|(_, m)| m.m.is_extruding() && m.m.length_mm > 3.0 * estimate)
+            .map(|(layer, m)| {
+                let (dx, dy) = (m.m.to[0] - m.m.from[0], m.m.to[1] - m.m.from[1]);
+                Line {
+                    layer,
+                    dir_deg: crate::math::atan2(dy, dx).to_degrees().rem_euclid(180.0),
+                    mid: [
+                        0.5 * (m.m.to[0] + m.m.from[0]),
+                        0.5 * (m.m.to[1] + m.m.from[1]),
+                    ],
+                }
+            })
+            .collect();
+        super::spacing::measured(&lines, estimate).unwrap_or(estimate)
     });
+    // Each layer's target: the length of the equivalent rectilinear lines over its area.
+    for w in &mut work {
+        w.nominal_mm = w.region.area_mm2 / spacing;
+    }
     if !(spacing.is_finite() && spacing > 0.05) {
         return Err(invalid(
             "could not measure a line spacing from the file's infill",
@@ -245,20 +300,28 @@ impl Prepared<'_> {
                 0.25 * self.clearance.max(0.05),
             )
         };
-        // Up to three corrections of the spacing by the length ratio (rows are discrete, so one
-        // is not always enough); keep the closest.
+        // Target: the layer's nominal length (area / S), kept within 5 % of the original's
+        // own length so the material of every layer stays put (slicers print first layers
+        // wider and sparser, for one). Line families have the exact pitch by construction and
+        // are accepted while within 7 % of the original; curves, whose length per area is only
+        // about 1/S, must also be within 3 % of the target. Otherwise the pitch is corrected by
+        // the length ratio (up to six times: rows are discrete); the closest result is kept.
+        let orig = w.target_mm;
+        let target = w.nominal_mm.clamp(0.95 * orig, 1.05 * orig);
         let mut s = self.spacing;
         let mut best: Option<(f64, Vec<Path>)> = None;
-        for _ in 0..3 {
+        for _ in 0..6 {
             let strokes = make(s);
             let len: f64 = strokes.iter().map(|s| path_len(s)).sum();
-            let ratio = len / w.target_mm;
+            let ratio = len / target;
             let err = (ratio - 1.0).abs();
+            let in_band = (len / orig - 1.0).abs() <= 0.07;
+            let good = in_band && (pattern.is_lines() || err <= 0.03);
             let better = best.as_ref().is_none_or(|b| err < b.0);
-            if better && !strokes.is_empty() {
+            if (better || good) && !strokes.is_empty() {
                 best = Some((err, strokes));
             }
-            if len.is_nan() || len <= 0.0 || err <= 0.03 {
+            if len.is_nan() || len <= 0.0 || good {
                 break;
             }
             s *= ratio.clamp(0.5, 2.0);

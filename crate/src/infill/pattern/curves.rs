@@ -98,6 +98,50 @@ pub(crate) fn hilbert(region: &Region, spacing: f64) -> Vec<Path> {
     clip(&[path], region)
 }
 
+/// The Sierpiński curve over the region's bounding square, anchored on the bed grid: the
+/// closed space-filling curve Cura's "cross" infill is built on. Right isosceles triangles are
+/// halved recursively through the midpoint of their hypotenuse; the curve joins the centroids
+/// of the leaves in order. Leaves are about `spacing` apart.
+pub(crate) fn sierpinski(region: &Region, spacing: f64) -> Vec<Path> {
+    let Some(b) = bbox(region.iter().flatten()) else {
+        return Vec::new();
+    };
+    let side0 = 2.0 * spacing;
+    let x0 = (b[0] / side0).floor() * side0;
+    let y0 = (b[1] / side0).floor() * side0;
+    let mut side = side0;
+    let mut depth = 2u32;
+    while side < (b[2] - x0).max(b[3] - y0) && depth < 36 {
+        side *= 2.0;
+        depth += 2;
+    }
+    if (1usize << depth.min(40)) > MAX_POINTS {
+        return Vec::new();
+    }
+    fn tri(a: P2, b: P2, c: P2, depth: u32, out: &mut Path) {
+        if depth == 0 {
+            out.push([(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0]);
+            return;
+        }
+        let m = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+        tri(a, c, m, depth - 1, out);
+        tri(c, b, m, depth - 1, out);
+    }
+    let (p0, p1, p2, p3) = (
+        [x0, y0],
+        [x0 + side, y0],
+        [x0 + side, y0 + side],
+        [x0, y0 + side],
+    );
+    let mut path = Path::new();
+    tri(p0, p2, p1, depth - 1, &mut path);
+    tri(p2, p0, p3, depth - 1, &mut path);
+    if let Some(&f) = path.first() {
+        path.push(f);
+    }
+    clip(&[path], region)
+}
+
 /// A spiral about the region's centre growing by `spacing` per turn; `star` > 0 makes each
 /// turn an eight-pointed star (inner vertices at `1 − star` of the radius).
 fn spiral(region: &Region, spacing: f64, per_turn: usize, star: f64) -> Vec<Path> {
@@ -175,6 +219,7 @@ mod tests {
             ("concentric", concentric as fn(&Region, f64) -> Vec<Path>),
             ("archimedean", archimedean),
             ("octagram", octagram),
+            ("sierpinski", sierpinski),
         ] {
             let len: f64 = f(&square(), 2.0).iter().map(|p| path_len(p)).sum();
             assert!(len > 100.0 && len < 400.0, "{name}: {len}");

@@ -33,11 +33,13 @@ pub enum Pattern {
     ArchimedeanChords,
     /// A spiral of eight-pointed stars.
     OctagramSpiral,
+    /// Cross-line: the Sierpiński space-filling curve (what Cura's "cross" infill is built on).
+    CrossLine,
 }
 
 impl Pattern {
     /// Every pattern.
-    pub const ALL: [Pattern; 8] = [
+    pub const ALL: [Pattern; 9] = [
         Pattern::Rectilinear,
         Pattern::Grid,
         Pattern::Triangles,
@@ -46,6 +48,7 @@ impl Pattern {
         Pattern::Hilbert,
         Pattern::ArchimedeanChords,
         Pattern::OctagramSpiral,
+        Pattern::CrossLine,
     ];
     /// The five patterns of the thesis's DOE (Table 4).
     pub const THESIS: [Pattern; 5] = [
@@ -67,6 +70,7 @@ impl Pattern {
             Pattern::Hilbert => "hilbert",
             Pattern::ArchimedeanChords => "archimedean_chords",
             Pattern::OctagramSpiral => "octagram_spiral",
+            Pattern::CrossLine => "cross_line",
         }
     }
 
@@ -78,6 +82,7 @@ impl Pattern {
             "trihexagon" => return Some(Pattern::TriHexagon),
             "archimedean" => return Some(Pattern::ArchimedeanChords),
             "octagram" => return Some(Pattern::OctagramSpiral),
+            "cross" | "crossline" => return Some(Pattern::CrossLine),
             _ => {}
         }
         Pattern::ALL.into_iter().find(|p| p.name() == s)
@@ -135,7 +140,8 @@ pub(crate) fn generate(
         Pattern::Concentric
         | Pattern::Hilbert
         | Pattern::ArchimedeanChords
-        | Pattern::OctagramSpiral => {
+        | Pattern::OctagramSpiral
+        | Pattern::CrossLine => {
             // Build upright in a frame turned by -angle, then turn back.
             let back = super::geom::cos_sin_deg(angle_deg);
             let fwd = (back.0, -back.1);
@@ -154,6 +160,7 @@ pub(crate) fn generate(
                 }
                 Pattern::Hilbert => curves::hilbert(&turned, pitch),
                 Pattern::ArchimedeanChords => curves::archimedean(&turned, pitch),
+                Pattern::CrossLine => curves::sierpinski(&turned, pitch),
                 _ => curves::octagram(&turned, pitch),
             };
             pieces
@@ -190,6 +197,48 @@ mod tests {
                     .sum();
                 // 1600 mm² / 2 mm = 800 mm of lines; the curves differ by their ends.
                 assert!(len > 640.0 && len < 960.0, "{p:?} at {angle}: {len}");
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod props {
+    use super::*;
+    use crate::infill::geom::inside_tol;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+        /// Every point of every pattern lies in the region (a rectangle with a square hole),
+        /// whatever the angle, size and spacing.
+        #[test]
+        fn pieces_stay_in_the_region(
+            w in 8.0f64..60.0,
+            h in 8.0f64..60.0,
+            hole in 0.1f64..0.4,
+            angle in -180.0f64..180.0,
+            spacing in 0.8f64..4.0,
+            k in 0usize..9,
+        ) {
+            let (hx, hy) = (w * hole, h * hole);
+            let region: Region = vec![
+                vec![[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]],
+                vec![
+                    [w / 2.0 - hx, h / 2.0 - hy],
+                    [w / 2.0 - hx, h / 2.0 + hy],
+                    [w / 2.0 + hx, h / 2.0 + hy],
+                    [w / 2.0 + hx, h / 2.0 - hy],
+                ],
+            ];
+            let p = Pattern::ALL[k];
+            for piece in generate(&region, p, angle, spacing, 1).iter().flatten() {
+                for w2 in piece.windows(2) {
+                    let mid = [0.5 * (w2[0][0] + w2[1][0]), 0.5 * (w2[0][1] + w2[1][1])];
+                    for q in [w2[0], w2[1], mid] {
+                        prop_assert!(inside_tol(&region, q, 1e-3), "{p:?} {q:?}");
+                    }
+                }
             }
         }
     }

@@ -1,0 +1,184 @@
+//! `infill` from outside: the CLI's JSON and DOE table, errors on inputs it cannot work on,
+//! cancellation and the per-layer hybrid.
+#![cfg(not(target_arch = "wasm32"))]
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use quietpath::error::ErrorKind;
+use quietpath::infill::{infill, infill_with_progress, InfillOptions, Pattern};
+
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("quietpath-infill-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn cli_json_and_doe_table() {
+    let out_path = scratch("rect.gcode");
+    let out = Command::new(env!("CARGO_BIN_EXE_quietpath"))
+        .args(["infill"])
+        .arg(data("rect_infill_45.gcode"))
+        .arg("-o")
+        .arg(&out_path)
+        .args([
+            "--angles",
+            "0,90",
+            "--patterns",
+            "rectilinear,grid",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in ["before", "after", "best", "candidates", "measured"] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    for key in [
+        "pattern",
+        "angle_deg",
+        "rotation_deg",
+        "thesis_j",
+        "total_j",
+        "time_s",
+        "length_mm",
+    ] {
+        assert!(v["best"].get(key).is_some(), "best lacks {key}");
+        assert!(
+            v["candidates"][0].get(key).is_some(),
+            "candidate lacks {key}"
+        );
+    }
+    assert_eq!(v["candidates"].as_array().unwrap().len(), 4);
+    let written = std::fs::read(&out_path).unwrap();
+    let again = quietpath::analyze(&written, &Default::default()).unwrap();
+    assert!(
+        (again.energy.total_j - v["after"]["energy"]["total_j"].as_f64().unwrap()).abs() < 1e-6
+    );
+
+    // DOE mode: two files, one CSV.
+    let csv = scratch("doe.csv");
+    let out = Command::new(env!("CARGO_BIN_EXE_quietpath"))
+        .arg("infill")
+        .arg(data("rect_infill_0.gcode"))
+        .arg(data("rect_infill_90.gcode"))
+        .args([
+            "--angles",
+            "0,45",
+            "--rotations",
+            "0,90",
+            "--patterns",
+            "rectilinear",
+            "--csv",
+        ])
+        .arg(&csv)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(text.lines().count(), 1 + 2 * 2 * 2, "{text}");
+    assert!(text.starts_with("file,pattern,angle_deg,rotation_deg,thesis_j,total_j"));
+
+    // Several files without --csv, and no output at all, are refused.
+    let out = Command::new(env!("CARGO_BIN_EXE_quietpath"))
+        .arg("infill")
+        .arg(data("rect_infill_0.gcode"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+}
+
+#[test]
+fn inputs_without_infill_and_bad_options_are_errors() {
+    let o = InfillOptions::default();
+    for input in [
+        &b""[..],
+        b"G1 X10 Y10 E1\n",
+        b"\x01\x02garbage\n\x00",
+        b";TYPE:Internal infill\n",
+    ] {
+        let e = infill(input, &o).unwrap_err();
+        assert!(matches!(e.kind, ErrorKind::InvalidOption { .. }), "{e}");
+    }
+    // Not G-code at all: the reader's own error.
+    assert!(infill(b"\xff\xfe\x00G\x001", &o).is_err());
+    let input = std::fs::read(data("rect_infill_45.gcode")).unwrap();
+    for bad in [
+        InfillOptions {
+            angles_deg: vec![],
+            ..o.clone()
+        },
+        InfillOptions {
+            rotations_deg: vec![f64::NAN],
+            ..o.clone()
+        },
+        InfillOptions {
+            spacing_mm: Some(0.0),
+            ..o.clone()
+        },
+        InfillOptions {
+            angles_deg: vec![0.0; 20_001],
+            ..o.clone()
+        },
+    ] {
+        assert!(infill(&input, &bad).is_err());
+    }
+    // A part turned off the bed is skipped, not written.
+    let big = InfillOptions {
+        patterns: vec![Pattern::Rectilinear],
+        angles_deg: vec![0.0],
+        rotations_deg: vec![0.0, 45.0],
+        ..o.clone()
+    };
+    let r = infill(&input, &big).unwrap();
+    assert!(
+        r.rotations_skipped.is_empty(),
+        "a 60 mm box fits a 200 mm bed turned"
+    );
+    let mut calls = 0;
+    let e = infill_with_progress(&input, &o, &mut |_| {
+        calls += 1;
+        calls < 3
+    })
+    .unwrap_err();
+    assert!(matches!(e.kind, ErrorKind::Cancelled));
+}
+
+#[test]
+fn per_layer_hybrid_is_kept_only_when_it_wins() {
+    let input = std::fs::read(data("rect_infill_45.gcode")).unwrap();
+    let o = InfillOptions {
+        patterns: vec![Pattern::Rectilinear, Pattern::Concentric],
+        angles_deg: vec![0.0, 45.0],
+        per_layer: true,
+        ..InfillOptions::default()
+    };
+    let r = infill(&input, &o).unwrap();
+    let single = r
+        .candidates
+        .iter()
+        .map(|c| c.total_j)
+        .fold(f64::INFINITY, f64::min);
+    assert!(r.best.total_j <= single + 1e-6);
+    assert!((r.best.total_j - r.after.energy.total_j).abs() < 1e-6 * r.after.energy.total_j);
+    if let Some(layers) = &r.best.layers {
+        assert_eq!(layers.len(), 25);
+    }
+}
