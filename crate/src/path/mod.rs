@@ -4,7 +4,7 @@
 //! `analyze` streams and keeps only sums; the optimisers (VTG, infill regeneration) and the
 //! dynamics simulation need the moves themselves, in order, grouped by layer and feature. This
 //! module reads a file exactly as `analyze` does (same extrusion-mode inference, prescan,
-//! machine profile and limits, see [`crate::analyze`]) and keeps each move.
+//! machine profile and limits, see [`crate::analyze::analyze`]) and keeps each move.
 //!
 //! ```
 //! let gcode = b";LAYER_CHANGE\n;TYPE:Internal infill\nG1 X10 Y0 E0.5 F1200\nG1 X10 Y10 E0.5\n";

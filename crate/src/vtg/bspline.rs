@@ -52,6 +52,7 @@ impl Curve {
     }
 
     /// Point and derivatives at `u` (clamped to the curve's range).
+    #[allow(clippy::needless_range_loop)] // three coordinates, indexed in step
     pub fn eval(&self, u: f64) -> Eval {
         let n = self.ctrl.len();
         let zero = Eval {
@@ -103,6 +104,7 @@ pub fn find_span(knots: &[f64], n: usize, u: f64) -> usize {
 
 /// The four non-zero cubic basis functions at `u` in span `span` and their first and second
 /// derivatives (A2.3): `ders[k][j]` is the k-th derivative of `N_{span−3+j,3}`.
+#[allow(clippy::needless_range_loop)] // A2.3 as Piegl & Tiller write it
 pub fn basis_ders(knots: &[f64], span: usize, u: f64) -> [[f64; 4]; 3] {
     const P: usize = DEGREE;
     let mut ders = [[0.0; 4]; 3];

@@ -262,6 +262,7 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<Curve> {
 /// Solves `A x = b` for a symmetric positive definite band matrix stored by rows as
 /// `a[i][k] = A[i][i+k]` (Cholesky `A = UᵀU`, then two triangular solves). `None` if `A` is
 /// not positive definite.
+#[allow(clippy::needless_range_loop)] // band indices, as in the textbook algorithm
 pub fn cholesky_band_solve(
     a: &mut [[f64; DEGREE + 1]],
     b: &mut [[f64; 3]],
@@ -330,6 +331,7 @@ mod tests {
     use super::*;
 
     #[test]
+    #[allow(clippy::needless_range_loop)]
     fn band_solver_matches_dense() {
         // A tridiagonal-plus SPD matrix.
         let n = 7;

@@ -45,7 +45,7 @@ impl KinematicLimits {
     /// first three terms, i.e. the chord error of one interpolation period, `a_n = v²κ` and
     /// `j_n = v³κ²`, within their limits; `v_max` on straights.
     pub fn feed_limit(&self, kappa: f64) -> f64 {
-        if !(kappa > 1e-12) {
+        if kappa.is_nan() || kappa <= 1e-12 {
             return self.v_max_mm_s;
         }
         let d = self.chord_tolerance_mm;

@@ -61,7 +61,7 @@ pub struct WalkStats {
 /// or `None` if the walk does not converge (degenerate curve).
 pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample>> {
     let (u_start, u_end) = (curve.start(), curve.end());
-    if !(u_end > u_start) {
+    if u_end.is_nan() || u_start.is_nan() || u_end <= u_start {
         return None;
     }
     let first = curve.eval(u_start);
@@ -204,7 +204,7 @@ fn newton(curve: &Curve, ui: f64, pi: &[f64; 3], step: f64, w: &Walk) -> Option<
     }
     // Eq. 27.
     let mut u = ui + step / s - dot(&e.d1, &e.d2) * step * step / (2.0 * s.powi(4));
-    if !(u > ui) {
+    if u.is_nan() || u <= ui {
         u = ui + step / s;
     }
     for _ in 0..30 {
@@ -219,7 +219,7 @@ fn newton(curve: &Curve, ui: f64, pi: &[f64; 3], step: f64, w: &Walk) -> Option<
             return None;
         }
         let fp = dot(&v, &c.d1) / dist;
-        if !(fp > 1e-12) {
+        if fp.is_nan() || fp <= 1e-12 {
             return None;
         }
         let mut next = u - w.phi * f / fp;

@@ -191,7 +191,7 @@ fn rewrite_path(
         };
         e.push(sum);
     }
-    if !(sum > 0.0) || e.windows(2).any(|w| w[1] < w[0] - 1e-9) {
+    if sum.is_nan() || sum <= 0.0 || e.windows(2).any(|w| w[1] < w[0] - 1e-9) {
         return None;
     }
     let feed: Vec<f64> = src

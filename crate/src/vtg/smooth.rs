@@ -213,7 +213,7 @@ fn attempt(
         tol / 10.0,
         budget,
     ));
-    if !(deviation <= budget) {
+    if deviation.is_nan() || deviation > budget {
         return None;
     }
     let total_e = *e.last()?;
