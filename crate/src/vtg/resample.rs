@@ -73,6 +73,8 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
         step_mm: 0.0,
     }];
     let end_p = curve.eval(u_end).p;
+    let index = CurvatureIndex::new(curve);
+    let max_curvature = |_: &Curve, a: f64, b: f64| index.max(curve, a, b);
     let mut u = u_start;
     let mut p = first.p;
     // Bounded: each accepted step advances u by at least a minimum amount.
@@ -173,26 +175,81 @@ fn fits(kappa: f64, step: f64, w: &Walk) -> bool {
     kappa * step * step <= 8.0 * w.chord_tol_mm * 1.0001 && kappa * step <= w.max_turn_rad * 1.0001
 }
 
-/// Largest curvature on `[a, b]`, sampled at five points in every knot span the interval
-/// touches (each span is one cubic, so its curvature varies smoothly; sampling by span never
-/// steps over a short, tight span).
-pub fn max_curvature(curve: &Curve, a: f64, b: f64) -> f64 {
-    const K: usize = 4;
-    let mut best = curve.eval(a).curvature().max(curve.eval(b).curvature());
-    let mut lo = a;
-    let mut knots = curve.knots.iter().copied().filter(|&k| k > a && k < b);
-    loop {
-        let hi = knots.next().unwrap_or(b);
-        for i in 1..=K {
-            let u = lo + (hi - lo) * i as f64 / (K + 1) as f64;
-            best = best.max(curve.eval(u).curvature());
+/// Largest curvature of a curve over parameter intervals, sampled at the ends of the interval
+/// and at fixed points of every knot span it touches (each span is one cubic, so its curvature
+/// varies smoothly; sampling by span never steps over a short, tight span). The spans' own
+/// samples are computed once, so a long step over many spans costs only table reads.
+#[derive(Debug, Clone)]
+pub struct CurvatureIndex {
+    /// Distinct knots.
+    breaks: Vec<f64>,
+    /// Largest sampled curvature of span `i` (`breaks[i]..breaks[i+1]`).
+    span_max: Vec<f64>,
+}
+
+/// Samples per span (its ends included).
+const SPAN_SAMPLES: usize = 6;
+
+impl CurvatureIndex {
+    /// Samples every span of `curve`.
+    pub fn new(curve: &Curve) -> Self {
+        let mut breaks: Vec<f64> = Vec::new();
+        for &k in &curve.knots {
+            if breaks.last().is_none_or(|&b| k > b) {
+                breaks.push(k);
+            }
         }
-        best = best.max(curve.eval(hi).curvature());
-        if hi >= b {
-            return best;
-        }
-        lo = hi;
+        let span_max = breaks
+            .windows(2)
+            .map(|w| {
+                (0..SPAN_SAMPLES)
+                    .map(|i| {
+                        let t = i as f64 / (SPAN_SAMPLES - 1) as f64;
+                        curve.eval(w[0] + (w[1] - w[0]) * t).curvature()
+                    })
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        Self { breaks, span_max }
     }
+
+    /// Largest curvature on `[a, b]`: the table for spans wholly inside, samples at the ends
+    /// and in the partly covered spans.
+    pub fn max(&self, curve: &Curve, a: f64, b: f64) -> f64 {
+        let sample = |lo: f64, hi: f64| -> f64 {
+            (0..SPAN_SAMPLES)
+                .map(|i| {
+                    let t = i as f64 / (SPAN_SAMPLES - 1) as f64;
+                    curve.eval(lo + (hi - lo) * t).curvature()
+                })
+                .fold(0.0, f64::max)
+        };
+        // Spans: i such that breaks[i] < b and breaks[i+1] > a.
+        let first = self.breaks.partition_point(|&k| k <= a).saturating_sub(1);
+        let mut best = 0.0f64;
+        let mut i = first;
+        while i + 1 < self.breaks.len() {
+            let (s0, s1) = (self.breaks[i], self.breaks[i + 1]);
+            if s0 >= b {
+                break;
+            }
+            let (lo, hi) = (s0.max(a), s1.min(b));
+            let m = if lo <= s0 && hi >= s1 {
+                self.span_max.get(i).copied().unwrap_or(0.0)
+            } else {
+                sample(lo, hi)
+            };
+            best = best.max(m);
+            i += 1;
+        }
+        best
+    }
+}
+
+/// Largest curvature on `[a, b]` (see [`CurvatureIndex`]; builds the index, so for one-off
+/// queries).
+pub fn max_curvature(curve: &Curve, a: f64, b: f64) -> f64 {
+    CurvatureIndex::new(curve).max(curve, a, b)
 }
 
 /// Eq. 27 predictor and Newton corrector: `u` past `u_i` with `‖C(u) − P_i‖ = L`.
@@ -297,6 +354,7 @@ mod tests {
             };
             let mut st = WalkStats::default();
             let Some(s) = walk(&f.curve, &w, &mut st) else { return Ok(()) };
+            let index = CurvatureIndex::new(&f.curve);
             for x in &s {
                 let on = f.curve.eval(x.u).p;
                 prop_assert!(norm(&sub(&on, &x.p)) < 1e-12);
@@ -309,7 +367,7 @@ mod tests {
                     prop_assert!((got - b.step_mm).abs() <= 1e-7, "{} vs {}", got, b.step_mm);
                     if b.step_mm > w.min_step_mm {
                         // Accepted by the test, not forced by the step floor.
-                        let k = max_curvature(&f.curve, a.u, b.u);
+                        let k = index.max(&f.curve, a.u, b.u);
                         prop_assert!(k * b.step_mm <= w.max_turn_rad * 1.0001);
                         prop_assert!(k * b.step_mm * b.step_mm <= 8.0 * w.chord_tol_mm * 1.0001);
                     }
