@@ -140,7 +140,7 @@ impl MetricsAccumulator {
         if cos < self.cos_critical {
             self.n_turning += 1;
         }
-        self.sum_turn += math::acos(cos);
+        self.sum_turn += fast_acos(cos);
         self.sum_chord += chord_error(a, la, b, lb);
     }
 
@@ -164,6 +164,22 @@ impl MetricsAccumulator {
             mean_chord_error_mm: per(self.sum_chord),
             critical_angle_deg: self.critical_deg,
         }
+    }
+}
+
+/// `acos` to within 7·10⁻⁵ rad (Abramowitz & Stegun 4.4.45): a polynomial and an IEEE square
+/// root, so the same on every target, and several times cheaper than libm's `acos` on the
+/// analysis' per-move path. Only the mean turning angle uses it; the turning-point count
+/// compares cosines exactly.
+#[inline]
+pub fn fast_acos(x: f64) -> f64 {
+    let a = x.abs().min(1.0);
+    let r =
+        (1.0 - a).sqrt() * (1.570_728_8 + a * (-0.212_114_4 + a * (0.074_261_0 - 0.018_729_3 * a)));
+    if x >= 0.0 {
+        r
+    } else {
+        std::f64::consts::PI - r
     }
 }
 
@@ -232,6 +248,14 @@ mod tests {
     use super::*;
 
     #[test]
+    fn fast_acos_is_close() {
+        for i in 0..=2000 {
+            let x = -1.0 + i as f64 / 1000.0;
+            assert!((fast_acos(x) - x.acos()).abs() < 7e-5, "{x}");
+        }
+    }
+
+    #[test]
     fn square_has_right_angle_corners() {
         let mut acc = MetricsAccumulator::new(30.0);
         let pts = [
@@ -247,7 +271,7 @@ mod tests {
         assert_eq!(m.n_total, 4);
         assert_eq!(m.n_corners, 2);
         assert_eq!(m.n_turning, 2);
-        assert!((m.mean_turn_deg - 90.0).abs() < 1e-9);
+        assert!((m.mean_turn_deg - 90.0).abs() < 1e-2);
         assert!((m.l_total_mm - 30.0).abs() < 1e-12);
         // Right angle: the circle through the three points has the diagonal as diameter.
         let r = 50f64.sqrt();
@@ -285,7 +309,7 @@ mod tests {
         let half = std::f64::consts::PI / n as f64;
         let sagitta = 5.0 * (1.0 - half.cos());
         assert!((m.mean_chord_error_mm - sagitta).abs() < 1e-9);
-        assert!((m.mean_turn_deg - 10.0).abs() < 1e-9);
+        assert!((m.mean_turn_deg - 10.0).abs() < 1e-2);
         assert_eq!(m.n_turning, 0);
     }
 }
