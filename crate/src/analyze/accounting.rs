@@ -11,9 +11,10 @@ use super::layers::LayerTracker;
 use super::report::{Bounds, FanEvent, FeatureSummary, TemperatureEvent};
 use crate::energy::Accumulator;
 use crate::energy::Material;
-use crate::gcode::feature_kind;
+use crate::gcode::{feature_kind, FeatureKind};
 use crate::machine::{Heater, Move};
 use crate::plan::{Limits, Motion, PlannedMove, Planner};
+use crate::vtg::metrics::{MetricsAccumulator, DEFAULT_CRITICAL_ANGLE_DEG};
 
 /// Feature slot of travel moves.
 pub const TRAVEL: u32 = u32::MAX;
@@ -58,6 +59,8 @@ pub struct Accounts {
     pub layers: LayerTracker,
     /// Material named in the file's comments, if any.
     pub material: Option<Material>,
+    /// Toolpath metrics of the VTG paper (eq. 24–26, 31).
+    pub toolpath: MetricsAccumulator,
     moves_read: u64,
 }
 
@@ -71,6 +74,7 @@ impl Accounts {
             travel: summary("travel", None),
             layers: LayerTracker::new(),
             material: None,
+            toolpath: MetricsAccumulator::new(DEFAULT_CRITICAL_ANGLE_DEG),
             moves_read: 0,
         }
     }
@@ -113,6 +117,13 @@ impl Accounts {
         } else {
             TRAVEL
         };
+        let infill = slot != TRAVEL
+            && matches!(
+                self.features.get(slot as usize).and_then(|f| f.kind),
+                Some(FeatureKind::SparseInfill | FeatureKind::SolidInfill)
+            );
+        self.toolpath
+            .push(&m.from, &m.to, slot != TRAVEL, slot, infill);
         let s = self.slot(slot);
         s.moves += 1;
         s.distance_mm += m.length_mm;

@@ -286,6 +286,7 @@ pub fn analyze_with_progress(
         mut features,
         travel,
         layers,
+        toolpath,
         ..
     } = acc;
     let Timing { planner, book } = timing;
@@ -365,7 +366,7 @@ pub fn analyze_with_progress(
         temperatures,
         fans,
         energy,
-        toolpath: Toolpath::default(),
+        toolpath: toolpath.finish(),
         warnings,
         warnings_dropped,
     })

@@ -231,6 +231,5 @@ pub struct Energy {
     pub co2: crate::energy::Co2Report,
 }
 
-/// Toolpath metrics; filled in by the VTG module.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct Toolpath {}
+/// Toolpath metrics of the VTG paper (eq. 24–26, 31), see [`crate::vtg::metrics`].
+pub type Toolpath = crate::vtg::metrics::ToolpathMetrics;

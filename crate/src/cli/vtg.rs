@@ -1,18 +1,104 @@
 //! `quietpath vtg`: Rewrite a file as a vibration-suppressed toolpath (NURBS fit, Taylor interpolation, curvature and feed limits).
 
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
+
+use quietpath::vtg::{vtg_with_progress, Comparison, VtgOptions, VtgReport};
+
+use super::{output, read, AnalyzeArgs, PROGRESS_MIN_BYTES};
 
 /// Arguments of `quietpath vtg`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Input file.
     pub file: PathBuf,
+    /// Output file.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Largest distance the new path may stray from the original, mm.
+    #[arg(long, value_name = "MM", default_value_t = 0.1)]
+    pub tolerance: f64,
+    /// Critical angle: turns above it are sharp corners, degrees.
+    #[arg(long, value_name = "DEG", default_value_t = 30.0)]
+    pub critical_angle: f64,
+    /// Keep the programmed feed rates even where the curvature is above K_cr.
+    #[arg(long)]
+    pub keep_feed: bool,
+    /// Overwrite the input file if OUT names it.
+    #[arg(long)]
+    pub force: bool,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    opts: AnalyzeArgs,
 }
 
 /// Runs `quietpath vtg`.
 pub fn run(args: Args) -> Result<(), String> {
-    Err(format!(
-        "{}: `vtg` is not available yet",
-        args.file.display()
-    ))
+    let input = read(&args.file)?;
+    let options = VtgOptions {
+        analyze: args.opts.options()?,
+        tolerance_mm: args.tolerance,
+        critical_angle_deg: args.critical_angle,
+        limit_feed: !args.keep_feed,
+        ..VtgOptions::default()
+    };
+    let mut bar = output::ProgressBar::new(
+        input.len() >= PROGRESS_MIN_BYTES && std::io::stderr().is_terminal(),
+    );
+    let report = vtg_with_progress(&input, &options, &mut |f| bar.update(f))
+        .map_err(|e| format!("{}:{}", args.file.display(), e))?;
+    bar.finish();
+    output::write_atomically(&args.file, &args.output, args.force, |out| {
+        out.write_all(&report.output)
+    })?;
+    let mut stdout = std::io::stdout().lock();
+    if args.json {
+        output::write_json(&mut stdout, &report)?;
+    } else {
+        print(&mut stdout, &report).map_err(|e| e.to_string())?;
+    }
+    stdout.flush().map_err(|e| e.to_string())
+}
+
+fn print(out: &mut impl Write, r: &VtgReport) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "tolerance {} mm, measured max deviation {:.4} mm, critical angle {}°, K_cr {:.4} /mm",
+        r.tolerance_mm, r.max_deviation_mm, r.critical_angle_deg, r.k_cr_per_mm
+    )?;
+    let p = &r.paths;
+    writeln!(
+        out,
+        "paths with sharp corners {}, rewritten {}; moves {} -> {}; feed lowered on {} segments",
+        p.candidates, p.rewritten, p.replaced_moves, p.written_moves, p.lowered_feed_segments
+    )?;
+    writeln!(
+        out,
+        "{:<28} {:>14} {:>14} {:>9}",
+        "metric", "before", "after", "change"
+    )?;
+    let row = |out: &mut dyn Write, name: &str, c: &Comparison| {
+        writeln!(
+            out,
+            "{:<28} {:>14.4} {:>14.4} {:>8.2}%",
+            name, c.before, c.after, c.change_pct
+        )
+    };
+    let t = &r.table1;
+    row(out, "L_total (mm)", &t.l_total_mm)?;
+    row(out, "n_total", &t.n_total)?;
+    row(out, "L_infill (mm)", &t.l_infill_mm)?;
+    row(out, "n_infill", &t.n_infill)?;
+    row(out, "n_turning", &t.n_turning)?;
+    row(out, "mean turn (deg)", &t.mean_turn_deg)?;
+    row(out, "mean chord error (mm)", &t.mean_chord_error_mm)?;
+    let t = &r.table2;
+    row(out, "energy E (J)", &t.energy_j)?;
+    row(out, "servo energy (J)", &t.servo_energy_j)?;
+    row(out, "material (g)", &t.material_g)?;
+    row(out, "CO2 (g)", &t.co2_g)?;
+    row(out, "time (s)", &t.time_s)?;
+    Ok(())
 }

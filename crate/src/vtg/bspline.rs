@@ -1,0 +1,263 @@
+//! Cubic B-spline curves in 3-D (the VTG paper's NURBS, eq. 21–22, with unit weights).
+//!
+//! The fitted data are polylines; rational weights only pay off for exact conics, so every
+//! weight is 1 and eq. 21 reduces to a B-spline. Basis functions and their derivatives follow
+//! Piegl & Tiller's A2.2/A2.3 (the Cox–de Boor recursion of eq. 22).
+
+/// Degree of the curves.
+pub const DEGREE: usize = 3;
+
+/// A clamped cubic B-spline: `knots.len() == ctrl.len() + 4`, first and last knots repeated
+/// four times.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Curve {
+    /// Knot vector.
+    pub knots: Vec<f64>,
+    /// Control points.
+    pub ctrl: Vec<[f64; 3]>,
+}
+
+/// A point of the curve with its first and second derivatives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Eval {
+    /// `C(u)`.
+    pub p: [f64; 3],
+    /// `C'(u)`.
+    pub d1: [f64; 3],
+    /// `C''(u)`.
+    pub d2: [f64; 3],
+}
+
+impl Eval {
+    /// Curvature `|C' × C''| / |C'|³`.
+    pub fn curvature(&self) -> f64 {
+        let c = cross(&self.d1, &self.d2);
+        let s = norm(&self.d1);
+        if s < 1e-12 {
+            return 0.0;
+        }
+        norm(&c) / (s * s * s)
+    }
+}
+
+impl Curve {
+    /// First parameter.
+    pub fn start(&self) -> f64 {
+        self.knots.first().copied().unwrap_or(0.0)
+    }
+
+    /// Last parameter.
+    pub fn end(&self) -> f64 {
+        self.knots.last().copied().unwrap_or(0.0)
+    }
+
+    /// Point and derivatives at `u` (clamped to the curve's range).
+    #[allow(clippy::needless_range_loop)] // three coordinates, indexed in step
+    pub fn eval(&self, u: f64) -> Eval {
+        let n = self.ctrl.len();
+        let zero = Eval {
+            p: [0.0; 3],
+            d1: [0.0; 3],
+            d2: [0.0; 3],
+        };
+        if n < DEGREE + 1 || self.knots.len() != n + DEGREE + 1 {
+            return zero;
+        }
+        let u = u.clamp(self.start(), self.end());
+        let span = find_span(&self.knots, n - 1, u);
+        let ders = basis_ders(&self.knots, span, u);
+        let mut e = zero;
+        for (j, row) in ders[0].iter().enumerate() {
+            let Some(cp) = self.ctrl.get(span + j - DEGREE) else {
+                return zero;
+            };
+            for k in 0..3 {
+                e.p[k] += row * cp[k];
+                e.d1[k] += ders[1][j] * cp[k];
+                e.d2[k] += ders[2][j] * cp[k];
+            }
+        }
+        e
+    }
+}
+
+/// Index of the knot span holding `u` (A2.1), for `n + 1` control points.
+pub fn find_span(knots: &[f64], n: usize, u: f64) -> usize {
+    let (Some(&hi), true) = (knots.get(n + 1), knots.len() > n + 1) else {
+        return DEGREE;
+    };
+    if u >= hi {
+        return n;
+    }
+    let (mut low, mut high) = (DEGREE, n + 1);
+    let mut mid = (low + high) / 2;
+    while mid > low && (u < knots[mid] || u >= knots[mid + 1]) {
+        if u < knots[mid] {
+            high = mid;
+        } else {
+            low = mid;
+        }
+        mid = (low + high) / 2;
+    }
+    mid.max(DEGREE)
+}
+
+/// The four non-zero cubic basis functions at `u` in span `span` and their first and second
+/// derivatives (A2.3): `ders[k][j]` is the k-th derivative of `N_{span−3+j,3}`.
+#[allow(clippy::needless_range_loop)] // A2.3 as Piegl & Tiller write it
+pub fn basis_ders(knots: &[f64], span: usize, u: f64) -> [[f64; 4]; 3] {
+    const P: usize = DEGREE;
+    let mut ders = [[0.0; 4]; 3];
+    if span < P || span + P >= knots.len() {
+        return ders;
+    }
+    let mut ndu = [[0.0f64; 4]; 4];
+    let mut left = [0.0f64; 4];
+    let mut right = [0.0f64; 4];
+    ndu[0][0] = 1.0;
+    for j in 1..=P {
+        left[j] = u - knots[span + 1 - j];
+        right[j] = knots[span + j] - u;
+        let mut saved = 0.0;
+        for r in 0..j {
+            ndu[j][r] = right[r + 1] + left[j - r];
+            let temp = if ndu[j][r] != 0.0 {
+                ndu[r][j - 1] / ndu[j][r]
+            } else {
+                0.0
+            };
+            ndu[r][j] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        ndu[j][j] = saved;
+    }
+    for j in 0..=P {
+        ders[0][j] = ndu[j][P];
+    }
+    let mut a = [[0.0f64; 4]; 2];
+    for r in 0..=P {
+        let (mut s1, mut s2) = (0usize, 1usize);
+        a[0][0] = 1.0;
+        for k in 1..=2usize {
+            let mut d = 0.0;
+            let rk = r as isize - k as isize;
+            let pk = P - k;
+            if r >= k {
+                let den = ndu[pk + 1][rk as usize];
+                a[s2][0] = if den != 0.0 { a[s1][0] / den } else { 0.0 };
+                d = a[s2][0] * ndu[rk as usize][pk];
+            }
+            let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
+            let j2 = if r as isize - 1 <= pk as isize {
+                k - 1
+            } else {
+                P - r
+            };
+            for j in j1..=j2 {
+                let idx = (rk + j as isize) as usize;
+                let den = ndu[pk + 1][idx];
+                a[s2][j] = if den != 0.0 {
+                    (a[s1][j] - a[s1][j - 1]) / den
+                } else {
+                    0.0
+                };
+                d += a[s2][j] * ndu[idx][pk];
+            }
+            if r <= pk {
+                let den = ndu[pk + 1][r];
+                a[s2][k] = if den != 0.0 { -a[s1][k - 1] / den } else { 0.0 };
+                d += a[s2][k] * ndu[r][pk];
+            }
+            ders[k][r] = d;
+            std::mem::swap(&mut s1, &mut s2);
+        }
+    }
+    // Multiply by p!/(p−k)!.
+    for j in 0..=P {
+        ders[1][j] *= P as f64;
+        ders[2][j] *= (P * (P - 1)) as f64;
+    }
+    ders
+}
+
+pub(crate) fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(crate) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+pub(crate) fn norm(a: &[f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+pub(crate) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A single Bézier span: C(u) = Σ B_i(u) P_i with Bernstein polynomials.
+    #[test]
+    fn bezier_span_matches_bernstein() {
+        let c = Curve {
+            knots: vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+            ctrl: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 2.0, 0.0],
+                [3.0, 2.0, 0.0],
+                [4.0, 0.0, 1.0],
+            ],
+        };
+        for &u in &[0.0, 0.25, 0.5, 0.9, 1.0] {
+            let e = c.eval(u);
+            let b = [
+                (1.0 - u).powi(3),
+                3.0 * u * (1.0 - u).powi(2),
+                3.0 * u * u * (1.0 - u),
+                u.powi(3),
+            ];
+            let db = [
+                -3.0 * (1.0 - u).powi(2),
+                3.0 * (1.0 - u).powi(2) - 6.0 * u * (1.0 - u),
+                6.0 * u * (1.0 - u) - 3.0 * u * u,
+                3.0 * u * u,
+            ];
+            let ddb = [
+                6.0 * (1.0 - u),
+                -12.0 * (1.0 - u) + 6.0 * u,
+                6.0 * (1.0 - u) - 12.0 * u,
+                6.0 * u,
+            ];
+            for k in 0..3 {
+                let p: f64 = (0..4).map(|i| b[i] * c.ctrl[i][k]).sum();
+                let d: f64 = (0..4).map(|i| db[i] * c.ctrl[i][k]).sum();
+                let dd: f64 = (0..4).map(|i| ddb[i] * c.ctrl[i][k]).sum();
+                assert!((e.p[k] - p).abs() < 1e-12);
+                assert!((e.d1[k] - d).abs() < 1e-12);
+                assert!((e.d2[k] - dd).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn partition_of_unity_with_interior_knots() {
+        let knots = [0.0, 0.0, 0.0, 0.0, 0.3, 0.35, 0.9, 2.0, 2.0, 2.0, 2.0];
+        for i in 0..=40 {
+            let u = i as f64 * 0.05;
+            let span = find_span(&knots, 6, u);
+            assert!(knots[span] <= u && (u < knots[span + 1] || span == 6));
+            let d = basis_ders(&knots, span, u);
+            assert!((d[0].iter().sum::<f64>() - 1.0).abs() < 1e-12);
+            assert!(d[1].iter().sum::<f64>().abs() < 1e-9);
+            assert!(d[2].iter().sum::<f64>().abs() < 1e-8);
+        }
+    }
+}

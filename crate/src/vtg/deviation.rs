@@ -1,0 +1,258 @@
+//! Measuring how far a rewritten path strays from the original, independently of the
+//! optimiser: only the two polylines are used (never the fitted curve or its parameters).
+//!
+//! Each output segment is sampled every `step` mm and every sample's distance to the original
+//! polyline is taken; the largest is the deviation (up to `step/2` optimistic on a segment that
+//! crosses a corner, so `step` is a small fraction of the tolerance).
+
+use std::collections::HashMap;
+
+use super::bspline::{dot, norm, sub};
+use crate::path::PrintPath;
+
+/// Distance from `p` to segment `a`–`b`.
+pub fn point_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let ab = sub(b, a);
+    let ap = sub(p, a);
+    let l2 = dot(&ab, &ab);
+    let t = if l2 > 0.0 {
+        (dot(&ap, &ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let q = [a[0] + ab[0] * t, a[1] + ab[1] * t, a[2] + ab[2] * t];
+    norm(&sub(p, &q))
+}
+
+/// Distance from `p` to the polyline `poly`.
+pub fn point_polyline(p: &[f64; 3], poly: &[[f64; 3]]) -> f64 {
+    match poly {
+        [] => f64::INFINITY,
+        [a] => norm(&sub(p, a)),
+        _ => poly
+            .windows(2)
+            .map(|w| point_segment(p, &w[0], &w[1]))
+            .fold(f64::INFINITY, f64::min),
+    }
+}
+
+/// Calls `each` with points along every segment of `poly`, at most `step` apart.
+fn samples(poly: &[[f64; 3]], step: f64, mut each: impl FnMut(&[f64; 3])) {
+    if let Some(p) = poly.first() {
+        each(p);
+    }
+    for w in poly.windows(2) {
+        let len = norm(&sub(&w[1], &w[0]));
+        let k = ((len / step).ceil() as usize).clamp(1, 100_000);
+        for i in 1..=k {
+            let t = i as f64 / k as f64;
+            each(&[
+                w[0][0] + (w[1][0] - w[0][0]) * t,
+                w[0][1] + (w[1][1] - w[0][1]) * t,
+                w[0][2] + (w[1][2] - w[0][2]) * t,
+            ]);
+        }
+    }
+}
+
+/// An upper bound of the largest distance from the polyline `out` to the polyline `orig`
+/// (exact to within `step/2`).
+///
+/// Distance to one segment is convex along a straight line, so an output segment whose two ends
+/// are both within `d` of the *same* original segment lies wholly within `d` of it: such
+/// segments are certified from their ends alone. Others (those that cut across a corner) are
+/// sampled every `step` mm, and `step/2` is added to what the samples show. Certificates up to
+/// `accept` mm are taken as they are (they are upper bounds); set it to the tolerance to check
+/// against, or to 0 for the tightest figure. With `accept > 0` the measurement stops as soon as
+/// it exceeds `accept`.
+pub fn polyline_deviation(out: &[[f64; 3]], orig: &[[f64; 3]], step: f64, accept: f64) -> f64 {
+    let segs = orig.len().saturating_sub(1);
+    if segs == 0 {
+        return match (out.is_empty(), orig.first()) {
+            (true, _) => 0.0,
+            (false, Some(o)) => out.iter().map(|p| norm(&sub(p, o))).fold(0.0, f64::max),
+            (false, None) => f64::INFINITY,
+        };
+    }
+    let seg_dist = |p: &[f64; 3], j: usize| point_segment(p, &orig[j], &orig[j + 1]);
+    // Nearest original segment to `p`, searched around `cursor` first, then everywhere.
+    let nearest = |p: &[f64; 3], cursor: usize| -> (usize, f64) {
+        const WINDOW: usize = 6;
+        let lo = cursor.saturating_sub(WINDOW);
+        let hi = (cursor + WINDOW).min(segs - 1);
+        let mut best = (cursor.min(segs - 1), f64::INFINITY);
+        for j in lo..=hi {
+            let d = seg_dist(p, j);
+            if d < best.1 {
+                best = (j, d);
+            }
+        }
+        best
+    };
+    let mut worst = 0.0f64;
+    let mut cursor = 0usize;
+    let mut prev: Option<([f64; 3], usize, f64)> = None;
+    for p in out {
+        let (j, d) = nearest(p, cursor);
+        cursor = j;
+        if let Some((q, jq, dq)) = prev {
+            // Certificate: both ends near one segment (either end's nearest).
+            let c1 = dq.max(seg_dist(p, jq));
+            let c2 = seg_dist(&q, j).max(d);
+            let cert = c1.min(c2);
+            let bound = if cert <= worst.max(step).max(accept) {
+                cert
+            } else {
+                // Walk the segment. Distance is 1-Lipschitz, so from a point at distance d the
+                // next `accept − d` mm cannot exceed `accept`: the walk strides there and steps
+                // `step` mm only where the segment comes close to the limit.
+                let dir = sub(p, &q);
+                let len = norm(&dir);
+                let mut m = 0.0f64;
+                let mut t = 0.0f64;
+                let mut c = jq;
+                let mut guard = 0usize;
+                loop {
+                    let f = if len > 0.0 { (t / len).min(1.0) } else { 1.0 };
+                    let x = [q[0] + dir[0] * f, q[1] + dir[1] * f, q[2] + dir[2] * f];
+                    let (jj, mut dx) = nearest(&x, c);
+                    c = jj;
+                    if dx > m.max(accept) {
+                        dx = point_polyline(&x, orig);
+                    }
+                    m = m.max(dx);
+                    guard += 1;
+                    if f >= 1.0 || guard > 1_000_000 {
+                        break;
+                    }
+                    t += step.max(accept - dx);
+                }
+                cert.min(if accept > 0.0 { m } else { m + step / 2.0 })
+            };
+            worst = worst.max(bound);
+            if accept > 0.0 && worst > accept {
+                // Over the line: the caller only needs to know that.
+                return worst;
+            }
+        } else {
+            let d = if d > step { point_polyline(p, orig) } else { d };
+            worst = worst.max(d);
+        }
+        prev = Some((*p, j, d));
+    }
+    worst
+}
+
+/// Segments bucketed by 2-D cell (XY) for nearest-segment queries.
+struct Grid {
+    cell: f64,
+    segs: Vec<([f64; 3], [f64; 3])>,
+    cells: HashMap<(i64, i64), Vec<u32>>,
+}
+
+impl Grid {
+    fn new(segs: impl Iterator<Item = ([f64; 3], [f64; 3])>, cell: f64) -> Self {
+        let mut g = Grid {
+            cell,
+            segs: Vec::new(),
+            cells: HashMap::new(),
+        };
+        for (a, b) in segs {
+            let i = g.segs.len() as u32;
+            g.segs.push((a, b));
+            let len = norm(&sub(&b, &a));
+            let k = ((len / (0.5 * cell)).ceil() as usize).clamp(1, 1_000_000);
+            let mut last = None;
+            for j in 0..=k {
+                let t = j as f64 / k as f64;
+                let key = g.key(&[a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, 0.0]);
+                if last != Some(key) {
+                    let v = g.cells.entry(key).or_default();
+                    if v.last() != Some(&i) {
+                        v.push(i);
+                    }
+                    last = Some(key);
+                }
+            }
+        }
+        g
+    }
+
+    fn key(&self, p: &[f64; 3]) -> (i64, i64) {
+        (
+            (p[0] / self.cell).floor() as i64,
+            (p[1] / self.cell).floor() as i64,
+        )
+    }
+
+    /// Distance to the nearest segment if one lies within one cell (exact then), else `None`.
+    fn distance(&self, p: &[f64; 3]) -> Option<f64> {
+        let (cx, cy) = self.key(p);
+        let mut best = f64::INFINITY;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                if let Some(v) = self.cells.get(&(cx + dx, cy + dy)) {
+                    for &i in v {
+                        if let Some((a, b)) = self.segs.get(i as usize) {
+                            best = best.min(point_segment(p, a, b));
+                        }
+                    }
+                }
+            }
+        }
+        (best <= self.cell).then_some(best)
+    }
+}
+
+/// Largest distance from any printing move of `output` to the printing moves of the same layer
+/// of `original`, sampled every `step` mm: the whole-file check, reading both files as moves
+/// (nothing of the optimiser is used). Moves identical in both are skipped cheaply by the grid
+/// (their distance is 0). Layers are matched by index; if the counts differ, `INFINITY`.
+pub fn file_deviation(original: &PrintPath, output: &PrintPath, step: f64) -> f64 {
+    if original.layers.len() != output.layers.len() {
+        return f64::INFINITY;
+    }
+    let xyz = |p: &crate::machine::Pos| [p[0], p[1], p[2]];
+    let mut worst = 0.0f64;
+    for li in 0..original.layers.len() {
+        let orig: Vec<([f64; 3], [f64; 3])> = original
+            .layer_moves(li)
+            .iter()
+            .filter(|m| m.is_extruding())
+            .map(|m| (xyz(&m.from), xyz(&m.to)))
+            .collect();
+        let grid = Grid::new(orig.iter().copied(), 1.0);
+        for m in output.layer_moves(li).iter().filter(|m| m.is_extruding()) {
+            let seg = [xyz(&m.from), xyz(&m.to)];
+            samples(&seg, step, |p| {
+                let d = grid.distance(p).unwrap_or_else(|| {
+                    orig.iter()
+                        .map(|(a, b)| point_segment(p, a, b))
+                        .fold(f64::INFINITY, f64::min)
+                });
+                worst = worst.max(d);
+            });
+        }
+    }
+    worst
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chord_across_a_corner_deviates_by_its_depth() {
+        let orig = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]];
+        let out = [
+            [0.0, 0.0, 0.0],
+            [0.9, 0.0, 0.0],
+            [1.0, 0.1, 0.0],
+            [1.0, 1.0, 0.0],
+        ];
+        let d = polyline_deviation(&out, &orig, 0.001, 0.0);
+        // The chord's midpoint is 0.05 from both legs.
+        let depth = 0.05;
+        assert!((d - depth).abs() < 1e-3, "{d}");
+    }
+}

@@ -1,0 +1,217 @@
+//! The VTG report: tolerance and measured deviation, the paper's Table 1 (toolpath metrics) and
+//! Table 2 (kinematic and energy figures), and `before` / `after` analyses.
+
+use serde::Serialize;
+
+use super::kinematics::KinematicLimits;
+use super::metrics::{from_path, ToolpathMetrics};
+use super::rewrite::Rewritten;
+use super::VtgOptions;
+use crate::analyze::Report;
+use crate::path::PrintPath;
+
+/// A figure before and after, and the relative change.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Comparison {
+    /// Before VTG.
+    pub before: f64,
+    /// After VTG.
+    pub after: f64,
+    /// `(after − before) / before`, percent (0 when `before` is 0).
+    pub change_pct: f64,
+}
+
+impl Comparison {
+    /// Compares two figures.
+    pub fn new(before: f64, after: f64) -> Self {
+        let change_pct = if before != 0.0 && before.is_finite() && after.is_finite() {
+            (after - before) / before * 100.0
+        } else {
+            0.0
+        };
+        Self {
+            before,
+            after,
+            change_pct,
+        }
+    }
+}
+
+/// The paper's Table 1: toolpath parameters before and after.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Table1 {
+    /// `L_total`, mm.
+    pub l_total_mm: Comparison,
+    /// `n_total`.
+    pub n_total: Comparison,
+    /// `L_infill`, mm.
+    pub l_infill_mm: Comparison,
+    /// `n_infill`.
+    pub n_infill: Comparison,
+    /// `n_turning` (turns above the critical angle).
+    pub n_turning: Comparison,
+    /// Mean turning angle, degrees.
+    pub mean_turn_deg: Comparison,
+    /// `mean(e_c)`, mm.
+    pub mean_chord_error_mm: Comparison,
+}
+
+/// Deviation of the simulated tool from the programmed path (the paper's Table 2 kinematic
+/// rows), from the dynamics model; filled in when that model is run on both files.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct DeviationComparison {
+    /// Largest deviation, mm.
+    pub max_mm: Comparison,
+    /// Smallest deviation, mm.
+    pub min_mm: Comparison,
+    /// Mean deviation, mm.
+    pub mean_mm: Comparison,
+}
+
+/// The paper's Table 2: kinematic and energy performance before and after.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Table2 {
+    /// Simulated toolpath deviation (dynamics model); `null` until that model is run.
+    pub deviation: Option<DeviationComparison>,
+    /// Total energy `E`, J (eq. 16).
+    pub energy_j: Comparison,
+    /// Servo (X/Y drive) energy, J.
+    pub servo_energy_j: Comparison,
+    /// Material, g.
+    pub material_g: Comparison,
+    /// Carbon emission, g CO₂ (eq. 17).
+    pub co2_g: Comparison,
+    /// Print time, s.
+    pub time_s: Comparison,
+}
+
+/// What the rewrite did to the paths.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PathCounts {
+    /// Extrusion paths with a turn above the critical angle.
+    pub candidates: u64,
+    /// Of those, paths rewritten (the rest could not be rounded within the tolerance, or their
+    /// lines could not be replaced safely, and were kept).
+    pub rewritten: u64,
+    /// Moves replaced.
+    pub replaced_moves: u64,
+    /// Moves written in their place.
+    pub written_moves: u64,
+    /// Written segments whose curvature is above `K_cr`.
+    pub above_k_cr_segments: u64,
+    /// Of those, segments written with a lower feed rate (eq. 29).
+    pub lowered_feed_segments: u64,
+    /// Mean speed fluctuation of the interpolation steps, percent (eq. 28).
+    pub mean_speed_fluctuation_pct: f64,
+}
+
+/// Per-layer toolpath metrics before and after.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LayerMetrics {
+    /// Layer index.
+    pub index: usize,
+    /// Before.
+    pub before: ToolpathMetrics,
+    /// After.
+    pub after: ToolpathMetrics,
+}
+
+/// Everything `vtg` says about a rewrite.
+#[derive(Debug, Clone, Serialize)]
+pub struct VtgReport {
+    /// Tolerance asked for, mm.
+    pub tolerance_mm: f64,
+    /// Largest distance of any written point or segment from the original path, mm (measured on
+    /// the output polylines, sampled every tolerance/10).
+    pub max_deviation_mm: f64,
+    /// Critical angle δθ, degrees.
+    pub critical_angle_deg: f64,
+    /// Critical curvature `K_cr` (eq. 30), 1/mm.
+    pub k_cr_per_mm: f64,
+    /// The limits `K_cr` is built from.
+    pub limits: KinematicLimits,
+    /// What was rewritten.
+    pub paths: PathCounts,
+    /// Table 1: toolpath parameters.
+    pub table1: Table1,
+    /// Table 2: kinematic and energy performance.
+    pub table2: Table2,
+    /// Per-layer toolpath metrics.
+    pub layers: Vec<LayerMetrics>,
+    /// Analysis of the input.
+    pub before: Report,
+    /// Analysis of the output.
+    pub after: Report,
+    /// The rewritten G-code.
+    #[serde(skip)]
+    pub output: Vec<u8>,
+}
+
+/// Assembles the report.
+pub(crate) fn build(
+    options: &VtgOptions,
+    limits: &KinematicLimits,
+    before: Report,
+    after: Report,
+    path: &PrintPath,
+    after_path: &PrintPath,
+    rewritten: Rewritten,
+) -> VtgReport {
+    let (mb, lb) = from_path(path, options.critical_angle_deg);
+    let (ma, la) = from_path(after_path, options.critical_angle_deg);
+    let c = Comparison::new;
+    let table1 = Table1 {
+        l_total_mm: c(mb.l_total_mm, ma.l_total_mm),
+        n_total: c(mb.n_total as f64, ma.n_total as f64),
+        l_infill_mm: c(mb.l_infill_mm, ma.l_infill_mm),
+        n_infill: c(mb.n_infill as f64, ma.n_infill as f64),
+        n_turning: c(mb.n_turning as f64, ma.n_turning as f64),
+        mean_turn_deg: c(mb.mean_turn_deg, ma.mean_turn_deg),
+        mean_chord_error_mm: c(mb.mean_chord_error_mm, ma.mean_chord_error_mm),
+    };
+    let table2 = Table2 {
+        deviation: None,
+        energy_j: c(before.energy.total_j, after.energy.total_j),
+        servo_energy_j: c(before.energy.servo_j, after.energy.servo_j),
+        material_g: c(before.material_g, after.material_g),
+        co2_g: c(before.energy.co2_g, after.energy.co2_g),
+        time_s: c(before.time_s, after.time_s),
+    };
+    let layers = lb
+        .into_iter()
+        .zip(la)
+        .enumerate()
+        .map(|(index, (before, after))| LayerMetrics {
+            index,
+            before,
+            after,
+        })
+        .collect();
+    let w = rewritten.walk;
+    VtgReport {
+        tolerance_mm: options.tolerance_mm,
+        max_deviation_mm: rewritten.max_deviation_mm,
+        critical_angle_deg: options.critical_angle_deg,
+        k_cr_per_mm: limits.critical_curvature(),
+        limits: *limits,
+        paths: PathCounts {
+            candidates: rewritten.candidate_paths,
+            rewritten: rewritten.rewritten_paths,
+            replaced_moves: rewritten.replaced_moves,
+            written_moves: rewritten.written_moves,
+            above_k_cr_segments: rewritten.above_k_cr_segments,
+            lowered_feed_segments: rewritten.lowered_segments,
+            mean_speed_fluctuation_pct: if w.steps > 0 {
+                w.fluctuation_sum / w.steps as f64 * 100.0
+            } else {
+                0.0
+            },
+        },
+        table1,
+        table2,
+        layers,
+        before,
+        after,
+        output: rewritten.output,
+    }
+}

@@ -1,0 +1,378 @@
+//! Algorithm 1 of the VTG paper: walk the fitted curve with the second-order Taylor interpolator
+//! (eq. 27) and correct each step with Newton's method so consecutive points are exactly `L_i`
+//! apart.
+//!
+//! The paper leaves `L_i` open; here it is what a CAM interpolator would pick: the longest step
+//! whose chord stays within the chord tolerance of the curve (sagitta `L²κ/8 ≤ δ`) and turns by
+//! at most a fraction of the critical angle (`κ·L ≤ θ_step`, so a rounded corner is walked in
+//! several gentle turns instead of one sharp one), checked on the stretch the step covers and
+//! halved until it holds. Line 2 of Algorithm 1 has `⟨C', C'⟩` where eq. 27 has `⟨C', C''⟩`;
+//! eq. 27 is used. Line 5's `F` is the step error `‖C(u) − P_i‖ − L_i`, and the damping `φ` of
+//! the paper scales the Newton step. Points are taken on the curve (`P_{i+1} = C(u_{i+1})`),
+//! which line 11 also gives once Newton has converged.
+
+use super::bspline::{dot, norm, sub, Curve};
+
+/// Settings of the walk.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Walk {
+    /// Chord tolerance between the curve and each step's chord, mm.
+    pub chord_tol_mm: f64,
+    /// Largest turn a step may cover, rad.
+    pub max_turn_rad: f64,
+    /// Longest step, mm.
+    pub max_step_mm: f64,
+    /// Shortest step, mm: below it the written coordinates' rounding (0.001 mm) would turn the
+    /// direction of a segment by more than a couple of degrees. Where the curve is tighter than
+    /// this step allows, the step is taken anyway (the turn is then sharper than asked).
+    pub min_step_mm: f64,
+    /// Newton damping φ (1 = plain Newton).
+    pub phi: f64,
+    /// Newton stops when `|‖C(u) − P_i‖ − L_i| ≤ newton_tol_mm`.
+    pub newton_tol_mm: f64,
+}
+
+/// One interpolated point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Curve parameter.
+    pub u: f64,
+    /// `C(u)`.
+    pub p: [f64; 3],
+    /// Largest curvature of the curve over the step that ends here, 1/mm.
+    pub kappa: f64,
+    /// Mean curvature over that step (turn of the tangent over the chord), 1/mm: what the
+    /// feed rate of the written segment must respect.
+    pub mean_kappa: f64,
+    /// The step `L_i` asked for (0 for the first point and the shortened last step).
+    pub step_mm: f64,
+}
+
+/// Steps walked, and the Newton error (eq. 28's speed fluctuation in mm).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct WalkStats {
+    /// Steps taken.
+    pub steps: u64,
+    /// Sum of `|L_i − ‖P_{i+1} − P_i‖| / L_i` (eq. 28) over full steps.
+    pub fluctuation_sum: f64,
+}
+
+/// Walks `curve` from start to end. Returns the points (first = `C(start)`, last = `C(end)`)
+/// or `None` if the walk does not converge (degenerate curve).
+pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample>> {
+    let (u_start, u_end) = (curve.start(), curve.end());
+    if u_end.is_nan() || u_start.is_nan() || u_end <= u_start {
+        return None;
+    }
+    let first = curve.eval(u_start);
+    let mut out = vec![Sample {
+        u: u_start,
+        p: first.p,
+        kappa: first.curvature(),
+        mean_kappa: 0.0,
+        step_mm: 0.0,
+    }];
+    let end_p = curve.eval(u_end).p;
+    let index = CurvatureIndex::new(curve);
+    let max_curvature = |_: &Curve, a: f64, b: f64| index.max(curve, a, b);
+    let mut u = u_start;
+    let mut p = first.p;
+    // Bounded: each accepted step advances u by at least a minimum amount.
+    let max_points = 200_000usize;
+    while out.len() < max_points {
+        let e = curve.eval(u);
+        let kappa = e.curvature();
+        // No longer than what is left of the curve (a closed loop ends near its start).
+        let left = (u_end - u) * norm(&e.d1) * 1.05;
+        let mut step = step_for(kappa, w).min(left).max(w.min_step_mm);
+        let remaining = norm(&sub(&end_p, &p));
+        let mut accepted = None;
+        for _ in 0..40 {
+            // The end is near along the curve, not just in space (a closed loop ends where it
+            // started).
+            if remaining <= step && (u_end - u) * norm(&e.d1) <= 1.5 * step + 1e-9 {
+                // Try the end point as the next point.
+                let k = max_curvature(curve, u, u_end);
+                if fits(k, remaining, w) {
+                    accepted = Some((u_end, end_p, k, 0.0));
+                    break;
+                }
+            }
+            let floor = step <= w.min_step_mm;
+            if let Some((un, pn)) = newton(curve, u, &p, step, w) {
+                if un < u_end {
+                    let k = max_curvature(curve, u, un);
+                    if floor || fits(k, step, w) {
+                        accepted = Some((un, pn, k, step));
+                        break;
+                    }
+                }
+            }
+            // Shrink to what the curvature met on the way allows (at least halving).
+            let k = max_curvature(
+                curve,
+                u,
+                (u + 2.0 * step / norm(&e.d1).max(1e-9)).min(u_end),
+            );
+            if floor {
+                break;
+            }
+            step = (0.5 * step)
+                .min(step_for(k, w).max(0.25 * step))
+                .max(w.min_step_mm);
+        }
+        let (mut un, mut pn, k, step) = accepted?;
+        // Do not leave a sliver before the end: stretch this step to it instead.
+        if un < u_end
+            && norm(&sub(&end_p, &pn)) < w.min_step_mm
+            && (u_end - un) * norm(&e.d1) < 2.0 * w.min_step_mm
+        {
+            un = u_end;
+            pn = end_p;
+        }
+        if step > 0.0 {
+            let got = norm(&sub(&pn, &p));
+            stats.fluctuation_sum += ((step - got) / step).abs();
+        }
+        stats.steps += 1;
+        // Mean curvature of the stretch: the turn of the tangent over the chord length.
+        let t0 = curve.eval(u).d1;
+        let t1 = curve.eval(un).d1;
+        let (n0, n1) = (norm(&t0), norm(&t1));
+        let chord = norm(&sub(&pn, &p));
+        let mean_kappa = if n0 > 0.0 && n1 > 0.0 && chord > 0.0 {
+            crate::math::acos((dot(&t0, &t1) / (n0 * n1)).clamp(-1.0, 1.0)) / chord
+        } else {
+            0.0
+        };
+        out.push(Sample {
+            u: un,
+            p: pn,
+            kappa: k,
+            mean_kappa,
+            step_mm: step,
+        });
+        if un >= u_end {
+            return Some(out);
+        }
+        u = un;
+        p = pn;
+    }
+    None
+}
+
+/// The step the chord tolerance and the turn allow at curvature `kappa`.
+fn step_for(kappa: f64, w: &Walk) -> f64 {
+    if kappa <= 1e-9 {
+        return w.max_step_mm;
+    }
+    let chord = (8.0 * w.chord_tol_mm / kappa).sqrt();
+    let turn = w.max_turn_rad / kappa;
+    chord.min(turn).min(w.max_step_mm)
+}
+
+fn fits(kappa: f64, step: f64, w: &Walk) -> bool {
+    kappa * step * step <= 8.0 * w.chord_tol_mm * 1.0001 && kappa * step <= w.max_turn_rad * 1.0001
+}
+
+/// Largest curvature of a curve over parameter intervals, sampled at the ends of the interval
+/// and at fixed points of every knot span it touches (each span is one cubic, so its curvature
+/// varies smoothly; sampling by span never steps over a short, tight span). The spans' own
+/// samples are computed once, so a long step over many spans costs only table reads.
+#[derive(Debug, Clone)]
+pub struct CurvatureIndex {
+    /// Distinct knots.
+    breaks: Vec<f64>,
+    /// Largest sampled curvature of span `i` (`breaks[i]..breaks[i+1]`).
+    span_max: Vec<f64>,
+}
+
+/// Samples per span (its ends included).
+const SPAN_SAMPLES: usize = 6;
+
+impl CurvatureIndex {
+    /// Samples every span of `curve`.
+    pub fn new(curve: &Curve) -> Self {
+        let mut breaks: Vec<f64> = Vec::new();
+        for &k in &curve.knots {
+            if breaks.last().is_none_or(|&b| k > b) {
+                breaks.push(k);
+            }
+        }
+        let span_max = breaks
+            .windows(2)
+            .map(|w| {
+                (0..SPAN_SAMPLES)
+                    .map(|i| {
+                        let t = i as f64 / (SPAN_SAMPLES - 1) as f64;
+                        curve.eval(w[0] + (w[1] - w[0]) * t).curvature()
+                    })
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        Self { breaks, span_max }
+    }
+
+    /// Largest curvature on `[a, b]`: the table for spans wholly inside, samples at the ends
+    /// and in the partly covered spans.
+    pub fn max(&self, curve: &Curve, a: f64, b: f64) -> f64 {
+        let sample = |lo: f64, hi: f64| -> f64 {
+            (0..SPAN_SAMPLES)
+                .map(|i| {
+                    let t = i as f64 / (SPAN_SAMPLES - 1) as f64;
+                    curve.eval(lo + (hi - lo) * t).curvature()
+                })
+                .fold(0.0, f64::max)
+        };
+        // Spans: i such that breaks[i] < b and breaks[i+1] > a.
+        let first = self.breaks.partition_point(|&k| k <= a).saturating_sub(1);
+        let mut best = 0.0f64;
+        let mut i = first;
+        while i + 1 < self.breaks.len() {
+            let (s0, s1) = (self.breaks[i], self.breaks[i + 1]);
+            if s0 >= b {
+                break;
+            }
+            let (lo, hi) = (s0.max(a), s1.min(b));
+            let m = if lo <= s0 && hi >= s1 {
+                self.span_max.get(i).copied().unwrap_or(0.0)
+            } else {
+                sample(lo, hi)
+            };
+            best = best.max(m);
+            i += 1;
+        }
+        best
+    }
+}
+
+/// Largest curvature on `[a, b]` (see [`CurvatureIndex`]; builds the index, so for one-off
+/// queries).
+pub fn max_curvature(curve: &Curve, a: f64, b: f64) -> f64 {
+    CurvatureIndex::new(curve).max(curve, a, b)
+}
+
+/// Eq. 27 predictor and Newton corrector: `u` past `u_i` with `‖C(u) − P_i‖ = L`.
+fn newton(curve: &Curve, ui: f64, pi: &[f64; 3], step: f64, w: &Walk) -> Option<(f64, [f64; 3])> {
+    let e = curve.eval(ui);
+    let s = norm(&e.d1);
+    if s < 1e-12 {
+        return None;
+    }
+    // Eq. 27.
+    let mut u = ui + step / s - dot(&e.d1, &e.d2) * step * step / (2.0 * s.powi(4));
+    if u.is_nan() || u <= ui {
+        u = ui + step / s;
+    }
+    for _ in 0..30 {
+        let c = curve.eval(u);
+        let v = sub(&c.p, pi);
+        let dist = norm(&v);
+        let f = dist - step;
+        if f.abs() <= w.newton_tol_mm {
+            return Some((u, c.p));
+        }
+        if dist < 1e-12 {
+            return None;
+        }
+        let fp = dot(&v, &c.d1) / dist;
+        if fp.is_nan() || fp <= 1e-12 {
+            return None;
+        }
+        let mut next = u - w.phi * f / fp;
+        // Keep the walk moving forward.
+        if next <= ui {
+            next = 0.5 * (ui + u);
+        }
+        if next > curve.end() + (u - ui) {
+            next = curve.end() + (u - ui);
+        }
+        u = next;
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vtg::fit::{fit, sample};
+
+    #[test]
+    fn walks_a_corner_in_gentle_equal_steps() {
+        let pts = [[0.0, 0.0, 0.2], [10.0, 0.0, 0.2], [10.0, 10.0, 0.2]];
+        let (d, u) = sample(&pts, 0.05, 2.0);
+        let f = fit(&d, &u, 0.05).unwrap();
+        let w = Walk {
+            chord_tol_mm: 0.01,
+            max_turn_rad: 20f64.to_radians(),
+            max_step_mm: 1e3,
+            min_step_mm: 0.02,
+            phi: 1.0,
+            newton_tol_mm: 1e-7,
+        };
+        let mut st = WalkStats::default();
+        let s = walk(&f.curve, &w, &mut st).unwrap();
+        assert!(s.len() >= 5, "{}", s.len());
+        for pair in s.windows(2) {
+            let got = norm(&sub(&pair[1].p, &pair[0].p));
+            if pair[1].step_mm > 0.0 {
+                assert!((got - pair[1].step_mm).abs() <= 1e-7);
+            }
+        }
+        assert_eq!(s.last().unwrap().p, [10.0, 10.0, 0.2]);
+    }
+
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+
+        /// On random polylines: every interpolated point lies on the fitted curve, every full
+        /// step equals `L_i` within the Newton tolerance, and where a step was accepted by the
+        /// curvature test its curvature bound holds.
+        #[test]
+        fn walk_invariants(
+            raw in proptest::collection::vec((-20.0f64..20.0, -20.0f64..20.0), 3..9),
+        ) {
+            let mut pts: Vec<[f64; 3]> = Vec::new();
+            for (x, y) in raw {
+                let p = [x, y, 0.2];
+                if pts.last().is_none_or(|q: &[f64; 3]| norm(&sub(&p, q)) > 0.5) {
+                    pts.push(p);
+                }
+            }
+            prop_assume!(pts.len() >= 3);
+            let (d, u) = sample(&pts, 0.25, 3.0);
+            let Some(f) = fit(&d, &u, 0.06) else { return Ok(()) };
+            let w = Walk {
+                chord_tol_mm: 0.03,
+                max_turn_rad: 0.45,
+                max_step_mm: 1e4,
+                min_step_mm: 0.03,
+                phi: 1.0,
+                newton_tol_mm: 1e-7,
+            };
+            let mut st = WalkStats::default();
+            let Some(s) = walk(&f.curve, &w, &mut st) else { return Ok(()) };
+            let index = CurvatureIndex::new(&f.curve);
+            for x in &s {
+                let on = f.curve.eval(x.u).p;
+                prop_assert!(norm(&sub(&on, &x.p)) < 1e-12);
+            }
+            for pair in s.windows(2) {
+                let (a, b) = (&pair[0], &pair[1]);
+                prop_assert!(b.u > a.u);
+                if b.step_mm > 0.0 {
+                    let got = norm(&sub(&b.p, &a.p));
+                    prop_assert!((got - b.step_mm).abs() <= 1e-7, "{} vs {}", got, b.step_mm);
+                    if b.step_mm > w.min_step_mm {
+                        // Accepted by the test, not forced by the step floor.
+                        let k = index.max(&f.curve, a.u, b.u);
+                        prop_assert!(k * b.step_mm <= w.max_turn_rad * 1.0001);
+                        prop_assert!(k * b.step_mm * b.step_mm <= 8.0 * w.chord_tol_mm * 1.0001);
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,292 @@
+//! Finding the extrusion paths of a file and replacing their lines.
+//!
+//! A path here is a run of consecutive printing `G1` moves of one feature and layer whose lines
+//! follow each other with nothing between them (a comment, fan change or `F`-only line ends
+//! the run, so every non-motion line stays where it was). Only paths with a turn above the
+//! critical angle are rewritten: a path without sharp corners has nothing to suppress.
+//!
+//! Material: the new points carry the filament the original path had pushed at the same arc
+//! length (the fit is parametrised by the original's arc length), so each stretch keeps its
+//! filament and the path's total is unchanged. In absolute mode the block ends on the original
+//! last `E` word exactly, so every later line stays valid; in relative mode the written amounts
+//! are differences of rounded running totals and add up to the original total.
+
+use std::fmt::Write as _;
+
+use super::kinematics::KinematicLimits;
+use super::resample::WalkStats;
+use super::smooth::{smooth_path, Settings};
+use super::source::MoveSource;
+use super::VtgOptions;
+use crate::error::{Error, ErrorKind};
+use crate::gcode::{apply_edits, Edit};
+use crate::machine::{ExtrusionMode, MoveKind};
+use crate::path::{PathMove, PrintPath};
+
+/// What the rewrite did.
+#[derive(Debug, Clone, Default)]
+pub struct Rewritten {
+    /// The new file.
+    pub output: Vec<u8>,
+    /// Paths with a sharp corner (candidates).
+    pub candidate_paths: u64,
+    /// Of those, paths rewritten.
+    pub rewritten_paths: u64,
+    /// Moves replaced.
+    pub replaced_moves: u64,
+    /// Moves written in their place.
+    pub written_moves: u64,
+    /// Segments whose feed was lowered (eq. 29).
+    pub lowered_segments: u64,
+    /// Segments whose curvature stays above `K_cr`.
+    pub above_k_cr_segments: u64,
+    /// Largest measured distance of a rewritten path from its original, mm.
+    pub max_deviation_mm: f64,
+    /// Algorithm 1 statistics.
+    pub walk: WalkStats,
+}
+
+/// The eq. 30 limits for a file: `v_max` and `A_n` from the machine's X/Y limits (`M203`,
+/// `M201`: the hardware's, since the firmware's print acceleration only bounds the tangential
+/// part), `T_s`, `J_n`, `R_n` and `δ` from the options.
+pub fn limits_for(path: &PrintPath, options: &VtgOptions) -> KinematicLimits {
+    let l = &path.print_limits;
+    let pick = |a: f64, b: f64, default: f64| {
+        let v = a.min(b);
+        if v.is_finite() && v > 0.0 {
+            v
+        } else {
+            default
+        }
+    };
+    KinematicLimits {
+        v_max_mm_s: pick(l.max_feedrate[0].value, l.max_feedrate[1].value, 200.0),
+        interpolation_period_s: options.interpolation_period_s,
+        chord_tolerance_mm: options.tolerance_mm,
+        normal_accel_mm_s2: pick(
+            l.max_acceleration[0].value,
+            l.max_acceleration[1].value,
+            1000.0,
+        ),
+        normal_jerk_mm_s3: options.normal_jerk_mm_s3,
+        nozzle_radius_mm: options.nozzle_diameter_mm / 2.0,
+    }
+}
+
+/// Rewrites every eligible path of `input`.
+pub fn rewrite(
+    input: &[u8],
+    path: &PrintPath,
+    sources: &[MoveSource],
+    options: &VtgOptions,
+    limits: &KinematicLimits,
+    progress: crate::analyze::Progress<'_>,
+) -> Result<Rewritten, Error> {
+    let mut out = Rewritten::default();
+    let moves = &path.moves;
+    let aligned =
+        sources.len() == moves.len() && sources.iter().zip(moves).all(|(s, m)| s.line == m.line);
+    if !aligned {
+        out.output = input.to_vec();
+        return Ok(out);
+    }
+    let settings = Settings {
+        tolerance_mm: options.tolerance_mm,
+        critical_rad: options.critical_angle_deg.to_radians(),
+        limits: *limits,
+        limit_feed: options.limit_feed,
+    };
+    let cos_critical = crate::math::cos(settings.critical_rad);
+    let mut edits: Vec<Edit> = Vec::new();
+    let mut i = 0usize;
+    let mut next_report = 0usize;
+    while i < moves.len() {
+        if i >= next_report {
+            next_report = i + 20_000;
+            if !progress(i as f64 / moves.len() as f64) {
+                return Err(Error::new(0, 0, ErrorKind::Cancelled));
+            }
+        }
+        let Some(j) = path_end(moves, sources, i) else {
+            i += 1;
+            continue;
+        };
+        let (run, src) = (&moves[i..j], &sources[i..j]);
+        i = j;
+        if run.len() < 2 || !has_sharp_corner(run, cos_critical) {
+            continue;
+        }
+        out.candidate_paths += 1;
+        if let Some(edit) = rewrite_path(run, src, &settings, &mut out) {
+            edits.extend(edit);
+        }
+    }
+    out.output = apply_edits(input, &edits);
+    Ok(out)
+}
+
+/// End (exclusive) of the path starting at move `i`, or `None` if move `i` cannot start one.
+fn path_end(moves: &[PathMove], sources: &[MoveSource], i: usize) -> Option<usize> {
+    let ok = |k: usize| {
+        let (m, s) = (&moves[k], &sources[k]);
+        s.plain && matches!(m.kind, MoveKind::Linear) && m.is_extruding()
+    };
+    if !ok(i) {
+        return None;
+    }
+    let first = &moves[i];
+    let mut j = i + 1;
+    while j < moves.len()
+        && ok(j)
+        && moves[j].feature == first.feature
+        && moves[j].layer == first.layer
+        && sources[j].mode == sources[i].mode
+        && sources[j].line == sources[j - 1].line + 1
+        && j - i < 100_000
+    {
+        j += 1;
+    }
+    Some(j)
+}
+
+fn has_sharp_corner(run: &[PathMove], cos_critical: f64) -> bool {
+    run.windows(2).any(|w| {
+        let a = [
+            w[0].to[0] - w[0].from[0],
+            w[0].to[1] - w[0].from[1],
+            w[0].to[2] - w[0].from[2],
+        ];
+        let b = [
+            w[1].to[0] - w[1].from[0],
+            w[1].to[1] - w[1].from[1],
+            w[1].to[2] - w[1].from[2],
+        ];
+        let (la, lb) = (super::bspline::norm(&a), super::bspline::norm(&b));
+        la > 0.0 && lb > 0.0 && super::bspline::dot(&a, &b) / (la * lb) < cos_critical
+    })
+}
+
+/// Rewrites one path; the edits replace its first line with the new block and delete the rest.
+fn rewrite_path(
+    run: &[PathMove],
+    src: &[MoveSource],
+    settings: &Settings,
+    out: &mut Rewritten,
+) -> Option<Vec<Edit>> {
+    let (first, first_src) = (run.first()?, src.first()?);
+    let last_src = src.last()?;
+    let xyz = |p: &crate::machine::Pos| [p[0], p[1], p[2]];
+    let mut pts = Vec::with_capacity(run.len() + 1);
+    pts.push(xyz(&first.from));
+    pts.extend(run.iter().map(|m| xyz(&m.to)));
+    // Filament from the path start at each vertex, in E words.
+    let mode = first_src.mode;
+    let mut e = Vec::with_capacity(pts.len());
+    e.push(0.0);
+    let mut sum = 0.0;
+    for s in src {
+        sum = match mode {
+            ExtrusionMode::Relative => sum + s.e_word,
+            ExtrusionMode::Absolute => s.e_word - first_src.e_before,
+        };
+        e.push(sum);
+    }
+    if sum.is_nan() || sum <= 0.0 || e.windows(2).any(|w| w[1] < w[0] - 1e-9) {
+        return None;
+    }
+    let feed: Vec<f64> = src
+        .iter()
+        .zip(run)
+        .map(|(s, m)| s.f_after.map_or(m.feed_mm_s, |f| f / 60.0))
+        .collect();
+    let smoothed = smooth_path(&pts, &e, &feed, settings)?;
+
+    // Write the block.
+    let mut text = String::with_capacity(smoothed.points.len() * 32);
+    let mut z_now = first.from[2];
+    let mut f_now = first_src.f_before;
+    let mut e_written = 0.0; // relative mode: rounded running total written so far
+    let count = smoothed.points.len();
+    for (k, ((p, &ek), &v)) in smoothed
+        .points
+        .iter()
+        .zip(&smoothed.e)
+        .zip(&smoothed.feed_mm_s)
+        .enumerate()
+    {
+        if !text.is_empty() {
+            text.push('\n');
+        }
+        let _ = write!(text, "G1 X{} Y{}", num(p[0], 3), num(p[1], 3));
+        if (p[2] - z_now).abs() > 5e-4 {
+            let _ = write!(text, " Z{}", num(p[2], 3));
+            z_now = p[2];
+        }
+        let last = k + 1 == count;
+        let e_text = match mode {
+            ExtrusionMode::Absolute if last => format!("{}", last_src.e_word),
+            ExtrusionMode::Absolute => num(first_src.e_before + ek, 5),
+            ExtrusionMode::Relative => {
+                let target = if last { sum } else { ek };
+                let rounded = round(target, 5);
+                let d = rounded - e_written;
+                e_written = rounded;
+                num(d, 5)
+            }
+        };
+        let _ = write!(text, " E{e_text}");
+        if f_now.is_some() {
+            let f = round(v * 60.0, 1);
+            if f_now.is_none_or(|now| (now - f).abs() > 0.05) {
+                let _ = write!(text, " F{}", num(f, 1));
+                f_now = Some(f);
+            }
+        }
+    }
+    // Leave the modal feed where the original left it.
+    if let (Some(now), Some(after)) = (f_now, last_src.f_after) {
+        if (now - after).abs() > 1e-9 {
+            let _ = write!(text, "\nG1 F{}", num(after, 3));
+        }
+    }
+    out.rewritten_paths += 1;
+    out.replaced_moves += run.len() as u64;
+    out.written_moves += count as u64;
+    out.lowered_segments += smoothed.lowered;
+    out.above_k_cr_segments += smoothed.above_k_cr;
+    out.max_deviation_mm = out.max_deviation_mm.max(smoothed.deviation_mm);
+    out.walk.steps += smoothed.stats.steps;
+    out.walk.fluctuation_sum += smoothed.stats.fluctuation_sum;
+    let mut edits = Vec::with_capacity(src.len());
+    edits.push(Edit {
+        line: first_src.line,
+        replacement: text.into_bytes(),
+    });
+    edits.extend(src.iter().skip(1).map(|s| Edit {
+        line: s.line,
+        replacement: Vec::new(),
+    }));
+    Some(edits)
+}
+
+fn round(v: f64, decimals: i32) -> f64 {
+    let s = 10f64.powi(decimals);
+    (v * s).round() / s
+}
+
+/// `v` with at most `decimals` decimals, trailing zeros dropped.
+fn num(v: f64, decimals: usize) -> String {
+    let mut s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        while s.ends_with('0') {
+            s.pop();
+        }
+        if s.ends_with('.') {
+            s.pop();
+        }
+    }
+    if s == "-0" {
+        s = "0".into();
+    }
+    s
+}

@@ -1,0 +1,106 @@
+//! What the rewriter needs to know about each move's source line, beyond [`crate::path`]:
+//! whether the line can be replaced safely, the extrusion mode its `E` word is read in, its
+//! `E` word and the modal feed rate word after it.
+//!
+//! A second pass reads the file exactly as `path::extract` does (same setup, limit commands
+//! skipped the same way), so its moves line up one for one with the path's.
+
+use crate::analyze::{prepare, AnalyzeOptions};
+use crate::error::Error;
+use crate::gcode::{self, Line};
+use crate::machine::{axis, Event, ExtrusionMode, Machine, MachineConfig};
+
+/// A move's source line as the rewriter sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MoveSource {
+    /// 1-based line.
+    pub line: u32,
+    /// A plain `G1` with only X/Y/Z/E/F words, no comment, E present, and its X/Y/Z words equal
+    /// to the machine position (absolute positioning in mm, no G92 offsets): safe to replace.
+    pub plain: bool,
+    /// Mode its `E` word is read in.
+    pub mode: ExtrusionMode,
+    /// Its `E` word.
+    pub e_word: f64,
+    /// Logical (G-code) E before the line.
+    pub e_before: f64,
+    /// The modal `F` word before the line, mm/min.
+    pub f_before: Option<f64>,
+    /// The modal `F` word after the line, mm/min (`None` before any `F`).
+    pub f_after: Option<f64>,
+}
+
+/// One entry per move, in the order `path::extract` lists them.
+pub fn move_sources(input: &[u8], options: &AnalyzeOptions) -> Result<Vec<MoveSource>, Error> {
+    let setup = prepare(input, options)?;
+    let mut warnings = setup.warnings;
+    let mut machine = Machine::new(MachineConfig {
+        extrusion: setup.mode,
+        ..MachineConfig::default()
+    });
+    let mut limits = setup.limits;
+    let mut f_modal: Option<f64> = None;
+    let mut out = Vec::new();
+    gcode::for_each_line(
+        input,
+        setup.strictness,
+        &mut warnings,
+        |raw, line, warnings| {
+            let Some(line) = line else { return Ok(()) };
+            if limits.apply_command(line, setup.units) {
+                return Ok(());
+            }
+            let mode = machine.extrusion_mode();
+            let e_before = machine.logical_position()[axis::E];
+            let f_before = f_modal;
+            let is_motion = line
+                .code()
+                .is_some_and(|c| c.letter == b'G' && c.number <= 3 && c.sub.is_none());
+            if is_motion {
+                if let Some(f) = line.params.get(b'F') {
+                    f_modal = Some(f);
+                }
+            }
+            if let Some(Event::Move(m)) = machine.apply(raw.number, line, warnings) {
+                let plain = is_plain(line, &m.to);
+                out.push(MoveSource {
+                    line: raw.number,
+                    plain,
+                    mode,
+                    e_word: line.params.get(b'E').unwrap_or(0.0),
+                    e_before,
+                    f_before,
+                    f_after: f_modal,
+                });
+            }
+            Ok(())
+        },
+    )?;
+    Ok(out)
+}
+
+fn is_plain(line: &Line<'_>, to: &crate::machine::Pos) -> bool {
+    let Some(code) = line.code() else {
+        return false;
+    };
+    if !code.is(b'G', 1) || line.comment.is_some() || line.line_number.is_some() {
+        return false;
+    }
+    if !line.params.has(b'E') || line.params.has_bare_word() {
+        return false;
+    }
+    for (letter, value) in line.params.iter() {
+        let Some(v) = value else { return false };
+        let ax = match letter {
+            b'X' => axis::X,
+            b'Y' => axis::Y,
+            b'Z' => axis::Z,
+            b'E' | b'F' => continue,
+            _ => return false,
+        };
+        if (to[ax] - v).abs() > 1e-9 {
+            return false;
+        }
+    }
+    true
+}

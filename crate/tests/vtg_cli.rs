@@ -1,0 +1,50 @@
+//! `quietpath vtg` from outside: output file, JSON report, refusal to overwrite the input.
+#![cfg(not(target_arch = "wasm32"))]
+
+use std::path::Path;
+use std::process::Command;
+
+#[test]
+fn vtg_writes_the_file_and_reports_json() {
+    let input = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures/gcode/prusaslicer-2.5.0_cube_marlin2_defaults.gcode");
+    let dir = std::env::temp_dir().join(format!("quietpath-vtg-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let out_path = dir.join("cube.vtg.gcode");
+    let out = Command::new(env!("CARGO_BIN_EXE_quietpath"))
+        .arg("vtg")
+        .arg(&input)
+        .arg("-o")
+        .arg(&out_path)
+        .args(["--tolerance", "0.1", "--critical-angle", "30", "--json"])
+        .output()
+        .expect("run quietpath");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+    assert_eq!(json["tolerance_mm"], 0.1);
+    let dev = json["max_deviation_mm"].as_f64().expect("deviation");
+    assert!(dev > 0.0 && dev <= 0.1, "{dev}");
+    for key in ["n_turning", "n_total", "l_total_mm", "mean_chord_error_mm"] {
+        assert!(json["table1"][key]["before"].is_number(), "{key}");
+    }
+    assert!(json["table2"]["energy_j"]["after"].is_number());
+    assert!(json["table2"]["deviation"].is_null());
+    assert!(json["before"]["toolpath"]["n_turning"].as_u64().expect("n") > 0);
+    let written = std::fs::read(&out_path).expect("output");
+    assert!(!written.is_empty());
+
+    // Refuses to overwrite its input without --force.
+    let again = Command::new(env!("CARGO_BIN_EXE_quietpath"))
+        .arg("vtg")
+        .arg(&input)
+        .arg("-o")
+        .arg(&input)
+        .output()
+        .expect("run quietpath");
+    assert!(!again.status.success());
+    let _ = std::fs::remove_dir_all(&dir);
+}
