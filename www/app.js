@@ -90,6 +90,7 @@ const client = new JobClient('./worker.js', {
   onHello(version, caps) {
     els.version.textContent = version ? `v${version}` : '';
     capabilities = new Set(caps);
+    document.body.dataset.capabilities = caps.join(' '); // for tests and curious users
     updateActions();
   },
   onCrash(detail, wasLoaded, hadPending) {

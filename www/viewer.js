@@ -82,40 +82,45 @@ export class LayerViewer {
     return [{ geom: this.before, x: 0, w, label: hasAfter ? 'before' : '' }];
   }
 
-  /** Fits the view to the printed (non-travel) extent of the current layer. */
+  /**
+   * Fits the view to the current layer's printed (non-travel) extent. The
+   * extent drops the outermost 1 % of segment ends on each side, so that a
+   * purge line at the bed's edge does not shrink the part to a speck.
+   */
   fit() {
     const g = this.before ?? this.after;
     if (!g) return;
-    let minX = Infinity;
-    let minY = Infinity;
-    let maxX = -Infinity;
-    let maxY = -Infinity;
-    const scan = (onlyPrinting) => {
+    const xs = [];
+    const ys = [];
+    const collect = (onlyPrinting) => {
       const { xy, kind } = g;
       for (let i = 0, n = kind.length; i < n; i++) {
         if (onlyPrinting && kind[i] === 0) continue;
         const o = 4 * i;
-        for (let k = 0; k < 4; k += 2) {
-          const x = xy[o + k];
-          const y = xy[o + k + 1];
-          if (x < minX) minX = x;
-          if (x > maxX) maxX = x;
-          if (y < minY) minY = y;
-          if (y > maxY) maxY = y;
-        }
+        xs.push(xy[o], xy[o + 2]);
+        ys.push(xy[o + 1], xy[o + 3]);
       }
     };
-    scan(true);
-    if (!Number.isFinite(minX)) scan(false);
-    if (!Number.isFinite(minX)) {
-      minX = minY = 0;
-      maxX = maxY = 100;
+    collect(true);
+    if (xs.length === 0) collect(false);
+    if (xs.length === 0) {
+      this.fitBox(0, 0, 100, 100);
+      return;
     }
+    const f = (a) => Float64Array.from(a).sort();
+    const sx = f(xs);
+    const sy = f(ys);
+    const lo = Math.floor(0.01 * (sx.length - 1));
+    const hi = Math.ceil(0.99 * (sx.length - 1));
+    this.fitBox(sx[lo], sy[lo], sx[hi], sy[hi]);
+  }
+
+  fitBox(minX, minY, maxX, maxY) {
     const pane = this.panes()[0];
     const h = this.canvas.clientHeight || 1;
     const spanX = Math.max(maxX - minX, 1);
     const spanY = Math.max(maxY - minY, 1);
-    const scale = 0.9 * Math.min((pane.w || 1) / spanX, h / spanY);
+    const scale = 0.85 * Math.min((pane.w || 1) / spanX, h / spanY);
     this.view = { cx: (minX + maxX) / 2, cy: (minY + maxY) / 2, scale: Math.min(MAX_SCALE, Math.max(MIN_SCALE, scale)) };
     this.requestDraw();
   }

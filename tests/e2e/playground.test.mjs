@@ -10,6 +10,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { spawnSync } from 'node:child_process';
 import { chromium } from 'playwright-core';
 import { startServer } from '../../scripts/serve.mjs';
 
@@ -208,6 +209,243 @@ test('dropping a file on the page analyzes it', async () => {
   const report = await reportJson();
   assert.ok(report.moves >= 2, `moves = ${report.moves}`);
   assert.equal(await page.evaluate(() => document.body.classList.contains('dragging')), false);
+});
+
+// ── Layer viewer, hash state ───────────────────────────────────────────────
+
+// Number of canvas pixels that are not fully transparent (what the viewer drew).
+async function inkedPixels() {
+  return page.evaluate(() => {
+    const c = document.querySelector('[data-testid="viewer"]');
+    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    let n = 0;
+    for (let i = 3; i < d.length; i += 4) if (d[i] !== 0) n++;
+    return n;
+  });
+}
+
+// A cheap fingerprint of the canvas, to see that a redraw changed something.
+async function canvasHash() {
+  return page.evaluate(() => {
+    const c = document.querySelector('[data-testid="viewer"]');
+    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    let h = 0;
+    for (let i = 0; i < d.length; i += 7) h = (h * 31 + d[i]) | 0;
+    return h;
+  });
+}
+
+async function waitForLayer(index) {
+  await page.waitForFunction(
+    (i) => {
+      const c = document.querySelector('[data-testid="viewer"]');
+      return c.dataset.layer === String(i) && Number(c.dataset.segments) > 0;
+    },
+    index,
+    { timeout: STEP_TIMEOUT },
+  );
+  // The draw happens on the next animation frame.
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+}
+
+async function setSlider(index) {
+  await byTestId('layer-slider').evaluate((s, i) => {
+    s.value = String(i);
+    s.dispatchEvent(new Event('input', { bubbles: true }));
+  }, index);
+}
+
+test('the layer viewer draws the toolpath and the slider changes the layer', async () => {
+  await page.goto(baseUrl);
+  await waitForStatus('ready', 'demo.gcode');
+  await waitForLayer(0);
+  const inked = await inkedPixels();
+  assert.ok(inked > 2_000, `the viewer canvas is nearly blank (${inked} pixels drawn)`);
+  const max = Number(await byTestId('layer-slider').getAttribute('max'));
+  const report = await reportJson();
+  assert.ok(Math.abs(max + 1 - report.layers) <= 1, `slider max ${max} vs ${report.layers} layers`);
+  const before = await canvasHash();
+  await setSlider(10);
+  await waitForLayer(10);
+  assert.notEqual(await canvasHash(), before, 'layer 10 looks exactly like layer 0');
+  assert.match(await byTestId('layer-number').textContent(), /^11 \/ \d+$/);
+  assert.match(new URL(page.url()).hash, /layer=10\b/);
+});
+
+test('colour by feature, speed and curvature, with a legend', async () => {
+  const hashes = new Set([await canvasHash()]);
+  assert.match(await byTestId('legend').textContent(), /wall/);
+  for (const mode of ['speed', 'curvature']) {
+    await byTestId('color-by').selectOption(mode);
+    await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    hashes.add(await canvasHash());
+    assert.match(await byTestId('legend').textContent(), mode === 'speed' ? /mm\/s/ : /1\/mm/);
+    assert.match(new URL(page.url()).hash, new RegExp(`color=${mode}`));
+  }
+  assert.equal(hashes.size, 3, 'the three colourings should look different');
+  await byTestId('show-travel').check();
+  assert.match(new URL(page.url()).hash, /travel=1/);
+});
+
+test('the URL hash restores the view on load', async () => {
+  await page.goto(`${baseUrl}#layer=7&color=speed&vtg.tolerance_mm=0.07`);
+  await page.reload(); // a plain hash change on the same URL would not reload the page
+  await waitForStatus('ready', 'demo.gcode');
+  await waitForLayer(7);
+  assert.equal(await byTestId('color-by').inputValue(), 'speed');
+  assert.equal(await byTestId('opt-vtg-tolerance').inputValue(), '0.07');
+  assert.match(await byTestId('legend').textContent(), /mm\/s/);
+  // Never the file: the hash holds view state only.
+  assert.doesNotMatch(decodeURIComponent(new URL(page.url()).hash), /gcode|G1/);
+  await byTestId('color-by').selectOption('feature');
+  await byTestId('opt-vtg-tolerance').fill('');
+  await byTestId('opt-vtg-tolerance').dispatchEvent('change');
+  assert.doesNotMatch(new URL(page.url()).hash, /tolerance/);
+});
+
+// ── Actions, compared with the native CLI ─────────────────────────────────
+
+const cli = path.join(repoRoot, 'target', 'release', 'quietpath');
+const MULTIAXIS = 'multiaxis-xyzbc_zhang-ral2021_model1.gcode';
+const JOB_TIMEOUT = 180_000;
+
+// Runs the CLI; returns { ok, json, output (Buffer | null), ms, stderr }.
+function runCli(job, file) {
+  const out = path.join(os.tmpdir(), `quietpath-e2e-${process.pid}-${job}.gcode`);
+  fs.rmSync(out, { force: true });
+  const args = job === 'vibration' || job === 'analyze' ? [job, file, '--json'] : [job, file, '-o', out, '--json'];
+  const t0 = process.hrtime.bigint();
+  const r = spawnSync(cli, args, { maxBuffer: 1 << 30, encoding: 'utf8' });
+  const ms = Number(process.hrtime.bigint() - t0) / 1e6;
+  let json = null;
+  try {
+    json = r.status === 0 ? JSON.parse(r.stdout) : null;
+  } catch {
+    json = null;
+  }
+  const output = fs.existsSync(out) ? fs.readFileSync(out) : null;
+  return { ok: r.status === 0 && json !== null, json, output, ms, stderr: r.stderr };
+}
+
+async function hasCapability(job) {
+  await page.waitForFunction(() => document.body.dataset.capabilities !== undefined);
+  return (await page.evaluate(() => document.body.dataset.capabilities)).split(' ').includes(job);
+}
+
+async function loadCorpus(name) {
+  const current = await byTestId('filename').textContent();
+  if (current === name && (await byTestId('status').textContent()) === 'ready') return;
+  await uploadPath(path.join(corpusDir, name));
+  await page.waitForFunction(
+    (n) => document.querySelector('[data-testid="filename"]').textContent === n && ['ready', 'error'].includes(document.querySelector('[data-testid="status"]').textContent),
+    name,
+    { timeout: JOB_TIMEOUT },
+  );
+  assert.equal(await byTestId('status').textContent(), 'ready', await byTestId('error').textContent());
+}
+
+async function runAction(job) {
+  await byTestId(`run-${job}`).click();
+  await page.waitForFunction(() => !document.body.classList.contains('busy'), null, { timeout: JOB_TIMEOUT });
+  const status = await byTestId('status').textContent();
+  assert.equal(status, 'ready', `${job}: ${await byTestId('error').textContent()}`);
+  return reportJson();
+}
+
+// The CLI's JSON may carry fields about its own output file; every field the
+// page shows must equal the CLI's.
+function assertSameAsCli(t, job, browser, native) {
+  const extra = Object.keys(native).filter((k) => !(k in browser));
+  if (extra.length) t.diagnostic(`${job}: fields only in the CLI's JSON: ${extra.join(', ')}`);
+  const cliSubset = Object.fromEntries(Object.keys(browser).map((k) => [k, native[k]]));
+  assert.deepEqual(browser, cliSubset, `${job}: report-json differs from \`quietpath ${job} --json\``);
+}
+
+for (const [job, file] of [
+  ['vtg', BENCHY],
+  ['infill', BENCHY],
+  ['smooth', MULTIAXIS],
+  ['vibration', BENCHY],
+]) {
+  test(`${job}: report-json equals the native CLI's JSON`, { timeout: 2 * JOB_TIMEOUT }, async (t) => {
+    await loadCorpus(file);
+    if (!(await hasCapability(job))) {
+      assert.equal(await byTestId(`run-${job}`).isDisabled(), true);
+      assert.match(await byTestId(`run-${job}`).textContent(), /not available in this build/i);
+      t.skip(`${job} is not exported by this build of the package`);
+      return;
+    }
+    const native = runCli(job, path.join(corpusDir, file));
+    assert.ok(native.ok, `the package has ${job} but \`quietpath ${job}\` failed: ${native.stderr.slice(0, 500)}`);
+    const browser = await runAction(job);
+    assert.ok(!('output' in browser), 'the optimized bytes must not be in report-json');
+    assertSameAsCli(t, job, browser, native.json);
+    if (job === 'vibration') {
+      assert.ok(Number(await byTestId('chart-psd').getAttribute('data-series')) >= 1, 'no PSD chart');
+      assert.ok(Number(await byTestId('chart-layers').getAttribute('data-series')) >= 1, 'no per-layer chart');
+      // With an optimized output (from VTG), run it there too: PSD before and after.
+      if (await page.locator('[data-testid="opt-vibration-target"] option[value="output"]').isEnabled()) {
+        await byTestId('opt-vibration-target').selectOption('output');
+        await runAction('vibration');
+        assert.equal(await byTestId('chart-psd').getAttribute('data-series'), '2', 'PSD before and after');
+        await byTestId('opt-vibration-target').selectOption('input');
+      }
+      return;
+    }
+    // The optimized G-code: a download identical to the CLI's -o file.
+    assert.equal(await byTestId('download-gcode').isEnabled(), true);
+    const [download] = await Promise.all([page.waitForEvent('download'), byTestId('download-gcode').click()]);
+    const bytes = fs.readFileSync(await download.path());
+    if (native.output) assert.ok(bytes.equals(native.output), `${job}: the downloaded G-code differs from the CLI's -o file`);
+    assert.ok((await byTestId('compare-table').locator('tbody tr').count()) > 0, 'empty before/after table');
+    const chart = { infill: 'chart-infill', smooth: 'chart-orientation' }[job];
+    if (chart) assert.ok(Number(await byTestId(chart).getAttribute('data-series')) >= 1, `no ${chart}`);
+    // The viewer offers the optimized output.
+    assert.equal(await byTestId('view-mode').isEnabled(), true);
+  });
+}
+
+test('analyze of the 34 MB corpus file in the worker is within 2× of the native CLI', { timeout: 4 * JOB_TIMEOUT }, async (t) => {
+  const name = 'curaengine-4.13.0_extruder-idler-x2.5_large.gcode';
+  const file = path.join(corpusDir, name);
+  assert.ok(fs.existsSync(cli), `no CLI at ${cli} (make cli)`);
+  // Best of 3 on both sides: the machine is shared, best-of is the least noisy figure.
+  const nativeMs = Math.min(...[0, 1, 2].map(() => {
+    const r = runCli('analyze', file);
+    assert.ok(r.ok, r.stderr);
+    return r.ms;
+  }));
+  const browser = [];
+  for (let i = 0; i < 3; i++) {
+    const t0 = Date.now();
+    await uploadPath(file);
+    await page.waitForFunction(() => ['ready', 'error'].includes(document.querySelector('[data-testid="status"]').textContent) && document.querySelector('[data-testid="elapsed"]').dataset.ms, null, { timeout: JOB_TIMEOUT });
+    assert.equal(await byTestId('status').textContent(), 'ready');
+    const ms = Number(await byTestId('elapsed').getAttribute('data-ms'));
+    const totalMs = Number(await byTestId('elapsed').getAttribute('data-total-ms'));
+    browser.push({ ms, totalMs, pageMs: Date.now() - t0 });
+  }
+  const best = browser.reduce((a, b) => (b.totalMs < a.totalMs ? b : a));
+  t.diagnostic(`native CLI (process wall time, best of 3): ${nativeMs.toFixed(0)} ms`);
+  t.diagnostic(`worker, best of 3: analyze ${best.ms.toFixed(0)} ms, load request (copy into wasm + analyze) ${best.totalMs.toFixed(0)} ms, page (pick to ready) ${best.pageMs} ms`);
+  t.diagnostic(`ratio (worker load request / CLI): ${(best.totalMs / nativeMs).toFixed(2)}×`);
+  assert.ok(best.totalMs <= 2 * nativeMs, `worker ${best.totalMs.toFixed(0)} ms > 2 × CLI ${nativeMs.toFixed(0)} ms`);
+  const report = await reportJson();
+  assert.deepEqual(report, runCli('analyze', file).json, 'the worker report differs from the CLI');
+});
+
+test('screenshot of the playground with the viewer (docs/screenshot.png)', { timeout: JOB_TIMEOUT }, async () => {
+  await loadCorpus(BENCHY);
+  await setSlider(40);
+  await waitForLayer(40);
+  await byTestId('fit').click();
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  await page.evaluate(() => window.scrollTo(0, 0));
+  const file = path.join(repoRoot, 'docs', 'screenshot.png');
+  fs.mkdirSync(path.dirname(file), { recursive: true });
+  await page.screenshot({ path: file, clip: { x: 0, y: 0, width: 1280, height: 1300 }, fullPage: true });
+  assert.ok(fs.statSync(file).size > 30_000, 'screenshot is suspiciously small');
+  assert.deepEqual(pageErrors, [], 'uncaught page errors');
 });
 
 test('a crashing worker is reported and replaced', async () => {
