@@ -225,7 +225,9 @@ function handleJob(msg) {
     if (typeof s.session[job] === 'function') {
       result = job === 'analyze' ? s.session.analyze(progress) : s.session[job](options ?? {}, progress);
     } else if (typeof qp[job] === 'function') {
-      result = job === 'analyze' ? qp.analyze(s.bytes, s.options, progress) : qp[job](s.bytes, options ?? {}, progress);
+      // The free vtg() takes the analyze options inside its own (a Session has them already).
+      const opts = job === 'vtg' && Object.keys(s.options).length && !options?.analyze ? { ...options, analyze: s.options } : options ?? {};
+      result = job === 'analyze' ? qp.analyze(s.bytes, s.options, progress) : qp[job](s.bytes, opts, progress);
     } else {
       throw new Error(`${job} is not available in this build`);
     }

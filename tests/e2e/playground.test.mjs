@@ -362,9 +362,11 @@ function assertSameAsCli(t, job, browser, native) {
 }
 
 for (const [job, file] of [
+  // smooth first: the other three share one loaded file, so vibration can
+  // also run on the optimized output of the one before.
+  ['smooth', MULTIAXIS],
   ['vtg', BENCHY],
   ['infill', BENCHY],
-  ['smooth', MULTIAXIS],
   ['vibration', BENCHY],
 ]) {
   test(`${job}: report-json equals the native CLI's JSON`, { timeout: 2 * JOB_TIMEOUT }, async (t) => {
@@ -404,6 +406,140 @@ for (const [job, file] of [
     assert.equal(await byTestId('view-mode').isEnabled(), true);
   });
 }
+
+// The job UI against a package that has every capability of the API contract:
+// a stand-in module re-exports the real package and adds vtg, infill, smooth and
+// vibration returning results of the documented shape (real analyze reports for
+// before/after). Checks the page's side: tables, charts, downloads, the viewer's
+// before/after; the real numbers are checked against the CLI above.
+const MOCK_PACKAGE = `
+import init, * as real from './quietpath.js?real';
+export default init;
+export * from './quietpath.js?real';
+const enc = new TextEncoder();
+const bytesOf = (input) => (typeof input === 'string' ? enc.encode(input) : new Uint8Array(input));
+function optimized(input, tag) {
+  const a = bytesOf(input);
+  const b = enc.encode('; mock ' + tag + '\\n');
+  const out = new Uint8Array(a.length + b.length);
+  out.set(a);
+  out.set(b, a.length);
+  return out;
+}
+export function vtg(input, options = {}, progress) {
+  progress?.(0.5);
+  const output = optimized(input, 'vtg');
+  const before = real.analyze(bytesOf(input));
+  const after = real.analyze(output);
+  return {
+    tolerance_mm: options.tolerance_mm ?? 0.05, max_deviation_mm: 0.0421, before, after,
+    table1: { time_s: { before: before.time_s, after: after.time_s, change: 0 } },
+    table2: [{ metric: 'energy_j', before: before.energy.total_j, after: after.energy.total_j }],
+    output,
+  };
+}
+export function infill(input, options = {}) {
+  const output = optimized(input, 'infill');
+  const candidates = [];
+  for (const pattern of ['rectilinear', 'zigzag']) for (const angle_deg of [0, 30, 45, 60, 90])
+    for (const rotation_deg of [0, 90]) candidates.push({ pattern, angle_deg, rotation_deg, thesis_j: 1000 + angle_deg, total_j: 5000 + 10 * Math.sin(angle_deg / 30) + (pattern === 'zigzag' ? 50 : 0) + rotation_deg, time_s: 60, length_mm: 1000 });
+  return { before: real.analyze(bytesOf(input)), after: real.analyze(output), best: { pattern: 'rectilinear', angle_deg: 0, rotation_deg: 0 }, candidates, output };
+}
+export function smooth(input) {
+  const n = 500;
+  const b = Array.from({ length: n }, (_, i) => 20 * Math.sin(i / 20) + (i % 7));
+  return {
+    points: n, corrected: 321, max_angle_to_original_deg: 2.5,
+    before: { max_jerk_deg: 4, mean_step_deg: 1.2 }, after: { max_jerk_deg: 1, mean_step_deg: 0.4 },
+    series: { b_before: b, b_after: b.map((v, i) => 20 * Math.sin(i / 20)), c_before: b.map((v) => v * 2), c_after: b.map((v, i) => 40 * Math.sin(i / 20)) },
+    output: optimized(input, 'smooth'),
+  };
+}
+export function vibration(input) {
+  const after = new TextDecoder().decode(bytesOf(input).subarray(-16)).includes('mock');
+  const freqs = Array.from({ length: 256 }, (_, i) => i * 2);
+  return {
+    natural_frequencies_hz: [41.2, 57.9],
+    deviation_mm: { max: after ? 0.02 : 0.05, min: 0, mean: after ? 0.004 : 0.01 },
+    layers: Array.from({ length: 50 }, (_, i) => ({ layer: i, amplitude: (after ? 0.5 : 1) * (1 + Math.sin(i / 5)) })),
+    psd: { fs_hz: 512, window: 256, freqs, power: freqs.map((f) => (after ? 0.3 : 1) / (1 + Math.abs(f - 41) / 5)), peaks: [{ hz: 41.2, power: 1 }] },
+  };
+}
+`;
+
+test('the job UI with every capability: tables, charts, downloads, before/after viewer', { timeout: JOB_TIMEOUT }, async () => {
+  const tab = await context.newPage();
+  tab.setDefaultTimeout(STEP_TIMEOUT);
+  const errors = [];
+  tab.on('pageerror', (e) => errors.push(String(e)));
+  await tab.route('**/pkg/quietpath.js', (route) => route.fulfill({ status: 200, contentType: 'text/javascript', body: MOCK_PACKAGE }));
+  const id = (x) => tab.locator(`[data-testid="${x}"]`);
+  const idle = async () => {
+    await tab.waitForFunction(() => !document.body.classList.contains('busy') && document.querySelector('[data-testid="status"]').textContent !== 'loading');
+    assert.equal(await id('status').textContent(), 'ready', await id('error').textContent());
+  };
+  await tab.goto(baseUrl);
+  await tab.waitForFunction(() => document.querySelector('[data-testid="status"]').textContent === 'ready');
+  await tab.waitForFunction(() => (document.body.dataset.capabilities ?? '').split(' ').length >= 5);
+  for (const job of ['vtg', 'infill', 'smooth', 'vibration']) assert.equal(await id(`run-${job}`).isEnabled(), true, `${job} button`);
+  const demo = fs.readFileSync(path.join(wwwRoot, 'demo', 'demo.gcode'));
+
+  // VTG: before/after table, paper tables, download, viewer side by side.
+  await id('opt-vtg-tolerance').fill('0.05');
+  await id('run-vtg').click();
+  await idle();
+  const vtgJson = JSON.parse(await id('report-json').textContent());
+  assert.equal(vtgJson.tolerance_mm, 0.05);
+  assert.ok(!('output' in vtgJson));
+  const rows = await id('compare-table').locator('tbody tr').allTextContents();
+  const metrics = ['Print time', 'Energy', 'CO₂', 'Material', 'Deviation'];
+  if (vtgJson.before.toolpath?.n_turning !== undefined) metrics.push('Turning points');
+  if (vtgJson.before.toolpath?.mean_chord_error_mm !== undefined) metrics.push('Mean chord error');
+  for (const m of metrics) assert.ok(rows.some((r) => r.startsWith(m)), `no ${m} row in ${rows}`);
+  assert.equal(await id('paper-tables').locator('table').count(), 2);
+  const [download] = await Promise.all([tab.waitForEvent('download'), id('download-gcode').click()]);
+  const got = fs.readFileSync(await download.path());
+  assert.ok(got.equals(Buffer.concat([demo, Buffer.from('; mock vtg\n')])), 'downloaded G-code is not the job output');
+  assert.match(download.suggestedFilename(), /demo\.vtg\.gcode$/);
+  assert.equal(await id('view-mode').inputValue(), 'side');
+  await tab.waitForFunction(() => /after/.test(document.querySelector('[data-testid="layer-info"]').textContent));
+  assert.match(tab.url(), /vtg\.tolerance_mm=0\.05/);
+  assert.match(tab.url(), /view=side/);
+
+  // Infill: one energy line per pattern.
+  await id('run-infill').click();
+  await idle();
+  assert.equal(await id('chart-infill').getAttribute('data-series'), '2');
+  assert.equal(await id('chart-infill').locator('canvas').count() > 0, true);
+  assert.match(await id('result-line').textContent(), /rectilinear/);
+
+  // Smoothing: rotary axes before/after; generic metrics rows.
+  await id('run-smooth').click();
+  await idle();
+  assert.equal(await id('chart-orientation').getAttribute('data-series'), '4');
+  assert.ok((await id('compare-table').textContent()).includes('max jerk deg'));
+
+  // Vibration on the file, then on the optimized output: PSD before and after.
+  await id('run-vibration').click();
+  await idle();
+  assert.equal(await id('chart-psd').getAttribute('data-series'), '1');
+  await id('opt-vibration-target').selectOption('output');
+  await id('run-vibration').click();
+  await idle();
+  assert.equal(await id('chart-psd').getAttribute('data-series'), '2');
+  assert.equal(await id('chart-layers').getAttribute('data-series'), '2');
+  assert.match(await id('compare-table').textContent(), /Deviation \(max\)/);
+  await tab.screenshot({ path: path.join(os.tmpdir(), 'playground-jobs.png'), fullPage: true });
+  if (process.env.JOBS_CLIP) await tab.screenshot({ path: path.join(os.tmpdir(), 'playground-jobs-clip.png'), fullPage: true, clip: { x: 0, y: Number(process.env.JOBS_CLIP), width: 1280, height: 1400 } });
+
+  // Cancel after a job: the next job re-loads the file into a fresh worker.
+  await tab.evaluate(() => document.querySelector('[data-testid="cancel"]').click());
+  await id('opt-vibration-target').selectOption('input');
+  await id('run-vibration').click();
+  await idle();
+  assert.deepEqual(errors, []);
+  await tab.close();
+});
 
 test('analyze of the 34 MB corpus file in the worker is within 2× of the native CLI', { timeout: 4 * JOB_TIMEOUT }, async (t) => {
   const name = 'curaengine-4.13.0_extruder-idler-x2.5_large.gcode';
