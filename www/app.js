@@ -521,6 +521,8 @@ let layerWanted = false;
 async function getLayer(which, index) {
   const key = `${fileToken}:${which}:${index}`;
   if (layerCache.has(key)) return layerCache.get(key);
+  // The first layer of a file makes the worker read the whole toolpath (seconds on 34 MB).
+  if (layerCounts[which] === 0) els.layerInfo.textContent = `reading the ${which === 'after' ? 'optimized ' : ''}toolpath…`;
   const g = await client.layer(which, index);
   layerCounts[which] = g.count;
   layerCache.set(key, g);

@@ -46,9 +46,10 @@ export class LayerViewer {
 
   /** Sets the geometry to draw; `after` may be null. Keeps the view. */
   setLayers(before, after) {
+    const panes = this.panes().length;
     this.before = before;
     this.after = after;
-    if (!this.view) this.fit();
+    if (!this.view || this.panes().length !== panes) this.fit();
     this.requestDraw();
   }
 
@@ -61,7 +62,10 @@ export class LayerViewer {
   }
 
   set(key, value) {
+    const panes = this.panes().length;
     this[key] = value;
+    // One pane to two (or back): the old scale would crop, fit again.
+    if (this.view && this.panes().length !== panes) this.fit();
     this.requestDraw();
   }
 
