@@ -235,6 +235,10 @@ function jobOptions(form) {
   const options = {};
   for (const input of form.elements) {
     if (!input.name || input.name === 'target') continue;
+    if (input.type === 'checkbox') {
+      if (input.checked) options[input.name] = true;
+      continue;
+    }
     const raw = String(input.value ?? '').trim();
     if (raw === '') continue;
     if (input.type === 'number') {
@@ -385,6 +389,12 @@ function compareRows(result, job) {
       if (isNum(before[k]) || isNum(after[k])) rows.push({ name: k.replaceAll('_', ' '), before: before[k], after: after[k], format: (v) => formatByKey(k, v) });
     }
   }
+  if (isNum(result.planned_time_before_s) && isNum(result.planned_time_after_s)) {
+    rows.unshift({ name: 'Print time (planned)', before: result.planned_time_before_s, after: result.planned_time_after_s, format: formatDuration });
+  }
+  if (isNum(result.max_tip_deviation_mm)) {
+    rows.push({ name: 'Tool-tip deviation (max)', before: 0, after: result.max_tip_deviation_mm, format: (v) => `${v.toFixed(4)} mm`, noChange: true });
+  }
   if (job === 'vtg' && isNum(result.max_deviation_mm)) {
     rows.push({ name: 'Deviation (max)', before: 0, after: result.max_deviation_mm, format: (v) => `${v.toFixed(4)} mm`, noChange: true });
   }
@@ -394,7 +404,11 @@ function compareRows(result, job) {
 function vibrationCompare() {
   const b = vibrationRuns.input;
   const a = vibrationRuns.output;
-  const mean = (r) => (Array.isArray(r?.layers) && r.layers.length ? r.layers.reduce((s, l) => s + (l.amplitude ?? 0), 0) / r.layers.length : null);
+  const meanOf = (r, key) => {
+    const v = Array.isArray(r?.layers) ? r.layers.map((l) => l[key]).filter(isNum) : [];
+    return v.length ? v.reduce((x, y) => x + y, 0) / v.length : null;
+  };
+  const mean = (r) => meanOf(r, 'amplitude');
   const peak = (r) => {
     const p = r?.psd?.peaks?.[0];
     return p ? p.hz : null;
@@ -403,7 +417,8 @@ function vibrationCompare() {
   return [
     { name: 'Deviation (max)', before: b?.deviation_mm?.max, after: a?.deviation_mm?.max, format: mm },
     { name: 'Deviation (mean)', before: b?.deviation_mm?.mean, after: a?.deviation_mm?.mean, format: mm },
-    { name: 'Mean layer amplitude', before: mean(b), after: mean(a), format: (v) => formatScalar(v) },
+    { name: 'Mean layer amplitude', before: mean(b), after: mean(a), format: mm },
+    { name: 'Mean layer acceleration RMS', before: meanOf(b, 'acceleration_rms'), after: meanOf(a, 'acceleration_rms'), format: (v) => `${fmt2.format(v)} m/s²` },
     { name: 'Strongest PSD peak', before: peak(b), after: peak(a), format: (v) => `${fmt1.format(v)} Hz`, noChange: true },
   ].filter((r) => isNum(r.before) || isNum(r.after));
 }
@@ -489,21 +504,25 @@ function renderCharts(job, r) {
     }
   }
   if (job === 'smooth' && r.series) {
+    // Two shapes: { axes, point, first_before, first_after, second_before, second_after }
+    // (the crate's Series, thinned to ≤ 2000 points) or { b_before, b_after, c_before, c_after }.
     const s = r.series;
-    const n = Math.max(...['b_before', 'b_after', 'c_before', 'c_after'].map((k) => (Array.isArray(s[k]) ? s[k].length : 0)));
+    const [ax1, ax2] = Array.isArray(s.axes) && s.axes.length >= 2 ? s.axes : ['B', 'C'];
+    const cols = s.first_before ? [s.first_before, s.first_after, s.second_before, s.second_after] : [s.b_before, s.b_after, s.c_before, s.c_after];
+    const n = Math.max(...cols.map((a) => (Array.isArray(a) ? a.length : 0)));
     if (n > 0) {
-      const x = Array.from({ length: n }, (_, i) => i);
-      const pad = (a) => (Array.isArray(a) ? (a.length === n ? a : [...a, ...new Array(n - a.length).fill(null)]) : new Array(n).fill(null));
+      const x = Array.isArray(s.point) && s.point.length === n ? s.point : Array.from({ length: n }, (_, i) => i);
+      const pad = (a) => (Array.isArray(a) ? (a.length === n ? a : [...a, ...new Array(Math.max(0, n - a.length)).fill(null)].slice(0, n)) : new Array(n).fill(null));
       lineChart(els.chartOrientation, {
         x,
         xLabel: 'point',
         yLabel: 'angle, °',
         points: false,
         series: [
-          { label: 'B before', values: pad(s.b_before), color: '#9ab8ae' },
-          { label: 'B after', values: pad(s.b_after), color: '#1f6f5c' },
-          { label: 'C before', values: pad(s.c_before), color: '#f2b7a6' },
-          { label: 'C after', values: pad(s.c_after), color: '#e4572e' },
+          { label: `${ax1} before`, values: pad(cols[0]), color: '#9ab8ae' },
+          { label: `${ax1} after`, values: pad(cols[1]), color: '#1f6f5c' },
+          { label: `${ax2} before`, values: pad(cols[2]), color: '#f2b7a6' },
+          { label: `${ax2} after`, values: pad(cols[3]), color: '#e4572e' },
         ],
       });
     }
@@ -596,7 +615,9 @@ function writeHash() {
   p.set('view', els.viewMode.value);
   for (const form of els.actionForms) {
     for (const input of form.elements) {
-      if (input.name && String(input.value).trim() !== '' && !(input.name === 'target' && input.value === 'input')) {
+      if (input.type === 'checkbox') {
+        if (input.checked) p.set(`${form.dataset.job}.${input.name}`, '1');
+      } else if (input.name && String(input.value).trim() !== '' && !(input.name === 'target' && input.value === 'input')) {
         p.set(`${form.dataset.job}.${input.name}`, String(input.value).trim());
       }
     }
@@ -617,7 +638,8 @@ function readHash() {
     for (const input of form.elements) {
       if (!input.name) continue;
       const v = p.get(`${form.dataset.job}.${input.name}`);
-      if (v !== null) input.value = v;
+      if (input.type === 'checkbox') input.checked = v === '1';
+      else if (v !== null) input.value = v;
     }
   }
   viewer.colorBy = els.colorBy.value;
