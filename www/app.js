@@ -1031,3 +1031,9 @@ resetOptimized();
 updateActions();
 client.warm();
 run(demoSource());
+
+// Offline once loaded (sw.js: network first, cache as the fallback). Not
+// essential, so a browser or context without service workers is fine.
+if ('serviceWorker' in navigator && /^https?:$/.test(location.protocol)) {
+  navigator.serviceWorker.register('./sw.js').catch(() => {});
+}

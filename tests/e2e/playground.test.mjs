@@ -53,7 +53,9 @@ before(async () => {
       '--disable-quic',
     ],
   });
-  context = await browser.newContext({ viewport: { width: 1280, height: 900 } });
+  // No service worker here: page.route() (the crash test) does not see requests
+  // a service worker makes. The offline test has its own context with one.
+  context = await browser.newContext({ viewport: { width: 1280, height: 900 }, serviceWorkers: 'block' });
   page = await context.newPage();
   page.setDefaultTimeout(STEP_TIMEOUT);
   // Every request the page and its worker make (context-level also sees workers).
@@ -637,6 +639,31 @@ test('a crashing worker is reported and replaced', async () => {
   assert.ok(JSON.parse(await tab.locator('[data-testid="report-json"]').textContent()).layers > 0);
   assert.ok(served >= 2, 'the worker was not recreated');
   await tab.close();
+});
+
+test('once loaded, the playground works offline', { timeout: JOB_TIMEOUT }, async () => {
+  const ctx = await browser.newContext({ viewport: { width: 1280, height: 900 } });
+  ctx.on('request', (req) => requests.push(req.url()));
+  const tab = await ctx.newPage();
+  tab.setDefaultTimeout(STEP_TIMEOUT);
+  const errors = [];
+  tab.on('pageerror', (e) => errors.push(String(e)));
+  const ready = (n) => tab.waitForFunction((name) => document.querySelector('[data-testid="status"]').textContent === 'ready' && document.querySelector('[data-testid="filename"]').textContent === name, n);
+  await tab.goto(baseUrl);
+  await ready('demo.gcode');
+  await tab.waitForFunction(() => navigator.serviceWorker?.controller, null, { timeout: STEP_TIMEOUT });
+  await ctx.setOffline(true);
+  await tab.reload();
+  await ready('demo.gcode');
+  await tab.waitForFunction(() => Number(document.querySelector('[data-testid="viewer"]').dataset.segments) > 0);
+  // A cancel starts a new worker (worker.js and the wasm fetched again): still fine offline.
+  await tab.locator('[data-testid="file"]').setInputFiles(path.join(corpusDir, 'curaengine-4.13.0_extruder-idler-x2.5_large.gcode'));
+  await tab.locator('[data-testid="cancel"]').click({ timeout: 2_000 }).catch(() => {});
+  await tab.locator('[data-testid="file"]').setInputFiles(path.join(corpusDir, BENCHY));
+  await ready(BENCHY);
+  assert.ok(Math.abs(JSON.parse(await tab.locator('[data-testid="report-json"]').textContent()).layers - 160) <= 1);
+  assert.deepEqual(errors, []);
+  await ctx.close();
 });
 
 test('no request leaves 127.0.0.1', async () => {
