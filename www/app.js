@@ -531,7 +531,14 @@ function renderCharts(job, r) {
 
 // ── Layer viewer ───────────────────────────────────────────────────────────
 
-const viewer = new LayerViewer(els.canvas, els.legend);
+const hoverInfo = $('hover-info');
+const viewer = new LayerViewer(els.canvas, els.legend, {
+  onHover(hit) {
+    hoverInfo.textContent = hit
+      ? `${hit.which ? `${hit.which}: ` : ''}${hit.kind} · ${fmt1.format(hit.speed)} mm/s · curvature ${hit.curvature.toFixed(3)} /mm · at ${fmt1.format(hit.x)}, ${fmt1.format(hit.y)} mm`
+      : '';
+  },
+});
 const layerCache = new Map(); // `${token}:${which}:${index}` → geometry
 const layerCounts = { before: 0, after: 0 };
 let layerLoading = false;

@@ -189,8 +189,21 @@ export class LayerViewer {
       c.setPointerCapture(e.pointerId);
       c.classList.add('dragging');
     });
+    let hoverFrame = 0;
+    let hoverAt = [0, 0];
     c.addEventListener('pointermove', (e) => {
-      if (!drag) return;
+      if (!drag) {
+        // Readout of the segment under the cursor, at most once per frame.
+        const r = c.getBoundingClientRect();
+        hoverAt = [e.clientX - r.left, e.clientY - r.top];
+        if (!hoverFrame) {
+          hoverFrame = requestAnimationFrame(() => {
+            hoverFrame = 0;
+            this.hooks.onHover?.(this.pick(...hoverAt));
+          });
+        }
+        return;
+      }
       const s = this.view.scale;
       this.view = { ...this.view, cx: drag.cx - (e.clientX - drag.x) / s, cy: drag.cy + (e.clientY - drag.y) / s };
       this.requestDraw();
@@ -201,6 +214,7 @@ export class LayerViewer {
       c.classList.remove('dragging');
       this.hooks.onViewChange?.();
     };
+    c.addEventListener('pointerleave', () => this.hooks.onHover?.(null));
     c.addEventListener('pointerup', end);
     c.addEventListener('pointercancel', end);
     c.addEventListener('dblclick', () => this.fit());
@@ -221,6 +235,40 @@ export class LayerViewer {
       this.view = v;
       this.requestDraw();
     });
+  }
+
+  /**
+   * The drawn segment nearest to CSS point (x, y), within a few pixels:
+   * { which, kind, speed, curvature } or null.
+   */
+  pick(x, y) {
+    if (!this.view) return null;
+    const { pane, wx, wy } = this.locate(x, y);
+    const g = pane.geom;
+    if (!g) return null;
+    const { xy, kind } = g;
+    const limit = 6 / this.view.scale;
+    let best = limit * limit;
+    let found = -1;
+    for (let i = 0, n = kind.length; i < n; i++) {
+      if (kind[i] === 0 && !this.showTravel) continue;
+      const o = 4 * i;
+      const x0 = xy[o];
+      const y0 = xy[o + 1];
+      const dx = xy[o + 2] - x0;
+      const dy = xy[o + 3] - y0;
+      const len2 = dx * dx + dy * dy;
+      const t = len2 > 0 ? Math.max(0, Math.min(1, ((wx - x0) * dx + (wy - y0) * dy) / len2)) : 0;
+      const ex = x0 + t * dx - wx;
+      const ey = y0 + t * dy - wy;
+      const d2 = ex * ex + ey * ey;
+      if (d2 < best) {
+        best = d2;
+        found = i;
+      }
+    }
+    if (found < 0) return null;
+    return { which: pane.label, kind: KINDS[kind[found]] ?? 'other', speed: g.speed[found], curvature: g.curvature[found], x: wx, y: wy };
   }
 
   /** Value range for speed / curvature colouring, shared by before and after. */

@@ -287,6 +287,21 @@ test('colour by feature, speed and curvature, with a legend', async () => {
   assert.equal(hashes.size, 3, 'the three colourings should look different');
   await byTestId('show-travel').check();
   assert.match(new URL(page.url()).hash, /travel=1/);
+  // Hovering a line names its feature and speed (layer 1: solid, so easy to hit).
+  await setSlider(0);
+  await waitForLayer(0);
+  await byTestId('viewer').scrollIntoViewIfNeeded();
+  const box = await byTestId('viewer').boundingBox();
+  let info = '';
+  for (let i = 1; i < 12 && !info; i++) {
+    for (let j = 1; j < 12 && !info; j++) {
+      await page.mouse.move(box.x + (box.width * i) / 12, box.y + (box.height * j) / 12);
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+      info = await byTestId('hover-info').textContent();
+    }
+  }
+  assert.match(info, /mm\/s/, `no hover readout anywhere on the canvas (${JSON.stringify(box)}, errors: ${pageErrors})`);
+  await page.mouse.move(0, 0);
 });
 
 test('the URL hash restores the view on load', async () => {
