@@ -480,7 +480,12 @@ export function smooth(input) {
     output: optimized(input, 'smooth'),
   };
 }
-export function vibration(input) {
+export function vibration(input, options = {}, progress) {
+  if (options.fs_hz === 999) {
+    // A slow job to cancel.
+    const t0 = Date.now();
+    while (Date.now() - t0 < 10000) progress?.((Date.now() - t0) / 10000);
+  }
   const after = new TextDecoder().decode(bytesOf(input).subarray(-16)).includes('mock');
   const freqs = Array.from({ length: 256 }, (_, i) => i * 2);
   return {
@@ -557,11 +562,26 @@ test('the job UI with every capability: tables, charts, downloads, before/after 
   await tab.screenshot({ path: path.join(os.tmpdir(), 'playground-jobs.png'), fullPage: true });
   if (process.env.JOBS_CLIP) await tab.screenshot({ path: path.join(os.tmpdir(), 'playground-jobs-clip.png'), fullPage: true, clip: { x: 0, y: Number(process.env.JOBS_CLIP), width: 1280, height: 1400 } });
 
-  // Cancel after a job: the next job re-loads the file into a fresh worker.
-  await tab.evaluate(() => document.querySelector('[data-testid="cancel"]').click());
+  // Cancel a running job: the next requests re-load the file and the
+  // optimized output into a fresh worker.
   await id('opt-vibration-target').selectOption('input');
+  await id('opt-vibration-fs').fill('999');
+  await id('run-vibration').click();
+  await tab.waitForFunction(() => document.querySelector('[data-testid="progress"]').value > 0);
+  await id('cancel').click();
+  await tab.waitForFunction(() => document.querySelector('[data-testid="status"]').textContent === 'cancelled');
+  await id('opt-vibration-fs').fill('');
   await id('run-vibration').click();
   await idle();
+  await id('view-mode').selectOption('overlay');
+  await tab.evaluate(() => {
+    const s = document.querySelector('[data-testid="layer-slider"]');
+    s.value = '5';
+    s.dispatchEvent(new Event('input', { bubbles: true }));
+  });
+  await tab.waitForFunction(() => document.querySelector('[data-testid="viewer"]').dataset.layer === '5' && /after/.test(document.querySelector('[data-testid="layer-info"]').textContent));
+  assert.ok(Number(await id('viewer').getAttribute('data-segments')) > 0);
+  assert.equal(await id('download-gcode').isEnabled(), true);
   assert.deepEqual(errors, []);
   await tab.close();
 });
