@@ -638,6 +638,7 @@ test('screenshot of the playground with the viewer (docs/screenshot.png with UPD
   await setSlider(40);
   await waitForLayer(40);
   await byTestId('fit').click();
+  await page.evaluate(() => document.activeElement?.blur());
   await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
   await page.evaluate(() => window.scrollTo(0, 0));
   // The README's screenshot is committed; it is rewritten on request
