@@ -624,6 +624,8 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
     return window.__maxFrameGap;
   });
   t.diagnostic(`longest main-thread frame gap during three 34 MB loads: ${maxGap.toFixed(0)} ms`);
+  // Loose (the machine is shared): catches work done on the main thread, which would take seconds.
+  assert.ok(maxGap < 1500, `the page froze for ${maxGap.toFixed(0)} ms`);
   const best = browser.reduce((a, b) => (b.totalMs < a.totalMs ? b : a));
   t.diagnostic(`native CLI (process wall time, best of 3): ${nativeMs.toFixed(0)} ms`);
   t.diagnostic(`worker, best of 3: analyze ${best.ms.toFixed(0)} ms, load request (copy into wasm + analyze) ${best.totalMs.toFixed(0)} ms, page (pick to ready) ${best.pageMs} ms`);
