@@ -130,20 +130,26 @@ export class JobClient {
     };
   }
 
-  /** Gives a fresh worker the sessions it lacks (after a cancel or crash). */
+  /**
+   * Gives a fresh worker the sessions it lacks (after a cancel or crash).
+   * Requests made at the same time (a job and a layer) share one re-load.
+   */
   async restore(needOutput) {
     const w = this.ensureWorker();
     if (!this.input) throw new JobError({ message: 'no file loaded' });
-    if (!w.has.input) {
-      const bytes = this.input.bytes.slice(0);
-      await this.post({ type: 'load', which: 'input', bytes, name: this.input.name, options: this.input.options, analyze: false }, { transfer: [bytes] }).promise;
-      w.has.input = true;
-    }
-    if (needOutput && this.output && !w.has.output) {
-      const bytes = this.output.slice(0);
-      await this.post({ type: 'load', which: 'output', bytes, name: 'output', options: this.input.options, analyze: false }, { transfer: [bytes] }).promise;
-      w.has.output = true;
-    }
+    const reload = (which, buffer) => {
+      w.reloading ??= {};
+      w.reloading[which] ??= (async () => {
+        const bytes = buffer.slice(0);
+        await this.post({ type: 'load', which, bytes, name: which, options: this.input.options, analyze: false }, { transfer: [bytes] }).promise;
+        w.has[which] = true;
+      })().finally(() => {
+        delete w.reloading[which];
+      });
+      return w.reloading[which];
+    };
+    if (!w.has.input) await reload('input', this.input.bytes);
+    if (needOutput && this.output && !w.has.output) await reload('output', this.output);
   }
 
   /**
