@@ -851,6 +851,9 @@ function renderWarnings(r) {
 function formatByKey(key, v) {
   if (!isNum(v)) return formatScalar(v);
   if (/_mm3$/.test(key)) return `${fmt1.format(v)} mm³`;
+  if (/_per_mm_deg$/.test(key)) return `${formatScalar(v)} °/mm`;
+  if (/_deg$/.test(key)) return `${formatScalar(v)}°`;
+  if (/_hz$/.test(key)) return `${formatScalar(v)} Hz`;
   if (/_mm$/.test(key)) return formatLength(v);
   if (/_s$/.test(key)) return formatDuration(v);
   if (/_ms$/.test(key)) return formatMs(v);
