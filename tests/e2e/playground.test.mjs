@@ -322,7 +322,7 @@ test('the URL hash restores the view on load', async () => {
 
 // ── Actions, compared with the native CLI ─────────────────────────────────
 
-const cli = path.join(repoRoot, 'target', 'release', 'quietpath');
+const cli = process.env.QUIETPATH_CLI ?? path.join(repoRoot, 'target', 'release', 'quietpath');
 const MULTIAXIS = 'multiaxis-xyzbc_zhang-ral2021_model1.gcode';
 const JOB_TIMEOUT = 180_000;
 
