@@ -2,7 +2,11 @@
 // scripts/serve.mjs and drives Debian's Chromium through playwright-core.
 //
 // Needs: www/pkg → the built wasm package (make does this), /usr/bin/chromium
-// (or $CHROMIUM), and the corpus in ../shared/corpus next to the repo.
+// (or $CHROMIUM), the corpus in ../shared/corpus next to the repo, and the
+// native CLI (target/release/quietpath, or $QUIETPATH_CLI) whose JSON the
+// browser's results must equal. The tests of a capability the loaded package
+// does not export yet are skipped (and its button must say so).
+// UPDATE_SCREENSHOT=1 rewrites docs/screenshot.png (the README's).
 
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
