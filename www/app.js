@@ -253,6 +253,12 @@ function jobOptions(form) {
       options[input.name] = raw;
     }
   }
+  // SmoothOptions.window is { points } or { millimetres } (types.d.ts).
+  if (form.dataset.job === 'smooth') {
+    if (isNum(options.window_mm)) options.window = { millimetres: options.window_mm };
+    else if (isNum(options.window)) options.window = { points: Math.round(options.window) };
+    delete options.window_mm;
+  }
   return options;
 }
 
