@@ -381,13 +381,51 @@ async function runAction(job) {
   return reportJson();
 }
 
+// Compares two JSON values of the same shape: { same: shapes and every
+// non-number equal and every number within tolerance, maxRel, maxAbs }.
+function compareJson(a, b, rel = 1e-9, abs = 1e-9) {
+  const r = { same: true, maxRel: 0, maxAbs: 0 };
+  const walk = (x, y) => {
+    if (typeof x === 'number' && typeof y === 'number') {
+      if (x === y) return;
+      const d = Math.abs(x - y);
+      r.maxAbs = Math.max(r.maxAbs, d);
+      r.maxRel = Math.max(r.maxRel, d / Math.max(Math.abs(x), Math.abs(y)));
+      if (!(d <= rel * Math.max(Math.abs(x), Math.abs(y)) + abs)) r.same = false;
+      return;
+    }
+    if (x === null || y === null || typeof x !== 'object' || typeof y !== 'object') {
+      if (x !== y) r.same = false;
+      return;
+    }
+    if (Array.isArray(x) !== Array.isArray(y) || Object.keys(x).length !== Object.keys(y).length) {
+      r.same = false;
+      return;
+    }
+    for (const k of Object.keys(x)) {
+      if (!(k in y)) r.same = false;
+      else walk(x[k], y[k]);
+    }
+  };
+  walk(a, b);
+  return r;
+}
+
 // The CLI's JSON may carry fields about its own output file; every field the
-// page shows must equal the CLI's.
+// page shows must equal the CLI's. Exactly when possible; jobs built on
+// transcendental functions (the dynamics' simulation: exp, sqrt, eigenvalues)
+// differ in the last bits between wasm and native code, so each number may
+// differ by 1e-9 relative plus 1e-9 absolute (the deviations are in mm: a
+// picometre), and the largest differences are reported.
 function assertSameAsCli(t, job, browser, native) {
   const extra = Object.keys(native).filter((k) => !(k in browser));
   if (extra.length) t.diagnostic(`${job}: fields only in the CLI's JSON: ${extra.join(', ')}`);
   const cliSubset = Object.fromEntries(Object.keys(browser).map((k) => [k, native[k]]));
-  assert.deepEqual(browser, cliSubset, `${job}: report-json differs from \`quietpath ${job} --json\``);
+  const c = compareJson(browser, cliSubset);
+  t.diagnostic(
+    `${job}: ${c.maxAbs === 0 ? 'identical to the CLI' : `largest difference from the CLI: ${c.maxRel.toExponential(2)} relative, ${c.maxAbs.toExponential(2)} absolute`}`,
+  );
+  if (!c.same) assert.deepEqual(browser, cliSubset, `${job}: report-json differs from \`quietpath ${job} --json\``);
 }
 
 for (const [job, file] of [
@@ -446,6 +484,13 @@ import init, * as real from './quietpath.js?real';
 export default init;
 export * from './quietpath.js?real';
 const enc = new TextEncoder();
+// The worker prefers Session methods: route them to the stand-ins below too.
+export class Session extends real.Session {
+  vtg(o, p) { return vtg(this.input(), o, p); }
+  infill(o, p) { return infill(this.input(), o, p); }
+  smooth(o, p) { return smooth(this.input(), o, p); }
+  vibration(o, p) { return vibration(this.input(), o, p); }
+}
 const bytesOf = (input) => (typeof input === 'string' ? enc.encode(input) : new Uint8Array(input));
 function optimized(input, tag) {
   const a = bytesOf(input);
