@@ -1,9 +1,17 @@
 // quietpath playground: page logic.
 //
 // Reads a G-code file (picker, drag-and-drop or the bundled demo) as an
-// ArrayBuffer, transfers it to worker.js, and renders the report it sends back.
-// Nothing is uploaded: the only requests this page makes are for its own files
-// (enforced by the Content-Security-Policy). See worker.js for the protocol.
+// ArrayBuffer and hands it to the job worker (jobs.js / worker.js), which keeps
+// it as a wasm Session; renders the analysis report, the layer viewer
+// (viewer.js), the optimization jobs' before/after tables and charts
+// (charts.js). Nothing is uploaded: the only requests this page makes are for
+// its own files (enforced by the Content-Security-Policy). The view state
+// (layer, colouring, job options) lives in the URL hash so a view can be
+// shared; the file itself never does.
+
+import { JobClient, Cancelled } from './jobs.js';
+import { LayerViewer } from './viewer.js';
+import { lineChart, clearChart, alignSeries, unionSeries } from './charts.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -31,10 +39,34 @@ const els = {
   download: $('download'),
   version: $('version'),
   dropOverlay: $('drop-overlay'),
+  // viewer
+  canvas: $('viewer'),
+  legend: $('legend'),
+  layerSlider: $('layer-slider'),
+  layerNumber: $('layer-number'),
+  layerInfo: $('layer-info'),
+  colorBy: $('color-by'),
+  showTravel: $('show-travel'),
+  viewMode: $('view-mode'),
+  fit: $('fit'),
+  // jobs
+  actionForms: [...document.querySelectorAll('form.action')],
+  resultPanel: $('result-panel'),
+  resultJob: $('result-job'),
+  resultLine: $('result-line'),
+  compareTable: $('compare-table'),
+  paperTables: $('paper-tables'),
+  downloadGcode: $('download-gcode'),
+  chartInfill: $('chart-infill'),
+  chartPsd: $('chart-psd'),
+  chartLayers: $('chart-layers'),
+  chartOrientation: $('chart-orientation'),
 };
 
 const DEMO_URL = 'demo/demo.gcode';
 const MAX_WARNINGS_SHOWN = 500;
+const JOB_NAMES = { vtg: 'VTG', infill: 'infill search', smooth: 'orientation smoothing', vibration: 'vibration analysis' };
+const LAYER_CACHE = 32;
 
 // Fields rendered by dedicated views; everything else goes to "More".
 const KNOWN_FIELDS = new Set([
@@ -42,97 +74,75 @@ const KNOWN_FIELDS = new Set([
   'warnings', 'file', 'extrusion', 'features', 'bounds',
 ]);
 
-// ── Worker management ──────────────────────────────────────────────────────
+// ── State ──────────────────────────────────────────────────────────────────
 
-let worker = null;
-let nextId = 1;
-let current = null; // the run in flight: { id, name, startedAt }
-let lastReport = null;
+let current = null; // the run in flight: { kind: 'load'|'job', name, startedAt }
 let lastSource = null; // { name, load: () => Promise<ArrayBuffer> }
-let downloadUrl = null;
+let loaded = null; // the analyzed file: { name, report }
+let output = null; // the latest optimized G-code: { job, bytes: ArrayBuffer }
+let lastJson = null; // what report-json shows: { value, filename }
+let capabilities = new Set();
+let fileToken = 0; // bumps with every new file or output: stale layer data is dropped
+const vibrationRuns = {}; // target → vibration result, for the before/after charts
+const downloadUrls = {};
 
-function createWorker() {
-  const w = new Worker('./worker.js', { type: 'module' });
-  w.onmessage = (event) => onWorkerMessage(w, event.data);
-  w.onerror = (event) => {
-    event.preventDefault();
-    const detail = event.message || 'the analysis worker failed to start (is pkg/ built?)';
-    onWorkerCrash(w, detail);
-  };
-  w.onmessageerror = () => onWorkerCrash(w, 'could not read a message from the analysis worker');
-  return w;
-}
-
-function getWorker() {
-  if (!worker) worker = createWorker();
-  return worker;
-}
-
-function discardWorker() {
-  if (worker) {
-    worker.terminate();
-    worker = null;
-  }
-}
-
-function onWorkerCrash(w, detail) {
-  if (w !== worker) return;
-  discardWorker();
-  showError({ message: w.loaded ? `The analyzer crashed: ${detail}` : `The analyzer could not be started: ${detail}` });
-  if (current) finishRun('error');
-  else setStatus('error');
-  // A worker that had loaded the wasm before is replaced right away (warm for
-  // the next file); one that never loaded is replaced lazily by the next run,
-  // so a missing pkg/ cannot make us respawn workers in a loop.
-  if (w.loaded) worker = createWorker();
-}
-
-function onWorkerMessage(w, msg) {
-  if (w !== worker || !msg) return;
-  if (msg.type === 'hello') {
-    w.loaded = true;
-    els.version.textContent = msg.version ? `v${msg.version}` : '';
-    return;
-  }
-  if (!current || msg.id !== current.id) return; // stale (cancelled) run
-  switch (msg.type) {
-    case 'progress':
-      els.progress.value = Math.max(els.progress.value, Math.min(1, msg.fraction));
-      break;
-    case 'result':
-      showReport(msg.report, current.name, msg.ms);
-      finishRun('ready');
-      break;
-    case 'error':
-      showError(msg);
-      finishRun('error');
-      if (msg.fatal) {
-        discardWorker();
-        worker = createWorker();
-      }
-      break;
-    default:
-      break;
-  }
-}
+const client = new JobClient('./worker.js', {
+  onHello(version, caps) {
+    els.version.textContent = version ? `v${version}` : '';
+    capabilities = new Set(caps);
+    document.body.dataset.capabilities = caps.join(' '); // for tests and curious users
+    updateActions();
+  },
+  onCrash(detail, wasLoaded, hadPending) {
+    // A crash while a request was pending is reported by that request.
+    if (hadPending) return;
+    showError({ message: wasLoaded ? `The analyzer crashed: ${detail}` : `The analyzer could not be started: ${detail}` }, { keepResults: true });
+    setStatus('error');
+  },
+});
 
 function setStatus(text) {
   els.status.textContent = text;
   els.status.dataset.state = text;
 }
 
+function startRun(kind, name) {
+  current = { kind, name, startedAt: performance.now() };
+  hideError();
+  els.elapsed.textContent = '';
+  delete els.elapsed.dataset.ms;
+  els.progress.value = 0;
+  els.cancel.disabled = false;
+  document.body.classList.add('busy');
+  updateActions();
+}
+
 function finishRun(status) {
-  if (current) {
-    const ms = performance.now() - current.startedAt;
-    if (status !== 'ready') els.elapsed.textContent = `${formatMs(ms)} total`;
-  }
+  if (current && status !== 'ready') els.elapsed.textContent = `${formatMs(performance.now() - current.startedAt)} total`;
   current = null;
   els.cancel.disabled = true;
   document.body.classList.remove('busy');
   setStatus(status);
+  updateActions();
 }
 
-// ── Running an analysis ────────────────────────────────────────────────────
+const onProgress = (fraction) => {
+  els.progress.value = Math.max(els.progress.value, Math.min(1, fraction));
+};
+
+// A failed request: cancelled (quietly), superseded (ignored) or an error.
+function failRun(err, { keepResults }) {
+  if (err instanceof Cancelled) {
+    if (err.reason === 'superseded') return;
+    finishRun('cancelled');
+    els.elapsed.textContent = '';
+    return;
+  }
+  showError(err, { keepResults });
+  finishRun('error');
+}
+
+// ── Loading a file ─────────────────────────────────────────────────────────
 
 function readOptions() {
   const form = new FormData(els.optionsForm);
@@ -149,45 +159,57 @@ function readOptions() {
 
 async function run(source) {
   lastSource = source;
-  if (current) cancel('superseded');
-  const id = nextId++;
-  current = { id, name: source.name, startedAt: performance.now() };
-  hideError();
+  if (current) client.cancel('superseded');
+  startRun('load', source.name);
+  const run = current;
+  run.posted = false;
   setStatus('reading');
   els.filename.textContent = source.name;
-  els.elapsed.textContent = '';
-  els.progress.value = 0;
-  els.cancel.disabled = false;
-  document.body.classList.add('busy');
 
   let bytes;
   try {
     bytes = await source.load();
   } catch (err) {
-    if (current?.id !== id) return;
+    if (current !== run) return;
     showError({ message: `Could not read ${source.name}: ${err?.message ?? err}` });
     finishRun('error');
     return;
   }
-  if (current?.id !== id) return; // cancelled while reading
+  if (current !== run) return; // cancelled while reading
+  run.posted = true;
   setStatus('analyzing');
-  getWorker().postMessage(
-    { id, type: 'analyze', bytes, name: source.name, options: readOptions() },
-    [bytes],
-  );
+  // The old file is gone from the worker from here on.
+  loaded = null;
+  resetOptimized();
+  try {
+    const msg = await client.load(bytes, source.name, readOptions(), onProgress);
+    if (current !== run) return;
+    loaded = { name: source.name, report: msg.report };
+    showReport(msg.report, source.name, msg.ms);
+    els.elapsed.dataset.totalMs = String(msg.totalMs);
+    finishRun('ready');
+    resetViewer();
+  } catch (err) {
+    if (current !== run) return;
+    failRun(err, { keepResults: false });
+  }
 }
 
-function cancel(reason = 'cancelled') {
+function cancel() {
   if (!current) return;
-  discardWorker();
-  current = null;
-  worker = createWorker();
-  els.cancel.disabled = true;
-  els.progress.value = 0;
-  document.body.classList.remove('busy');
-  if (reason === 'cancelled') {
-    setStatus('cancelled');
+  const wasLoad = current.kind === 'load';
+  const posted = current.posted;
+  client.cancel('cancelled'); // the run's promise settles as cancelled
+  if (!posted) {
+    // Still reading the file: nothing is in the worker yet.
+    finishRun('cancelled');
     els.elapsed.textContent = '';
+  }
+  // A cancelled load leaves no file behind: don't show the previous one's report.
+  if (wasLoad) {
+    loaded = null;
+    els.results.hidden = true;
+    updateActions();
   }
 }
 
@@ -204,6 +226,443 @@ function demoSource() {
       return res.arrayBuffer();
     },
   };
+}
+
+// ── Jobs (VTG, infill, smoothing, vibration) ───────────────────────────────
+
+/** Options of an action form: empty fields are left out (the function's defaults). */
+function jobOptions(form) {
+  const options = {};
+  for (const input of form.elements) {
+    if (!input.name || input.name === 'target') continue;
+    if (input.type === 'checkbox') {
+      if (input.checked) options[input.name] = true;
+      continue;
+    }
+    const raw = String(input.value ?? '').trim();
+    if (raw === '') continue;
+    if (input.type === 'number') {
+      const v = Number(raw);
+      if (Number.isFinite(v)) options[input.name] = v;
+    } else if (input.name === 'patterns') {
+      options.patterns = raw.split(/[\s,;]+/).filter(Boolean);
+    } else if (input.name.endsWith('_deg') && input.type === 'text') {
+      const list = raw.split(/[\s,;]+/).filter(Boolean).map(Number);
+      if (list.length && list.every(Number.isFinite)) options[input.name] = list;
+    } else {
+      options[input.name] = raw;
+    }
+  }
+  // SmoothOptions.window is { points } or { millimetres } (types.d.ts).
+  if (form.dataset.job === 'smooth') {
+    if (isNum(options.window_mm)) options.window = { millimetres: options.window_mm };
+    else if (isNum(options.window)) options.window = { points: Math.round(options.window) };
+    delete options.window_mm;
+  }
+  return options;
+}
+
+function updateActions() {
+  const busy = !!current;
+  for (const form of els.actionForms) {
+    const job = form.dataset.job;
+    const button = form.querySelector('button[type="submit"]');
+    const note = form.querySelector('.availability');
+    button.dataset.label ??= button.textContent;
+    const known = capabilities.size > 0;
+    const available = capabilities.has(job);
+    const needsOutput = job === 'vibration' && form.elements.target.value === 'output' && !output;
+    button.disabled = !available || !loaded || busy || needsOutput;
+    button.textContent = known && !available ? 'Not available in this build' : button.dataset.label;
+    note.textContent = !known ? '' : !available ? `${JOB_NAMES[job]} is not available in this build of the package.` : needsOutput ? 'Run VTG, infill or smoothing first.' : '';
+    if (job === 'vibration') form.elements.target.querySelector('option[value="output"]').disabled = !output;
+  }
+  els.viewMode.disabled = !output;
+}
+
+async function runJob(job, form) {
+  if (!loaded || current) return;
+  const target = job === 'vibration' ? form.elements.target.value : 'input';
+  const options = jobOptions(form);
+  startRun('job', loaded.name);
+  const run = current;
+  run.posted = true;
+  setStatus(`running ${job}`);
+  try {
+    const msg = await client.job(job, options, target, onProgress);
+    if (current !== run) return;
+    showJobResult(job, plain(msg.result), msg.output, target);
+    els.elapsed.textContent = `${JOB_NAMES[job]} in ${formatMs(msg.ms)}`;
+    els.elapsed.dataset.ms = String(msg.ms);
+    finishRun('ready');
+  } catch (err) {
+    if (current !== run) return;
+    failRun(err, { keepResults: true });
+  }
+}
+
+/** Forgets everything derived from an optimized output (a new file). */
+function resetOptimized() {
+  output = null;
+  delete vibrationRuns.input;
+  delete vibrationRuns.output;
+  els.resultPanel.hidden = true;
+  els.downloadGcode.disabled = true;
+  clearChart(els.chartInfill, 'Run the infill search to see the energy of each pattern against the infill angle.');
+  clearChart(els.chartPsd, 'Run the vibration analysis to see the spectrum.');
+  clearChart(els.chartLayers, 'Run the vibration analysis to see the amplitude per layer.');
+  clearChart(els.chartOrientation, 'Run the orientation smoothing to see the rotary axes.');
+}
+
+function showJobResult(job, result, outBytes, target) {
+  showJson(result, `${baseName(loaded.name)}.${job}${target === 'output' ? '.output' : ''}.json`);
+  els.resultPanel.hidden = false;
+  els.resultJob.textContent = `· ${JOB_NAMES[job]}${target === 'output' ? ' of the optimized output' : ''}`;
+  els.resultLine.textContent = resultLine(job, result);
+  if (outBytes) {
+    output = { job, bytes: outBytes };
+    fileToken++;
+    layerCache.clear();
+    els.downloadGcode.disabled = false;
+    // The optimized output changed: a vibration run on the old one is stale.
+    delete vibrationRuns.output;
+    if (els.viewMode.value === 'before') els.viewMode.value = 'side';
+    viewer.set('mode', els.viewMode.value);
+    refreshLayers();
+  }
+  if (job === 'vibration') {
+    vibrationRuns[target] = result;
+    renderCompare(vibrationCompare());
+    els.paperTables.replaceChildren();
+  } else {
+    renderCompare(compareRows(result, job));
+    renderPaperTables(result);
+  }
+  renderCharts(job, result);
+  updateActions();
+  writeHash();
+}
+
+function resultLine(job, r) {
+  const n = (v, d = 3) => (isNum(v) ? String(Math.round(v * 10 ** d) / 10 ** d) : '—');
+  const pct = (a, b) => (isNum(a) && isNum(b) && b !== 0 ? signedPercent(a / b - 1) : '—');
+  switch (job) {
+    case 'vtg':
+      return `Tolerance ${n(r.tolerance_mm)} mm, largest deviation from the original path ${n(r.max_deviation_mm, 4)} mm; energy ${pct(r.after?.energy?.total_j, r.before?.energy?.total_j)}, time ${pct(r.after?.time_s, r.before?.time_s)}.`;
+    case 'infill': {
+      const b = r.best ?? {};
+      return `Best: ${b.pattern ?? '—'} at ${n(b.angle_deg, 1)}°${isNum(b.rotation_deg) ? ` (rotation ${n(b.rotation_deg, 1)}°)` : ''} of ${Array.isArray(r.candidates) ? r.candidates.length : '—'} candidates; energy ${pct(r.after?.energy?.total_j, r.before?.energy?.total_j)}.`;
+    }
+    case 'smooth':
+      return `${formatCount(r.points)} points, ${formatCount(r.corrected)} corrected; the smoothed orientation stays within ${n(r.max_angle_to_original_deg, 2)}° of the original.`;
+    case 'vibration': {
+      const f = Array.isArray(r.natural_frequencies_hz) ? r.natural_frequencies_hz.map((v) => `${n(v, 1)} Hz`).join(', ') : '—';
+      return `Natural frequencies ${f}; deviation max ${n(r.deviation_mm?.max, 4)} mm, mean ${n(r.deviation_mm?.mean, 4)} mm.`;
+    }
+    default:
+      return '';
+  }
+}
+
+// Rows of the before/after table, in the order of the VTG paper's Tables 1 and 2.
+const REPORT_METRICS = [
+  ['Print time', (r) => r.time_s, formatDuration],
+  ['Energy', (r) => r.energy?.total_j, formatEnergy],
+  ['Stepper energy', (r) => r.energy?.thesis_j, formatEnergy],
+  ['CO₂', (r) => r.energy?.co2_g, (v) => `${fmt2.format(v)} g`],
+  ['Material', (r) => r.material_g, (v) => `${fmt2.format(v)} g`],
+  ['Path length', (r) => r.toolpath?.l_total_mm ?? r.distance_mm, formatLength],
+  ['Turning points', (r) => r.toolpath?.n_turning, formatCount],
+  ['Mean turning angle', (r) => r.toolpath?.mean_turn_deg, (v) => `${fmt1.format(v)}°`],
+  ['Mean chord error', (r) => r.toolpath?.mean_chord_error_mm, (v) => `${v.toFixed(4)} mm`],
+];
+
+function compareRows(result, job) {
+  const { before, after } = result;
+  if (!before || !after) return [];
+  const isReport = (r) => isNum(r.time_s) || isNum(r.energy?.total_j);
+  const rows = [];
+  if (isReport(before) && isReport(after)) {
+    for (const [name, get, format] of REPORT_METRICS) {
+      const b = get(before);
+      const a = get(after);
+      if (isNum(b) || isNum(a)) rows.push({ name, before: b, after: a, format });
+    }
+  } else {
+    // Metrics objects (smoothing): every numeric field, formatted by its unit.
+    const keys = [...new Set([...Object.keys(before), ...Object.keys(after)])];
+    for (const k of keys) {
+      if (isNum(before[k]) || isNum(after[k])) rows.push({ name: k.replaceAll('_', ' '), before: before[k], after: after[k], format: (v) => formatByKey(k, v) });
+    }
+  }
+  if (isNum(result.planned_time_before_s) && isNum(result.planned_time_after_s)) {
+    rows.unshift({ name: 'Print time (planned)', before: result.planned_time_before_s, after: result.planned_time_after_s, format: formatDuration });
+  }
+  if (isNum(result.max_tip_deviation_mm)) {
+    rows.push({ name: 'Tool-tip deviation (max)', before: 0, after: result.max_tip_deviation_mm, format: (v) => `${v.toFixed(4)} mm`, noChange: true });
+  }
+  if (job === 'vtg' && isNum(result.max_deviation_mm)) {
+    rows.push({ name: 'Deviation (max)', before: 0, after: result.max_deviation_mm, format: (v) => `${v.toFixed(4)} mm`, noChange: true });
+  }
+  return rows;
+}
+
+function vibrationCompare() {
+  const b = vibrationRuns.input;
+  const a = vibrationRuns.output;
+  const meanOf = (r, key) => {
+    const v = Array.isArray(r?.layers) ? r.layers.map((l) => l[key]).filter(isNum) : [];
+    return v.length ? v.reduce((x, y) => x + y, 0) / v.length : null;
+  };
+  const mean = (r) => meanOf(r, 'amplitude');
+  const peak = (r) => {
+    const p = r?.psd?.peaks?.[0];
+    return p ? p.hz : null;
+  };
+  const mm = (v) => `${v.toFixed(4)} mm`;
+  return [
+    { name: 'Deviation (max)', before: b?.deviation_mm?.max, after: a?.deviation_mm?.max, format: mm },
+    { name: 'Deviation (mean)', before: b?.deviation_mm?.mean, after: a?.deviation_mm?.mean, format: mm },
+    { name: 'Mean layer amplitude', before: mean(b), after: mean(a), format: mm },
+    { name: 'Mean layer acceleration RMS', before: meanOf(b, 'acceleration_rms'), after: meanOf(a, 'acceleration_rms'), format: (v) => `${fmt2.format(v)} m/s²` },
+    { name: 'Strongest PSD peak', before: peak(b), after: peak(a), format: (v) => `${fmt1.format(v)} Hz`, noChange: true },
+  ].filter((r) => isNum(r.before) || isNum(r.after));
+}
+
+function renderCompare(rows) {
+  const cell = (v, format) => el('td', { class: 'num', text: isNum(v) ? format(v) : '—' });
+  els.compareTable.tBodies[0].replaceChildren(
+    ...rows.map((r) => {
+      const change = !r.noChange && isNum(r.before) && isNum(r.after) && r.before !== 0 ? signedPercent(r.after / r.before - 1) : '—';
+      const tr = el('tr', {}, el('th', { scope: 'row', text: r.name }), cell(r.before, r.format), cell(r.after, r.format), el('td', { class: 'num', text: change }));
+      if (change.startsWith('−')) tr.classList.add('better');
+      return tr;
+    }),
+  );
+}
+
+/** Rows of a paper table in whatever shape the result gives it. */
+function tableRows(t) {
+  if (Array.isArray(t)) return t.map((r) => (r && typeof r === 'object' ? r : { value: r }));
+  if (t && typeof t === 'object') {
+    return Object.entries(t).map(([k, v]) => (v && typeof v === 'object' && !Array.isArray(v) ? { metric: k, ...v } : { metric: k, value: v }));
+  }
+  return [];
+}
+
+function renderPaperTables(result) {
+  const tables = Object.keys(result).filter((k) => /^table\d+$/.test(k));
+  els.paperTables.replaceChildren(
+    ...tables.map((k) => {
+      const rows = tableRows(result[k]);
+      const first = ['metric', 'name', 'quantity'];
+      const cols = [...new Set(rows.flatMap((r) => Object.keys(r)))].sort((a, b) => (first.includes(b) ? 1 : 0) - (first.includes(a) ? 1 : 0));
+      return el(
+        'div',
+        { class: 'paper-table', 'data-table': k },
+        el('h3', { text: `Paper ${k.replace('table', 'Table ')}` }),
+        el(
+          'div',
+          { class: 'table-scroll' },
+          el(
+            'table',
+            { class: 'grid' },
+            el('thead', {}, el('tr', {}, ...cols.map((c) => el('th', { class: first.includes(c) ? null : 'num', text: c.replaceAll('_', ' ') })))),
+            el('tbody', {}, ...rows.map((r) => el('tr', {}, ...cols.map((c) => el('td', { class: first.includes(c) ? null : 'num', text: formatByKey(c, r[c]) }))))),
+          ),
+        ),
+      );
+    }),
+  );
+}
+
+function renderCharts(job, r) {
+  if (job === 'infill' && Array.isArray(r.candidates) && r.candidates.length) {
+    // Best rotation for each (pattern, angle): one line per pattern.
+    const byPattern = new Map();
+    for (const c of r.candidates) {
+      if (!isNum(c.angle_deg) || !isNum(c.total_j)) continue;
+      const m = byPattern.get(c.pattern) ?? new Map();
+      if (!m.has(c.angle_deg) || c.total_j < m.get(c.angle_deg)) m.set(c.angle_deg, c.total_j);
+      byPattern.set(c.pattern, m);
+    }
+    const list = [...byPattern].map(([pattern, m]) => {
+      const x = [...m.keys()].sort((a, b) => a - b);
+      return { label: String(pattern), x, y: x.map((a) => m.get(a)) };
+    });
+    if (list.length) {
+      const u = unionSeries(list);
+      lineChart(els.chartInfill, { x: u.x, xLabel: 'infill angle, °', yLabel: 'energy, J', points: true, series: list.map((s, i) => ({ label: s.label, values: u.values[i] })) });
+    }
+  }
+  if (job === 'vibration') {
+    const runs = ['input', 'output'].filter((t) => vibrationRuns[t]?.psd?.freqs?.length);
+    if (runs.length) {
+      const list = runs.map((t) => ({ label: t === 'input' ? 'before' : 'after', x: vibrationRuns[t].psd.freqs, y: vibrationRuns[t].psd.power }));
+      const a = alignSeries(list);
+      lineChart(els.chartPsd, { x: a.x, xLabel: 'frequency, Hz', yLabel: 'power', logY: true, points: false, series: list.map((s, i) => ({ label: s.label, values: a.values[i] })) });
+    }
+    const layerRuns = ['input', 'output'].filter((t) => Array.isArray(vibrationRuns[t]?.layers) && vibrationRuns[t].layers.length);
+    if (layerRuns.length) {
+      const list = layerRuns.map((t) => ({ label: t === 'input' ? 'before' : 'after', x: vibrationRuns[t].layers.map((l, i) => (isNum(l.layer) ? l.layer : i)), y: vibrationRuns[t].layers.map((l) => l.amplitude) }));
+      const u = unionSeries(list);
+      lineChart(els.chartLayers, { x: u.x, xLabel: 'layer', yLabel: 'amplitude', series: list.map((s, i) => ({ label: s.label, values: u.values[i] })) });
+    }
+  }
+  if (job === 'smooth' && r.series) {
+    // Two shapes: { axes, point, first_before, first_after, second_before, second_after }
+    // (the crate's Series, thinned to ≤ 2000 points) or { b_before, b_after, c_before, c_after }.
+    const s = r.series;
+    const [ax1, ax2] = Array.isArray(s.axes) && s.axes.length >= 2 ? s.axes : ['B', 'C'];
+    const cols = s.first_before ? [s.first_before, s.first_after, s.second_before, s.second_after] : [s.b_before, s.b_after, s.c_before, s.c_after];
+    const n = Math.max(...cols.map((a) => (Array.isArray(a) ? a.length : 0)));
+    if (n > 0) {
+      const x = Array.isArray(s.point) && s.point.length === n ? s.point : Array.from({ length: n }, (_, i) => i);
+      const pad = (a) => (Array.isArray(a) ? (a.length === n ? a : [...a, ...new Array(Math.max(0, n - a.length)).fill(null)].slice(0, n)) : new Array(n).fill(null));
+      lineChart(els.chartOrientation, {
+        x,
+        xLabel: 'point',
+        yLabel: 'angle, °',
+        points: false,
+        series: [
+          { label: `${ax1} before`, values: pad(cols[0]), color: '#9ab8ae' },
+          { label: `${ax1} after`, values: pad(cols[1]), color: '#1f6f5c' },
+          { label: `${ax2} before`, values: pad(cols[2]), color: '#f2b7a6' },
+          { label: `${ax2} after`, values: pad(cols[3]), color: '#e4572e' },
+        ],
+      });
+    }
+  }
+}
+
+// ── Layer viewer ───────────────────────────────────────────────────────────
+
+const hoverInfo = $('hover-info');
+const viewer = new LayerViewer(els.canvas, els.legend, {
+  onHover(hit) {
+    hoverInfo.textContent = hit
+      ? `${hit.which ? `${hit.which}: ` : ''}${hit.kind} · ${fmt1.format(hit.speed)} mm/s · curvature ${hit.curvature.toFixed(3)} /mm · at ${fmt1.format(hit.x)}, ${fmt1.format(hit.y)} mm`
+      : '';
+  },
+});
+const layerCache = new Map(); // `${token}:${which}:${index}` → geometry
+const layerCounts = { before: 0, after: 0 };
+let layerLoading = false;
+let layerWanted = false;
+
+async function getLayer(which, index) {
+  const key = `${fileToken}:${which}:${index}`;
+  if (layerCache.has(key)) return layerCache.get(key);
+  // The first layer of a file makes the worker read the whole toolpath (seconds on 34 MB).
+  if (layerCounts[which] === 0) els.layerInfo.textContent = `reading the ${which === 'after' ? 'optimized ' : ''}toolpath…`;
+  const g = await client.layer(which, index);
+  layerCounts[which] = g.count;
+  layerCache.set(key, g);
+  if (layerCache.size > LAYER_CACHE) layerCache.delete(layerCache.keys().next().value);
+  return g;
+}
+
+/**
+ * Fetches and draws the selected layer. Calls coalesce: while one fetch is in
+ * flight, moving the slider only records the wish, so a fast drag costs one
+ * extra fetch rather than one per step.
+ */
+async function refreshLayers() {
+  if (!loaded) return;
+  if (layerLoading) {
+    layerWanted = true;
+    return;
+  }
+  layerLoading = true;
+  try {
+    do {
+      layerWanted = false;
+      const token = fileToken;
+      const index = Number(els.layerSlider.value);
+      const before = await getLayer('before', index);
+      const after = output ? await getLayer('after', Math.min(index, Math.max(0, (layerCounts.after || 1) - 1))) : null;
+      if (token !== fileToken) {
+        layerWanted = true;
+        continue;
+      }
+      const count = Math.max(layerCounts.before, output ? layerCounts.after : 0);
+      els.layerSlider.max = String(Math.max(0, count - 1));
+      if (Number(els.layerSlider.value) > count - 1) els.layerSlider.value = String(Math.max(0, count - 1));
+      els.layerNumber.textContent = `${before.index + 1} / ${count}`;
+      els.layerInfo.textContent = `${isNum(before.z) ? `z = ${before.z.toFixed(2)} mm · ` : ''}${formatCount(before.kind.length)} segments${after ? ` before, ${formatCount(after.kind.length)} after` : ''}`;
+      els.canvas.dataset.layer = String(before.index);
+      viewer.setLayers(before, after);
+    } while (layerWanted && loaded);
+  } catch (err) {
+    if (!(err instanceof Cancelled)) els.layerInfo.textContent = `Cannot draw this layer: ${err.message}`;
+  } finally {
+    layerLoading = false;
+  }
+}
+
+/** A new file: empty viewer, layer from the hash (or 0), view fitted. */
+function resetViewer() {
+  fileToken++;
+  layerCache.clear();
+  layerCounts.before = 0;
+  layerCounts.after = 0;
+  viewer.clear();
+  const wanted = Number(hashState().get('layer'));
+  // The slider's max is unknown until the first layer arrives: allow the wish.
+  els.layerSlider.max = String(Math.max(Number.isInteger(wanted) ? wanted : 0, loaded?.report?.layers ?? 1));
+  els.layerSlider.value = String(Number.isInteger(wanted) && wanted >= 0 ? wanted : 0);
+  refreshLayers();
+}
+
+// ── URL hash state (never the file) ────────────────────────────────────────
+
+function hashState() {
+  return new URLSearchParams(location.hash.replace(/^#/, ''));
+}
+
+function writeHash() {
+  const p = new URLSearchParams();
+  p.set('layer', els.layerSlider.value);
+  p.set('color', els.colorBy.value);
+  if (els.showTravel.checked) p.set('travel', '1');
+  p.set('view', els.viewMode.value);
+  for (const form of els.actionForms) {
+    for (const input of form.elements) {
+      if (input.type === 'checkbox') {
+        if (input.checked) p.set(`${form.dataset.job}.${input.name}`, '1');
+      } else if (input.name && String(input.value).trim() !== '' && !(input.name === 'target' && input.value === 'input')) {
+        p.set(`${form.dataset.job}.${input.name}`, String(input.value).trim());
+      }
+    }
+  }
+  const hash = `#${p.toString()}`;
+  if (location.hash !== hash) history.replaceState(null, '', hash);
+}
+
+/** Applies the hash to the controls (on load and when the user edits the URL). */
+function readHash() {
+  const p = hashState();
+  const color = p.get('color');
+  if (['feature', 'speed', 'curvature'].includes(color)) els.colorBy.value = color;
+  els.showTravel.checked = p.get('travel') === '1';
+  const view = p.get('view');
+  if (['before', 'after', 'side', 'overlay'].includes(view)) els.viewMode.value = view;
+  for (const form of els.actionForms) {
+    for (const input of form.elements) {
+      if (!input.name) continue;
+      const v = p.get(`${form.dataset.job}.${input.name}`);
+      if (input.type === 'checkbox') input.checked = v === '1';
+      else if (v !== null) input.value = v;
+    }
+  }
+  viewer.colorBy = els.colorBy.value;
+  viewer.showTravel = els.showTravel.checked;
+  viewer.set('mode', els.viewMode.value);
+  const layer = Number(p.get('layer'));
+  if (Number.isInteger(layer) && layer >= 0 && String(layer) !== els.layerSlider.value) {
+    els.layerSlider.value = String(layer);
+    refreshLayers();
+  }
 }
 
 // ── Rendering ──────────────────────────────────────────────────────────────
@@ -398,6 +857,9 @@ function renderWarnings(r) {
 function formatByKey(key, v) {
   if (!isNum(v)) return formatScalar(v);
   if (/_mm3$/.test(key)) return `${fmt1.format(v)} mm³`;
+  if (/_per_mm_deg$/.test(key)) return `${formatScalar(v)} °/mm`;
+  if (/_deg$/.test(key)) return `${formatScalar(v)}°`;
+  if (/_hz$/.test(key)) return `${formatScalar(v)} Hz`;
   if (/_mm$/.test(key)) return formatLength(v);
   if (/_s$/.test(key)) return formatDuration(v);
   if (/_ms$/.test(key)) return formatMs(v);
@@ -435,20 +897,27 @@ function renderExtra(r) {
 
 function showReport(rawReport, name, ms) {
   const report = plain(rawReport);
-  lastReport = { report, name };
   renderStats(report);
   renderSummary(report, name, ms);
   renderFeatures(report);
   renderWarnings(report);
   renderExtra(report);
-  els.reportJson.textContent = toJson(report, 2);
+  showJson(report, `${baseName(name)}.quietpath.json`);
   els.elapsed.textContent = `analyzed in ${formatMs(ms)}`;
+  els.elapsed.dataset.ms = String(ms);
   els.results.hidden = false;
   hideError();
 }
 
-function showError({ message, line, column, excerpt }) {
-  els.results.hidden = true; // whatever report is shown belongs to another file
+/** Shows `value` as the latest report JSON (and what "Download report JSON" saves). */
+function showJson(value, filename) {
+  lastJson = { value, filename };
+  els.reportJson.textContent = toJson(value, 2);
+}
+
+function showError({ message, line, column, excerpt }, { keepResults = false } = {}) {
+  // After a failed load, whatever report is shown belongs to another file.
+  if (!keepResults) els.results.hidden = true;
   const parts = [];
   const where = isNum(line) ? `Line ${line}${isNum(column) ? `, column ${column}` : ''}` : null;
   // The analyzer's message usually starts with its own "line N, column M:"; don't say it twice.
@@ -475,15 +944,27 @@ function hideError() {
   delete els.error.dataset.line;
 }
 
-function downloadReport() {
-  if (!lastReport) return;
-  if (downloadUrl) URL.revokeObjectURL(downloadUrl);
-  const blob = new Blob([toJson(lastReport.report, 2) + '\n'], { type: 'application/json' });
-  downloadUrl = URL.createObjectURL(blob);
-  const a = el('a', { href: downloadUrl, download: `${lastReport.name.replace(/\.[^.]*$/, '') || 'report'}.quietpath.json` });
+function baseName(name) {
+  return String(name ?? '').replace(/\.[^.]*$/, '') || 'quietpath';
+}
+
+function saveBlob(key, blob, filename) {
+  if (downloadUrls[key]) URL.revokeObjectURL(downloadUrls[key]);
+  downloadUrls[key] = URL.createObjectURL(blob);
+  const a = el('a', { href: downloadUrls[key], download: filename });
   document.body.append(a);
   a.click();
   a.remove();
+}
+
+function downloadReport() {
+  if (!lastJson) return;
+  saveBlob('json', new Blob([toJson(lastJson.value, 2) + '\n'], { type: 'application/json' }), lastJson.filename);
+}
+
+function downloadGcode() {
+  if (!output || !loaded) return;
+  saveBlob('gcode', new Blob([output.bytes], { type: 'text/plain' }), `${baseName(loaded.name)}.${output.job}.gcode`);
 }
 
 // ── Wiring ─────────────────────────────────────────────────────────────────
@@ -497,10 +978,42 @@ els.file.addEventListener('change', () => {
 els.demo.addEventListener('click', () => run(demoSource()));
 els.cancel.addEventListener('click', () => cancel());
 els.download.addEventListener('click', downloadReport);
+els.downloadGcode.addEventListener('click', downloadGcode);
 els.optionsForm.addEventListener('submit', (e) => e.preventDefault());
 els.optionsForm.addEventListener('change', () => {
   if (lastSource && lastSource.name && !current) run(lastSource);
 });
+
+for (const form of els.actionForms) {
+  form.addEventListener('submit', (e) => {
+    e.preventDefault();
+    runJob(form.dataset.job, form);
+  });
+  form.addEventListener('change', () => {
+    updateActions();
+    writeHash();
+  });
+}
+
+els.layerSlider.addEventListener('input', () => {
+  els.layerNumber.textContent = `${Number(els.layerSlider.value) + 1} / ${Number(els.layerSlider.max) + 1}`;
+  refreshLayers();
+  writeHash();
+});
+els.colorBy.addEventListener('change', () => {
+  viewer.set('colorBy', els.colorBy.value);
+  writeHash();
+});
+els.showTravel.addEventListener('change', () => {
+  viewer.set('showTravel', els.showTravel.checked);
+  writeHash();
+});
+els.viewMode.addEventListener('change', () => {
+  viewer.set('mode', els.viewMode.value);
+  writeHash();
+});
+els.fit.addEventListener('click', () => viewer.fit());
+window.addEventListener('hashchange', readHash);
 
 let dragDepth = 0;
 const hasFiles = (e) => Array.from(e.dataTransfer?.types ?? []).includes('Files');
@@ -527,7 +1040,16 @@ window.addEventListener('drop', (e) => {
   if (file) run(fileSource(file));
 });
 
-// Start the worker right away (the wasm compiles while the demo downloads),
-// then analyze the bundled demo.
-getWorker();
+// Restore the shared view, start the worker right away (the wasm compiles
+// while the demo downloads), then analyze the bundled demo.
+readHash();
+resetOptimized();
+updateActions();
+client.warm();
 run(demoSource());
+
+// Offline once loaded (sw.js: network first, cache as the fallback). Not
+// essential, so a browser or context without service workers is fine.
+if ('serviceWorker' in navigator && /^https?:$/.test(location.protocol)) {
+  navigator.serviceWorker.register('./sw.js').catch(() => {});
+}

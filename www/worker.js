@@ -1,27 +1,50 @@
-// quietpath analysis worker (module worker).
+// quietpath job worker (module worker).
 //
-// Created by app.js as: new Worker('./worker.js', { type: 'module' })
-// It loads the wasm package from ./pkg/quietpath.js and runs analyze() off the
-// main thread, so the page stays responsive on big files.
+// Created by jobs.js as: new Worker('./worker.js', { type: 'module' })
+// It loads the wasm package from ./pkg/quietpath.js and runs every job off the
+// main thread, so the page stays responsive on big files. It keeps two
+// sessions: `input` (the loaded file) and `output` (the latest optimized
+// G-code), so jobs and layer drawing never copy the file across again.
 //
 // ── Protocol ────────────────────────────────────────────────────────────────
+// Requests are handled strictly one after another (the wasm calls are
+// synchronous). To cancel, the page terminates the worker and starts a new
+// one; the new worker holds no session, so the page sends `load` again first.
+//
 // page → worker
-//   { id, type: 'analyze', bytes: ArrayBuffer, name: string, options }
-//       `bytes` should be transferred (postMessage(msg, [bytes])).
-//       `options` is passed to analyze() as is, e.g.
-//       { strict?: boolean, filament_diameter_mm?: number, density_g_cm3?: number }.
-//       One request at a time: analyze() is synchronous, so a second request
-//       waits until the first is done. To cancel, terminate the worker.
+//   { id, type: 'load', which?: 'input'|'output', bytes: ArrayBuffer, name,
+//     options, analyze?: boolean }
+//       Creates the `which` session (default 'input') from `bytes` (transfer
+//       it) with analyze `options` ({ strict?, filament_diameter_mm?, … }).
+//       Creating the input session drops the output session.
+//       With analyze !== false (the default for 'input'), runs analyze().
+//       → { id, type: 'result', report?, ms?, totalMs }
+//         report: the analysis report (same JSON as the CLI's --json), only
+//         when analyzed; ms: analyze() wall time; totalMs: the whole request.
+//   { id, type: 'job', job: 'vtg'|'infill'|'smooth'|'vibration'|'analyze',
+//     options, target?: 'input'|'output' }
+//       Runs the capability on a session (default 'input'), as a Session
+//       method when the package has one, else as the free function on the
+//       session's bytes.
+//       → { id, type: 'result', result, ms, output: ArrayBuffer | null }
+//         result: the function's result without its `output` bytes;
+//         output: those bytes (transferred). When present they also become
+//         the new `output` session (for the viewer's "after").
+//   { id, type: 'layer', which: 'before'|'after', index }
+//       Drawing data of one layer of the input ('before') or output ('after')
+//       session.
+//       → { id, type: 'layer', which, index, count, z, xy, kind, speed,
+//           curvature }   (typed arrays transferred; see types.d.ts
+//           LayerGeometry; count: the session's number of layers)
 //
 // worker → page
-//   { type: 'hello', version }                 once, when the wasm is loaded
-//   { id, type: 'progress', fraction }         0 ≤ fraction ≤ 1, increasing,
-//                                              throttled (≈ every 1 % / 50 ms)
-//   { id, type: 'result', report, ms }         report: the analysis report
-//                                              (same JSON as the CLI's --json),
-//                                              ms: analyze() wall time
+//   { type: 'hello', version, capabilities: string[] }
+//       once, when the wasm is loaded; capabilities lists the jobs this build
+//       has (e.g. ['analyze', 'vtg']): the page disables the others.
+//   { id, type: 'progress', fraction }   0 ≤ fraction ≤ 1, increasing,
+//                                        throttled (≈ every 1 % / 50 ms)
 //   { id, type: 'error', message, line, column, excerpt, kind, fatal }
-//       message: human-readable, from the Error thrown by analyze();
+//       message: human-readable, from the Error thrown by the wasm;
 //       line/column: 1-based position of the problem, or null when unknown;
 //       excerpt: the text of that line (≤ 200 chars) or null;
 //       kind: the Error's `kind` property (e.g. { kind: 'invalid_number',
@@ -32,31 +55,41 @@
 // An uncaught failure shows up as the Worker's `error` event on the page.
 // ────────────────────────────────────────────────────────────────────────────
 
-import init, { analyze, version } from './pkg/quietpath.js';
+import init, * as qp from './pkg/quietpath.js';
 
 const PROGRESS_STEP = 0.01;
 const PROGRESS_INTERVAL_MS = 50;
 const EXCERPT_MAX = 200;
+const JOBS = ['analyze', 'vtg', 'infill', 'smooth', 'vibration'];
+
+// Which jobs this build offers: a Session method or a free function.
+function capabilities() {
+  const proto = qp.Session?.prototype ?? {};
+  return JOBS.filter((j) => typeof qp[j] === 'function' || typeof proto[j] === 'function');
+}
 
 let loadError = null;
 const ready = init().then(
   () => {
     let v = null;
     try {
-      v = version();
+      v = qp.version();
     } catch {
       // version() is informational only
     }
-    self.postMessage({ type: 'hello', version: v });
+    self.postMessage({ type: 'hello', version: v, capabilities: capabilities() });
   },
   (err) => {
     loadError = err;
   },
 );
 
+/** The sessions: { session: Session, bytes: Uint8Array, options } or null. */
+const sessions = { input: null, output: null };
+
 // Text of 1-based line `line` in `bytes`, or null.
 function lineExcerpt(bytes, line) {
-  if (!Number.isInteger(line) || line < 1) return null;
+  if (!bytes || !Number.isInteger(line) || line < 1) return null;
   let start = 0;
   for (let n = 1; n < line; n++) {
     const nl = bytes.indexOf(10, start);
@@ -102,26 +135,27 @@ function plainKind(err) {
   }
 }
 
-async function handleAnalyze(msg) {
-  const { id, bytes, options } = msg;
-  await ready;
-  if (loadError) {
-    self.postMessage({
-      id,
-      type: 'error',
-      message: `could not load the WebAssembly analyzer: ${describe(loadError)}`,
-      line: null,
-      column: null,
-      excerpt: null,
-      kind: null,
-      fatal: true,
-    });
-    return;
-  }
-  const data = new Uint8Array(bytes);
+function postError(id, err, bytes) {
+  const line = positionOf(err, 'line');
+  const column = positionOf(err, 'column');
+  self.postMessage({
+    id,
+    type: 'error',
+    message: describe(err),
+    line,
+    column,
+    excerpt: lineExcerpt(bytes, line),
+    kind: plainKind(err),
+    // A trap (e.g. a Rust panic → "unreachable") leaves the instance unusable.
+    fatal: err instanceof WebAssembly.RuntimeError || !(err instanceof Error),
+  });
+}
+
+// A progress callback for the wasm that posts throttled, increasing fractions.
+function progressFor(id) {
   let lastFraction = -1;
   let lastTime = 0;
-  const onProgress = (fraction) => {
+  const fn = (fraction) => {
     const now = performance.now();
     if (fraction >= 1 || fraction - lastFraction >= PROGRESS_STEP || now - lastTime >= PROGRESS_INTERVAL_MS) {
       if (fraction <= lastFraction) return;
@@ -130,44 +164,157 @@ async function handleAnalyze(msg) {
       self.postMessage({ id, type: 'progress', fraction });
     }
   };
-  const t0 = performance.now();
-  try {
-    const report = analyze(data, options ?? {}, onProgress);
-    const ms = performance.now() - t0;
+  fn.finish = () => {
     if (lastFraction < 1) self.postMessage({ id, type: 'progress', fraction: 1 });
-    self.postMessage({ id, type: 'result', report, ms });
-  } catch (err) {
-    const line = positionOf(err, 'line');
-    const column = positionOf(err, 'column');
-    self.postMessage({
-      id,
-      type: 'error',
-      message: describe(err),
-      line,
-      column,
-      excerpt: lineExcerpt(data, line),
-      kind: plainKind(err),
-      // A trap (e.g. a Rust panic → "unreachable") leaves the instance unusable.
-      fatal: err instanceof WebAssembly.RuntimeError || !(err instanceof Error),
-    });
+  };
+  return fn;
+}
+
+function dropSession(which) {
+  const s = sessions[which];
+  sessions[which] = null;
+  try {
+    s?.session.free?.();
+  } catch {
+    // already freed
   }
 }
+
+function handleLoad(msg) {
+  const { id, options } = msg;
+  const which = msg.which === 'output' ? 'output' : 'input';
+  const t0 = performance.now();
+  const bytes = new Uint8Array(msg.bytes);
+  dropSession(which);
+  if (which === 'input') dropSession('output');
+  try {
+    const session = new qp.Session(bytes, options ?? {});
+    sessions[which] = { session, bytes, options: options ?? {} };
+    const analyze = msg.analyze ?? which === 'input';
+    if (!analyze) {
+      self.postMessage({ id, type: 'result', totalMs: performance.now() - t0 });
+      return;
+    }
+    const progress = progressFor(id);
+    const a0 = performance.now();
+    const report = session.analyze(progress);
+    const ms = performance.now() - a0;
+    progress.finish();
+    self.postMessage({ id, type: 'result', report, ms, totalMs: performance.now() - t0 });
+  } catch (err) {
+    postError(id, err, bytes);
+  }
+}
+
+function handleJob(msg) {
+  const { id, job, options } = msg;
+  const target = msg.target === 'output' ? 'output' : 'input';
+  const s = sessions[target];
+  if (!s) {
+    postError(id, new Error(target === 'output' ? 'no optimized output yet: run VTG, infill or smoothing first' : 'no file loaded'), null);
+    return;
+  }
+  if (!JOBS.includes(job)) {
+    postError(id, new Error(`unknown job: ${job}`), null);
+    return;
+  }
+  const progress = progressFor(id);
+  const t0 = performance.now();
+  try {
+    let result;
+    if (typeof s.session[job] === 'function') {
+      result = job === 'analyze' ? s.session.analyze(progress) : s.session[job](options ?? {}, progress);
+    } else if (typeof qp[job] === 'function') {
+      // The free vtg() takes the analyze options inside its own (a Session has them already).
+      const opts = job === 'vtg' && Object.keys(s.options).length && !options?.analyze ? { ...options, analyze: s.options } : options ?? {};
+      result = job === 'analyze' ? qp.analyze(s.bytes, s.options, progress) : qp[job](s.bytes, opts, progress);
+    } else {
+      throw new Error(`${job} is not available in this build`);
+    }
+    const ms = performance.now() - t0;
+    progress.finish();
+    let output = null;
+    const out = takeOutput(result);
+    if (out) {
+      // The optimized file becomes the "after" session (viewer, chained jobs).
+      dropSession('output');
+      const copy = out.slice();
+      sessions.output = { session: new qp.Session(copy, s.options), bytes: copy, options: s.options };
+      output = out.byteOffset === 0 && out.buffer.byteLength === out.byteLength ? out.buffer : out.slice().buffer;
+    }
+    self.postMessage({ id, type: 'result', result, ms, output }, output ? [output] : []);
+  } catch (err) {
+    postError(id, err, s.bytes);
+  }
+}
+
+// Removes the optimized G-code from a job result and returns it as bytes, or
+// null. Accepts what a serde bridge may produce: Uint8Array (serde_bytes), an
+// array of numbers, or a string; on a plain object or a Map.
+function takeOutput(result) {
+  if (!result || typeof result !== 'object') return null;
+  let v;
+  if (result instanceof Map) {
+    v = result.get('output');
+    result.delete('output');
+  } else {
+    v = result.output;
+    delete result.output;
+  }
+  if (v instanceof Uint8Array) return v;
+  if (Array.isArray(v)) return Uint8Array.from(v);
+  if (typeof v === 'string') return new TextEncoder().encode(v);
+  return null;
+}
+
+function handleLayer(msg) {
+  const { id, index } = msg;
+  const which = msg.which === 'after' ? 'after' : 'before';
+  const s = sessions[which === 'after' ? 'output' : 'input'];
+  if (!s) {
+    postError(id, new Error(`no ${which === 'after' ? 'optimized output' : 'file'} loaded`), null);
+    return;
+  }
+  try {
+    const count = s.session.layerCount();
+    const i = Math.max(0, Math.min(count - 1, index | 0));
+    const g = count > 0 ? s.session.layer(i) : { z: null, xy: new Float32Array(), kind: new Uint8Array(), speed: new Float32Array(), curvature: new Float32Array() };
+    self.postMessage(
+      { id, type: 'layer', which, index: i, count, z: g.z, xy: g.xy, kind: g.kind, speed: g.speed, curvature: g.curvature },
+      [g.xy.buffer, g.kind.buffer, g.speed.buffer, g.curvature.buffer],
+    );
+  } catch (err) {
+    postError(id, err, s.bytes);
+  }
+}
+
+const HANDLERS = { load: handleLoad, job: handleJob, layer: handleLayer, analyze: handleLoad };
 
 // Requests are handled strictly one after another.
 let queue = Promise.resolve();
 self.onmessage = (event) => {
   const msg = event.data;
-  if (!msg || msg.type !== 'analyze') return;
-  queue = queue.then(() => handleAnalyze(msg)).catch((err) => {
-    self.postMessage({
-      id: msg.id,
-      type: 'error',
-      message: describe(err),
-      line: null,
-      column: null,
-      excerpt: null,
-      kind: null,
-      fatal: true,
+  const handler = msg && HANDLERS[msg.type];
+  if (!handler) return;
+  queue = queue
+    .then(async () => {
+      await ready;
+      if (loadError) {
+        self.postMessage({
+          id: msg.id,
+          type: 'error',
+          message: `could not load the WebAssembly analyzer: ${describe(loadError)}`,
+          line: null,
+          column: null,
+          excerpt: null,
+          kind: null,
+          fatal: true,
+        });
+        return;
+      }
+      handler(msg);
+    })
+    .catch((err) => {
+      self.postMessage({ id: msg.id, type: 'error', message: describe(err), line: null, column: null, excerpt: null, kind: null, fatal: true });
     });
-  });
 };

@@ -2,7 +2,11 @@
 // scripts/serve.mjs and drives Debian's Chromium through playwright-core.
 //
 // Needs: www/pkg → the built wasm package (make does this), /usr/bin/chromium
-// (or $CHROMIUM), and the corpus in ../shared/corpus next to the repo.
+// (or $CHROMIUM), the corpus in ../shared/corpus next to the repo, and the
+// native CLI (target/release/quietpath, or $QUIETPATH_CLI) whose JSON the
+// browser's results must equal. The tests of a capability the loaded package
+// does not export yet are skipped (and its button must say so).
+// UPDATE_SCREENSHOT=1 rewrites docs/screenshot.png (the README's).
 
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -10,6 +14,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { spawnSync } from 'node:child_process';
 import { chromium } from 'playwright-core';
 import { startServer } from '../../scripts/serve.mjs';
 
@@ -52,7 +57,9 @@ before(async () => {
       '--disable-quic',
     ],
   });
-  context = await browser.newContext({ viewport: { width: 1280, height: 900 } });
+  // No service worker here: page.route() (the crash test) does not see requests
+  // a service worker makes. The offline test has its own context with one.
+  context = await browser.newContext({ viewport: { width: 1280, height: 900 }, serviceWorkers: 'block' });
   page = await context.newPage();
   page.setDefaultTimeout(STEP_TIMEOUT);
   // Every request the page and its worker make (context-level also sees workers).
@@ -210,6 +217,491 @@ test('dropping a file on the page analyzes it', async () => {
   assert.equal(await page.evaluate(() => document.body.classList.contains('dragging')), false);
 });
 
+// ── Layer viewer, hash state ───────────────────────────────────────────────
+
+// Number of canvas pixels that are not fully transparent (what the viewer drew).
+async function inkedPixels() {
+  return page.evaluate(() => {
+    const c = document.querySelector('[data-testid="viewer"]');
+    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    let n = 0;
+    for (let i = 3; i < d.length; i += 4) if (d[i] !== 0) n++;
+    return n;
+  });
+}
+
+// A cheap fingerprint of the canvas, to see that a redraw changed something.
+async function canvasHash() {
+  return page.evaluate(() => {
+    const c = document.querySelector('[data-testid="viewer"]');
+    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    let h = 0;
+    for (let i = 0; i < d.length; i += 7) h = (h * 31 + d[i]) | 0;
+    return h;
+  });
+}
+
+async function waitForLayer(index) {
+  await page.waitForFunction(
+    (i) => {
+      const c = document.querySelector('[data-testid="viewer"]');
+      return c.dataset.layer === String(i) && Number(c.dataset.segments) > 0;
+    },
+    index,
+    { timeout: STEP_TIMEOUT },
+  );
+  // The draw happens on the next animation frame.
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+}
+
+async function setSlider(index) {
+  await byTestId('layer-slider').evaluate((s, i) => {
+    s.value = String(i);
+    s.dispatchEvent(new Event('input', { bubbles: true }));
+  }, index);
+}
+
+test('the layer viewer draws the toolpath and the slider changes the layer', async () => {
+  await page.goto(baseUrl);
+  await waitForStatus('ready', 'demo.gcode');
+  await waitForLayer(0);
+  const inked = await inkedPixels();
+  assert.ok(inked > 2_000, `the viewer canvas is nearly blank (${inked} pixels drawn)`);
+  const max = Number(await byTestId('layer-slider').getAttribute('max'));
+  const report = await reportJson();
+  assert.ok(Math.abs(max + 1 - report.layers) <= 1, `slider max ${max} vs ${report.layers} layers`);
+  const before = await canvasHash();
+  await setSlider(10);
+  await waitForLayer(10);
+  assert.notEqual(await canvasHash(), before, 'layer 10 looks exactly like layer 0');
+  assert.match(await byTestId('layer-number').textContent(), /^11 \/ \d+$/);
+  assert.match(new URL(page.url()).hash, /layer=10\b/);
+});
+
+test('colour by feature, speed and curvature, with a legend', async () => {
+  const hashes = new Set([await canvasHash()]);
+  assert.match(await byTestId('legend').textContent(), /wall/);
+  for (const mode of ['speed', 'curvature']) {
+    await byTestId('color-by').selectOption(mode);
+    await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    hashes.add(await canvasHash());
+    assert.match(await byTestId('legend').textContent(), mode === 'speed' ? /mm\/s/ : /1\/mm/);
+    assert.match(new URL(page.url()).hash, new RegExp(`color=${mode}`));
+  }
+  assert.equal(hashes.size, 3, 'the three colourings should look different');
+  await byTestId('show-travel').check();
+  assert.match(new URL(page.url()).hash, /travel=1/);
+  // Hovering a line names its feature and speed (layer 1: solid, so easy to hit).
+  await setSlider(0);
+  await waitForLayer(0);
+  await byTestId('viewer').scrollIntoViewIfNeeded();
+  const box = await byTestId('viewer').boundingBox();
+  let info = '';
+  for (let i = 1; i < 12 && !info; i++) {
+    for (let j = 1; j < 12 && !info; j++) {
+      await page.mouse.move(box.x + (box.width * i) / 12, box.y + (box.height * j) / 12);
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+      info = await byTestId('hover-info').textContent();
+    }
+  }
+  assert.match(info, /mm\/s/, `no hover readout anywhere on the canvas (${JSON.stringify(box)}, errors: ${pageErrors})`);
+  await page.mouse.move(0, 0);
+});
+
+test('the URL hash restores the view on load', async () => {
+  await page.goto(`${baseUrl}#layer=7&color=speed&vtg.tolerance_mm=0.07`);
+  await page.reload(); // a plain hash change on the same URL would not reload the page
+  await waitForStatus('ready', 'demo.gcode');
+  await waitForLayer(7);
+  assert.equal(await byTestId('color-by').inputValue(), 'speed');
+  assert.equal(await byTestId('opt-vtg-tolerance').inputValue(), '0.07');
+  assert.match(await byTestId('legend').textContent(), /mm\/s/);
+  // Never the file: the hash holds view state only.
+  assert.doesNotMatch(decodeURIComponent(new URL(page.url()).hash), /gcode|G1/);
+  await byTestId('color-by').selectOption('feature');
+  await byTestId('opt-vtg-tolerance').fill('');
+  await byTestId('opt-vtg-tolerance').dispatchEvent('change');
+  assert.doesNotMatch(new URL(page.url()).hash, /tolerance/);
+});
+
+// ── Actions, compared with the native CLI ─────────────────────────────────
+
+const cli = process.env.QUIETPATH_CLI ?? path.join(repoRoot, 'target', 'release', 'quietpath');
+const MULTIAXIS = 'multiaxis-xyzbc_zhang-ral2021_model1.gcode';
+const JOB_TIMEOUT = 180_000;
+
+// Runs the CLI; returns { ok, json, output (Buffer | null), ms, stderr }.
+function runCli(job, file) {
+  const out = path.join(os.tmpdir(), `quietpath-e2e-${process.pid}-${job}.gcode`);
+  fs.rmSync(out, { force: true });
+  const args = job === 'vibration' || job === 'analyze' ? [job, file, '--json'] : [job, file, '-o', out, '--json'];
+  const t0 = process.hrtime.bigint();
+  const r = spawnSync(cli, args, { maxBuffer: 1 << 30, encoding: 'utf8' });
+  const ms = Number(process.hrtime.bigint() - t0) / 1e6;
+  let json = null;
+  try {
+    json = r.status === 0 ? JSON.parse(r.stdout) : null;
+  } catch {
+    json = null;
+  }
+  const output = fs.existsSync(out) ? fs.readFileSync(out) : null;
+  return { ok: r.status === 0 && json !== null, json, output, ms, stderr: r.stderr };
+}
+
+async function hasCapability(job) {
+  await page.waitForFunction(() => document.body.dataset.capabilities !== undefined);
+  return (await page.evaluate(() => document.body.dataset.capabilities)).split(' ').includes(job);
+}
+
+// Tests below can run alone (--test-name-pattern): open the page if needed.
+async function ensurePage() {
+  if (page.url().startsWith(baseUrl)) return;
+  await page.goto(baseUrl);
+  await waitForStatus('ready', 'demo.gcode');
+}
+
+async function loadCorpus(name) {
+  await ensurePage();
+  const current = await byTestId('filename').textContent();
+  if (current === name && (await byTestId('status').textContent()) === 'ready') return;
+  await uploadPath(path.join(corpusDir, name));
+  await page.waitForFunction(
+    (n) => document.querySelector('[data-testid="filename"]').textContent === n && ['ready', 'error'].includes(document.querySelector('[data-testid="status"]').textContent),
+    name,
+    { timeout: JOB_TIMEOUT },
+  );
+  assert.equal(await byTestId('status').textContent(), 'ready', await byTestId('error').textContent());
+}
+
+async function runAction(job) {
+  await byTestId(`run-${job}`).click();
+  await page.waitForFunction(() => !document.body.classList.contains('busy'), null, { timeout: JOB_TIMEOUT });
+  const status = await byTestId('status').textContent();
+  assert.equal(status, 'ready', `${job}: ${await byTestId('error').textContent()}`);
+  return reportJson();
+}
+
+// Compares two JSON values of the same shape: { same: shapes and every
+// non-number equal and every number within tolerance, maxRel, maxAbs }.
+function compareJson(a, b, rel = 1e-9, abs = 1e-9) {
+  const r = { same: true, maxRel: 0, maxAbs: 0 };
+  const walk = (x, y) => {
+    if (typeof x === 'number' && typeof y === 'number') {
+      if (x === y) return;
+      const d = Math.abs(x - y);
+      r.maxAbs = Math.max(r.maxAbs, d);
+      r.maxRel = Math.max(r.maxRel, d / Math.max(Math.abs(x), Math.abs(y)));
+      if (!(d <= rel * Math.max(Math.abs(x), Math.abs(y)) + abs)) r.same = false;
+      return;
+    }
+    if (x === null || y === null || typeof x !== 'object' || typeof y !== 'object') {
+      if (x !== y) r.same = false;
+      return;
+    }
+    if (Array.isArray(x) !== Array.isArray(y) || Object.keys(x).length !== Object.keys(y).length) {
+      r.same = false;
+      return;
+    }
+    for (const k of Object.keys(x)) {
+      if (!(k in y)) r.same = false;
+      else walk(x[k], y[k]);
+    }
+  };
+  walk(a, b);
+  return r;
+}
+
+// The CLI's JSON may carry fields about its own output file; every field the
+// page shows must equal the CLI's. Exactly when possible; jobs built on
+// transcendental functions (the dynamics' simulation: exp, sqrt, eigenvalues)
+// differ in the last bits between wasm and native code, so each number may
+// differ by 1e-9 relative plus 1e-9 absolute (the deviations are in mm: a
+// picometre), and the largest differences are reported.
+function assertSameAsCli(t, job, browser, native) {
+  const extra = Object.keys(native).filter((k) => !(k in browser));
+  if (extra.length) t.diagnostic(`${job}: fields only in the CLI's JSON: ${extra.join(', ')}`);
+  const cliSubset = Object.fromEntries(Object.keys(browser).map((k) => [k, native[k]]));
+  const c = compareJson(browser, cliSubset);
+  t.diagnostic(
+    `${job}: ${c.maxAbs === 0 ? 'identical to the CLI' : `largest difference from the CLI: ${c.maxRel.toExponential(2)} relative, ${c.maxAbs.toExponential(2)} absolute`}`,
+  );
+  if (!c.same) assert.deepEqual(browser, cliSubset, `${job}: report-json differs from \`quietpath ${job} --json\``);
+}
+
+for (const [job, file] of [
+  // smooth first: the other three share one loaded file, so vibration can
+  // also run on the optimized output of the one before.
+  ['smooth', MULTIAXIS],
+  ['vtg', BENCHY],
+  ['infill', BENCHY],
+  ['vibration', BENCHY],
+]) {
+  test(`${job}: report-json equals the native CLI's JSON`, { timeout: 2 * JOB_TIMEOUT }, async (t) => {
+    await loadCorpus(file);
+    if (!(await hasCapability(job))) {
+      assert.equal(await byTestId(`run-${job}`).isDisabled(), true);
+      assert.match(await byTestId(`run-${job}`).textContent(), /not available in this build/i);
+      t.skip(`${job} is not exported by this build of the package`);
+      return;
+    }
+    const native = runCli(job, path.join(corpusDir, file));
+    assert.ok(native.ok, `the package has ${job} but \`quietpath ${job}\` failed: ${native.stderr.slice(0, 500)}`);
+    const browser = await runAction(job);
+    assert.ok(!('output' in browser), 'the optimized bytes must not be in report-json');
+    assertSameAsCli(t, job, browser, native.json);
+    if (job === 'vibration') {
+      assert.ok(Number(await byTestId('chart-psd').getAttribute('data-series')) >= 1, 'no PSD chart');
+      assert.ok(Number(await byTestId('chart-layers').getAttribute('data-series')) >= 1, 'no per-layer chart');
+      // With an optimized output (from VTG), run it there too: PSD before and after.
+      if (await page.locator('[data-testid="opt-vibration-target"] option[value="output"]').isEnabled()) {
+        await byTestId('opt-vibration-target').selectOption('output');
+        await runAction('vibration');
+        assert.equal(await byTestId('chart-psd').getAttribute('data-series'), '2', 'PSD before and after');
+        await byTestId('opt-vibration-target').selectOption('input');
+      }
+      return;
+    }
+    // The optimized G-code: a download identical to the CLI's -o file.
+    assert.equal(await byTestId('download-gcode').isEnabled(), true);
+    const [download] = await Promise.all([page.waitForEvent('download'), byTestId('download-gcode').click()]);
+    const bytes = fs.readFileSync(await download.path());
+    if (native.output) assert.ok(bytes.equals(native.output), `${job}: the downloaded G-code differs from the CLI's -o file`);
+    assert.ok((await byTestId('compare-table').locator('tbody tr').count()) > 0, 'empty before/after table');
+    const chart = { infill: 'chart-infill', smooth: 'chart-orientation' }[job];
+    if (chart) assert.ok(Number(await byTestId(chart).getAttribute('data-series')) >= 1, `no ${chart}`);
+    // The viewer offers the optimized output.
+    assert.equal(await byTestId('view-mode').isEnabled(), true);
+  });
+}
+
+// The job UI against a package that has every capability of the API contract:
+// a stand-in module re-exports the real package and adds vtg, infill, smooth and
+// vibration returning results of the documented shape (real analyze reports for
+// before/after). Checks the page's side: tables, charts, downloads, the viewer's
+// before/after; the real numbers are checked against the CLI above.
+const MOCK_PACKAGE = `
+import init, * as real from './quietpath.js?real';
+export default init;
+export * from './quietpath.js?real';
+const enc = new TextEncoder();
+// The worker prefers Session methods: route them to the stand-ins below too.
+export class Session extends real.Session {
+  vtg(o, p) { return vtg(this.input(), o, p); }
+  infill(o, p) { return infill(this.input(), o, p); }
+  smooth(o, p) { return smooth(this.input(), o, p); }
+  vibration(o, p) { return vibration(this.input(), o, p); }
+}
+const bytesOf = (input) => (typeof input === 'string' ? enc.encode(input) : new Uint8Array(input));
+function optimized(input, tag) {
+  const a = bytesOf(input);
+  const b = enc.encode('; mock ' + tag + '\\n');
+  const out = new Uint8Array(a.length + b.length);
+  out.set(a);
+  out.set(b, a.length);
+  return out;
+}
+export function vtg(input, options = {}, progress) {
+  progress?.(0.5);
+  const output = optimized(input, 'vtg');
+  const before = real.analyze(bytesOf(input));
+  const after = real.analyze(output);
+  return {
+    tolerance_mm: options.tolerance_mm ?? 0.05, max_deviation_mm: 0.0421, before, after,
+    table1: { time_s: { before: before.time_s, after: after.time_s, change: 0 } },
+    table2: [{ metric: 'energy_j', before: before.energy.total_j, after: after.energy.total_j }],
+    output,
+  };
+}
+export function infill(input, options = {}) {
+  const output = optimized(input, 'infill');
+  const candidates = [];
+  for (const pattern of ['rectilinear', 'zigzag']) for (const angle_deg of [0, 30, 45, 60, 90])
+    for (const rotation_deg of [0, 90]) candidates.push({ pattern, angle_deg, rotation_deg, thesis_j: 1000 + angle_deg, total_j: 5000 + 10 * Math.sin(angle_deg / 30) + (pattern === 'zigzag' ? 50 : 0) + rotation_deg, time_s: 60, length_mm: 1000 });
+  return { before: real.analyze(bytesOf(input)), after: real.analyze(output), best: { pattern: 'rectilinear', angle_deg: 0, rotation_deg: 0 }, candidates, output };
+}
+export function smooth(input) {
+  const n = 500;
+  const b = Array.from({ length: n }, (_, i) => 20 * Math.sin(i / 20) + (i % 7));
+  return {
+    points: n, corrected: 321, max_angle_to_original_deg: 2.5,
+    before: { max_jerk_deg: 4, mean_step_deg: 1.2 }, after: { max_jerk_deg: 1, mean_step_deg: 0.4 },
+    series: { b_before: b, b_after: b.map((v, i) => 20 * Math.sin(i / 20)), c_before: b.map((v) => v * 2), c_after: b.map((v, i) => 40 * Math.sin(i / 20)) },
+    output: optimized(input, 'smooth'),
+  };
+}
+export function vibration(input, options = {}, progress) {
+  if (options.fs_hz === 999) {
+    // A slow job to cancel.
+    const t0 = Date.now();
+    while (Date.now() - t0 < 10000) progress?.((Date.now() - t0) / 10000);
+  }
+  const after = new TextDecoder().decode(bytesOf(input).subarray(-16)).includes('mock');
+  const freqs = Array.from({ length: 256 }, (_, i) => i * 2);
+  return {
+    natural_frequencies_hz: [41.2, 57.9],
+    deviation_mm: { max: after ? 0.02 : 0.05, min: 0, mean: after ? 0.004 : 0.01 },
+    layers: Array.from({ length: 50 }, (_, i) => ({ layer: i, amplitude: (after ? 0.5 : 1) * (1 + Math.sin(i / 5)) })),
+    psd: { fs_hz: 512, window: 256, freqs, power: freqs.map((f) => (after ? 0.3 : 1) / (1 + Math.abs(f - 41) / 5)), peaks: [{ hz: 41.2, power: 1 }] },
+  };
+}
+`;
+
+test('the job UI with every capability: tables, charts, downloads, before/after viewer', { timeout: JOB_TIMEOUT }, async () => {
+  const tab = await context.newPage();
+  tab.setDefaultTimeout(STEP_TIMEOUT);
+  const errors = [];
+  tab.on('pageerror', (e) => errors.push(String(e)));
+  await tab.route('**/pkg/quietpath.js', (route) => route.fulfill({ status: 200, contentType: 'text/javascript', body: MOCK_PACKAGE }));
+  const id = (x) => tab.locator(`[data-testid="${x}"]`);
+  const idle = async () => {
+    await tab.waitForFunction(() => !document.body.classList.contains('busy') && document.querySelector('[data-testid="status"]').textContent !== 'loading');
+    assert.equal(await id('status').textContent(), 'ready', await id('error').textContent());
+  };
+  await tab.goto(baseUrl);
+  await tab.waitForFunction(() => document.querySelector('[data-testid="status"]').textContent === 'ready');
+  await tab.waitForFunction(() => (document.body.dataset.capabilities ?? '').split(' ').length >= 5);
+  for (const job of ['vtg', 'infill', 'smooth', 'vibration']) assert.equal(await id(`run-${job}`).isEnabled(), true, `${job} button`);
+  const demo = fs.readFileSync(path.join(wwwRoot, 'demo', 'demo.gcode'));
+
+  // VTG: before/after table, paper tables, download, viewer side by side.
+  await id('opt-vtg-tolerance').fill('0.05');
+  await id('run-vtg').click();
+  await idle();
+  const vtgJson = JSON.parse(await id('report-json').textContent());
+  assert.equal(vtgJson.tolerance_mm, 0.05);
+  assert.ok(!('output' in vtgJson));
+  const rows = await id('compare-table').locator('tbody tr').allTextContents();
+  const metrics = ['Print time', 'Energy', 'CO₂', 'Material', 'Deviation'];
+  if (vtgJson.before.toolpath?.n_turning !== undefined) metrics.push('Turning points');
+  if (vtgJson.before.toolpath?.mean_chord_error_mm !== undefined) metrics.push('Mean chord error');
+  for (const m of metrics) assert.ok(rows.some((r) => r.startsWith(m)), `no ${m} row in ${rows}`);
+  assert.equal(await id('paper-tables').locator('table').count(), 2);
+  const [download] = await Promise.all([tab.waitForEvent('download'), id('download-gcode').click()]);
+  const got = fs.readFileSync(await download.path());
+  assert.ok(got.equals(Buffer.concat([demo, Buffer.from('; mock vtg\n')])), 'downloaded G-code is not the job output');
+  assert.match(download.suggestedFilename(), /demo\.vtg\.gcode$/);
+  assert.equal(await id('view-mode').inputValue(), 'side');
+  await tab.waitForFunction(() => /after/.test(document.querySelector('[data-testid="layer-info"]').textContent));
+  assert.match(tab.url(), /vtg\.tolerance_mm=0\.05/);
+  assert.match(tab.url(), /view=side/);
+
+  // Infill: one energy line per pattern.
+  await id('run-infill').click();
+  await idle();
+  assert.equal(await id('chart-infill').getAttribute('data-series'), '2');
+  assert.equal(await id('chart-infill').locator('canvas').count() > 0, true);
+  assert.match(await id('result-line').textContent(), /rectilinear/);
+
+  // Smoothing: rotary axes before/after; generic metrics rows.
+  await id('run-smooth').click();
+  await idle();
+  assert.equal(await id('chart-orientation').getAttribute('data-series'), '4');
+  assert.ok((await id('compare-table').textContent()).includes('max jerk deg'));
+
+  // Vibration on the file, then on the optimized output: PSD before and after.
+  await id('run-vibration').click();
+  await idle();
+  assert.equal(await id('chart-psd').getAttribute('data-series'), '1');
+  await id('opt-vibration-target').selectOption('output');
+  await id('run-vibration').click();
+  await idle();
+  assert.equal(await id('chart-psd').getAttribute('data-series'), '2');
+  assert.equal(await id('chart-layers').getAttribute('data-series'), '2');
+  assert.match(await id('compare-table').textContent(), /Deviation \(max\)/);
+  await tab.screenshot({ path: path.join(os.tmpdir(), 'playground-jobs.png'), fullPage: true });
+  if (process.env.JOBS_CLIP) await tab.screenshot({ path: path.join(os.tmpdir(), 'playground-jobs-clip.png'), fullPage: true, clip: { x: 0, y: Number(process.env.JOBS_CLIP), width: 1280, height: 1400 } });
+
+  // Cancel a running job: the next requests re-load the file and the
+  // optimized output into a fresh worker.
+  await id('opt-vibration-target').selectOption('input');
+  await id('opt-vibration-fs').fill('999');
+  await id('run-vibration').click();
+  await tab.waitForFunction(() => document.querySelector('[data-testid="progress"]').value > 0);
+  await id('cancel').click();
+  await tab.waitForFunction(() => document.querySelector('[data-testid="status"]').textContent === 'cancelled');
+  await id('opt-vibration-fs').fill('');
+  await id('run-vibration').click();
+  await idle();
+  await id('view-mode').selectOption('overlay');
+  await tab.evaluate(() => {
+    const s = document.querySelector('[data-testid="layer-slider"]');
+    s.value = '5';
+    s.dispatchEvent(new Event('input', { bubbles: true }));
+  });
+  await tab.waitForFunction(() => document.querySelector('[data-testid="viewer"]').dataset.layer === '5' && /after/.test(document.querySelector('[data-testid="layer-info"]').textContent));
+  assert.ok(Number(await id('viewer').getAttribute('data-segments')) > 0);
+  assert.equal(await id('download-gcode').isEnabled(), true);
+  assert.deepEqual(errors, []);
+  await tab.close();
+});
+
+test('analyze of the 34 MB corpus file in the worker is within 2× of the native CLI', { timeout: 4 * JOB_TIMEOUT }, async (t) => {
+  const name = 'curaengine-4.13.0_extruder-idler-x2.5_large.gcode';
+  const file = path.join(corpusDir, name);
+  assert.ok(fs.existsSync(cli), `no CLI at ${cli} (make cli)`);
+  await ensurePage();
+  // Best of 3 on both sides: the machine is shared, best-of is the least noisy figure.
+  const nativeMs = Math.min(...[0, 1, 2].map(() => {
+    const r = runCli('analyze', file);
+    assert.ok(r.ok, r.stderr);
+    return r.ms;
+  }));
+  const browser = [];
+  // The page must stay responsive meanwhile: the longest gap between animation frames.
+  await page.evaluate(() => {
+    window.__maxFrameGap = 0;
+    let last = performance.now();
+    const tick = (now) => {
+      window.__maxFrameGap = Math.max(window.__maxFrameGap, now - last);
+      last = now;
+      if (!window.__stopFrames) requestAnimationFrame(tick);
+    };
+    window.__stopFrames = false;
+    requestAnimationFrame(tick);
+  });
+  for (let i = 0; i < 3; i++) {
+    const t0 = Date.now();
+    await uploadPath(file);
+    await page.waitForFunction(() => ['ready', 'error'].includes(document.querySelector('[data-testid="status"]').textContent) && document.querySelector('[data-testid="elapsed"]').dataset.ms, null, { timeout: JOB_TIMEOUT });
+    assert.equal(await byTestId('status').textContent(), 'ready');
+    const ms = Number(await byTestId('elapsed').getAttribute('data-ms'));
+    const totalMs = Number(await byTestId('elapsed').getAttribute('data-total-ms'));
+    browser.push({ ms, totalMs, pageMs: Date.now() - t0 });
+  }
+  const maxGap = await page.evaluate(() => {
+    window.__stopFrames = true;
+    return window.__maxFrameGap;
+  });
+  t.diagnostic(`longest main-thread frame gap during three 34 MB loads: ${maxGap.toFixed(0)} ms`);
+  // Loose (the machine is shared): catches work done on the main thread, which would take seconds.
+  assert.ok(maxGap < 1500, `the page froze for ${maxGap.toFixed(0)} ms`);
+  const best = browser.reduce((a, b) => (b.totalMs < a.totalMs ? b : a));
+  t.diagnostic(`native CLI (process wall time, best of 3): ${nativeMs.toFixed(0)} ms`);
+  t.diagnostic(`worker, best of 3: analyze ${best.ms.toFixed(0)} ms, load request (copy into wasm + analyze) ${best.totalMs.toFixed(0)} ms, page (pick to ready) ${best.pageMs} ms`);
+  t.diagnostic(`ratio (worker load request / CLI): ${(best.totalMs / nativeMs).toFixed(2)}×`);
+  assert.ok(best.totalMs <= 2 * nativeMs, `worker ${best.totalMs.toFixed(0)} ms > 2 × CLI ${nativeMs.toFixed(0)} ms`);
+  const report = await reportJson();
+  assert.deepEqual(report, runCli('analyze', file).json, 'the worker report differs from the CLI');
+});
+
+test('screenshot of the playground with the viewer (docs/screenshot.png with UPDATE_SCREENSHOT=1)', { timeout: JOB_TIMEOUT }, async () => {
+  await loadCorpus(BENCHY);
+  await setSlider(40);
+  await waitForLayer(40);
+  await byTestId('fit').click();
+  await page.evaluate(() => document.activeElement?.blur());
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  await page.evaluate(() => window.scrollTo(0, 0));
+  // The README's screenshot is committed; it is rewritten on request
+  // (UPDATE_SCREENSHOT=1) or when missing, so a test run leaves the tree clean.
+  const docs = path.join(repoRoot, 'docs', 'screenshot.png');
+  const file = process.env.UPDATE_SCREENSHOT || !fs.existsSync(docs) ? docs : path.join(os.tmpdir(), 'playground-viewer.png');
+  fs.mkdirSync(path.dirname(file), { recursive: true });
+  await page.screenshot({ path: file, clip: { x: 0, y: 0, width: 1280, height: 1300 }, fullPage: true });
+  assert.ok(fs.statSync(file).size > 30_000, 'screenshot is suspiciously small');
+  assert.deepEqual(pageErrors, [], 'uncaught page errors');
+});
+
 test('a crashing worker is reported and replaced', async () => {
   // A second tab whose first worker throws on its first message (standing in
   // for a wasm panic); every later worker request gets the real worker.js.
@@ -234,6 +726,31 @@ test('a crashing worker is reported and replaced', async () => {
   assert.ok(JSON.parse(await tab.locator('[data-testid="report-json"]').textContent()).layers > 0);
   assert.ok(served >= 2, 'the worker was not recreated');
   await tab.close();
+});
+
+test('once loaded, the playground works offline', { timeout: JOB_TIMEOUT }, async () => {
+  const ctx = await browser.newContext({ viewport: { width: 1280, height: 900 } });
+  ctx.on('request', (req) => requests.push(req.url()));
+  const tab = await ctx.newPage();
+  tab.setDefaultTimeout(STEP_TIMEOUT);
+  const errors = [];
+  tab.on('pageerror', (e) => errors.push(String(e)));
+  const ready = (n) => tab.waitForFunction((name) => document.querySelector('[data-testid="status"]').textContent === 'ready' && document.querySelector('[data-testid="filename"]').textContent === name, n);
+  await tab.goto(baseUrl);
+  await ready('demo.gcode');
+  await tab.waitForFunction(() => navigator.serviceWorker?.controller, null, { timeout: STEP_TIMEOUT });
+  await ctx.setOffline(true);
+  await tab.reload();
+  await ready('demo.gcode');
+  await tab.waitForFunction(() => Number(document.querySelector('[data-testid="viewer"]').dataset.segments) > 0);
+  // A cancel starts a new worker (worker.js and the wasm fetched again): still fine offline.
+  await tab.locator('[data-testid="file"]').setInputFiles(path.join(corpusDir, 'curaengine-4.13.0_extruder-idler-x2.5_large.gcode'));
+  await tab.locator('[data-testid="cancel"]').click({ timeout: 2_000 }).catch(() => {});
+  await tab.locator('[data-testid="file"]').setInputFiles(path.join(corpusDir, BENCHY));
+  await ready(BENCHY);
+  assert.ok(Math.abs(JSON.parse(await tab.locator('[data-testid="report-json"]').textContent()).layers - 160) <= 1);
+  assert.deepEqual(errors, []);
+  await ctx.close();
 });
 
 test('no request leaves 127.0.0.1', async () => {

@@ -1,0 +1,129 @@
+// Charts of the job results, drawn with uPlot (vendored by `make pkg` into
+// www/vendor/, so the page still makes no outside request). Each chart lives in
+// its own container and is redrawn from scratch when its data changes; a
+// ResizeObserver keeps it as wide as the container.
+
+import uPlot from './vendor/uPlot.esm.js';
+
+const PALETTE = ['#1f6f5c', '#e4572e', '#2e86ab', '#f3a712', '#5a4fcf', '#a23b72', '#29bf12', '#7f7f7f'];
+const MAX_POINTS = 20000;
+
+const charts = new WeakMap(); // container → { plot, observer }
+
+/** Removes the chart in `container` and shows `message` instead. */
+export function clearChart(container, message) {
+  const prev = charts.get(container);
+  if (prev) {
+    prev.observer.disconnect();
+    prev.plot.destroy();
+    charts.delete(container);
+  }
+  const p = document.createElement('p');
+  p.className = 'empty';
+  p.textContent = message;
+  container.replaceChildren(p);
+  container.dataset.series = '0';
+}
+
+// Keeps every k-th point so a long series stays quick to draw (uPlot itself
+// copes with 10⁵ points, but the orientation series can be much longer).
+function thin(x, ys) {
+  if (x.length <= MAX_POINTS) return [x, ys];
+  const k = Math.ceil(x.length / MAX_POINTS);
+  const pick = (a) => a.filter((_, i) => i % k === 0);
+  return [pick(x), ys.map(pick)];
+}
+
+/**
+ * Draws a line chart in `container`.
+ * @param {object} spec { title, x: number[], xLabel, yLabel, logY?, points?,
+ *   series: [{ label, values: (number|null)[], color?, dash? }] }
+ */
+export function lineChart(container, spec) {
+  const prev = charts.get(container);
+  if (prev) {
+    prev.observer.disconnect();
+    prev.plot.destroy();
+  }
+  container.replaceChildren();
+  const [x, ys] = thin(spec.x, spec.series.map((s) => s.values));
+  // A log axis cannot show zero or negative values: leave a gap there.
+  const data = [x, ...ys.map((v) => (spec.logY ? v.map((y) => (y > 0 ? y : null)) : v))];
+  const width = Math.max(280, container.clientWidth || 600);
+  const opts = {
+    title: spec.title,
+    width,
+    height: spec.height ?? 260,
+    scales: { x: { time: false }, y: spec.logY ? { distr: 3, log: 10 } : {} },
+    axes: [
+      { label: spec.xLabel, stroke: 'currentColor', grid: { stroke: 'rgba(128,128,128,0.18)' }, ticks: { stroke: 'rgba(128,128,128,0.3)' } },
+      { label: spec.yLabel, stroke: 'currentColor', grid: { stroke: 'rgba(128,128,128,0.18)' }, ticks: { stroke: 'rgba(128,128,128,0.3)' }, size: 64 },
+    ],
+    series: [
+      { label: spec.xLabel },
+      ...spec.series.map((s, i) => ({
+        label: s.label,
+        stroke: s.color ?? PALETTE[i % PALETTE.length],
+        width: 1.5,
+        dash: s.dash,
+        spanGaps: true,
+        points: { show: spec.points ?? x.length <= 60 },
+      })),
+    ],
+    legend: { live: true },
+    cursor: { drag: { x: true, y: false } },
+  };
+  const plot = new uPlot(opts, data, container);
+  const observer = new ResizeObserver(() => {
+    const w = Math.max(280, container.clientWidth);
+    if (Math.abs(w - plot.width) > 2) plot.setSize({ width: w, height: plot.height });
+  });
+  observer.observe(container);
+  charts.set(container, { plot, observer });
+  container.dataset.series = String(spec.series.length);
+  container.dataset.points = String(x.length);
+  return plot;
+}
+
+/** Linear interpolation of (xs, ys) at x (xs ascending); null outside. */
+function interp(xs, ys, x) {
+  if (xs.length === 0 || x < xs[0] || x > xs[xs.length - 1]) return null;
+  let lo = 0;
+  let hi = xs.length - 1;
+  while (hi - lo > 1) {
+    const mid = (lo + hi) >> 1;
+    if (xs[mid] <= x) lo = mid;
+    else hi = mid;
+  }
+  if (xs[hi] === xs[lo]) return ys[lo];
+  const t = (x - xs[lo]) / (xs[hi] - xs[lo]);
+  return ys[lo] + t * (ys[hi] - ys[lo]);
+}
+
+/**
+ * Puts several (x, y) series on one x axis (uPlot's data layout): the x values
+ * of the first series, the others interpolated onto them when they differ.
+ */
+export function alignSeries(list) {
+  const base = list[0].x;
+  return {
+    x: base,
+    values: list.map((s, i) => {
+      if (i === 0) return s.y;
+      const same = s.x.length === base.length && s.x.every((v, j) => v === base[j]);
+      return same ? s.y : base.map((x) => interp(s.x, s.y, x));
+    }),
+  };
+}
+
+/** Union of the x values of several series; each series null where it has no point. */
+export function unionSeries(list) {
+  const xs = [...new Set(list.flatMap((s) => s.x))].sort((a, b) => a - b);
+  return {
+    x: xs,
+    values: list.map((s) => {
+      const m = new Map(s.x.map((x, i) => [x, s.y[i]]));
+      return xs.map((x) => (m.has(x) ? m.get(x) : null));
+    }),
+  };
+}

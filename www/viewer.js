@@ -1,0 +1,423 @@
+// Layer viewer: draws one layer's toolpath (Session.layer geometry) on a 2D
+// canvas, before and after an optimization, coloured by feature, speed or
+// curvature.
+//
+// Why canvas 2D and colour buckets: a layer of a big print has 10⁴–10⁵
+// segments. Stroking each one with its own colour is slow (one state change per
+// segment); grouping the segments into a few colour buckets and stroking each
+// bucket as one path keeps a redraw in a few milliseconds, which is what makes
+// wheel zoom and drag pan smooth. WebGL would be faster still but adds a lot
+// of code for no visible gain at these sizes.
+
+/** Feature kinds of LayerGeometry.kind (see crate/src/wasm/types.d.ts). */
+export const KINDS = ['travel', 'outer wall', 'inner wall', 'sparse infill', 'solid infill', 'bridge', 'gap fill', 'support', 'adhesion', 'other'];
+const KIND_COLORS = ['#9aa4a0', '#e4572e', '#f3a712', '#2e86ab', '#5a4fcf', '#29bf12', '#a23b72', '#8d6a9f', '#6c8ead', '#7f7f7f'];
+
+// A perceptually ordered ramp (viridis-like) for speed and curvature.
+const RAMP = ['#440154', '#482878', '#3e4a89', '#31688e', '#26828e', '#1f9e89', '#35b779', '#6ece58', '#b5de2b', '#fde725'];
+const BUCKETS = RAMP.length;
+
+const MIN_SCALE = 1e-3;
+const MAX_SCALE = 1e4;
+
+export class LayerViewer {
+  /**
+   * @param {HTMLCanvasElement} canvas
+   * @param {HTMLElement} legend  gets the colour legend
+   * @param {object} hooks       onViewChange(): the user zoomed or panned
+   */
+  constructor(canvas, legend, hooks = {}) {
+    this.canvas = canvas;
+    this.ctx = canvas.getContext('2d');
+    this.legend = legend;
+    this.hooks = hooks;
+    this.before = null; // LayerGeometry (+ index, count)
+    this.after = null;
+    this.colorBy = 'feature';
+    this.showTravel = false;
+    this.mode = 'before'; // before | after | side | overlay
+    this.view = null; // { cx, cy, scale } (scale: CSS px per mm)
+    this.frame = 0;
+    this.installInput();
+    this.resizeObserver = new ResizeObserver(() => this.resize());
+    this.resizeObserver.observe(canvas);
+    this.resize();
+  }
+
+  /** Sets the geometry to draw; `after` may be null. Keeps the view. */
+  setLayers(before, after) {
+    const panes = this.panes().length;
+    this.before = before;
+    this.after = after;
+    if (!this.view || this.panes().length !== panes) this.fit();
+    this.requestDraw();
+  }
+
+  /** Forgets the geometry and the view (a new file). */
+  clear() {
+    this.before = null;
+    this.after = null;
+    this.view = null;
+    this.requestDraw();
+  }
+
+  set(key, value) {
+    const panes = this.panes().length;
+    this[key] = value;
+    // One pane to two (or back): the old scale would crop, fit again.
+    if (this.view && this.panes().length !== panes) this.fit();
+    this.requestDraw();
+  }
+
+  /** The panes to draw: [{ geom, ghost, x, w }] in CSS px. */
+  panes() {
+    const w = this.canvas.clientWidth;
+    const hasAfter = !!this.after;
+    const mode = hasAfter ? this.mode : 'before';
+    if (mode === 'side') {
+      const half = Math.floor(w / 2);
+      return [
+        { geom: this.before, x: 0, w: half, label: 'before' },
+        { geom: this.after, x: half, w: w - half, label: 'after' },
+      ];
+    }
+    if (mode === 'overlay') return [{ geom: this.after, ghost: this.before, x: 0, w, label: 'after over before' }];
+    if (mode === 'after') return [{ geom: this.after, x: 0, w, label: 'after' }];
+    return [{ geom: this.before, x: 0, w, label: hasAfter ? 'before' : '' }];
+  }
+
+  /**
+   * Fits the view to the current layer's printed (non-travel) extent. The
+   * extent drops the outermost 1 % of segment ends on each side, so that a
+   * purge line at the bed's edge does not shrink the part to a speck.
+   */
+  fit() {
+    const g = this.before ?? this.after;
+    if (!g) return;
+    const xs = [];
+    const ys = [];
+    const collect = (onlyPrinting) => {
+      const { xy, kind } = g;
+      for (let i = 0, n = kind.length; i < n; i++) {
+        if (onlyPrinting && kind[i] === 0) continue;
+        const o = 4 * i;
+        xs.push(xy[o], xy[o + 2]);
+        ys.push(xy[o + 1], xy[o + 3]);
+      }
+    };
+    collect(true);
+    if (xs.length === 0) collect(false);
+    if (xs.length === 0) {
+      this.fitBox(0, 0, 100, 100);
+      return;
+    }
+    const f = (a) => Float64Array.from(a).sort();
+    const sx = f(xs);
+    const sy = f(ys);
+    const lo = Math.floor(0.01 * (sx.length - 1));
+    const hi = Math.ceil(0.99 * (sx.length - 1));
+    this.fitBox(sx[lo], sy[lo], sx[hi], sy[hi]);
+  }
+
+  fitBox(minX, minY, maxX, maxY) {
+    const pane = this.panes()[0];
+    const h = this.canvas.clientHeight || 1;
+    const spanX = Math.max(maxX - minX, 1);
+    const spanY = Math.max(maxY - minY, 1);
+    const scale = 0.85 * Math.min((pane.w || 1) / spanX, h / spanY);
+    this.view = { cx: (minX + maxX) / 2, cy: (minY + maxY) / 2, scale: Math.min(MAX_SCALE, Math.max(MIN_SCALE, scale)) };
+    this.requestDraw();
+  }
+
+  resize() {
+    const dpr = window.devicePixelRatio || 1;
+    const w = Math.max(1, Math.round(this.canvas.clientWidth * dpr));
+    const h = Math.max(1, Math.round(this.canvas.clientHeight * dpr));
+    if (this.canvas.width !== w || this.canvas.height !== h) {
+      this.canvas.width = w;
+      this.canvas.height = h;
+    }
+    this.draw();
+  }
+
+  requestDraw() {
+    if (this.frame) return;
+    this.frame = requestAnimationFrame(() => {
+      this.frame = 0;
+      this.draw();
+    });
+  }
+
+  /** Pane under CSS x, and the world point under (x, y). */
+  locate(x, y) {
+    const panes = this.panes();
+    const pane = panes.find((p) => x >= p.x && x < p.x + p.w) ?? panes[0];
+    const h = this.canvas.clientHeight;
+    const { cx, cy, scale } = this.view;
+    return { pane, wx: cx + (x - pane.x - pane.w / 2) / scale, wy: cy - (y - h / 2) / scale };
+  }
+
+  installInput() {
+    const c = this.canvas;
+    c.addEventListener(
+      'wheel',
+      (e) => {
+        if (!this.view) return;
+        e.preventDefault();
+        const r = c.getBoundingClientRect();
+        const x = e.clientX - r.left;
+        const y = e.clientY - r.top;
+        const { pane, wx, wy } = this.locate(x, y);
+        const factor = Math.exp(-e.deltaY * (e.deltaMode === 1 ? 0.05 : 0.0015));
+        const scale = Math.min(MAX_SCALE, Math.max(MIN_SCALE, this.view.scale * factor));
+        // Keep the world point under the cursor where it is.
+        const h = c.clientHeight;
+        this.view = {
+          scale,
+          cx: wx - (x - pane.x - pane.w / 2) / scale,
+          cy: wy + (y - h / 2) / scale,
+        };
+        this.requestDraw();
+        this.hooks.onViewChange?.();
+      },
+      { passive: false },
+    );
+    let drag = null;
+    c.addEventListener('pointerdown', (e) => {
+      if (!this.view || e.button !== 0) return;
+      drag = { x: e.clientX, y: e.clientY, cx: this.view.cx, cy: this.view.cy };
+      c.setPointerCapture(e.pointerId);
+      c.classList.add('dragging');
+    });
+    let hoverFrame = 0;
+    let hoverAt = [0, 0];
+    c.addEventListener('pointermove', (e) => {
+      if (!drag) {
+        // Readout of the segment under the cursor, at most once per frame.
+        const r = c.getBoundingClientRect();
+        hoverAt = [e.clientX - r.left, e.clientY - r.top];
+        if (!hoverFrame) {
+          hoverFrame = requestAnimationFrame(() => {
+            hoverFrame = 0;
+            this.hooks.onHover?.(this.pick(...hoverAt));
+          });
+        }
+        return;
+      }
+      const s = this.view.scale;
+      this.view = { ...this.view, cx: drag.cx - (e.clientX - drag.x) / s, cy: drag.cy + (e.clientY - drag.y) / s };
+      this.requestDraw();
+    });
+    const end = () => {
+      if (!drag) return;
+      drag = null;
+      c.classList.remove('dragging');
+      this.hooks.onViewChange?.();
+    };
+    c.addEventListener('pointerleave', () => this.hooks.onHover?.(null));
+    c.addEventListener('pointerup', end);
+    c.addEventListener('pointercancel', end);
+    c.addEventListener('dblclick', () => this.fit());
+    // Keyboard: arrows pan, +/- zoom, 0 fits (the canvas is focusable).
+    c.addEventListener('keydown', (e) => {
+      if (!this.view) return;
+      const step = 40 / this.view.scale;
+      const v = { ...this.view };
+      if (e.key === 'ArrowLeft') v.cx -= step;
+      else if (e.key === 'ArrowRight') v.cx += step;
+      else if (e.key === 'ArrowUp') v.cy += step;
+      else if (e.key === 'ArrowDown') v.cy -= step;
+      else if (e.key === '+' || e.key === '=') v.scale = Math.min(MAX_SCALE, v.scale * 1.25);
+      else if (e.key === '-') v.scale = Math.max(MIN_SCALE, v.scale / 1.25);
+      else if (e.key === '0') return this.fit();
+      else return;
+      e.preventDefault();
+      this.view = v;
+      this.requestDraw();
+    });
+  }
+
+  /**
+   * The drawn segment nearest to CSS point (x, y), within a few pixels:
+   * { which, kind, speed, curvature } or null.
+   */
+  pick(x, y) {
+    if (!this.view) return null;
+    const { pane, wx, wy } = this.locate(x, y);
+    const g = pane.geom;
+    if (!g) return null;
+    const { xy, kind } = g;
+    const limit = 6 / this.view.scale;
+    let best = limit * limit;
+    let found = -1;
+    for (let i = 0, n = kind.length; i < n; i++) {
+      if (kind[i] === 0 && !this.showTravel) continue;
+      const o = 4 * i;
+      const x0 = xy[o];
+      const y0 = xy[o + 1];
+      const dx = xy[o + 2] - x0;
+      const dy = xy[o + 3] - y0;
+      const len2 = dx * dx + dy * dy;
+      const t = len2 > 0 ? Math.max(0, Math.min(1, ((wx - x0) * dx + (wy - y0) * dy) / len2)) : 0;
+      const ex = x0 + t * dx - wx;
+      const ey = y0 + t * dy - wy;
+      const d2 = ex * ex + ey * ey;
+      if (d2 < best) {
+        best = d2;
+        found = i;
+      }
+    }
+    if (found < 0) return null;
+    return { which: pane.label, kind: KINDS[kind[found]] ?? 'other', speed: g.speed[found], curvature: g.curvature[found], x: wx, y: wy };
+  }
+
+  /** Value range for speed / curvature colouring, shared by before and after. */
+  range() {
+    if (this.colorBy === 'feature') return null;
+    const key = this.colorBy === 'speed' ? 'speed' : 'curvature';
+    const values = [];
+    for (const g of [this.before, this.after]) {
+      if (!g) continue;
+      const a = g[key];
+      const step = Math.max(1, Math.floor(a.length / 20000)); // a sample is enough for a range
+      for (let i = 0; i < a.length; i += step) if (g.kind[i] !== 0 && Number.isFinite(a[i])) values.push(a[i]);
+    }
+    if (values.length === 0) return { key, lo: 0, hi: 1 };
+    values.sort((p, q) => p - q);
+    // Curvature has a long tail (corners): clip at the 95th percentile.
+    const lo = key === 'speed' ? values[0] : 0;
+    const hi = key === 'speed' ? values[values.length - 1] : values[Math.floor(0.95 * (values.length - 1))];
+    return { key, lo, hi: hi > lo ? hi : lo + 1 };
+  }
+
+  draw() {
+    const { ctx, canvas } = this;
+    const dpr = window.devicePixelRatio || 1;
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.clearRect(0, 0, canvas.width, canvas.height);
+    let drawn = 0;
+    const range = this.range();
+    if (this.view && (this.before || this.after)) {
+      const h = canvas.clientHeight;
+      const panes = this.panes();
+      for (const p of panes) {
+        ctx.save();
+        ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+        ctx.beginPath();
+        ctx.rect(p.x, 0, p.w, h);
+        ctx.clip();
+        if (p.ghost) this.drawGeometry(p.ghost, p, h, null, true);
+        if (p.geom) drawn += this.drawGeometry(p.geom, p, h, range, false);
+        if (panes.length > 1 || p.label) {
+          ctx.font = '12px system-ui, sans-serif';
+          ctx.fillStyle = getComputedStyle(canvas).color;
+          ctx.fillText(p.label + (p.geom && Number.isFinite(p.geom.z) ? `  z = ${p.geom.z.toFixed(2)} mm` : ''), p.x + 8, 16);
+        }
+        ctx.restore();
+      }
+      if (panes.length > 1) {
+        ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+        ctx.strokeStyle = 'rgba(128,128,128,0.5)';
+        ctx.lineWidth = 1;
+        ctx.beginPath();
+        ctx.moveTo(panes[1].x + 0.5, 0);
+        ctx.lineTo(panes[1].x + 0.5, h);
+        ctx.stroke();
+      }
+    }
+    canvas.dataset.segments = String(drawn);
+    this.renderLegend(range);
+  }
+
+  /** Strokes one geometry into a pane; returns the number of segments drawn. */
+  drawGeometry(g, pane, h, range, ghost) {
+    const { ctx } = this;
+    const { cx, cy, scale } = this.view;
+    const ox = pane.x + pane.w / 2 - cx * scale;
+    const oy = h / 2 + cy * scale;
+    const { xy, kind } = g;
+    const n = kind.length;
+    // Bucket of each segment: -1 skipped, 0 travel, 1.. colour buckets.
+    const bucket = new Int8Array(n);
+    let colors;
+    if (ghost) {
+      colors = [null, 'rgba(140,140,140,0.35)'];
+      for (let i = 0; i < n; i++) bucket[i] = kind[i] === 0 ? -1 : 1;
+    } else if (!range) {
+      colors = [null, ...KIND_COLORS.slice(1)];
+      for (let i = 0; i < n; i++) bucket[i] = kind[i];
+    } else {
+      colors = [null, ...RAMP];
+      const a = g[range.key];
+      const k = BUCKETS / (range.hi - range.lo);
+      for (let i = 0; i < n; i++) {
+        if (kind[i] === 0) continue;
+        const b = Math.floor((a[i] - range.lo) * k);
+        bucket[i] = 1 + (b < 0 ? 0 : b >= BUCKETS ? BUCKETS - 1 : b);
+      }
+    }
+    // Extrusion lines about as wide as a real line when zoomed in.
+    const width = Math.max(1, Math.min(0.45 * scale, 8));
+    ctx.lineCap = 'round';
+    ctx.lineJoin = 'round';
+    let drawn = 0;
+    const strokeBucket = (b, style, lw, dash) => {
+      ctx.beginPath();
+      let px = NaN;
+      let py = NaN;
+      let count = 0;
+      for (let i = 0; i < n; i++) {
+        if (bucket[i] !== b) continue;
+        const o = 4 * i;
+        const x0 = ox + xy[o] * scale;
+        const y0 = oy - xy[o + 1] * scale;
+        // Consecutive segments share an end: continue the polyline.
+        if (x0 !== px || y0 !== py) ctx.moveTo(x0, y0);
+        px = ox + xy[o + 2] * scale;
+        py = oy - xy[o + 3] * scale;
+        ctx.lineTo(px, py);
+        count++;
+      }
+      if (count === 0) return 0;
+      ctx.strokeStyle = style;
+      ctx.lineWidth = lw;
+      ctx.setLineDash(dash);
+      ctx.stroke();
+      return count;
+    };
+    if (this.showTravel && !ghost) drawn += strokeBucket(0, 'rgba(140,150,146,0.7)', 0.75, [3, 3]);
+    for (let b = 1; b < colors.length; b++) drawn += strokeBucket(b, colors[b], ghost ? Math.max(1, width * 0.8) : width, []);
+    ctx.setLineDash([]);
+    return drawn;
+  }
+
+  renderLegend(range) {
+    const items = [];
+    const swatch = (color, label, dashed) => {
+      const li = document.createElement('li');
+      const s = document.createElement('span');
+      s.className = dashed ? 'swatch dashed' : 'swatch';
+      s.style.background = dashed ? 'transparent' : color;
+      if (dashed) s.style.borderColor = color;
+      li.append(s, label);
+      return li;
+    };
+    if (!range) {
+      const present = new Set();
+      for (const g of [this.before, this.after]) if (g) for (const k of g.kind) present.add(k);
+      for (let k = 1; k < KINDS.length; k++) if (present.has(k)) items.push(swatch(KIND_COLORS[k], KINDS[k]));
+    } else {
+      const unit = range.key === 'speed' ? 'mm/s' : '1/mm';
+      const fmt = (v) => (Math.abs(v) >= 10 ? v.toFixed(0) : v.toFixed(2));
+      const li = document.createElement('li');
+      li.className = 'ramp';
+      const bar = document.createElement('span');
+      bar.className = 'ramp-bar';
+      bar.style.background = `linear-gradient(to right, ${RAMP.join(', ')})`;
+      li.append(`${fmt(range.lo)}`, bar, `${fmt(range.hi)}${range.key === 'curvature' ? '+' : ''} ${unit}`);
+      items.push(li);
+    }
+    if (this.showTravel) items.push(swatch('#9aa4a0', 'travel', true));
+    this.legend.replaceChildren(...items);
+  }
+}
