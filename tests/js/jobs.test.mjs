@@ -64,6 +64,22 @@ test('smooth: wasm report and output equal the CLI on the 5-axis corpus file', (
   assert.ok(report.max_angle_to_original_deg <= report.cone_deg / 2);
 });
 
+test('vtg: wasm report and output equal the CLI (dynamics rows to 1e-9)', () => {
+  const out = path.join(tmp, 'vtg.gcode');
+  const fromCli = runCli(['vtg', DEMO, '-o', out, '--json']);
+  const { report, output } = reportOf(qp.vtg(fs.readFileSync(DEMO)));
+  // Only Table 2's deviation rows come from the dynamics model (see the vibration test).
+  const { deviation: devWasm, ...t2Wasm } = report.table2;
+  const { deviation: devCli, ...t2Cli } = fromCli.table2;
+  assert.deepEqual({ ...report, table2: t2Wasm }, { ...fromCli, table2: t2Cli });
+  // (Their change_pct, a difference of near-equal numbers, amplifies the last-bit noise.)
+  const values = (d) => Object.fromEntries(Object.entries(d).map(([k, c]) => [k, [c.before, c.after]]));
+  assert.deepEqual(diffs(values(devWasm), values(devCli), 1e-9), []);
+  assert.ok(Buffer.from(output).equals(fs.readFileSync(out)), 'rewritten file differs from the CLI output');
+  assert.ok(report.max_deviation_mm <= report.tolerance_mm);
+  assert.ok(report.table1.n_turning.after < report.table1.n_turning.before);
+});
+
 test('infill: wasm report and output equal the CLI (angles 0/45/90, two patterns)', () => {
   const out = path.join(tmp, 'infill.gcode');
   const fromCli = runCli(['infill', DEMO, '-o', out, '--angles', '0,45,90', '--patterns', 'rectilinear,grid', '--json']);

@@ -96,12 +96,13 @@ test('TypeScript: declarations compile (tsc --strict) and match real CLI output'
   const json = (args) => execFileSync(cli, args, { encoding: 'utf8', maxBuffer: 64 << 20, stdio: ['ignore', 'pipe', 'ignore'] }).trim();
   const typed = [
     ['VibrationReport', json(['vibration', path.join(repoRoot, 'www', 'demo', 'demo.gcode'), '--json'])],
+    ['VtgReport', json(['vtg', path.join(repoRoot, 'www', 'demo', 'demo.gcode'), '-o', path.join(dir, 'vtg.gcode'), '--json'])],
     ['InfillReport', json(['infill', path.join(repoRoot, 'www', 'demo', 'demo.gcode'), '-o', path.join(dir, 'infill.gcode'), '--angles', '0:90:90', '--json'])],
     ['SmoothReport', json(['smooth', path.join(corpusDir, 'multiaxis-xyzbc_zhang-ral2021_model1.gcode'), '-o', path.join(dir, 'smooth.gcode'), '--kinematics', 'table-bc', '--json'])],
   ];
   const api = path.join(pkgDir, 'web', 'quietpath.js').replaceAll('\\', '/');
   const src = [
-    `import init, { analyze, calibrate, Session, version, vibration, smooth, infill } from '${api}';`,
+    `import init, { analyze, calibrate, Session, version, vibration, smooth, infill, vtg } from '${api}';`,
     `import type { Report, AnalyzeOptions, LayerGeometry, CalibrationFit, QuietpathError, ${typed.map(([t]) => t).join(', ')} } from '${api}';`,
     'export async function use(bytes: Uint8Array): Promise<number> {',
     '  await init();',
@@ -113,11 +114,13 @@ test('TypeScript: declarations compile (tsc --strict) and match real CLI output'
     "  const vr: VibrationReport = vibration(bytes, { ts_ms: 1, window: 256 }, () => true);",
     "  const sr = smooth(bytes, { cone_deg: 60, window: { millimetres: 5 } });",
     "  const smoothed: Uint8Array = sr.output;",
+    "  const vr2 = vtg(bytes, { tolerance_mm: 0.05, limit_feed: false, dynamics: false });",
+    "  const turning: number = vr2.table1.n_turning.change_pct + (vr2.table2.deviation?.mean_mm.after ?? 0) + vr2.output.length;",
     "  const ir = infill(bytes, { angles_deg: [0, 90], patterns: ['rectilinear', 'hilbert'], objective: 'time' });",
     "  const best: string = ir.best.pattern + ir.candidates[0].total_j + ir.output.length;",
     "  const sv: VibrationReport = s.vibration({ analyze: { machine: 'vtg-ldam-servo' } });",
     "  try { analyze('G1 X1.2.3'); } catch (e) { const err = e as QuietpathError; return err.line ?? 0; }",
-    '  return r.time_s + g.xy.length + fit.k_c + version().length + s.layerCount() + vr.psd.freqs.length + smoothed.length + sv.steps + sr.corrected + best.length;',
+    '  return r.time_s + g.xy.length + fit.k_c + version().length + s.layerCount() + vr.psd.freqs.length + smoothed.length + sv.steps + sr.corrected + best.length + turning;',
     '}',
     ...reports.map((json, i) => `export const report${i}: Report = ${json.trim()};`),
     ...typed.map(([t, json], i) => `export const typed${i}: ${t} = ${json};`),

@@ -24,6 +24,9 @@ pub struct Args {
     /// Keep the programmed feed rates even where the curvature is above K_cr.
     #[arg(long)]
     pub keep_feed: bool,
+    /// Skip the dynamics simulation of both files (Table 2's deviation rows).
+    #[arg(long)]
+    pub no_dynamics: bool,
     /// Overwrite the input file if OUT names it.
     #[arg(long)]
     pub force: bool,
@@ -42,6 +45,7 @@ pub fn run(args: Args) -> Result<(), String> {
         tolerance_mm: args.tolerance,
         critical_angle_deg: args.critical_angle,
         limit_feed: !args.keep_feed,
+        dynamics: !args.no_dynamics,
         ..VtgOptions::default()
     };
     let mut bar = output::ProgressBar::new(

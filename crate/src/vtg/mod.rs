@@ -49,6 +49,9 @@ pub struct VtgOptions {
     pub nozzle_diameter_mm: f64,
     /// Lower the feed rate where the curvature exceeds `K_cr` (default true).
     pub limit_feed: bool,
+    /// Run the dynamics model ([`crate::dynamics`]) on both files for the deviation rows of
+    /// Table 2 (default true; it costs about as much as the rewrite itself).
+    pub dynamics: bool,
 }
 
 impl Default for VtgOptions {
@@ -61,6 +64,7 @@ impl Default for VtgOptions {
             normal_jerk_mm_s3: 500_000.0,
             nozzle_diameter_mm: 0.4,
             limit_feed: true,
+            dynamics: true,
         }
     }
 }
@@ -133,6 +137,32 @@ pub fn vtg_with_progress(
         &after_path,
         rewritten,
     );
+    let mut report = report;
+    if options.dynamics {
+        report.table2.deviation = simulated_deviation(input, &report.output, &options.analyze);
+    }
     progress(1.0);
     Ok(report)
+}
+
+/// Table 2's deviation rows: the dynamics model on the original and on the rewritten file,
+/// over printing moves (travels are not rewritten). `None` when the model cannot run (a print
+/// too long to simulate, for instance): the rest of the report stands without it.
+fn simulated_deviation(
+    input: &[u8],
+    output: &[u8],
+    analyze: &AnalyzeOptions,
+) -> Option<report::DeviationComparison> {
+    let options = crate::dynamics::VibrationOptions {
+        analyze: analyze.clone(),
+        ..Default::default()
+    };
+    let before = crate::dynamics::vibration(input, &options).ok()?;
+    let after = crate::dynamics::vibration(output, &options).ok()?;
+    let (b, a) = (before.printing_deviation_mm, after.printing_deviation_mm);
+    Some(report::DeviationComparison {
+        max_mm: Comparison::new(b.max, a.max),
+        min_mm: Comparison::new(b.min, a.min),
+        mean_mm: Comparison::new(b.mean, a.mean),
+    })
 }

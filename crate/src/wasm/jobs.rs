@@ -10,9 +10,14 @@ use crate::analyze::AnalyzeOptions;
 use crate::dynamics::{vibration_with_progress, VibrationOptions};
 use crate::infill::{infill_with_progress, InfillOptions};
 use crate::orient::{smooth_with_progress, SmoothOptions};
+use crate::vtg::{vtg_with_progress, VtgOptions};
 
 #[wasm_bindgen]
 extern "C" {
+    /// `VtgOptions` in TypeScript.
+    #[wasm_bindgen(typescript_type = "VtgOptions")]
+    #[derive(Debug)]
+    pub type JsVtgOptions;
     /// `InfillOptions` in TypeScript.
     #[wasm_bindgen(typescript_type = "InfillOptions")]
     #[derive(Debug)]
@@ -59,6 +64,11 @@ where
     Ok(o)
 }
 
+fn run_vtg(bytes: &[u8], o: &VtgOptions, p: Option<JsProgress>) -> Result<JsValue, JsValue> {
+    let r = vtg_with_progress(bytes, o, &mut progress_fn(p)).map_err(|e| js_error(&e))?;
+    with_output(&r, &r.output)
+}
+
 fn run_infill(bytes: &[u8], o: &InfillOptions, p: Option<JsProgress>) -> Result<JsValue, JsValue> {
     let r = infill_with_progress(bytes, o, &mut progress_fn(p)).map_err(|e| js_error(&e))?;
     with_output(&r, &r.output)
@@ -76,6 +86,19 @@ fn run_vibration(
 ) -> Result<JsValue, JsValue> {
     let r = vibration_with_progress(bytes, o, &mut progress_fn(p)).map_err(|e| js_error(&e))?;
     to_js(&r)
+}
+
+/// Vibration-suppressed toolpath (`quietpath vtg --json`, plus `output`).
+#[wasm_bindgen(unchecked_return_type = "VtgResult")]
+pub fn vtg(
+    #[wasm_bindgen(unchecked_param_type = "string | Uint8Array | ArrayBuffer")] input: JsValue,
+    options_value: Option<JsVtgOptions>,
+    on_progress: Option<JsProgress>,
+) -> Result<JsValue, JsValue> {
+    let o = job_options(options_value.as_deref(), None, |o: &mut VtgOptions, a| {
+        o.analyze = a
+    })?;
+    run_vtg(&input_bytes(&input)?, &o, on_progress)
 }
 
 /// Infill regeneration and the search over pattern, angle and orientation
@@ -126,6 +149,21 @@ pub fn vibration(
 
 #[wasm_bindgen]
 impl Session {
+    /// `vtg` of the session's file.
+    #[wasm_bindgen(unchecked_return_type = "VtgResult")]
+    pub fn vtg(
+        &self,
+        options_value: Option<JsVtgOptions>,
+        on_progress: Option<JsProgress>,
+    ) -> Result<JsValue, JsValue> {
+        let o = job_options(
+            options_value.as_deref(),
+            Some(self),
+            |o: &mut VtgOptions, a| o.analyze = a,
+        )?;
+        run_vtg(self.input_ref(), &o, on_progress)
+    }
+
     /// `infill` of the session's file.
     #[wasm_bindgen(unchecked_return_type = "InfillResult")]
     pub fn infill(

@@ -7,7 +7,7 @@
 mod jobs;
 mod session;
 
-pub use jobs::{infill, smooth, vibration};
+pub use jobs::{infill, smooth, vibration, vtg};
 pub use session::Session;
 
 use js_sys::{Function, Reflect, Uint8Array};

@@ -121,14 +121,17 @@ export interface Energy {
 }
 /** Trajectory metrics of the VTG paper (eq. 24–26, 28, 31). */
 export interface ToolpathMetrics {
-  l_total_mm?: number;
-  l_infill_mm?: number;
-  n_total?: number;
-  n_infill?: number;
-  n_turning?: number;
-  mean_turn_deg?: number;
-  mean_chord_error_mm?: number;
-  [key: string]: unknown;
+  l_total_mm: number;
+  l_infill_mm: number;
+  n_total: number;
+  n_infill: number;
+  /** Turns above the critical angle. */
+  n_turning: number;
+  /** Vertices between two printing segments. */
+  n_corners: number;
+  mean_turn_deg: number;
+  mean_chord_error_mm: number;
+  critical_angle_deg: number;
 }
 /** The analysis report (`quietpath analyze --json`). */
 export interface Report {
@@ -365,3 +368,68 @@ export interface InfillReport {
 }
 /** infill() result: the report plus the rewritten file. */
 export interface InfillResult extends InfillReport { output: Uint8Array }
+
+// ── vtg (`quietpath vtg --json`) ──
+export interface VtgOptions {
+  analyze?: AnalyzeOptions;
+  /** Largest distance the new path may stray from the original, mm (default 0.1). */
+  tolerance_mm?: number;
+  /** Critical angle δθ, degrees (default 30). */
+  critical_angle_deg?: number;
+  interpolation_period_s?: number;
+  normal_jerk_mm_s3?: number;
+  nozzle_diameter_mm?: number;
+  /** Lower the feed where the curvature exceeds K_cr (eq. 29–30; default true). */
+  limit_feed?: boolean;
+  /** Simulate both files for Table 2's deviation rows (default true). */
+  dynamics?: boolean;
+}
+/** before, after and the relative change in percent. */
+export interface Comparison { before: number; after: number; change_pct: number }
+export interface VtgReport {
+  tolerance_mm: number;
+  max_deviation_mm: number;
+  critical_angle_deg: number;
+  k_cr_per_mm: number;
+  limits: {
+    v_max_mm_s: number;
+    interpolation_period_s: number;
+    chord_tolerance_mm: number;
+    normal_accel_mm_s2: number;
+    normal_jerk_mm_s3: number;
+    nozzle_radius_mm: number;
+  };
+  paths: {
+    candidates: number;
+    rewritten: number;
+    replaced_moves: number;
+    written_moves: number;
+    above_k_cr_segments: number;
+    lowered_feed_segments: number;
+    mean_speed_fluctuation_pct: number;
+  };
+  /** The VTG paper's Table 1. */
+  table1: {
+    l_total_mm: Comparison;
+    n_total: Comparison;
+    l_infill_mm: Comparison;
+    n_infill: Comparison;
+    n_turning: Comparison;
+    mean_turn_deg: Comparison;
+    mean_chord_error_mm: Comparison;
+  };
+  /** The VTG paper's Table 2 (deviation from the dynamics model; null when not simulated). */
+  table2: {
+    deviation: { max_mm: Comparison; min_mm: Comparison; mean_mm: Comparison } | null;
+    energy_j: Comparison;
+    servo_energy_j: Comparison;
+    material_g: Comparison;
+    co2_g: Comparison;
+    time_s: Comparison;
+  };
+  layers: { index: number; before: ToolpathMetrics; after: ToolpathMetrics }[];
+  before: Report;
+  after: Report;
+}
+/** vtg() result: the report plus the rewritten file. */
+export interface VtgResult extends VtgReport { output: Uint8Array }
