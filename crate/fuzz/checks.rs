@@ -327,3 +327,22 @@ pub fn vibration(data: &[u8]) {
         );
     }
 }
+
+/// VTG on arbitrary input: Ok (with a sane output that stays within its measured tolerance)
+/// or a typed error. (The dynamics rows are skipped: `vibration` is checked on its own.)
+pub fn vtg(data: &[u8]) {
+    use quietpath::vtg::{vtg as run, VtgOptions};
+    let options = VtgOptions {
+        dynamics: false,
+        ..VtgOptions::default()
+    };
+    if let Ok(r) = run(data, &options) {
+        check_rewritten(data, &r.output, "vtg");
+        assert!(
+            r.max_deviation_mm.is_finite() && r.max_deviation_mm <= r.tolerance_mm * 1.01 + 1e-9,
+            "vtg: deviation {} over tolerance {}",
+            r.max_deviation_mm,
+            r.tolerance_mm
+        );
+    }
+}

@@ -13,7 +13,7 @@ set -uo pipefail
 secs=${1:-20}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(parse_line analyze rewrite planner)
+[ ${#targets[@]} -gt 0 ] || targets=(parse_line analyze rewrite planner vtg infill smooth vibration)
 
 case $secs in ''|*[!0-9]*) echo "smoke.sh: SECONDS must be a whole number, got '$secs'" >&2; exit 2 ;; esac
 

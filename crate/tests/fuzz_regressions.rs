@@ -51,6 +51,7 @@ fn fuzz_regressions_do_not_panic() {
             ("analyze", checks::analyze),
             ("rewrite", checks::rewrite),
             ("planner", checks::planner),
+            ("vtg", checks::vtg),
             ("infill", checks::infill),
             ("smooth", checks::smooth),
             ("vibration", checks::vibration),

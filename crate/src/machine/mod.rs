@@ -61,6 +61,9 @@ pub const MIN_FEED_MM_S: f64 = 1e-3;
 pub const MAX_DWELL_S: f64 = 1e7;
 /// Range of `M220`/`M221` factors accepted, percent.
 pub const OVERRIDE_RANGE_PERCENT: std::ops::RangeInclusive<f64> = 1.0..=1000.0;
+/// Heater targets accepted, °C: from "off" (negative values are read as off by firmware too)
+/// to well above any hotend's maximum (high-temperature printers reach 500 °C).
+pub const TEMPERATURE_RANGE_C: std::ops::RangeInclusive<f64> = -273.15..=1500.0;
 /// Default firmware retraction length, mm (Marlin's `RETRACT_LENGTH`).
 pub const DEFAULT_RETRACT_MM: f64 = 3.0;
 /// Default firmware retraction speed, mm/s (Marlin's `RETRACT_FEEDRATE`).
@@ -284,6 +287,31 @@ impl Machine {
         }
     }
 
+    /// A heater target from `S` (or `R`), if it is a temperature at all: targets outside
+    /// [`TEMPERATURE_RANGE_C`] are corruption and are ignored with a warning, so no energy
+    /// figure can become infinite.
+    fn temperature_target(
+        &self,
+        line_no: u32,
+        p: &crate::gcode::Params,
+        warnings: &mut Warnings,
+    ) -> Option<f64> {
+        let target = p.get(b'S').or_else(|| p.get(b'R'))?;
+        if TEMPERATURE_RANGE_C.contains(&target) {
+            Some(target)
+        } else {
+            warnings.push(
+                line_no,
+                format!(
+                    "temperature {target:.3e} °C ignored (accepted: {} to {} °C)",
+                    TEMPERATURE_RANGE_C.start(),
+                    TEMPERATURE_RANGE_C.end()
+                ),
+            );
+            None
+        }
+    }
+
     /// Applies one parsed line; `line_no` is used in warnings and events.
     pub fn apply(
         &mut self,
@@ -378,7 +406,7 @@ impl Machine {
             }
             (b'M', 104 | 109, _) => {
                 let tool = p.get(b'T').map_or(self.tool, to_u16);
-                let target = p.get(b'S').or_else(|| p.get(b'R'))?;
+                let target = self.temperature_target(line_no, p, warnings)?;
                 Some(Event::Temperature {
                     heater: Heater::Hotend(tool),
                     target_c: target,
@@ -386,7 +414,7 @@ impl Machine {
                 })
             }
             (b'M', 140 | 190, _) => {
-                let target = p.get(b'S').or_else(|| p.get(b'R'))?;
+                let target = self.temperature_target(line_no, p, warnings)?;
                 Some(Event::Temperature {
                     heater: Heater::Bed,
                     target_c: target,
@@ -394,7 +422,7 @@ impl Machine {
                 })
             }
             (b'M', 141 | 191, _) => {
-                let target = p.get(b'S').or_else(|| p.get(b'R'))?;
+                let target = self.temperature_target(line_no, p, warnings)?;
                 Some(Event::Temperature {
                     heater: Heater::Chamber,
                     target_c: target,
