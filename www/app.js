@@ -726,11 +726,13 @@ function formatScalar(v) {
   return String(v);
 }
 
-// JSON.stringify that survives Map (serde-wasm-bindgen's default for maps) and BigInt.
+// JSON.stringify that survives Map, BigInt and typed arrays (the API returns spectra as
+// Float64Array): the JSON shown and downloaded is the CLI's.
 function toJson(value, space) {
   return JSON.stringify(
     value,
     (_key, v) => {
+      if (ArrayBuffer.isView(v)) return Array.from(v);
       if (v instanceof Map) return Object.fromEntries(v);
       if (typeof v === 'bigint') return Number.isSafeInteger(Number(v)) ? Number(v) : v.toString();
       return v;

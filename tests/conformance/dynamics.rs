@@ -112,3 +112,42 @@ fn smoothed_corners_vibrate_less_than_sharp_ones() {
         assert_eq!(change.layers.len(), 1);
     }
 }
+
+/// The VTG rewrite of real slicer output (our PrusaSlicer star with 15 mm/s jerk, and the
+/// playground demo), with its default eq. 29 feed caps, vibrates less on average than the
+/// original: the deviation rows of its Table 2 come from this model. (Not every file: see the
+/// README's VTG section for the benchy, where the mean rises.)
+#[test]
+fn vtg_output_has_a_lower_mean_simulated_deviation() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    for file in [
+        "tests/fixtures/gcode/prusaslicer-2.5.0_star_fast_jerk15.gcode",
+        "www/demo/demo.gcode",
+    ] {
+        let path = root.join(file);
+        let input = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let r = quietpath::vtg::vtg(&input, &quietpath::vtg::VtgOptions::default()).expect("vtg");
+        let d = r
+            .table2
+            .deviation
+            .expect("the dynamics rows are computed by default");
+        assert!(
+            d.mean_mm.after < 0.95 * d.mean_mm.before,
+            "{file}: mean deviation {} → {} mm",
+            d.mean_mm.before,
+            d.mean_mm.after
+        );
+        // And the same from the vibration report of each file directly.
+        let o = VibrationOptions::default();
+        let before = vibration(&input, &o)
+            .expect("vibration")
+            .printing_deviation_mm;
+        let after = vibration(&r.output, &o)
+            .expect("vibration")
+            .printing_deviation_mm;
+        assert_eq!(
+            (before.mean, after.mean),
+            (d.mean_mm.before, d.mean_mm.after)
+        );
+    }
+}

@@ -2,7 +2,7 @@
 //! the CLI's `--json` object; rewriting jobs add the new file as `output` (a `Uint8Array`),
 //! which the JSON leaves out.
 
-use js_sys::{Reflect, Uint8Array};
+use js_sys::{Float64Array, Reflect, Uint8Array};
 use wasm_bindgen::prelude::*;
 
 use super::{input_bytes, js_error, options, progress_fn, to_js, JsProgress, Session};
@@ -85,7 +85,20 @@ fn run_vibration(
     p: Option<JsProgress>,
 ) -> Result<JsValue, JsValue> {
     let r = vibration_with_progress(bytes, o, &mut progress_fn(p)).map_err(|e| js_error(&e))?;
-    to_js(&r)
+    let value = to_js(&r)?;
+    // The spectrum as typed arrays (ready for a chart, and no boxing of thousands of numbers).
+    let psd = Reflect::get(&value, &JsValue::from_str("psd"))?;
+    Reflect::set(
+        &psd,
+        &JsValue::from_str("freqs"),
+        &Float64Array::from(&r.psd.freqs[..]),
+    )?;
+    Reflect::set(
+        &psd,
+        &JsValue::from_str("power"),
+        &Float64Array::from(&r.psd.power[..]),
+    )?;
+    Ok(value)
 }
 
 /// Vibration-suppressed toolpath (`quietpath vtg --json`, plus `output`).
@@ -132,8 +145,9 @@ pub fn smooth(
     run_smooth(&input_bytes(&input)?, &o, on_progress)
 }
 
-/// Axis dynamics, trajectory deviation and vibration spectrum (`quietpath vibration --json`).
-#[wasm_bindgen(unchecked_return_type = "VibrationReport")]
+/// Axis dynamics, trajectory deviation and vibration spectrum (`quietpath vibration --json`,
+/// with the spectrum's `freqs` and `power` as `Float64Array`s).
+#[wasm_bindgen(unchecked_return_type = "VibrationResult")]
 pub fn vibration(
     #[wasm_bindgen(unchecked_param_type = "string | Uint8Array | ArrayBuffer")] input: JsValue,
     options_value: Option<JsVibrationOptions>,
@@ -195,7 +209,7 @@ impl Session {
     }
 
     /// `vibration` of the session's file.
-    #[wasm_bindgen(unchecked_return_type = "VibrationReport")]
+    #[wasm_bindgen(unchecked_return_type = "VibrationResult")]
     pub fn vibration(
         &self,
         options_value: Option<JsVibrationOptions>,

@@ -241,6 +241,10 @@ export interface VibrationReport {
   simulated_s: number;
   steps: number;
 }
+/** vibration() result: the report with the spectrum as typed arrays. */
+export interface VibrationResult extends Omit<VibrationReport, "psd"> {
+  psd: Omit<VibrationReport["psd"], "freqs" | "power"> & { freqs: Float64Array; power: Float64Array };
+}
 
 // ── smooth (`quietpath smooth --json`) ──
 export type FilterKind = "zero-phase-moving-average" | "zero-phase-median" | "moving-average" | "median";
