@@ -32,10 +32,33 @@ fn vtg_writes_the_file_and_reports_json() {
         assert!(json["table1"][key]["before"].is_number(), "{key}");
     }
     assert!(json["table2"]["energy_j"]["after"].is_number());
-    assert!(json["table2"]["deviation"].is_null());
+    // Table 2's deviation rows come from the dynamics model, run on both files by default.
+    for row in ["max_mm", "min_mm", "mean_mm"] {
+        assert!(
+            json["table2"]["deviation"][row]["after"]
+                .as_f64()
+                .expect(row)
+                >= 0.0,
+            "{row}"
+        );
+    }
     assert!(json["before"]["toolpath"]["n_turning"].as_u64().expect("n") > 0);
     let written = std::fs::read(&out_path).expect("output");
     assert!(!written.is_empty());
+
+    // --no-dynamics skips the simulation: same file, deviation rows null.
+    let fast = Command::new(env!("CARGO_BIN_EXE_quietpath"))
+        .arg("vtg")
+        .arg(&input)
+        .arg("-o")
+        .arg(&out_path)
+        .args(["--no-dynamics", "--force", "--json"])
+        .output()
+        .expect("run quietpath");
+    assert!(fast.status.success());
+    let fast: serde_json::Value = serde_json::from_slice(&fast.stdout).expect("json");
+    assert!(fast["table2"]["deviation"].is_null());
+    assert_eq!(std::fs::read(&out_path).expect("output"), written);
 
     // Refuses to overwrite its input without --force.
     let again = Command::new(env!("CARGO_BIN_EXE_quietpath"))
