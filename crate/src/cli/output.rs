@@ -10,6 +10,27 @@ pub fn write_json<T: serde::Serialize>(out: &mut impl Write, value: &T) -> Resul
     writeln!(out).map_err(|e| e.to_string())
 }
 
+/// The end of a rewriting command: the new file written atomically, then the report on
+/// stdout as JSON or as the command's table (`table`).
+pub fn finish_rewrite<T: serde::Serialize>(
+    input: &Path,
+    output: &Path,
+    force: bool,
+    bytes: &[u8],
+    report: &T,
+    json: bool,
+    table: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> Result<(), String> {
+    write_atomically(input, output, force, |out| out.write_all(bytes))?;
+    let mut stdout = io::stdout().lock();
+    if json {
+        write_json(&mut stdout, report)?;
+    } else {
+        table(&mut stdout).map_err(|e| e.to_string())?;
+    }
+    stdout.flush().map_err(|e| e.to_string())
+}
+
 /// Writes `output` through a temporary file in the same directory and a rename, so an
 /// interrupted run never leaves a half-written file where a complete one is expected. Refuses to
 /// replace `input` unless `force`.

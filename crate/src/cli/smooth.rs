@@ -153,16 +153,15 @@ pub fn run(args: Args) -> Result<(), String> {
     for w in &report.warnings {
         eprintln!("warning: {}:{}: {}", args.file.display(), w.line, w.message);
     }
-    output::write_atomically(&args.file, &args.output, args.force, |out| {
-        out.write_all(&report.output)
-    })?;
-    let mut stdout = std::io::stdout().lock();
-    if args.json {
-        output::write_json(&mut stdout, &report)?;
-    } else {
-        print(&mut stdout, &args, &report).map_err(|e| e.to_string())?;
-    }
-    stdout.flush().map_err(|e| e.to_string())
+    output::finish_rewrite(
+        &args.file,
+        &args.output,
+        args.force,
+        &report.output,
+        &report,
+        args.json,
+        |mut w| print(&mut w, &args, &report),
+    )
 }
 
 fn print(out: &mut impl Write, args: &Args, r: &SmoothReport) -> std::io::Result<()> {

@@ -54,16 +54,15 @@ pub fn run(args: Args) -> Result<(), String> {
     let report = vtg_with_progress(&input, &options, &mut |f| bar.update(f))
         .map_err(|e| format!("{}:{}", args.file.display(), e))?;
     bar.finish();
-    output::write_atomically(&args.file, &args.output, args.force, |out| {
-        out.write_all(&report.output)
-    })?;
-    let mut stdout = std::io::stdout().lock();
-    if args.json {
-        output::write_json(&mut stdout, &report)?;
-    } else {
-        print(&mut stdout, &report).map_err(|e| e.to_string())?;
-    }
-    stdout.flush().map_err(|e| e.to_string())
+    output::finish_rewrite(
+        &args.file,
+        &args.output,
+        args.force,
+        &report.output,
+        &report,
+        args.json,
+        |mut w| print(&mut w, &report),
+    )
 }
 
 fn print(out: &mut impl Write, r: &VtgReport) -> std::io::Result<()> {
