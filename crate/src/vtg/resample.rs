@@ -121,14 +121,16 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
                 .min(step_for(k, w).max(0.25 * step))
                 .max(w.min_step_mm);
         }
-        let (mut un, mut pn, k, step) = accepted?;
-        // Do not leave a sliver before the end: stretch this step to it instead.
+        let (mut un, mut pn, k, mut step) = accepted?;
+        // Do not leave a sliver before the end: stretch this step to it instead (it is then
+        // the last, shorter-or-longer step to the end, not a full `L_i`, as the end step is).
         if un < u_end
             && norm(&sub(&end_p, &pn)) < w.min_step_mm
             && (u_end - un) * norm(&e.d1) < 2.0 * w.min_step_mm
         {
             un = u_end;
             pn = end_p;
+            step = 0.0;
         }
         if step > 0.0 {
             let got = norm(&sub(&pn, &p));
