@@ -55,22 +55,28 @@ fn parser_rejects_non_finite_numbers() {
 
 #[wasm_bindgen_test]
 fn binding_returns_plain_objects_and_js_errors() {
-    let report = quietpath::wasm::analyze_js(
-        JsValue::from_str("M83\nG1 X10 E1 F600\n"),
-        JsValue::UNDEFINED,
-        None,
-    )
-    .expect("report");
+    let report =
+        quietpath::wasm::analyze_js(JsValue::from_str("M83\nG1 X10 E1 F600\n"), None, None)
+            .expect("report");
     let moves = Reflect::get(&report, &JsValue::from_str("moves")).expect("moves");
     assert_eq!(moves.as_f64(), Some(1.0));
     let strict = js_sys::JSON::parse(r#"{"strict": true}"#).expect("json");
-    let err = quietpath::wasm::analyze_js(JsValue::from_str("G1 X1\nG1 X1e999\n"), strict, None)
-        .expect_err("strict");
+    let err = quietpath::wasm::analyze_js(
+        JsValue::from_str("G1 X1\nG1 X1e999\n"),
+        Some(strict.unchecked_into()),
+        None,
+    )
+    .expect_err("strict");
     assert!(err.is_instance_of::<js_sys::Error>());
     let line = Reflect::get(&err, &JsValue::from_str("line")).expect("line");
     assert_eq!(line.as_f64(), Some(2.0));
     let bad_opts = js_sys::JSON::parse(r#"{"filament_diameter_mm": -1}"#).expect("json");
-    assert!(quietpath::wasm::analyze_js(JsValue::from_str("G1 X1"), bad_opts, None).is_err());
+    assert!(quietpath::wasm::analyze_js(
+        JsValue::from_str("G1 X1"),
+        Some(bad_opts.unchecked_into()),
+        None
+    )
+    .is_err());
 }
 
 /// The thesis's Table 3, read at compile time from the committed fixture.

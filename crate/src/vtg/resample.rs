@@ -324,54 +324,59 @@ mod tests {
         assert_eq!(s.last().unwrap().p, [10.0, 10.0, 0.2]);
     }
 
-    use proptest::prelude::*;
+    /// Property tests (proptest is a native-only dev-dependency).
+    #[cfg(not(target_arch = "wasm32"))]
+    mod props {
+        use super::*;
+        use proptest::prelude::*;
 
-    proptest! {
-        #![proptest_config(ProptestConfig::with_cases(48))]
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(48))]
 
-        /// On random polylines: every interpolated point lies on the fitted curve, every full
-        /// step equals `L_i` within the Newton tolerance, and where a step was accepted by the
-        /// curvature test its curvature bound holds.
-        #[test]
-        fn walk_invariants(
-            raw in proptest::collection::vec((-20.0f64..20.0, -20.0f64..20.0), 3..9),
-        ) {
-            let mut pts: Vec<[f64; 3]> = Vec::new();
-            for (x, y) in raw {
-                let p = [x, y, 0.2];
-                if pts.last().is_none_or(|q: &[f64; 3]| norm(&sub(&p, q)) > 0.5) {
-                    pts.push(p);
+            /// On random polylines: every interpolated point lies on the fitted curve, every full
+            /// step equals `L_i` within the Newton tolerance, and where a step was accepted by the
+            /// curvature test its curvature bound holds.
+            #[test]
+            fn walk_invariants(
+                raw in proptest::collection::vec((-20.0f64..20.0, -20.0f64..20.0), 3..9),
+            ) {
+                let mut pts: Vec<[f64; 3]> = Vec::new();
+                for (x, y) in raw {
+                    let p = [x, y, 0.2];
+                    if pts.last().is_none_or(|q: &[f64; 3]| norm(&sub(&p, q)) > 0.5) {
+                        pts.push(p);
+                    }
                 }
-            }
-            prop_assume!(pts.len() >= 3);
-            let (d, u) = sample(&pts, 0.25, 3.0);
-            let Some(f) = fit(&d, &u, 0.06) else { return Ok(()) };
-            let w = Walk {
-                chord_tol_mm: 0.03,
-                max_turn_rad: 0.45,
-                max_step_mm: 1e4,
-                min_step_mm: 0.03,
-                phi: 1.0,
-                newton_tol_mm: 1e-7,
-            };
-            let mut st = WalkStats::default();
-            let Some(s) = walk(&f.curve, &w, &mut st) else { return Ok(()) };
-            let index = CurvatureIndex::new(&f.curve);
-            for x in &s {
-                let on = f.curve.eval(x.u).p;
-                prop_assert!(norm(&sub(&on, &x.p)) < 1e-12);
-            }
-            for pair in s.windows(2) {
-                let (a, b) = (&pair[0], &pair[1]);
-                prop_assert!(b.u > a.u);
-                if b.step_mm > 0.0 {
-                    let got = norm(&sub(&b.p, &a.p));
-                    prop_assert!((got - b.step_mm).abs() <= 1e-7, "{} vs {}", got, b.step_mm);
-                    if b.step_mm > w.min_step_mm {
-                        // Accepted by the test, not forced by the step floor.
-                        let k = index.max(&f.curve, a.u, b.u);
-                        prop_assert!(k * b.step_mm <= w.max_turn_rad * 1.0001);
-                        prop_assert!(k * b.step_mm * b.step_mm <= 8.0 * w.chord_tol_mm * 1.0001);
+                prop_assume!(pts.len() >= 3);
+                let (d, u) = sample(&pts, 0.25, 3.0);
+                let Some(f) = fit(&d, &u, 0.06) else { return Ok(()) };
+                let w = Walk {
+                    chord_tol_mm: 0.03,
+                    max_turn_rad: 0.45,
+                    max_step_mm: 1e4,
+                    min_step_mm: 0.03,
+                    phi: 1.0,
+                    newton_tol_mm: 1e-7,
+                };
+                let mut st = WalkStats::default();
+                let Some(s) = walk(&f.curve, &w, &mut st) else { return Ok(()) };
+                let index = CurvatureIndex::new(&f.curve);
+                for x in &s {
+                    let on = f.curve.eval(x.u).p;
+                    prop_assert!(norm(&sub(&on, &x.p)) < 1e-12);
+                }
+                for pair in s.windows(2) {
+                    let (a, b) = (&pair[0], &pair[1]);
+                    prop_assert!(b.u > a.u);
+                    if b.step_mm > 0.0 {
+                        let got = norm(&sub(&b.p, &a.p));
+                        prop_assert!((got - b.step_mm).abs() <= 1e-7, "{} vs {}", got, b.step_mm);
+                        if b.step_mm > w.min_step_mm {
+                            // Accepted by the test, not forced by the step floor.
+                            let k = index.max(&f.curve, a.u, b.u);
+                            prop_assert!(k * b.step_mm <= w.max_turn_rad * 1.0001);
+                            prop_assert!(k * b.step_mm * b.step_mm <= 8.0 * w.chord_tol_mm * 1.0001);
+                        }
                     }
                 }
             }

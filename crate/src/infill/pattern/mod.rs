@@ -202,7 +202,7 @@ mod tests {
     }
 }
 
-#[cfg(test)]
+#[cfg(all(test, not(target_arch = "wasm32")))]
 mod props {
     use super::*;
     use crate::infill::geom::inside_tol;
