@@ -126,6 +126,17 @@ pub(crate) struct Setup {
     pub units: FeedUnits,
 }
 
+impl Setup {
+    /// The machine a pass starts with: the file's extrusion mode, everything else at its
+    /// power-on state.
+    pub fn machine(&self) -> Machine {
+        Machine::new(MachineConfig {
+            extrusion: self.mode,
+            ..MachineConfig::default()
+        })
+    }
+}
+
 /// Builds the [`Setup`] of a pass over `input`.
 pub(crate) fn prepare(input: &[u8], options: &AnalyzeOptions) -> Result<Setup, Error> {
     validate_options(options)?;
@@ -195,6 +206,8 @@ pub fn analyze_with_progress(
     options: &AnalyzeOptions,
     progress: Progress<'_>,
 ) -> Result<Report, Error> {
+    let setup = prepare(input, options)?;
+    let mut machine = setup.machine();
     let Setup {
         strictness,
         mode,
@@ -206,7 +219,7 @@ pub fn analyze_with_progress(
         model_reason,
         limits,
         units,
-    } = prepare(input, options)?;
+    } = setup;
     let mut limits_now = limits.clone();
     let mut print_limits = None;
     let mut timing = Timing::new(
@@ -214,10 +227,6 @@ pub fn analyze_with_progress(
         Accumulator::new(&options.energy.clone().unwrap_or_default(), &profile.name),
     );
 
-    let mut machine = Machine::new(MachineConfig {
-        extrusion: mode,
-        ..MachineConfig::default()
-    });
     let mut info = SlicerInfo::default();
     let mut acc = Accounts::new();
     let mut next_progress = PROGRESS_STEP;

@@ -9,7 +9,7 @@
 use crate::analyze::{layers::LayerTracker, prepare, AnalyzeOptions, LayerSource, Setup};
 use crate::error::Error;
 use crate::gcode::{self, classify_comment, feature_kind, Command, FeatureKind, Marker};
-use crate::machine::{axis, Event, Heater, Machine, MachineConfig, Move, MoveKind};
+use crate::machine::{axis, Event, Heater, Machine, Move, MoveKind};
 use crate::plan::{JunctionModel, Limits, MachineProfile};
 
 /// One thing the timing side sees.
@@ -87,20 +87,17 @@ pub(crate) struct Program {
 
 /// Reads `input` into a [`Program`].
 pub(crate) fn read(input: &[u8], options: &AnalyzeOptions) -> Result<Program, Error> {
+    let setup = prepare(input, options)?;
+    let mut machine = setup.machine();
     let Setup {
         strictness,
-        mode,
         mut warnings,
         profile,
         model,
         limits,
         units,
         ..
-    } = prepare(input, options)?;
-    let mut machine = Machine::new(MachineConfig {
-        extrusion: mode,
-        ..MachineConfig::default()
-    });
+    } = setup;
     let mut limits_now = limits.clone();
     let mut tracker = LayerTracker::new();
     let mut moves: Vec<Mv> = Vec::new();

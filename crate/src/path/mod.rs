@@ -24,7 +24,7 @@ use serde::Serialize;
 use crate::analyze::{layers::LayerTracker, prepare, AnalyzeOptions, LayerSource, Setup};
 use crate::error::{Error, Warning};
 use crate::gcode::{self, classify_comment, feature_kind, FeatureKind, Marker};
-use crate::machine::{Event, ExtrusionMode, Machine, MachineConfig, MoveKind, Pos};
+use crate::machine::{Event, ExtrusionMode, MoveKind, Pos};
 use crate::plan::{JunctionModel, Limits, MachineProfile, Motion, PlannedMove, Planner, Profile};
 
 /// Feature index of moves before the file names any feature.
@@ -144,6 +144,8 @@ impl PrintPath {
 /// also gets the planner's timing (look-ahead over the whole file, limit commands applied where
 /// they appear, dwells and heater waits flushing the queue as firmware does).
 pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<PrintPath, Error> {
+    let setup = prepare(input, options)?;
+    let mut machine = setup.machine();
     let Setup {
         strictness,
         mode,
@@ -153,11 +155,7 @@ pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<Pri
         limits,
         units,
         ..
-    } = prepare(input, options)?;
-    let mut machine = Machine::new(MachineConfig {
-        extrusion: mode,
-        ..MachineConfig::default()
-    });
+    } = setup;
     let mut planner = Planner::new(limits.clone(), model);
     let mut limits_now = limits;
     let mut print_limits = None;

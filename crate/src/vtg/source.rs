@@ -8,7 +8,7 @@
 use crate::analyze::{prepare, AnalyzeOptions};
 use crate::error::Error;
 use crate::gcode::{self, Line};
-use crate::machine::{axis, Event, ExtrusionMode, Machine, MachineConfig};
+use crate::machine::{axis, Event, ExtrusionMode};
 
 /// A move's source line as the rewriter sees it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -33,11 +33,8 @@ pub struct MoveSource {
 /// One entry per move, in the order `path::extract` lists them.
 pub fn move_sources(input: &[u8], options: &AnalyzeOptions) -> Result<Vec<MoveSource>, Error> {
     let setup = prepare(input, options)?;
+    let mut machine = setup.machine();
     let mut warnings = setup.warnings;
-    let mut machine = Machine::new(MachineConfig {
-        extrusion: setup.mode,
-        ..MachineConfig::default()
-    });
     let mut limits = setup.limits;
     let mut f_modal: Option<f64> = None;
     let mut out = Vec::new();
