@@ -63,11 +63,11 @@ bench: cli
 	target/release/quietpath bench "$(LARGE)"
 	cargo bench -p quietpath --bench parse
 
-## Short fuzzing smoke run of every cargo-fuzz target (make test); `make fuzz` runs long.
+## Short, reproducible (seeded, fixed-count) fuzzing smoke run of every target (make test).
 test-fuzz:
-	crate/fuzz/smoke.sh 10
+	FUZZ_SEED=20261122 crate/fuzz/smoke.sh 10
 
-## Long fuzzing run of every target (parse_line, analyze, rewrite), 10 minutes each.
+## Long, unseeded fuzzing run of all eight targets, 10 minutes each, keeping its corpus.
 ## Installs nightly and cargo-fuzz if missing. FUZZ_SECONDS=… to change.
 FUZZ_SECONDS ?= 600
 fuzz:

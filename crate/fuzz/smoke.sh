@@ -8,6 +8,13 @@
 # fuzz/corpus/<target>/ (git-ignored); fuzz/seeds/<target>/ is only read. Crashing inputs are
 # written to fuzz/artifacts/<target>/ (git-ignored): copy them into fuzz/regressions/ so that
 # `cargo test` (tests/fuzz_regressions.rs) replays them for ever.
+#
+# FUZZ_SEED=N makes the run reproducible (what `make test` does): libFuzzer's random seed is N,
+# each target starts from the committed seeds alone (a fresh corpus directory) and runs a fixed
+# number of inputs (about SECONDS' worth on the 2-core reference machine, from the table below),
+# so every machine tries the same inputs in the same order and CI cannot turn red on a find
+# that depends on how fast, or for how long, the machine fuzzed before. Exploration is the job
+# of `make fuzz`, which runs unseeded and keeps its corpus.
 set -uo pipefail
 
 secs=${1:-20}
@@ -30,18 +37,37 @@ if ! cargo fuzz --version >/dev/null 2>&1; then
     cargo install cargo-fuzz --locked || exit 2
 fi
 
+# Inputs per second each target runs on the reference machine (60 % of what it measured), for
+# the seeded mode's fixed run counts.
+declare -A per_second=(
+    [parse_line]=4300 [analyze]=220 [rewrite]=9300 [planner]=8600
+    [vtg]=21 [infill]=330 [smooth]=63 [vibration]=3
+)
+
 failed=()
 for t in "${targets[@]}"; do
     mkdir -p "fuzz/corpus/$t" "fuzz/artifacts/$t"
-    echo "== fuzz $t for ${secs}s"
+    corpus="fuzz/corpus/$t"
+    mode=(-max_total_time="$secs")
+    if [ -n "${FUZZ_SEED:-}" ]; then
+        corpus=$(mktemp -d)
+        runs=$(( ${per_second[$t]:-100} * secs ))
+        # The time cap only guards a much slower machine; it then runs a prefix of the same
+        # sequence.
+        mode=(-seed="$FUZZ_SEED" -runs="$runs" -max_total_time=$(( 4 * secs )))
+        echo "== fuzz $t: $runs inputs, seed $FUZZ_SEED"
+    else
+        echo "== fuzz $t for ${secs}s"
+    fi
     # -timeout: one input taking longer than 10 s is a bug (quadratic paths on hostile input).
     # -rss_limit_mb: the parser streams; 2 GB means a leak or an unbounded structure.
-    if ! cargo +nightly fuzz run "$t" "fuzz/corpus/$t" "fuzz/seeds/$t" -- \
-        -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 -dict=fuzz/gcode.dict \
+    if ! cargo +nightly fuzz run "$t" "$corpus" "fuzz/seeds/$t" -- \
+        "${mode[@]}" -timeout=10 -rss_limit_mb=2048 -dict=fuzz/gcode.dict \
         -print_final_stats=1; then
         echo "!! fuzz target $t failed; reproducer in crate/fuzz/artifacts/$t/" >&2
         failed+=("$t")
     fi
+    [ -z "${FUZZ_SEED:-}" ] || rm -rf "$corpus"
 done
 
 if [ ${#failed[@]} -gt 0 ]; then
