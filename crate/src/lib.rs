@@ -38,6 +38,7 @@ pub mod infill;
 pub mod machine;
 pub mod math;
 pub mod orient;
+pub mod parallel;
 pub mod path;
 pub mod plan;
 pub mod vtg;

@@ -5,6 +5,7 @@
 pub mod dialect;
 pub mod line;
 pub mod lines;
+pub mod number;
 pub mod writer;
 
 pub use dialect::{

@@ -10,6 +10,7 @@ use super::cost::Replacement;
 use super::geom::{dist, Path, P2};
 use super::program::{Block, Program};
 use crate::error::Warnings;
+use crate::gcode::number::push_fixed;
 use crate::gcode::parse_line;
 use crate::machine::{axis, Event, ExtrusionMode, MoveKind};
 use crate::plan::Motion;
@@ -118,25 +119,6 @@ pub(crate) fn habit(prog: &Program) -> Option<Habit> {
         min_travel_mm,
         firmware,
     })
-}
-
-/// Appends `v` with `digits` decimals (3 or 5) by integer arithmetic: the same text as
-/// `format!("{v:.3}")` up to trailing zeros, several times faster (emission is a hot path of
-/// the search).
-fn push_fixed(out: &mut String, v: f64, digits: u32) {
-    let scale = 10i64.pow(digits);
-    let n = (v * scale as f64).round();
-    if !n.is_finite() || n.abs() > 9.0e15 {
-        let _ = write!(out, "{v:.0$}", digits as usize);
-        return;
-    }
-    let n = n as i64;
-    if n < 0 {
-        out.push('-');
-    }
-    let a = n.unsigned_abs();
-    let s = scale as u64;
-    let _ = write!(out, "{}.{:0w$}", a / s, a % s, w = digits as usize);
 }
 
 fn r3(v: f64) -> f64 {
@@ -309,21 +291,6 @@ pub(crate) fn motions(block: &Block, text: &str, start: P2) -> Replacement {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn fixed_point_text() {
-        for (v, d, want) in [
-            (70.85, 3, "70.850"),
-            (-0.0004, 3, "0.000"),
-            (-2.0, 5, "-2.00000"),
-            (0.123456, 5, "0.12346"),
-            (-12.3456, 3, "-12.346"),
-        ] {
-            let mut s = String::new();
-            push_fixed(&mut s, v, d);
-            assert_eq!(s, want);
-        }
-    }
 
     #[test]
     fn weighted_mode() {

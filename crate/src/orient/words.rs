@@ -1,46 +1,6 @@
 //! Rewriting the axis words of one motion line, keeping everything else as written.
 
-/// `v · 10^decimals` rounded to an integer (half away from zero), when it is exactly
-/// representable; the written value is then exactly `scaled / 10^decimals`.
-fn scaled(v: f64, decimals: usize) -> Option<(i64, f64)> {
-    const POW10: [f64; 10] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9];
-    let p = *POW10.get(decimals)?;
-    let s = libm::round(v * p);
-    (s.is_finite() && s.abs() < 9.0e15).then_some((s as i64, p))
-}
-
-/// Formats `v` with `decimals` places, without a sign on zero (`-0.000` → `0.000`).
-pub fn format_value(v: f64, decimals: usize) -> String {
-    let Some((n, _)) = scaled(v, decimals).filter(|_| decimals > 0) else {
-        return format!("{v:.decimals$}");
-    };
-    let digits = n.unsigned_abs().to_string();
-    let mut out = String::with_capacity(digits.len() + decimals + 3);
-    if n < 0 {
-        out.push('-');
-    }
-    if digits.len() <= decimals {
-        out.push_str("0.");
-        out.extend(std::iter::repeat_n('0', decimals - digits.len()));
-        out.push_str(&digits);
-    } else {
-        let (int, frac) = digits.split_at(digits.len() - decimals);
-        out.push_str(int);
-        if decimals > 0 {
-            out.push('.');
-            out.push_str(frac);
-        }
-    }
-    out
-}
-
-/// The value [`format_value`] writes, as a number.
-pub fn rounded(v: f64, decimals: usize) -> f64 {
-    match scaled(v, decimals) {
-        Some((n, p)) => n as f64 / p,
-        None => v,
-    }
-}
+pub use crate::gcode::number::{fixed as format_value, rounded};
 
 fn is_number_byte(b: u8) -> bool {
     b.is_ascii_digit() || b == b'.' || b == b'-' || b == b'+'
@@ -149,24 +109,5 @@ mod tests {
         let out = rewrite_line(b"N10 G1 X1 E2*99", &vals(&[(b'X', "5")]));
         let cs = crate::gcode::line::checksum(b"N10 G1 X5 E2");
         assert_eq!(out, format!("N10 G1 X5 E2*{cs}").into_bytes());
-    }
-
-    #[test]
-    fn negative_zero_is_written_as_zero() {
-        assert_eq!(format_value(-0.0004, 3), "0.000");
-        assert_eq!(format_value(-1.0004, 3), "-1.000");
-        assert_eq!(format_value(-0.0456, 3), "-0.046");
-        assert_eq!(format_value(2912.7, 3), "2912.700");
-        assert_eq!(format_value(1e300, 2).len(), 304);
-    }
-
-    #[test]
-    fn rounded_is_what_is_written() {
-        for v in [-25.4624999, 0.0005, -0.0005, 38.4795, 1234.56789, -2689.7] {
-            for d in 1..=6 {
-                let text = format_value(v, d);
-                assert_eq!(text.parse::<f64>().ok(), Some(rounded(v, d)), "{v} {d}");
-            }
-        }
     }
 }

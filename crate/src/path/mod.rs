@@ -140,10 +140,62 @@ impl PrintPath {
     }
 }
 
-/// Reads every move of `input` the way [`crate::analyze::analyze`] does. With `plan`, each move
-/// also gets the planner's timing (look-ahead over the whole file, limit commands applied where
-/// they appear, dwells and heater waits flushing the queue as firmware does).
-pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<PrintPath, Error> {
+/// Where [`walk`] delivers the moves it reads, one at a time in file order.
+pub trait MoveSink {
+    /// A move was read: `index` is its position in file order, `layers` the layer it belongs to
+    /// by marker and by counting (which one the file uses is known only at the end, in
+    /// [`Walked::layer_source`]), `features` the features named so far (`m.feature` indexes it).
+    fn moved(&mut self, index: usize, m: PathMove, layers: (u32, u32), features: &[PathFeature]);
+    /// The planner has timed move `pm.tag` (only when planning; several calls for the segments
+    /// of one arc).
+    fn timed(&mut self, _pm: &PlannedMove) {}
+}
+
+/// What [`walk`] learns of a file besides its moves.
+#[derive(Debug, Clone)]
+pub struct Walked {
+    /// Layers in order, with their heights and first lines (no move ranges).
+    pub layers: Vec<PathLayer>,
+    /// How layers were counted.
+    pub layer_source: LayerSource,
+    /// Features named in the file.
+    pub features: Vec<PathFeature>,
+    /// Machine profile the file is planned with.
+    pub profile: MachineProfile,
+    /// Junction model.
+    pub junction_model: JunctionModel,
+    /// Limits in force at the first extrusion.
+    pub print_limits: Limits,
+    /// Extrusion mode at the start of the file.
+    pub extrusion_mode: ExtrusionMode,
+    /// Total planned time, s (0 without planning).
+    pub time_s: f64,
+    /// Warnings met while reading.
+    pub warnings: Vec<Warning>,
+    /// Moves read.
+    pub moves: usize,
+}
+
+impl Walked {
+    /// The layer a move belongs to, from the pair [`MoveSink::moved`] was given.
+    pub fn layer_of(&self, layers: (u32, u32)) -> u32 {
+        match self.layer_source {
+            LayerSource::Markers(_) => layers.0,
+            _ => layers.1,
+        }
+    }
+}
+
+/// Reads every move of `input` the way [`crate::analyze::analyze`] does and hands each to
+/// `sink`, keeping nothing itself: memory stays bounded whatever the file's size (what a sink
+/// keeps is its own business). With `plan`, the planner's timing follows through
+/// [`MoveSink::timed`].
+pub fn walk(
+    input: &[u8],
+    options: &AnalyzeOptions,
+    plan: bool,
+    sink: &mut impl MoveSink,
+) -> Result<Walked, Error> {
     let setup = prepare(input, options)?;
     let mut machine = setup.machine();
     let Setup {
@@ -160,23 +212,9 @@ pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<Pri
     let mut limits_now = limits;
     let mut print_limits = None;
     let mut tracker = LayerTracker::new();
-    let mut moves: Vec<PathMove> = Vec::new();
-    // Both layer counts per move; the one the tracker settles on is picked at the end.
-    let mut layer_pairs: Vec<(u32, u32)> = Vec::new();
+    let mut count = 0usize;
     let mut features: Vec<PathFeature> = Vec::new();
     let mut current_feature = NO_FEATURE;
-
-    fn set_timing(moves: &mut [PathMove], pm: &PlannedMove) {
-        if let Some(m) = moves.get_mut(pm.tag as usize) {
-            let end = pm.start_s + pm.duration();
-            let start_s = m.timing.map_or(pm.start_s, |t| t.start_s);
-            m.timing = Some(MoveTiming {
-                start_s,
-                duration_s: end - start_s,
-                profile: pm.profile,
-            });
-        }
-    }
 
     gcode::for_each_line(input, strictness, &mut warnings, |raw, line, warnings| {
         let Some(line) = line else { return Ok(()) };
@@ -211,9 +249,9 @@ pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<Pri
                     print_limits = Some(limits_now.clone());
                 }
                 tracker.motion(&m);
-                layer_pairs.push(tracker.current());
-                let index = moves.len();
-                moves.push(PathMove {
+                let index = count;
+                count += 1;
+                let moved = PathMove {
                     line: m.line,
                     kind: m.kind,
                     from: m.from,
@@ -223,33 +261,25 @@ pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<Pri
                     feature: current_feature,
                     layer: NO_LAYER,
                     timing: None,
-                });
+                };
+                sink.moved(index, moved, tracker.current(), &features);
                 if plan {
-                    planner.push(&Motion::from(&m), index as u64, &mut |pm| {
-                        set_timing(&mut moves, pm)
-                    });
+                    planner.push(&Motion::from(&m), index as u64, &mut |pm| sink.timed(pm));
                 }
             }
-            Some(Event::Dwell(secs)) if plan => {
-                planner.dwell(secs, &mut |pm| set_timing(&mut moves, pm));
-            }
+            Some(Event::Dwell(secs)) if plan => planner.dwell(secs, &mut |pm| sink.timed(pm)),
             Some(Event::Temperature { wait: true, .. }) if plan => {
-                planner.flush(&mut |pm| set_timing(&mut moves, pm));
+                planner.flush(&mut |pm| sink.timed(pm));
             }
             _ => {}
         }
         Ok(())
     })?;
     if plan {
-        planner.flush(&mut |pm| set_timing(&mut moves, pm));
+        planner.flush(&mut |pm| sink.timed(pm));
     }
-
     let (summaries, layer_source) = tracker.finish();
-    let by_marker = matches!(layer_source, LayerSource::Markers(_));
-    for (m, &(a, b)) in moves.iter_mut().zip(&layer_pairs) {
-        m.layer = if by_marker { a } else { b };
-    }
-    let mut layers: Vec<PathLayer> = summaries
+    let layers = summaries
         .iter()
         .map(|s| PathLayer {
             z: s.z,
@@ -258,6 +288,73 @@ pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<Pri
             end: 0,
         })
         .collect();
+    let (warnings, _) = warnings.into_parts();
+    Ok(Walked {
+        layers,
+        layer_source,
+        features,
+        profile,
+        junction_model: model,
+        print_limits: print_limits.unwrap_or(limits_now),
+        extrusion_mode: mode,
+        time_s: planner.elapsed_s(),
+        warnings,
+        moves: count,
+    })
+}
+
+/// [`MoveSink`] keeping every move (for [`extract`]).
+#[derive(Default)]
+struct Collect {
+    moves: Vec<PathMove>,
+    layer_pairs: Vec<(u32, u32)>,
+}
+
+impl MoveSink for Collect {
+    fn moved(&mut self, _: usize, m: PathMove, layers: (u32, u32), _: &[PathFeature]) {
+        self.moves.push(m);
+        self.layer_pairs.push(layers);
+    }
+
+    fn timed(&mut self, pm: &PlannedMove) {
+        if let Some(m) = self.moves.get_mut(pm.tag as usize) {
+            let end = pm.start_s + pm.duration();
+            let start_s = m.timing.map_or(pm.start_s, |t| t.start_s);
+            m.timing = Some(MoveTiming {
+                start_s,
+                duration_s: end - start_s,
+                profile: pm.profile,
+            });
+        }
+    }
+}
+
+/// Reads every move of `input` the way [`crate::analyze::analyze`] does and keeps them all. With
+/// `plan`, each move also gets the planner's timing (look-ahead over the whole file, limit
+/// commands applied where they appear, dwells and heater waits flushing the queue as firmware
+/// does). [`walk`] reads the same moves without keeping them.
+pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<PrintPath, Error> {
+    let mut kept = Collect::default();
+    let walked = walk(input, options, plan, &mut kept)?;
+    let Collect {
+        mut moves,
+        layer_pairs,
+    } = kept;
+    for (m, &pair) in moves.iter_mut().zip(&layer_pairs) {
+        m.layer = walked.layer_of(pair);
+    }
+    let Walked {
+        mut layers,
+        layer_source,
+        features,
+        profile,
+        junction_model,
+        print_limits,
+        extrusion_mode,
+        time_s,
+        warnings,
+        ..
+    } = walked;
     // Moves are in file order and layer indices never decrease (moves before the first layer
     // have none), so each layer is one range.
     let mut seen = vec![false; layers.len()];
@@ -282,17 +379,16 @@ pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<Pri
             layer.end = next;
         }
     }
-    let (warnings, _) = warnings.into_parts();
     Ok(PrintPath {
         moves,
         layers,
         layer_source,
         features,
         profile,
-        junction_model: model,
-        print_limits: print_limits.unwrap_or(limits_now),
-        extrusion_mode: mode,
-        time_s: planner.elapsed_s(),
+        junction_model,
+        print_limits,
+        extrusion_mode,
+        time_s,
         warnings,
     })
 }

@@ -89,11 +89,26 @@ pub fn polyline_deviation(out: &[[f64; 3]], orig: &[[f64; 3]], step: f64, accept
         }
         best
     };
+    // Nearest segment over the whole polyline: where the window has lost track (the other
+    // polyline is much denser here, or doubles back), it puts the cursor back.
+    let nearest_anywhere = |p: &[f64; 3]| -> (usize, f64) {
+        (0..segs).fold((0, f64::INFINITY), |best, j| {
+            let d = seg_dist(p, j);
+            if d < best.1 {
+                (j, d)
+            } else {
+                best
+            }
+        })
+    };
     let mut worst = 0.0f64;
     let mut cursor = 0usize;
     let mut prev: Option<([f64; 3], usize, f64)> = None;
     for p in out {
-        let (j, d) = nearest(p, cursor);
+        let (mut j, mut d) = nearest(p, cursor);
+        if d > worst.max(step).max(accept) {
+            (j, d) = nearest_anywhere(p);
+        }
         cursor = j;
         if let Some((q, jq, dq)) = prev {
             // Certificate: both ends near one segment (either end's nearest).
@@ -115,11 +130,11 @@ pub fn polyline_deviation(out: &[[f64; 3]], orig: &[[f64; 3]], step: f64, accept
                 loop {
                     let f = if len > 0.0 { (t / len).min(1.0) } else { 1.0 };
                     let x = [q[0] + dir[0] * f, q[1] + dir[1] * f, q[2] + dir[2] * f];
-                    let (jj, mut dx) = nearest(&x, c);
-                    c = jj;
+                    let (mut jj, mut dx) = nearest(&x, c);
                     if dx > m.max(accept) {
-                        dx = point_polyline(&x, orig);
+                        (jj, dx) = nearest_anywhere(&x);
                     }
+                    c = jj;
                     m = m.max(dx);
                     guard += 1;
                     if f >= 1.0 || guard > 1_000_000 {
@@ -135,7 +150,6 @@ pub fn polyline_deviation(out: &[[f64; 3]], orig: &[[f64; 3]], step: f64, accept
                 return worst;
             }
         } else {
-            let d = if d > step { point_polyline(p, orig) } else { d };
             worst = worst.max(d);
         }
         prev = Some((*p, j, d));

@@ -243,6 +243,81 @@ pub fn from_path(
     (file.finish(), layers.iter().map(|l| l.finish()).collect())
 }
 
+/// [`MoveSink`](crate::path::MoveSink) accumulating the metrics of a file and of its layers
+/// under both layer numberings (which one holds is known at the end): a few hundred bytes per
+/// layer, however many moves.
+struct MetricsSink {
+    critical_angle_deg: f64,
+    file: MetricsAccumulator,
+    by_marker: Vec<MetricsAccumulator>,
+    by_count: Vec<MetricsAccumulator>,
+}
+
+impl MetricsSink {
+    fn layer(&mut self, marker: bool, layer: u32) -> Option<&mut MetricsAccumulator> {
+        if layer == crate::path::NO_LAYER {
+            return None;
+        }
+        let (list, i) = if marker {
+            (&mut self.by_marker, layer as usize)
+        } else {
+            (&mut self.by_count, layer as usize)
+        };
+        while list.len() <= i {
+            list.push(MetricsAccumulator::new(self.critical_angle_deg));
+        }
+        list.get_mut(i)
+    }
+}
+
+impl crate::path::MoveSink for MetricsSink {
+    fn moved(
+        &mut self,
+        _: usize,
+        m: crate::path::PathMove,
+        layers: (u32, u32),
+        features: &[crate::path::PathFeature],
+    ) {
+        use crate::gcode::FeatureKind;
+        let infill = matches!(
+            features.get(m.feature as usize).map(|f| f.kind),
+            Some(FeatureKind::SparseInfill | FeatureKind::SolidInfill)
+        );
+        let (extruding, feature) = (m.is_extruding(), u32::from(m.feature));
+        self.file.push(&m.from, &m.to, extruding, feature, infill);
+        for (marker, layer) in [(true, layers.0), (false, layers.1)] {
+            if let Some(l) = self.layer(marker, layer) {
+                l.push(&m.from, &m.to, extruding, feature, infill);
+            }
+        }
+    }
+}
+
+/// What [`from_path`] gives, read straight from G-code without keeping the moves (the
+/// rewritten file of a VTG run can hold ten times the input's moves).
+pub fn from_input(
+    input: &[u8],
+    options: &crate::analyze::AnalyzeOptions,
+    critical_angle_deg: f64,
+) -> Result<(ToolpathMetrics, Vec<ToolpathMetrics>), crate::error::Error> {
+    let mut sink = MetricsSink {
+        critical_angle_deg,
+        file: MetricsAccumulator::new(critical_angle_deg),
+        by_marker: Vec::new(),
+        by_count: Vec::new(),
+    };
+    let walked = crate::path::walk(input, options, false, &mut sink)?;
+    let mut layers = match walked.layer_source {
+        crate::analyze::LayerSource::Markers(_) => sink.by_marker,
+        _ => sink.by_count,
+    };
+    layers.truncate(walked.layers.len());
+    Ok((
+        sink.file.finish(),
+        layers.iter().map(MetricsAccumulator::finish).collect(),
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -277,6 +352,34 @@ mod tests {
         let r = 50f64.sqrt();
         let e = r - (r * r - 25.0).sqrt();
         assert!((m.mean_chord_error_mm - e).abs() < 1e-12);
+    }
+
+    #[test]
+    fn streamed_metrics_equal_those_of_the_kept_moves() {
+        // Markers (the demo) and Z-counted layers (markers stripped), with and without an
+        // empty layer and moves before the first one.
+        let demo = include_bytes!("../../../www/demo/demo.gcode");
+        let stripped: Vec<u8> = String::from_utf8_lossy(demo)
+            .lines()
+            .filter(|l| !l.starts_with(";LAYER_CHANGE"))
+            .flat_map(|l| l.bytes().chain([b'\n']))
+            .collect();
+        let small = b"G1 X5 Y5 F3000\n;LAYER_CHANGE\n;LAYER_CHANGE\n;TYPE:Internal infill\n\
+G1 X10 Y0 E0.5 F1200\nG1 X10 Y10 E0.5\nG1 X0 Y10 E0.5\n";
+        for (name, g) in [
+            ("demo", &demo[..]),
+            ("no markers", &stripped),
+            ("small", small),
+        ] {
+            let o = crate::analyze::AnalyzeOptions::default();
+            let kept = from_path(&crate::path::extract(g, &o, false).unwrap(), 25.0);
+            let streamed = from_input(g, &o, 25.0).unwrap();
+            assert_eq!(streamed.0, kept.0, "{name}");
+            // The kept list stops at the last layer with moves; the stream lists every layer.
+            assert!(streamed.1.len() >= kept.1.len(), "{name}");
+            assert_eq!(streamed.1[..kept.1.len()], kept.1[..], "{name}");
+            assert!(streamed.1[kept.1.len()..].iter().all(|m| m.n_total == 0));
+        }
     }
 
     #[test]

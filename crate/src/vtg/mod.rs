@@ -108,12 +108,16 @@ pub fn vtg_with_progress(
 ) -> Result<VtgReport, Error> {
     options.validate()?;
     let cancelled = || Error::new(0, 0, ErrorKind::Cancelled);
-    let before = crate::analyze::analyze(input, &options.analyze)?;
-    if !progress(0.15) {
-        return Err(cancelled());
-    }
-    let path = crate::path::extract(input, &options.analyze, false)?;
-    let sources = source::move_sources(input, &options.analyze)?;
+    // Independent reads of the same bytes, side by side where there are threads.
+    let (before, read) = crate::parallel::join(
+        || crate::analyze::analyze(input, &options.analyze),
+        || {
+            let path = crate::path::extract(input, &options.analyze, false)?;
+            let sources = source::move_sources(input, &options.analyze)?;
+            Ok::<_, Error>((path, sources))
+        },
+    );
+    let (before, (path, sources)) = (before?, read?);
     if !progress(0.3) {
         return Err(cancelled());
     }
@@ -123,8 +127,19 @@ pub fn vtg_with_progress(
     if !progress(0.7) {
         return Err(cancelled());
     }
-    let after = crate::analyze::analyze(&rewritten.output, &options.analyze)?;
-    let after_path = crate::path::extract(&rewritten.output, &options.analyze, false)?;
+    // The output's metrics streamed, not from a kept move list: rounding corners can multiply
+    // the moves tenfold.
+    let (after, after_metrics) = crate::parallel::join(
+        || crate::analyze::analyze(&rewritten.output, &options.analyze),
+        || {
+            metrics::from_input(
+                &rewritten.output,
+                &options.analyze,
+                options.critical_angle_deg,
+            )
+        },
+    );
+    let (after, after_metrics) = (after?, after_metrics?);
     if !progress(0.9) {
         return Err(cancelled());
     }
@@ -134,7 +149,7 @@ pub fn vtg_with_progress(
         before,
         after,
         &path,
-        &after_path,
+        after_metrics,
         rewritten,
     );
     let mut report = report;

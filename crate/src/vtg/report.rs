@@ -154,11 +154,10 @@ pub(crate) fn build(
     before: Report,
     after: Report,
     path: &PrintPath,
-    after_path: &PrintPath,
+    (ma, la): (ToolpathMetrics, Vec<ToolpathMetrics>),
     rewritten: Rewritten,
 ) -> VtgReport {
     let (mb, lb) = from_path(path, options.critical_angle_deg);
-    let (ma, la) = from_path(after_path, options.critical_angle_deg);
     let c = Comparison::new;
     let table1 = Table1 {
         l_total_mm: c(mb.l_total_mm, ma.l_total_mm),

@@ -11,7 +11,7 @@
 //! the paper scales the Newton step. Points are taken on the curve (`P_{i+1} = C(u_{i+1})`),
 //! which line 11 also gives once Newton has converged.
 
-use super::bspline::{dot, norm, sub, Curve};
+use super::bspline::{dot, norm, sub, Curve, Eval};
 
 /// Settings of the walk.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -94,16 +94,16 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
                 // Try the end point as the next point.
                 let k = max_curvature(curve, u, u_end);
                 if fits(k, remaining, w) {
-                    accepted = Some((u_end, end_p, k, 0.0));
+                    accepted = Some((u_end, end_p, k, 0.0, None));
                     break;
                 }
             }
             let floor = step <= w.min_step_mm;
-            if let Some((un, pn)) = newton(curve, u, &p, step, w) {
+            if let Some((un, at)) = newton(curve, u, &e, &p, step, w) {
                 if un < u_end {
                     let k = max_curvature(curve, u, un);
                     if floor || fits(k, step, w) {
-                        accepted = Some((un, pn, k, step));
+                        accepted = Some((un, at.p, k, step, Some(at.d1)));
                         break;
                     }
                 }
@@ -121,7 +121,7 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
                 .min(step_for(k, w).max(0.25 * step))
                 .max(w.min_step_mm);
         }
-        let (mut un, mut pn, k, mut step) = accepted?;
+        let (mut un, mut pn, k, mut step, mut d1_next) = accepted?;
         // Do not leave a sliver before the end: stretch this step to it instead (it is then
         // the last, shorter-or-longer step to the end, not a full `L_i`, as the end step is).
         if un < u_end
@@ -131,6 +131,7 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
             un = u_end;
             pn = end_p;
             step = 0.0;
+            d1_next = None;
         }
         if step > 0.0 {
             let got = norm(&sub(&pn, &p));
@@ -138,8 +139,8 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
         }
         stats.steps += 1;
         // Mean curvature of the stretch: the turn of the tangent over the chord length.
-        let t0 = curve.eval(u).d1;
-        let t1 = curve.eval(un).d1;
+        let t0 = e.d1;
+        let t1 = d1_next.unwrap_or_else(|| curve.eval(un).d1);
         let (n0, n1) = (norm(&t0), norm(&t1));
         let chord = norm(&sub(&pn, &p));
         let mean_kappa = if n0 > 0.0 && n1 > 0.0 && chord > 0.0 {
@@ -254,9 +255,16 @@ pub fn max_curvature(curve: &Curve, a: f64, b: f64) -> f64 {
     CurvatureIndex::new(curve).max(curve, a, b)
 }
 
-/// Eq. 27 predictor and Newton corrector: `u` past `u_i` with `‖C(u) − P_i‖ = L`.
-fn newton(curve: &Curve, ui: f64, pi: &[f64; 3], step: f64, w: &Walk) -> Option<(f64, [f64; 3])> {
-    let e = curve.eval(ui);
+/// Eq. 27 predictor and Newton corrector: `u` past `u_i` with `‖C(u) − P_i‖ = L`; `e` is the
+/// curve at `u_i`. Returns `u` and the curve there.
+fn newton(
+    curve: &Curve,
+    ui: f64,
+    e: &Eval,
+    pi: &[f64; 3],
+    step: f64,
+    w: &Walk,
+) -> Option<(f64, Eval)> {
     let s = norm(&e.d1);
     if s < 1e-12 {
         return None;
@@ -272,7 +280,7 @@ fn newton(curve: &Curve, ui: f64, pi: &[f64; 3], step: f64, w: &Walk) -> Option<
         let dist = norm(&v);
         let f = dist - step;
         if f.abs() <= w.newton_tol_mm {
-            return Some((u, c.p));
+            return Some((u, c));
         }
         if dist < 1e-12 {
             return None;

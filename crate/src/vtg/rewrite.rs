@@ -19,6 +19,7 @@ use super::smooth::{smooth_path, Settings};
 use super::source::MoveSource;
 use super::VtgOptions;
 use crate::error::{Error, ErrorKind};
+use crate::gcode::number::{push_trimmed, rounded};
 use crate::gcode::{apply_edits, Edit};
 use crate::machine::{ExtrusionMode, MoveKind};
 use crate::path::{PathMove, PrintPath};
@@ -97,32 +98,64 @@ pub fn rewrite(
         limit_feed: options.limit_feed,
     };
     let cos_critical = crate::math::cos(settings.critical_rad);
-    let mut edits: Vec<Edit> = Vec::new();
+    // The candidates first (cheap), then the paths rewritten in parallel batches: each path is
+    // independent, results are merged in file order (the same output on any number of
+    // threads), and progress and cancellation are checked between batches.
+    let mut candidates: Vec<(usize, usize)> = Vec::new();
     let mut i = 0usize;
-    let mut next_report = 0usize;
     while i < moves.len() {
-        if i >= next_report {
-            next_report = i + 20_000;
-            if !progress(i as f64 / moves.len() as f64) {
-                return Err(Error::new(0, 0, ErrorKind::Cancelled));
-            }
-        }
         let Some(j) = path_end(moves, sources, i) else {
             i += 1;
             continue;
         };
-        let (run, src) = (&moves[i..j], &sources[i..j]);
-        i = j;
-        if run.len() < 2 || !has_sharp_corner(run, cos_critical) {
-            continue;
+        let run = &moves[i..j];
+        if run.len() >= 2 && has_sharp_corner(run, cos_critical) {
+            candidates.push((i, j));
         }
-        out.candidate_paths += 1;
-        if let Some(edit) = rewrite_path(run, src, &settings, &mut out) {
-            edits.extend(edit);
+        i = j;
+    }
+    out.candidate_paths = candidates.len() as u64;
+    let mut edits: Vec<Edit> = Vec::new();
+    for (b, batch) in candidates.chunks(BATCH_PATHS).enumerate() {
+        if !progress((b * BATCH_PATHS) as f64 / candidates.len().max(1) as f64) {
+            return Err(Error::new(0, 0, ErrorKind::Cancelled));
+        }
+        // One result per path, added up here in file order: sums are then the same to the
+        // last bit as a sequential run's (the wasm build's, which the CLI's JSON must equal).
+        let parts = crate::parallel::map_chunks(batch, |chunk| {
+            chunk
+                .iter()
+                .map(|&(i, j)| {
+                    let mut part = Rewritten::default();
+                    let e = rewrite_path(&moves[i..j], &sources[i..j], &settings, &mut part);
+                    (e, part)
+                })
+                .collect()
+        });
+        for (path_edits, part) in parts {
+            edits.extend(path_edits.into_iter().flatten());
+            out.add(&part);
         }
     }
     out.output = apply_edits(input, &edits);
     Ok(out)
+}
+
+/// Candidate paths per batch between progress reports.
+const BATCH_PATHS: usize = 4096;
+
+impl Rewritten {
+    /// Adds the counts of a part of the file rewritten separately.
+    fn add(&mut self, part: &Rewritten) {
+        self.rewritten_paths += part.rewritten_paths;
+        self.replaced_moves += part.replaced_moves;
+        self.written_moves += part.written_moves;
+        self.lowered_segments += part.lowered_segments;
+        self.above_k_cr_segments += part.above_k_cr_segments;
+        self.max_deviation_mm = self.max_deviation_mm.max(part.max_deviation_mm);
+        self.walk.steps += part.walk.steps;
+        self.walk.fluctuation_sum += part.walk.fluctuation_sum;
+    }
 }
 
 /// End (exclusive) of the path starting at move `i`, or `None` if move `i` cannot start one.
@@ -217,28 +250,34 @@ fn rewrite_path(
         if !text.is_empty() {
             text.push('\n');
         }
-        let _ = write!(text, "G1 X{} Y{}", num(p[0], 3), num(p[1], 3));
+        text.push_str("G1 X");
+        push_trimmed(&mut text, p[0], 3);
+        text.push_str(" Y");
+        push_trimmed(&mut text, p[1], 3);
         if (p[2] - z_now).abs() > 5e-4 {
-            let _ = write!(text, " Z{}", num(p[2], 3));
+            text.push_str(" Z");
+            push_trimmed(&mut text, p[2], 3);
             z_now = p[2];
         }
         let last = k + 1 == count;
-        let e_text = match mode {
-            ExtrusionMode::Absolute if last => format!("{}", last_src.e_word),
-            ExtrusionMode::Absolute => num(first_src.e_before + ek, 5),
+        text.push_str(" E");
+        match mode {
+            ExtrusionMode::Absolute if last => {
+                let _ = write!(text, "{}", last_src.e_word);
+            }
+            ExtrusionMode::Absolute => push_trimmed(&mut text, first_src.e_before + ek, 5),
             ExtrusionMode::Relative => {
                 let target = if last { sum } else { ek };
-                let rounded = round(target, 5);
-                let d = rounded - e_written;
-                e_written = rounded;
-                num(d, 5)
+                let written = rounded(target, 5);
+                push_trimmed(&mut text, written - e_written, 5);
+                e_written = written;
             }
-        };
-        let _ = write!(text, " E{e_text}");
+        }
         if f_now.is_some() {
-            let f = round(v * 60.0, 1);
+            let f = rounded(v * 60.0, 1);
             if f_now.is_none_or(|now| (now - f).abs() > 0.05) {
-                let _ = write!(text, " F{}", num(f, 1));
+                text.push_str(" F");
+                push_trimmed(&mut text, f, 1);
                 f_now = Some(f);
             }
         }
@@ -246,7 +285,8 @@ fn rewrite_path(
     // Leave the modal feed where the original left it.
     if let (Some(now), Some(after)) = (f_now, last_src.f_after) {
         if (now - after).abs() > 1e-9 {
-            let _ = write!(text, "\nG1 F{}", num(after, 3));
+            text.push_str("\nG1 F");
+            push_trimmed(&mut text, after, 3);
         }
     }
     out.rewritten_paths += 1;
@@ -267,26 +307,4 @@ fn rewrite_path(
         replacement: Vec::new(),
     }));
     Some(edits)
-}
-
-fn round(v: f64, decimals: i32) -> f64 {
-    let s = 10f64.powi(decimals);
-    (v * s).round() / s
-}
-
-/// `v` with at most `decimals` decimals, trailing zeros dropped.
-fn num(v: f64, decimals: usize) -> String {
-    let mut s = format!("{v:.decimals$}");
-    if s.contains('.') {
-        while s.ends_with('0') {
-            s.pop();
-        }
-        if s.ends_with('.') {
-            s.pop();
-        }
-    }
-    if s == "-0" {
-        s = "0".into();
-    }
-    s
 }
