@@ -5,9 +5,14 @@ use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
 /// Writes `value` as pretty JSON and a newline.
+///
+/// Buffered: stdout is line-buffered, and a report of 200 000 layers is millions of short
+/// lines (one `write` call each would take longer than the job).
 pub fn write_json<T: serde::Serialize>(out: &mut impl Write, value: &T) -> Result<(), String> {
-    serde_json::to_writer_pretty(&mut *out, value).map_err(|e| e.to_string())?;
-    writeln!(out).map_err(|e| e.to_string())
+    let mut buffered = io::BufWriter::with_capacity(1 << 16, out);
+    serde_json::to_writer_pretty(&mut buffered, value).map_err(|e| e.to_string())?;
+    writeln!(buffered).map_err(|e| e.to_string())?;
+    buffered.flush().map_err(|e| e.to_string())
 }
 
 /// The end of a rewriting command: the new file written atomically, then the report on
