@@ -57,6 +57,28 @@ pub(super) fn run(
         .map(|r| program::samples(kin, moves, r))
         .collect();
     warnings.extend(summary::short_run_warning(&before, true));
+    if !has_rotary {
+        // A constant tool vector: nothing to filter, nothing to write, nothing to read back.
+        summary::tick(progress, 0.95)?;
+        let mut report = summary::assemble(
+            options,
+            Counts {
+                format: InputFormat::Gcode,
+                motion_lines: lines.len(),
+                corrected: 0,
+                changed: 0,
+                skip_first: true,
+            },
+            &before,
+            &before,
+            warnings,
+            input.to_vec(),
+        );
+        report.planned_time_before_s = read.time_s;
+        report.planned_time_after_s = read.time_s;
+        summary::tick(progress, 1.0)?;
+        return Ok(report);
+    }
     let mut smoothed = Vec::with_capacity(runs.len());
     let mut corrected = 0usize;
     for (i, run) in before.iter().enumerate() {
