@@ -59,25 +59,15 @@ pub(super) fn run(
     warnings.extend(summary::short_run_warning(&before, true));
     if !has_rotary {
         // A constant tool vector: nothing to filter, nothing to write, nothing to read back.
-        summary::tick(progress, 0.95)?;
-        let mut report = summary::assemble(
-            options,
-            Counts {
-                format: InputFormat::Gcode,
-                motion_lines: lines.len(),
-                corrected: 0,
-                changed: 0,
-                skip_first: true,
-            },
-            &before,
-            &before,
-            warnings,
-            input.to_vec(),
-        );
-        report.planned_time_before_s = read.time_s;
-        report.planned_time_after_s = read.time_s;
-        summary::tick(progress, 1.0)?;
-        return Ok(report);
+        let done = Done {
+            motion_lines: lines.len(),
+            corrected: 0,
+            changed: 0,
+            output: input.to_vec(),
+            planned_time_before_s: read.time_s,
+            planned_time_after_s: read.time_s,
+        };
+        return finish(options, &before, &before, warnings, done, progress);
     }
     let mut smoothed = Vec::with_capacity(runs.len());
     let mut corrected = 0usize;
@@ -207,23 +197,53 @@ pub(super) fn run(
             after_est
         }
     };
+    let done = Done {
+        motion_lines: lines.len(),
+        corrected,
+        changed: edits.len(),
+        output,
+        planned_time_before_s: read.time_s,
+        planned_time_after_s,
+    };
+    finish(options, &before, &after, warnings, done, progress)
+}
+
+/// What the smoothing did, for the report.
+struct Done {
+    motion_lines: usize,
+    corrected: usize,
+    changed: usize,
+    output: Vec<u8>,
+    planned_time_before_s: f64,
+    planned_time_after_s: f64,
+}
+
+/// The report from the samples before and after.
+fn finish(
+    options: &SmoothOptions,
+    before: &[Vec<Sample>],
+    after: &[Vec<Sample>],
+    warnings: Vec<Warning>,
+    done: Done,
+    progress: Progress<'_>,
+) -> Result<SmoothReport, Error> {
     summary::tick(progress, 0.95)?;
     let mut report = summary::assemble(
         options,
         Counts {
             format: InputFormat::Gcode,
-            motion_lines: lines.len(),
-            corrected,
-            changed: edits.len(),
+            motion_lines: done.motion_lines,
+            corrected: done.corrected,
+            changed: done.changed,
             skip_first: true,
         },
-        &before,
-        &after,
+        before,
+        after,
         warnings,
-        output,
+        done.output,
     );
-    report.planned_time_before_s = read.time_s;
-    report.planned_time_after_s = planned_time_after_s;
+    report.planned_time_before_s = done.planned_time_before_s;
+    report.planned_time_after_s = done.planned_time_after_s;
     summary::tick(progress, 1.0)?;
     Ok(report)
 }
