@@ -72,7 +72,10 @@ fn analyze_table_is_human_readable() {
 #[test]
 fn rewrite_is_byte_identical_and_atomic() {
     let input = corpus("crealityprint-4.3.4_k1_benchy_m83_arcs.gcode");
-    let output = scratch("benchy.gcode");
+    // A directory of its own: the other tests write (atomically, through temporary files)
+    // into the shared one at the same time.
+    let output = scratch("atomic/benchy.gcode");
+    std::fs::create_dir_all(output.parent().expect("dir")).expect("atomic dir");
     let out = run(bin().arg("rewrite").arg(&input).arg("-o").arg(&output));
     assert!(
         out.status.success(),
