@@ -48,7 +48,7 @@ fn gcode(layers: &[Layer], relative: bool) -> String {
         if relative { "M83" } else { "M82" }
     );
     let mut e = 0.0f64;
-    let mut at = (0.0f64, 0.0f64);
+    let mut at: (f64, f64);
     let mut extrude = |s: &mut String, at: &mut (f64, f64), to: (f64, f64), feed: Option<f64>| {
         let d = ((to.0 - at.0).powi(2) + (to.1 - at.1).powi(2)).sqrt() * E_PER_MM;
         e += d;
