@@ -645,8 +645,9 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
   const file = path.join(corpusDir, name);
   assert.ok(fs.existsSync(cli), `no CLI at ${cli} (make cli)`);
   await ensurePage();
-  // Best of 3 on both sides: the machine is shared, best-of is the least noisy figure.
-  const nativeMs = Math.min(...[0, 1, 2].map(() => {
+  // Best of 5 on both sides: the machine is shared, best-of is the least noisy figure.
+  const RUNS = 5;
+  const nativeMs = Math.min(...Array.from({ length: RUNS }, () => {
     const r = runCli('analyze', file);
     assert.ok(r.ok, r.stderr);
     return r.ms;
@@ -664,7 +665,7 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
     window.__stopFrames = false;
     requestAnimationFrame(tick);
   });
-  for (let i = 0; i < 3; i++) {
+  for (let i = 0; i < RUNS; i++) {
     const t0 = Date.now();
     await uploadPath(file);
     await page.waitForFunction(() => ['ready', 'error'].includes(document.querySelector('[data-testid="status"]').textContent) && document.querySelector('[data-testid="elapsed"]').dataset.ms, null, { timeout: JOB_TIMEOUT });
@@ -677,12 +678,12 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
     window.__stopFrames = true;
     return window.__maxFrameGap;
   });
-  t.diagnostic(`longest main-thread frame gap during three 34 MB loads: ${maxGap.toFixed(0)} ms`);
+  t.diagnostic(`longest main-thread frame gap during ${RUNS} 34 MB loads: ${maxGap.toFixed(0)} ms`);
   // Loose (the machine is shared): catches work done on the main thread, which would take seconds.
   assert.ok(maxGap < 1500, `the page froze for ${maxGap.toFixed(0)} ms`);
   const best = browser.reduce((a, b) => (b.totalMs < a.totalMs ? b : a));
-  t.diagnostic(`native CLI (process wall time, best of 3): ${nativeMs.toFixed(0)} ms`);
-  t.diagnostic(`worker, best of 3: analyze ${best.ms.toFixed(0)} ms, load request (copy into wasm + analyze) ${best.totalMs.toFixed(0)} ms, page (pick to ready) ${best.pageMs} ms`);
+  t.diagnostic(`native CLI (process wall time, best of ${RUNS}): ${nativeMs.toFixed(0)} ms`);
+  t.diagnostic(`worker, best of ${RUNS}: analyze ${best.ms.toFixed(0)} ms, load request (copy into wasm + analyze) ${best.totalMs.toFixed(0)} ms, page (pick to ready) ${best.pageMs} ms`);
   t.diagnostic(`ratio (worker analyze / CLI): ${(best.ms / nativeMs).toFixed(2)}×, with the copy into wasm ${(best.totalMs / nativeMs).toFixed(2)}×`);
   // The requirement: analyze in the worker within 2× of the native CLI (which reads the file
   // and runs the planner on a second thread; the worker runs on one).
