@@ -182,3 +182,73 @@ fn per_layer_hybrid_is_kept_only_when_it_wins() {
         assert_eq!(layers.len(), 25);
     }
 }
+
+/// The VTG paper's Fig. 4–5 comparison (length and turning of each pattern's infill) comes from
+/// the candidates' replay; read back from the written file it must be the same: the infill
+/// moves of the output, through the same metrics, give the same length, turning points and
+/// mean turn (to the rounding of written coordinates).
+#[test]
+fn pattern_length_and_turning_match_the_written_file() {
+    use quietpath::gcode::FeatureKind;
+    use quietpath::vtg::metrics::{MetricsAccumulator, DEFAULT_CRITICAL_ANGLE_DEG};
+    let input = std::fs::read(data("rect_infill_45.gcode")).unwrap();
+    let mut seen = Vec::new();
+    for pattern in [
+        Pattern::Rectilinear,
+        Pattern::Concentric,
+        Pattern::Hilbert,
+        Pattern::ArchimedeanChords,
+    ] {
+        let options = InfillOptions {
+            angles_deg: vec![0.0],
+            rotations_deg: vec![0.0],
+            patterns: vec![pattern],
+            ..Default::default()
+        };
+        let r = infill(&input, &options).unwrap();
+        let c = &r.candidates[0];
+        let path = quietpath::path::extract(&r.output, &Default::default(), false).unwrap();
+        let mut acc = MetricsAccumulator::new(DEFAULT_CRITICAL_ANGLE_DEG);
+        for m in &path.moves {
+            let infill = path.feature_kind(m) == Some(FeatureKind::SparseInfill);
+            // Only the new infill, and its travels (which break paths as in the replay).
+            if infill || !m.is_extruding() {
+                acc.push(&m.from, &m.to, infill && m.is_extruding(), 0, true);
+            }
+        }
+        let back = acc.finish();
+        let rel = (back.l_total_mm - c.infill_length_mm).abs() / c.infill_length_mm;
+        assert!(
+            rel < 1e-3,
+            "{pattern:?}: length {} vs {}",
+            back.l_total_mm,
+            c.infill_length_mm
+        );
+        let dn = back.n_turning.abs_diff(c.infill_turning_points);
+        assert!(
+            dn <= 2 + c.infill_turning_points / 100,
+            "{pattern:?}: turns {} vs {}",
+            back.n_turning,
+            c.infill_turning_points
+        );
+        assert!(
+            (back.mean_turn_deg - c.infill_mean_turn_deg).abs() < 1.0,
+            "{pattern:?}: mean turn {} vs {}",
+            back.mean_turn_deg,
+            c.infill_mean_turn_deg
+        );
+        seen.push((pattern, c.infill_turning_points, c.infill_mean_turn_deg));
+    }
+    // The patterns differ the way Fig. 5 shows: a zigzag turns by right angles at every line
+    // end, a Hilbert curve turns at every step, the chords of an Archimedean spiral hardly turn.
+    let turn = |p: Pattern| seen.iter().find(|s| s.0 == p).unwrap();
+    assert!(
+        (turn(Pattern::Rectilinear).2 - 90.0).abs() < 10.0,
+        "{seen:?}"
+    );
+    assert!(
+        turn(Pattern::Hilbert).1 > turn(Pattern::Rectilinear).1,
+        "{seen:?}"
+    );
+    assert!(turn(Pattern::ArchimedeanChords).2 < 30.0, "{seen:?}");
+}

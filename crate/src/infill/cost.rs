@@ -64,6 +64,9 @@ pub(crate) struct Costs {
     pub total_j: f64,
     pub length_mm: f64,
     pub filament_mm: f64,
+    /// VTG trajectory metrics (eq. 24–26, 31) of the new infill strokes alone: the paper's
+    /// Fig. 4–5 comparison of patterns by length and turning.
+    pub infill: crate::vtg::metrics::ToolpathMetrics,
 }
 
 /// What replay needs from the original analysis.
@@ -193,6 +196,9 @@ pub(crate) fn replay_blocks(
     let mut next_start = 0usize;
     let mut skip_until = 0usize;
     let mut resume_from: Option<[f64; 3]> = None;
+    let mut infill_metrics = crate::vtg::metrics::MetricsAccumulator::new(
+        crate::vtg::metrics::DEFAULT_CRITICAL_ANGLE_DEG,
+    );
 
     macro_rules! push {
         ($m:expr, $owner:expr) => {{
@@ -224,8 +230,15 @@ pub(crate) fn replay_blocks(
                             .map_or(0.0, |ms| ms.iter().map(|m| m.m.extrusion()).sum::<f64>());
                         filament -= orig;
                         if let Some(r) = &replace[b] {
+                            // Turning and length need directions only: positions from the
+                            // block's start.
+                            let mut at = [0.0f64; 3];
                             for m in &r.motions {
                                 filament += m.delta[3];
+                                let to =
+                                    [at[0] + m.delta[0], at[1] + m.delta[1], at[2] + m.delta[2]];
+                                infill_metrics.push(&at, &to, m.delta[3] > 0.0, b as u32, true);
+                                at = to;
                                 push!(*m, b as u32);
                             }
                             resume_from = Some(r.end);
@@ -336,5 +349,6 @@ pub(crate) fn replay_blocks(
         total_j: e.total_j,
         length_mm: length,
         filament_mm: filament,
+        infill: infill_metrics.finish(),
     }
 }

@@ -160,6 +160,12 @@ pub struct Candidate {
     pub length_mm: f64,
     /// Filament, mm.
     pub filament_mm: f64,
+    /// Length of the new infill strokes, mm (`L_infill`, eq. 25; the paper's Fig. 4).
+    pub infill_length_mm: f64,
+    /// Turning points of the new infill (turns above 30°, eq. 26's δθ; Fig. 5).
+    pub infill_turning_points: u64,
+    /// Mean turning angle of the new infill, degrees (eq. 26; Fig. 5).
+    pub infill_mean_turn_deg: f64,
 }
 
 /// A layer's choice in a per-layer (hybrid) result.

@@ -444,6 +444,9 @@ pub fn infill_with_progress(
                     time_s: c.time_s,
                     length_mm: c.length_mm,
                     filament_mm: c.filament_mm,
+                    infill_length_mm: c.infill.l_total_mm,
+                    infill_turning_points: c.infill.n_turning,
+                    infill_mean_turn_deg: c.infill.mean_turn_deg,
                 });
             }
         }
@@ -469,6 +472,7 @@ pub fn infill_with_progress(
         total_j: chosen.total_j,
         length_mm: chosen.length_mm,
         filament_mm: chosen.filament_mm,
+        infill: Default::default(),
     };
     if options.per_layer {
         if let Some((hybrid, choices, costs)) =

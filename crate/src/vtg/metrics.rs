@@ -20,7 +20,7 @@ use crate::math;
 pub const DEFAULT_CRITICAL_ANGLE_DEG: f64 = 30.0;
 
 /// Toolpath metrics of a file or a layer (eq. 24–26, 31).
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct ToolpathMetrics {
     /// Printed path length `L_total`, mm (eq. 24).
     pub l_total_mm: f64,

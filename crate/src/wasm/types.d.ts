@@ -340,6 +340,12 @@ export interface InfillCandidate {
   time_s: number;
   length_mm: number;
   filament_mm: number;
+  /** Length of the new infill strokes, mm (VTG eq. 25; Fig. 4). */
+  infill_length_mm: number;
+  /** Turning points of the new infill (turns above 30°; Fig. 5). */
+  infill_turning_points: number;
+  /** Mean turning angle of the new infill, degrees (eq. 26; Fig. 5). */
+  infill_mean_turn_deg: number;
 }
 export interface InfillReport {
   before: Report;
