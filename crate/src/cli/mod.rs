@@ -10,7 +10,7 @@ mod table;
 mod vibration;
 mod vtg;
 
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -203,9 +203,7 @@ fn run(cli: Cli) -> Result<(), String> {
     match cli.command {
         Cmd::Analyze { file, json, opts } => {
             let input = read(&file)?;
-            let mut bar = output::ProgressBar::new(
-                input.len() >= PROGRESS_MIN_BYTES && std::io::stderr().is_terminal(),
-            );
+            let mut bar = output::ProgressBar::for_input(input.len());
             let options = opts.options()?;
             let report = analyze_with_progress(&input, &options, &mut |f| bar.update(f))
                 .map_err(|e| format!("{}:{}", file.display(), e))?;

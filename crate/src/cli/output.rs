@@ -97,6 +97,12 @@ impl ProgressBar {
         Self { enabled, last: -1 }
     }
 
+    /// The bar of a job over an input of `len` bytes: drawn when the input is large enough for
+    /// the job to take a while and stderr is a terminal.
+    pub fn for_input(len: usize) -> Self {
+        Self::new(len >= super::PROGRESS_MIN_BYTES && io::IsTerminal::is_terminal(&io::stderr()))
+    }
+
     /// Shows `fraction` done; always asks the job to go on.
     pub fn update(&mut self, fraction: f64) -> bool {
         let pct = (fraction.clamp(0.0, 1.0) * 100.0) as i32;

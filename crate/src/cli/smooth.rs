@@ -143,10 +143,7 @@ pub fn run(args: Args) -> Result<(), String> {
         feed_mm_s: args.feed,
         analyze: args.opts.options()?,
     };
-    let mut bar = output::ProgressBar::new(
-        input.len() >= super::PROGRESS_MIN_BYTES
-            && std::io::IsTerminal::is_terminal(&std::io::stderr()),
-    );
+    let mut bar = output::ProgressBar::for_input(input.len());
     let report = smooth_with_progress(&input, &options, &mut |f| bar.update(f))
         .map_err(|e| format!("{}:{}", args.file.display(), e))?;
     bar.finish();

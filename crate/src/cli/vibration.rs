@@ -1,12 +1,12 @@
 //! `quietpath vibration`: Simulate the machine's axis dynamics on a file: natural frequencies,
 //! trajectory deviation, per-layer vibration and the acceleration spectrum.
 
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::PathBuf;
 
 use quietpath::dynamics::{self, VibrationOptions, VibrationReport, Window};
 
-use super::{output, read, AnalyzeArgs, PROGRESS_MIN_BYTES};
+use super::{output, read, AnalyzeArgs};
 
 /// Arguments of `quietpath vibration`.
 #[derive(Debug, clap::Args)]
@@ -82,9 +82,7 @@ pub fn run(args: Args) -> Result<(), String> {
         peaks: args.peaks,
         ..VibrationOptions::default()
     };
-    let mut bar = output::ProgressBar::new(
-        input.len() >= PROGRESS_MIN_BYTES && std::io::stderr().is_terminal(),
-    );
+    let mut bar = output::ProgressBar::for_input(input.len());
     let report = dynamics::vibration_with_progress(&input, &options, &mut |f| bar.update(f))
         .map_err(|e| format!("{}:{}", args.file.display(), e))?;
     bar.finish();

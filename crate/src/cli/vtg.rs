@@ -1,11 +1,11 @@
 //! `quietpath vtg`: Rewrite a file as a vibration-suppressed toolpath (NURBS fit, Taylor interpolation, curvature and feed limits).
 
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::PathBuf;
 
 use quietpath::vtg::{vtg_with_progress, Comparison, VtgOptions, VtgReport};
 
-use super::{output, read, AnalyzeArgs, PROGRESS_MIN_BYTES};
+use super::{output, read, AnalyzeArgs};
 
 /// Arguments of `quietpath vtg`.
 #[derive(Debug, clap::Args)]
@@ -48,9 +48,7 @@ pub fn run(args: Args) -> Result<(), String> {
         dynamics: !args.no_dynamics,
         ..VtgOptions::default()
     };
-    let mut bar = output::ProgressBar::new(
-        input.len() >= PROGRESS_MIN_BYTES && std::io::stderr().is_terminal(),
-    );
+    let mut bar = output::ProgressBar::for_input(input.len());
     let report = vtg_with_progress(&input, &options, &mut |f| bar.update(f))
         .map_err(|e| format!("{}:{}", args.file.display(), e))?;
     bar.finish();
