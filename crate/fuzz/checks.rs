@@ -236,7 +236,10 @@ fn check_rewritten(input: &[u8], output: &[u8], what: &str) {
     // Words of the input's motion lines: a job that rewrites a line carries its other words
     // over (the smoother changes B and C and keeps the line's F, whatever it is).
     let mut input_words: std::collections::HashSet<(u8, u64)> = Default::default();
+    // Every input line: an output line found here was copied, not written.
+    let mut input_lines: std::collections::HashSet<&[u8]> = Default::default();
     for raw in Lines::new(input) {
+        input_lines.insert(raw.text);
         if let Ok(l) = parse_one(raw.text) {
             let motion = matches!(l.command, Command::Code(c) if c.letter == b'G' && c.number <= 3);
             if !motion && !raw.text.is_empty() {
@@ -253,7 +256,6 @@ fn check_rewritten(input: &[u8], output: &[u8], what: &str) {
     }
     // Lines the job copied unchanged are the input's business (a hostile input may hold
     // absurd values the job rightly leaves alone); lines it wrote must be sane.
-    let input_lines: std::collections::HashSet<&[u8]> = Lines::new(input).map(|l| l.text).collect();
     let written = |text: &[u8]| !input_lines.contains(text);
     let mut kept_out: Vec<&[u8]> = Vec::new();
     for raw in Lines::new(output) {

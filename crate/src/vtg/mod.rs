@@ -143,7 +143,7 @@ pub fn vtg_with_progress(
     if !progress(0.9) {
         return Err(cancelled());
     }
-    let report = report::build(
+    let mut report = report::build(
         options,
         &limits,
         before,
@@ -152,7 +152,6 @@ pub fn vtg_with_progress(
         after_metrics,
         rewritten,
     );
-    let mut report = report;
     if options.dynamics {
         report.table2.deviation = simulated_deviation(input, &report.output, &options.analyze);
     }
