@@ -4,6 +4,28 @@
 //! threads; the results come back in the items' order, so the outcome is the same bit for bit
 //! as a sequential run. In wasm (one thread) and for short lists, the map runs in place.
 
+/// Threads to use natively: the cores available (at most 8), or `QUIETPATH_THREADS` when set
+/// (`QUIETPATH_THREADS=1` runs everything on one thread, as wasm does: the way to measure what
+/// the browser will pay). Read once.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn threads() -> usize {
+    static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *THREADS.get_or_init(|| {
+        std::env::var("QUIETPATH_THREADS")
+            .ok()
+            .and_then(|v| v.trim().parse::<usize>().ok())
+            .filter(|&n| n >= 1)
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+            .min(8)
+    })
+}
+
+/// Threads to use: always one in wasm.
+#[cfg(target_arch = "wasm32")]
+pub fn threads() -> usize {
+    1
+}
+
 /// Items below which threads cost more than they save.
 #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
 const MIN_ITEMS: usize = 64;
@@ -17,9 +39,7 @@ where
 {
     #[cfg(not(target_arch = "wasm32"))]
     {
-        let threads = std::thread::available_parallelism()
-            .map_or(1, |n| n.get())
-            .min(8);
+        let threads = threads();
         if threads > 1 && items.len() >= MIN_ITEMS {
             let chunk = items.len().div_ceil(threads);
             let parts: Option<Vec<Vec<R>>> = std::thread::scope(|scope| {
@@ -54,20 +74,17 @@ where
     RA: Send,
 {
     #[cfg(not(target_arch = "wasm32"))]
-    {
-        std::thread::scope(|scope| {
+    if threads() > 1 {
+        return std::thread::scope(|scope| {
             let handle = scope.spawn(a);
             let rb = b();
             match handle.join() {
                 Ok(ra) => (ra, rb),
                 Err(panic) => std::panic::resume_unwind(panic),
             }
-        })
+        });
     }
-    #[cfg(target_arch = "wasm32")]
-    {
-        (a(), b())
-    }
+    (a(), b())
 }
 
 #[cfg(test)]

@@ -645,13 +645,10 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
   const file = path.join(corpusDir, name);
   assert.ok(fs.existsSync(cli), `no CLI at ${cli} (make cli)`);
   await ensurePage();
-  // Best of 5 on both sides: the machine is shared, best-of is the least noisy figure.
-  const RUNS = 5;
-  const nativeMs = Math.min(...Array.from({ length: RUNS }, () => {
-    const r = runCli('analyze', file);
-    assert.ok(r.ok, r.stderr);
-    return r.ms;
-  }));
+  // Best of 7 on both sides, the native and the browser runs taken in turn: the machine is
+  // shared, and a burst of load elsewhere then slows both sides alike instead of one.
+  const RUNS = 7;
+  const native = [];
   const browser = [];
   // The page must stay responsive meanwhile: the longest gap between animation frames.
   await page.evaluate(() => {
@@ -666,6 +663,9 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
     requestAnimationFrame(tick);
   });
   for (let i = 0; i < RUNS; i++) {
+    const r = runCli('analyze', file);
+    assert.ok(r.ok, r.stderr);
+    native.push(r.ms);
     const t0 = Date.now();
     await uploadPath(file);
     await page.waitForFunction(() => ['ready', 'error'].includes(document.querySelector('[data-testid="status"]').textContent) && document.querySelector('[data-testid="elapsed"]').dataset.ms, null, { timeout: JOB_TIMEOUT });
@@ -673,7 +673,12 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
     const ms = Number(await byTestId('elapsed').getAttribute('data-ms'));
     const totalMs = Number(await byTestId('elapsed').getAttribute('data-total-ms'));
     browser.push({ ms, totalMs, pageMs: Date.now() - t0 });
+    // The worker then reads the toolpath for the viewer: let it finish before the next native
+    // run, which would otherwise share the cores with it.
+    await page.waitForFunction(() => /segments/.test(document.querySelector('[data-testid="layer-info"]').textContent), null, { timeout: JOB_TIMEOUT });
+    await new Promise((r) => setTimeout(r, 500));
   }
+  const nativeMs = Math.min(...native);
   const maxGap = await page.evaluate(() => {
     window.__stopFrames = true;
     return window.__maxFrameGap;
@@ -681,7 +686,7 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
   t.diagnostic(`longest main-thread frame gap during ${RUNS} 34 MB loads: ${maxGap.toFixed(0)} ms`);
   // Loose (the machine is shared): catches work done on the main thread, which would take seconds.
   assert.ok(maxGap < 1500, `the page froze for ${maxGap.toFixed(0)} ms`);
-  const best = browser.reduce((a, b) => (b.totalMs < a.totalMs ? b : a));
+  const best = browser.reduce((a, b) => (b.ms < a.ms ? b : a));
   t.diagnostic(`native CLI (process wall time, best of ${RUNS}): ${nativeMs.toFixed(0)} ms`);
   t.diagnostic(`worker, best of ${RUNS}: analyze ${best.ms.toFixed(0)} ms, load request (copy into wasm + analyze) ${best.totalMs.toFixed(0)} ms, page (pick to ready) ${best.pageMs} ms`);
   t.diagnostic(`ratio (worker analyze / CLI): ${(best.ms / nativeMs).toFixed(2)}×, with the copy into wasm ${(best.totalMs / nativeMs).toFixed(2)}×`);

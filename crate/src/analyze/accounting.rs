@@ -13,6 +13,7 @@ use crate::energy::Accumulator;
 use crate::energy::Material;
 use crate::gcode::{feature_kind, FeatureKind};
 use crate::machine::{Heater, Move};
+use crate::math::Bound;
 use crate::plan::{Limits, Motion, PlannedMove, Planner};
 use crate::vtg::metrics::{MetricsAccumulator, DEFAULT_CRITICAL_ANGLE_DEG};
 
@@ -102,8 +103,8 @@ impl Accounts {
     }
 
     /// A move was read; returns its sequence number (the planner's tag).
-    pub fn read_move(&mut self, m: Move) -> TimeMsg {
-        account_move(&m, &mut self.totals);
+    pub fn read_move(&mut self, m: &Move) -> TimeMsg {
+        account_move(m, &mut self.totals);
         let slot = if m.is_extruding() {
             let i = match self.current_feature {
                 Some(i) => i,
@@ -128,11 +129,11 @@ impl Accounts {
         s.moves += 1;
         s.distance_mm += m.length_mm;
         s.filament_mm += m.extrusion();
-        self.layers.motion(&m);
+        self.layers.motion(m);
         let seq = self.moves_read;
         self.moves_read += 1;
         TimeMsg::Move {
-            m: Motion::from(&m),
+            m: Motion::from(m),
             seq,
             slot,
             layers: self.layers.current(),
@@ -382,8 +383,8 @@ fn account_move(m: &Move, totals: &mut Totals) {
         });
         for p in [&m.from, &m.to] {
             for ((lo, hi), v) in b.min.iter_mut().zip(b.max.iter_mut()).zip(&p[..3]) {
-                *lo = lo.min(*v);
-                *hi = hi.max(*v);
+                *lo = lo.at_most(*v);
+                *hi = hi.at_least(*v);
             }
         }
     } else {

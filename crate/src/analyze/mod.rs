@@ -263,7 +263,7 @@ pub fn analyze_with_progress(
                     if print_limits.is_none() && m.is_extruding() {
                         print_limits = Some(limits_now.clone());
                     }
-                    to_timing(acc.read_move(m));
+                    to_timing(acc.read_move(&m));
                 }
                 Event::Dwell(secs) => to_timing(acc.dwell(secs)),
                 Event::Temperature {

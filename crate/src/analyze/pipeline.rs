@@ -3,7 +3,8 @@
 //! Both sides are sequential and exchange [`TimeMsg`]s in file order, so the result is the
 //! same bit for bit however they are run. Natively, files of a few megabytes and more run the
 //! timing side on a second thread, fed in batches over a bounded channel (memory stays bounded:
-//! at most [`QUEUED_BATCHES`] batches wait); in wasm, and for small files, both run on one.
+//! at most [`QUEUED_BATCHES`] batches wait); in wasm, for small files and with
+//! `QUIETPATH_THREADS=1`, both run on one.
 
 use super::accounting::{TimeMsg, Timing};
 use crate::error::Error;
@@ -24,7 +25,7 @@ where
     R: FnOnce(&mut dyn FnMut(TimeMsg)) -> Result<(), Error>,
 {
     #[cfg(not(target_arch = "wasm32"))]
-    if input_len >= THREAD_MIN_BYTES {
+    if input_len >= THREAD_MIN_BYTES && crate::parallel::threads() > 1 {
         return threaded(timing, read);
     }
     let _ = input_len;

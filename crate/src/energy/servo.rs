@@ -18,6 +18,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::math::Bound;
 use crate::plan::PlannedMove;
 
 /// Parameters of the physical servo model. Defaults describe a large-format ball-screw gantry
@@ -129,7 +130,7 @@ impl ServoProfile {
     /// Adds a dwell of `secs` (standby only) to `r`; returns its energy, J.
     #[inline]
     pub fn add_dwell(&self, secs: f64, r: &mut ServoReport) -> f64 {
-        let e = (self.standby_w[0] + self.standby_w[1]) * secs.max(0.0);
+        let e = (self.standby_w[0] + self.standby_w[1]) * secs.at_least(0.0);
         r.standby_j += e;
         e
     }

@@ -27,6 +27,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::math::Bound;
 use crate::plan::PlannedMove;
 
 /// Displacement below which an axis counts as holding during a move, mm.
@@ -111,7 +112,7 @@ pub fn move_terms_and_holds(pm: &PlannedMove) -> ([f64; 4], f64) {
 /// The terms of a dwell of `secs`: both axes hold.
 #[inline]
 pub fn dwell_terms(secs: f64) -> [f64; 4] {
-    [0.0, 0.0, 0.0, 2.0 * secs.max(0.0)]
+    [0.0, 0.0, 0.0, 2.0 * secs.at_least(0.0)]
 }
 
 /// The sums `A`, `B`, `C`, `H` over a file, and the coefficients they are weighed with.

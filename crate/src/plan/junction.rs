@@ -1,6 +1,7 @@
 //! Junction speeds: how fast the machine may pass from one move into the next.
 
 use super::limits::Limits;
+use crate::math::Bound;
 
 /// Marlin's `MINIMUM_PLANNER_SPEED`, mm/s: the speed junction-deviation planners start and stop
 /// at, and pass a reversal with.
@@ -29,7 +30,7 @@ pub fn safe_speed(axis_feedrate: &[f64; 4], cruise: f64, limits: &Limits) -> f64
     let mut safe = cruise;
     for (v, jerk) in axis_feedrate.iter().zip(&limits.max_jerk) {
         if v.abs() > jerk.value {
-            safe = safe.min(jerk.value);
+            safe = safe.at_most(jerk.value);
         }
     }
     safe
@@ -55,39 +56,33 @@ pub fn classic_jerk(prev: &Segment, curr: &Segment, limits: &Limits) -> f64 {
     } else {
         prev.cruise
     };
-    let mut v_factor = 1.0;
-    let mut limited = false;
+    // Marlin scales every later axis by the factor the earlier ones imposed and, when an axis
+    // is over its limit, multiplies the factor by limit / scaled jerk. Jerk is homogeneous in
+    // the speeds, so that product is simply limit / jerk of the unscaled speeds, and the final
+    // factor is the smallest limit / jerk over the axes (or 1): the same number without the
+    // dependent chain of branches, which mispredicts at every other corner.
+    let exit_scale = if prev_speed_larger {
+        smaller_speed_factor
+    } else {
+        1.0
+    };
+    let mut v_factor: f64 = 1.0;
     for axis in 0..4 {
-        let mut v_exit = prev.axis_feedrate[axis];
-        let mut v_entry = curr.axis_feedrate[axis];
-        if prev_speed_larger {
-            v_exit *= smaller_speed_factor;
-        }
-        if limited {
-            v_exit *= v_factor;
-            v_entry *= v_factor;
-        }
-        // Coasting in the same direction, or reversing.
-        let jerk = if v_exit > v_entry {
-            if v_entry > 0.0 || v_exit < 0.0 {
-                v_exit - v_entry
-            } else {
-                v_exit.max(-v_entry)
-            }
-        } else if v_entry < 0.0 || v_exit > 0.0 {
-            v_entry - v_exit
+        let v_exit = prev.axis_feedrate[axis] * exit_scale;
+        let v_entry = curr.axis_feedrate[axis];
+        // Coasting in the same direction: the change of speed; reversing (or from or to rest):
+        // the larger of the two speeds, as Marlin's four cases come to.
+        let jerk = if v_exit * v_entry > 0.0 {
+            (v_exit - v_entry).abs()
         } else {
-            (-v_exit).max(v_entry)
+            v_exit.abs().at_least(v_entry.abs())
         };
         let max_jerk = limits.max_jerk[axis].value;
         if jerk > max_jerk {
-            v_factor *= max_jerk / jerk;
-            limited = true;
+            v_factor = v_factor.at_most(max_jerk / jerk);
         }
     }
-    if limited {
-        vmax_junction *= v_factor;
-    }
+    vmax_junction *= v_factor;
     // If both moves could start from rest at the junction speed anyway, start at the safe speed.
     let threshold = vmax_junction * 0.99;
     if prev.safe > threshold && curr.safe > threshold {
@@ -112,7 +107,7 @@ pub fn junction_deviation(prev: &Segment, curr: &Segment, limits: &Limits) -> f6
     let v_sqr = if cos > 0.999_999 {
         MINIMUM_PLANNER_SPEED * MINIMUM_PLANNER_SPEED
     } else {
-        let cos = cos.max(-0.999_999);
+        let cos = cos.at_least(-0.999_999);
         let sin_d2 = (0.5 * (1.0 - cos)).sqrt();
         let a = curr.acceleration;
         let mut v_sqr = a * limits.junction_deviation.value * sin_d2 / (1.0 - sin_d2);
@@ -120,12 +115,12 @@ pub fn junction_deviation(prev: &Segment, curr: &Segment, limits: &Limits) -> f6
             // The change of direction, acos(-cos) (Marlin approximates it by a polynomial).
             let theta = crate::math::acos((-cos).clamp(-1.0, 1.0));
             if theta > 0.0 {
-                v_sqr = v_sqr.min(curr.distance * a / theta);
+                v_sqr = v_sqr.at_most(curr.distance * a / theta);
             }
         }
         v_sqr
     };
-    v_sqr.sqrt().min(curr.cruise).min(prev.cruise)
+    v_sqr.sqrt().at_most(curr.cruise).at_most(prev.cruise)
 }
 
 /// Klipper's junction speed: the square-corner velocity as an equivalent junction deviation
@@ -136,28 +131,28 @@ pub fn klipper(prev: &Segment, curr: &Segment, limits: &Limits) -> f64 {
     }
     let scv = limits.square_corner_velocity.value;
     let mut max_v2 = curr.cruise * curr.cruise;
-    max_v2 = max_v2.min(prev.cruise * prev.cruise);
+    max_v2 = max_v2.at_most(prev.cruise * prev.cruise);
     let cos = cos_theta(prev, curr);
-    let sin_d2 = (0.5 * (1.0 - cos)).max(0.0).sqrt();
-    let cos_d2 = (0.5 * (1.0 + cos)).max(0.0).sqrt();
+    let sin_d2 = (0.5 * (1.0 - cos)).at_least(0.0).sqrt();
+    let cos_d2 = (0.5 * (1.0 + cos)).at_least(0.0).sqrt();
     let one_minus_sin = 1.0 - sin_d2;
     if one_minus_sin > 0.0 && cos_d2 > 0.0 {
         let r_jd = sin_d2 / one_minus_sin;
         let jd = |accel: f64| klipper_junction_deviation(scv, accel);
         let quarter_tan = 0.25 * sin_d2 / cos_d2;
         max_v2 = max_v2
-            .min(r_jd * jd(curr.acceleration) * curr.acceleration)
-            .min(r_jd * jd(prev.acceleration) * prev.acceleration)
-            .min(2.0 * curr.distance * curr.acceleration * quarter_tan)
-            .min(2.0 * prev.distance * prev.acceleration * quarter_tan);
+            .at_most(r_jd * jd(curr.acceleration) * curr.acceleration)
+            .at_most(r_jd * jd(prev.acceleration) * prev.acceleration)
+            .at_most(2.0 * curr.distance * curr.acceleration * quarter_tan)
+            .at_most(2.0 * prev.distance * prev.acceleration * quarter_tan);
     }
-    max_v2.max(0.0).sqrt()
+    max_v2.at_least(0.0).sqrt()
 }
 
 /// Klipper's junction deviation for a square-corner velocity and acceleration:
 /// `scv² (√2 − 1) / accel`, the deviation at which a 90° corner runs at exactly `scv`.
 pub fn klipper_junction_deviation(scv: f64, accel: f64) -> f64 {
-    scv * scv * (std::f64::consts::SQRT_2 - 1.0) / accel.max(1e-9)
+    scv * scv * (std::f64::consts::SQRT_2 - 1.0) / accel.at_least(1e-9)
 }
 
 fn is_e_only(s: &Segment) -> bool {

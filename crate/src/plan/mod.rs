@@ -17,11 +17,10 @@ pub mod limits;
 pub mod profiles;
 pub mod trapezoid;
 
-use std::collections::VecDeque;
-
 use serde::Serialize;
 
 use crate::machine::{axis, Move, MoveKind};
+use crate::math::Bound;
 use junction::Segment;
 pub use limits::{FeedUnits, JunctionModel, Limit, LimitSource, Limits};
 pub use profiles::Profile as MachineProfile;
@@ -137,10 +136,10 @@ pub const ARC_SEGMENTS_PER_SEC: f64 = 50.0;
 /// [`ARC_SEGMENTS_PER_SEC`] at the feed rate, but between [`MIN_ARC_SEGMENT_MM`] and the
 /// machine's `arc_segment_mm`.
 pub fn arc_segments(radius: f64, planar_length: f64, feed_mm_s: f64, max_segment_mm: f64) -> usize {
-    let max = max_segment_mm.max(MIN_ARC_SEGMENT_MM);
+    let max = max_segment_mm.at_least(MIN_ARC_SEGMENT_MM);
     let seg = (8.0 * radius * MAX_ARC_DEVIATION_MM)
         .sqrt()
-        .min(feed_mm_s / ARC_SEGMENTS_PER_SEC)
+        .at_most(feed_mm_s / ARC_SEGMENTS_PER_SEC)
         .clamp(MIN_ARC_SEGMENT_MM, max);
     let n = planar_length / seg + 0.8;
     if n.is_finite() {
@@ -183,7 +182,10 @@ impl Block {
             // reach full speed only to brake at once.
             let v2 = 0.5 * (self.entry * self.entry + self.exit * self.exit)
                 + self.distance * self.accel_to_decel;
-            cruise = cruise.min(v2.sqrt()).max(self.entry).max(self.exit);
+            cruise = cruise
+                .at_most(v2.sqrt())
+                .at_least(self.entry)
+                .at_least(self.exit);
         }
         Profile::new(
             self.distance,
@@ -200,7 +202,7 @@ impl Block {
 pub struct Planner {
     limits: Limits,
     model: JunctionModel,
-    blocks: VecDeque<Block>,
+    blocks: Vec<Block>,
     prev: Option<Segment>,
     elapsed_s: f64,
     finalized: u64,
@@ -212,7 +214,7 @@ impl Planner {
         Self {
             limits,
             model,
-            blocks: VecDeque::with_capacity(REFRESH_THRESHOLD + 1),
+            blocks: Vec::with_capacity(REFRESH_THRESHOLD + 1),
             prev: None,
             elapsed_s: 0.0,
             finalized: 0,
@@ -323,14 +325,16 @@ impl Planner {
             MoveClass::Travel => l.min_travel_feedrate.value,
             _ => l.min_feedrate.value,
         };
-        let mut cruise = feed.max(min_feed).max(crate::machine::MIN_FEED_MM_S);
+        let mut cruise = feed
+            .at_least(min_feed)
+            .at_least(crate::machine::MIN_FEED_MM_S);
         let mut axis_feedrate = [0.0; 4];
         let mut factor: f64 = 1.0;
         for i in 0..4 {
             axis_feedrate[i] = cruise * delta[i] * inv_distance;
             let max = l.max_feedrate[i].value;
             if max > 0.0 && axis_feedrate[i].abs() > max {
-                factor = factor.min(max / axis_feedrate[i].abs());
+                factor = factor.at_most(max / axis_feedrate[i].abs());
             }
         }
         cruise *= factor;
@@ -349,7 +353,7 @@ impl Planner {
                 acceleration = max * distance / d;
             }
         }
-        let acceleration = acceleration.max(1e-3);
+        let acceleration = acceleration.at_least(1e-3);
         let unit = if class == MoveClass::Retract {
             [0.0; 3]
         } else {
@@ -361,7 +365,7 @@ impl Planner {
         };
         let safe = match self.model {
             JunctionModel::ClassicJerk => junction::safe_speed(&axis_feedrate, cruise, l),
-            _ => junction::MINIMUM_PLANNER_SPEED.min(cruise),
+            _ => junction::MINIMUM_PLANNER_SPEED.at_most(cruise),
         };
         let curr = Segment {
             axis_feedrate,
@@ -393,7 +397,7 @@ impl Planner {
             delta,
             distance,
             acceleration,
-            entry: vmax_junction.min(v_allowable),
+            entry: vmax_junction.at_most(v_allowable),
             cruise,
             exit: safe,
             max_entry: vmax_junction,
@@ -404,7 +408,7 @@ impl Planner {
             entry_fixed: false,
         };
         self.prev = Some(curr);
-        self.blocks.push_back(block);
+        self.blocks.push(block);
         if self.blocks.len() > REFRESH_THRESHOLD {
             self.plan_window(KEEP_BLOCKS, sink);
         }
@@ -413,7 +417,7 @@ impl Planner {
     /// A dwell (`G4`) or any wait: every queued move completes first, then time passes.
     pub fn dwell(&mut self, secs: f64, sink: &mut impl FnMut(&PlannedMove)) {
         self.flush(sink);
-        self.elapsed_s += secs.max(0.0);
+        self.elapsed_s += secs.at_least(0.0);
     }
 
     /// Finalises every queued move (end of file, or a command that waits for motion to end).
@@ -424,26 +428,28 @@ impl Planner {
 
     /// Look-ahead over the window, then finalises all but `keep` blocks.
     fn plan_window(&mut self, keep: usize, sink: &mut impl FnMut(&PlannedMove)) {
-        let n = self.blocks.len();
+        // A plain vector (the kept tail moves to the front after each window, a few kilobytes)
+        // so the passes below run over one contiguous slice.
+        let blocks = &mut self.blocks[..];
+        let n = blocks.len();
         if n == 0 {
             return;
         }
         // Reverse pass: every block must be able to brake to the next block's entry speed.
-        for i in (0..n.saturating_sub(1)).rev() {
-            let (next_entry, next_changed) =
-                (self.blocks[i + 1].entry, self.blocks[i + 1].recalculate);
-            let b = &mut self.blocks[i];
+        for i in (0..n - 1).rev() {
+            let (head, tail) = blocks.split_at_mut(i + 1);
+            let (b, next) = (&mut head[i], &tail[0]);
             if b.entry_fixed {
                 continue;
             }
-            if b.entry != b.max_entry || next_changed {
+            if b.entry != b.max_entry || next.recalculate {
                 // A block of nominal length reaches any junction speed within itself.
                 let entry = if b.nominal_length {
                     b.max_entry
                 } else {
-                    b.max_entry.min(trapezoid::max_allowable_speed(
+                    b.max_entry.at_most(trapezoid::max_allowable_speed(
                         -b.acceleration,
-                        next_entry,
+                        next.entry,
                         b.distance,
                     ))
                 };
@@ -455,21 +461,18 @@ impl Planner {
         }
         // Forward pass: every block must be reachable from the previous block's entry speed.
         for i in 1..n {
-            let (prev_entry, prev_accel, prev_distance) = {
-                let p = &self.blocks[i - 1];
-                (p.entry, p.acceleration, p.distance)
-            };
-            let b = &mut self.blocks[i];
+            let (head, tail) = blocks.split_at_mut(i);
+            let (p, b) = (&head[i - 1], &mut tail[0]);
             // Marlin and PrusaSlicer skip this check after a block of "nominal length", but they
             // set that flag from the block's safe speed, not the minimum planner speed, so the
             // shortcut can let a block start faster than the previous one can reach: a jump in
             // speed. Checking every block keeps the speed continuous (proptest in
             // tests/fuzz_regressions.rs); print times move by well under 0.1 %.
-            if prev_entry < b.entry {
-                let entry = b.entry.min(trapezoid::max_allowable_speed(
-                    -prev_accel,
-                    prev_entry,
-                    prev_distance,
+            if p.entry < b.entry {
+                let entry = b.entry.at_most(trapezoid::max_allowable_speed(
+                    -p.acceleration,
+                    p.entry,
+                    p.distance,
                 ));
                 if entry != b.entry {
                     b.entry = entry;
@@ -479,14 +482,17 @@ impl Planner {
         }
         // Exit speeds: each block exits at the next block's entry speed (the last one at its
         // safe speed until something follows it).
-        for i in 0..n {
-            let next = self.blocks.get(i + 1).map(|b| (b.entry, b.recalculate));
-            let b = &mut self.blocks[i];
-            let next_recalc = next.is_some_and(|(_, r)| r);
-            if b.recalculate || next_recalc || next.is_none() {
-                b.exit = next.map_or(b.safe, |(e, _)| e);
+        for i in 0..n - 1 {
+            let (head, tail) = blocks.split_at_mut(i + 1);
+            let (b, next) = (&mut head[i], &tail[0]);
+            if b.recalculate || next.recalculate {
+                b.exit = next.entry;
                 b.recalculate = false;
             }
+        }
+        if let Some(last) = blocks.last_mut() {
+            last.exit = last.safe;
+            last.recalculate = false;
         }
         let finalize = n.saturating_sub(keep);
         for b in self.blocks.drain(..finalize) {
@@ -509,7 +515,7 @@ impl Planner {
         // Marlin, where a block's entry is frozen once the block before it is executing).
         // Later moves only relax constraints, so it can still brake to what follows.
         if finalize > 0 {
-            if let Some(first) = self.blocks.front_mut() {
+            if let Some(first) = self.blocks.first_mut() {
                 first.entry_fixed = true;
             }
         }

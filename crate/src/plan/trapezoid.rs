@@ -1,5 +1,7 @@
 //! Constant-acceleration velocity profiles (trapezoids and triangles) along one move.
 
+use crate::math::Bound;
+
 /// Distance needed to go from speed `v0` to `v1` at acceleration `a` (negative to brake).
 #[inline]
 pub fn acceleration_distance(v0: f64, v1: f64, a: f64) -> f64 {
@@ -14,7 +16,7 @@ pub fn acceleration_distance(v0: f64, v1: f64, a: f64) -> f64 {
 /// reached with acceleration `a` (`a` negative: braking, as firmware calls it).
 #[inline]
 pub fn max_allowable_speed(a: f64, v_target: f64, d: f64) -> f64 {
-    (v_target * v_target - 2.0 * a * d).max(0.0).sqrt()
+    (v_target * v_target - 2.0 * a * d).at_least(0.0).sqrt()
 }
 
 /// Where acceleration from `v0` must stop so that braking at the same rate ends at `v1` after
@@ -61,10 +63,10 @@ impl Profile {
     /// at `cruise`, with acceleration `a` (firmware `calculate_trapezoid`). Entry and exit must
     /// be reachable (the look-ahead guarantees it); if not, they are lowered.
     pub fn new(d: f64, entry: f64, cruise: f64, exit: f64, a: f64) -> Profile {
-        let cruise = cruise.max(entry).max(exit);
+        let cruise = cruise.at_least(entry).at_least(exit);
         if d <= 0.0 || a <= 0.0 || cruise <= 0.0 {
             let t = if cruise > 0.0 {
-                d.max(0.0) / cruise
+                d.at_least(0.0) / cruise
             } else {
                 0.0
             };
@@ -74,12 +76,12 @@ impl Profile {
                 exit,
                 acceleration: a,
                 cruise_s: t,
-                cruise_mm: d.max(0.0),
+                cruise_mm: d.at_least(0.0),
                 ..Profile::default()
             };
         }
-        let mut accel_mm = acceleration_distance(entry, cruise, a).max(0.0);
-        let decel_mm = acceleration_distance(cruise, exit, -a).max(0.0);
+        let mut accel_mm = acceleration_distance(entry, cruise, a).at_least(0.0);
+        let decel_mm = acceleration_distance(cruise, exit, -a).at_least(0.0);
         let mut cruise_mm = d - accel_mm - decel_mm;
         let mut peak = cruise;
         let (mut entry, mut exit) = (entry, exit);
@@ -89,8 +91,8 @@ impl Profile {
             cruise_mm = 0.0;
             peak = (entry * entry + 2.0 * a * accel_mm).sqrt();
             // Unreachable end speeds (only with inconsistent input) are clipped to the peak.
-            entry = entry.min(peak);
-            exit = exit.min(peak);
+            entry = entry.at_most(peak);
+            exit = exit.at_most(peak);
         }
         let accel_s = (peak - entry) / a;
         let decel_s = (peak - exit) / a;

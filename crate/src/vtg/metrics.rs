@@ -15,6 +15,7 @@
 use serde::Serialize;
 
 use crate::math;
+use crate::math::Bound;
 
 /// Default critical angle δθ: turns above it are sharp corners (turning points), degrees.
 pub const DEFAULT_CRITICAL_ANGLE_DEG: f64 = 30.0;
@@ -173,7 +174,7 @@ impl MetricsAccumulator {
 /// compares cosines exactly.
 #[inline]
 pub fn fast_acos(x: f64) -> f64 {
-    let a = x.abs().min(1.0);
+    let a = x.abs().at_most(1.0);
     let r =
         (1.0 - a).sqrt() * (1.570_728_8 + a * (-0.212_114_4 + a * (0.074_261_0 - 0.018_729_3 * a)));
     if x >= 0.0 {
@@ -205,7 +206,7 @@ pub fn chord_error(a: &[f64; 3], la: f64, b: &[f64; 3], lb: f64) -> f64 {
     }
     let r = la * lb * lc / (2.0 * twice_area);
     let h = la / 2.0;
-    let e = h * h / (r + (r * r - h * h).max(0.0).sqrt());
+    let e = h * h / (r + (r * r - h * h).at_least(0.0).sqrt());
     if e.is_finite() {
         e
     } else {
