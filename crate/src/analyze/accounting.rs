@@ -31,6 +31,7 @@ pub struct Totals {
     pub retractions: u64,
     pub lines: u64,
     pub bounds: Option<Bounds>,
+    pub dwell_s: f64,
 }
 
 /// An event waiting for its time.
@@ -141,7 +142,8 @@ impl Accounts {
     }
 
     /// A dwell, charged to the current layer.
-    pub fn dwell(&self, secs: f64) -> TimeMsg {
+    pub fn dwell(&mut self, secs: f64) -> TimeMsg {
+        self.totals.dwell_s += secs.at_least(0.0);
         TimeMsg::Dwell {
             secs,
             layers: self.layers.current(),

@@ -345,6 +345,7 @@ pub fn analyze_with_progress(
             slicer_time_s: pre.slicer_time_s,
         },
         time_s,
+        dwell_s: totals.dwell_s,
         time_model: "planner".into(),
         machine: MachineInfo {
             profile: profile.name,

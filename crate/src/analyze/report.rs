@@ -14,8 +14,11 @@ pub struct Report {
     pub version: String,
     /// Facts about the file itself.
     pub file: FileInfo,
-    /// Estimated print time, s (nominal: path length over feed rate, plus dwells).
+    /// Estimated print time, s (the planned moves, plus dwells).
     pub time_s: f64,
+    /// Time spent in dwells (`G4`), s: included in `time_s`. (PrusaSlicer's estimate leaves
+    /// dwells out, so comparisons with it subtract this.)
+    pub dwell_s: f64,
     /// How `time_s` was computed (`planner`: firmware look-ahead with the junction model below).
     pub time_model: String,
     /// The machine the file was planned for.

@@ -187,11 +187,17 @@ impl Block {
                 .at_least(self.entry)
                 .at_least(self.exit);
         }
+        // Marlin's safe-speed rule can put a junction above this block's nominal speed (a slow
+        // extrusion followed by a travel): the firmware runs the block at its nominal rate and
+        // the next one starts faster (the stepper's braking phase, clamped to the final rate,
+        // would begin after a plateau that already covers the whole block), as PrusaSlicer's
+        // estimator also times it. Raising the block's cruise to its exit instead would run a
+        // 1.4 mm/s perimeter at the travel's 8 mm/s.
         Profile::new(
             self.distance,
             self.entry,
             cruise,
-            self.exit,
+            self.exit.at_most(cruise),
             self.acceleration,
         )
     }
@@ -592,6 +598,24 @@ mod tests {
             let total: f64 = p.iter().map(PlannedMove::duration).sum();
             assert!(total > 40.0 / 100.0, "{model:?}: slower than nominal");
         }
+    }
+
+    #[test]
+    fn a_slow_move_before_a_travel_runs_at_its_own_feed() {
+        // 10 mm at 1.5 mm/s (below the 10 mm/s jerk), then a fast travel: the junction is the
+        // travel's safe speed, 10 mm/s, but the slow move still takes 10 / 1.5 s, and the
+        // travel starts at the junction speed.
+        let src = "M83\nG1 X10 E1 F90\nG1 X60 F6000";
+        let p = plan(src, JunctionModel::ClassicJerk);
+        assert_eq!(p.len(), 2);
+        let slow = &p[0];
+        assert!(slow.profile.peak <= 1.5 + 1e-9, "{:?}", slow.profile);
+        assert!(
+            (slow.duration() - 10.0 / 1.5).abs() < 0.01,
+            "{}",
+            slow.duration()
+        );
+        assert!(p[1].profile.entry > 1.5, "{:?}", p[1].profile);
     }
 
     #[test]

@@ -138,6 +138,8 @@ export interface Report {
   version: string;
   file: { bytes: number; lines: number; slicer: string | null; flavor: string | null; slicer_time_s: number | null };
   time_s: number;
+  /** Time in dwells (G4), s, included in time_s. */
+  dwell_s: number;
   time_model: string;
   machine: { profile: string; junction_model: JunctionModel; reason: string; limits: Limits };
   moves: number;
