@@ -204,6 +204,22 @@ impl MachineDynamics {
     }
 }
 
+impl MachineDynamics {
+    /// The lowest natural frequency of the X and Y drives as they run (mechanism and position
+    /// loop), over the travel (the screws' stiffness changes with the nut's position), Hz.
+    pub fn lowest_frequency_hz(&self) -> f64 {
+        let mut lowest = f64::INFINITY;
+        for drive in [&self.x, &self.y] {
+            for position_m in [0.05, 0.25, 0.5] {
+                for mode in super::axis::modes(drive, position_m) {
+                    lowest = lowest.min(mode.frequency_hz);
+                }
+            }
+        }
+        lowest
+    }
+}
+
 /// An axis of the VTG paper's 1000 × 800 × 350 mm printer: a 20 mm ball screw with 10 mm lead
 /// (HIWIN/THK 2010 class: `C_a` = 10 kN, nut rigidity 300 N/µm, preload 5 % of `C_a`), a pair of
 /// 20 mm ball-screw support bearings (400–750 N/µm in NSK's BSN tables; 500 N/µm here), a

@@ -59,6 +59,37 @@ impl Profile {
         self.accel_s + self.cruise_s + self.decel_s
     }
 
+    /// Highest speed between distances `x0 ≤ x1` (mm) from the start of the move, mm/s: the
+    /// profile rises, holds, then falls, so it is the peak if the interval reaches the top,
+    /// else the speed at the interval's end nearer to it.
+    pub fn max_speed_between(&self, x0: f64, x1: f64) -> f64 {
+        if x1 < self.accel_mm {
+            self.speed_at(x1)
+        } else if x0 > self.accel_mm + self.cruise_mm {
+            self.speed_at(x0)
+        } else {
+            self.peak
+        }
+    }
+
+    /// Speed at distance `x` (mm) from the start of the move, mm/s: accelerating, cruising,
+    /// then braking to the exit speed (`x` is clamped to the move).
+    pub fn speed_at(&self, x: f64) -> f64 {
+        let a = self.acceleration;
+        let decel_from = self.accel_mm + self.cruise_mm;
+        if x < self.accel_mm && a > 0.0 {
+            (self.entry * self.entry + 2.0 * a * x.at_least(0.0)).sqrt()
+        } else if x <= decel_from || a <= 0.0 {
+            self.peak
+        } else {
+            let decel_mm = acceleration_distance(self.peak, self.exit, -a);
+            let left = (decel_from + decel_mm - x).at_least(0.0);
+            (self.exit * self.exit + 2.0 * a * left)
+                .sqrt()
+                .at_most(self.peak)
+        }
+    }
+
     /// The profile of a move of length `d` entered at `entry`, left at `exit`, cruising at most
     /// at `cruise`, with acceleration `a` (firmware `calculate_trapezoid`). Entry and exit must
     /// be reachable (the look-ahead guarantees it); if not, they are lowered.
@@ -146,6 +177,28 @@ mod tests {
         assert!(close(d, 10.0));
         assert!(close(p.accel_s, 20.0 / 500.0));
         assert!(close(p.decel_s, 30.0 / 500.0));
+    }
+
+    #[test]
+    fn speed_along_a_trapezoid() {
+        // From 10 to 50 mm/s over 1.2 mm at 1000 mm/s², 97.5 mm cruising, down to 0 over 1.25.
+        let p = Profile::new(100.0, 10.0, 50.0, 0.0, 1000.0);
+        assert!(close(p.speed_at(0.0), 10.0));
+        assert!(close(p.speed_at(0.6), (100.0f64 + 1200.0).sqrt()));
+        assert!(close(p.speed_at(50.0), 50.0));
+        // 0.25 mm before the end: v² = 2 a · 0.25.
+        assert!(close(p.speed_at(99.75), 500f64.sqrt()));
+        assert!(close(p.speed_at(100.0), 0.0));
+        assert!(close(p.speed_at(-1.0), 10.0) && close(p.speed_at(101.0), 0.0));
+        // A triangle peaks where acceleration meets braking.
+        let t = Profile::new(1.0, 0.0, 100.0, 0.0, 1000.0);
+        assert!(close(t.speed_at(0.5), t.peak));
+        // The highest speed over a stretch: on the ramp up, its far end; on the way down, its
+        // near end; across the top, the peak.
+        assert!(close(p.max_speed_between(0.1, 0.6), p.speed_at(0.6)));
+        assert!(close(p.max_speed_between(99.0, 99.75), p.speed_at(99.0)));
+        assert!(close(p.max_speed_between(0.5, 99.5), 50.0));
+        assert!(close(t.max_speed_between(0.2, 0.8), t.peak));
     }
 
     #[test]

@@ -8,13 +8,16 @@
 pub const DEGREE: usize = 3;
 
 /// A clamped cubic B-spline: `knots.len() == ctrl.len() + 4`, first and last knots repeated
-/// four times.
+/// four times. The control points of its first and second derivative curves are kept beside
+/// it (P&T eq. 3.8), so a point and both derivatives cost one pass of the basis recursion.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Curve {
-    /// Knot vector.
-    pub knots: Vec<f64>,
-    /// Control points.
-    pub ctrl: Vec<[f64; 3]>,
+    knots: Vec<f64>,
+    ctrl: Vec<[f64; 3]>,
+    /// `Q_i = 3 (P_{i+1} − P_i) / (u_{i+4} − u_{i+1})`, for `C' = Σ N_{i+1,2} Q_i`.
+    d1_ctrl: Vec<[f64; 3]>,
+    /// `R_i = 2 (Q_{i+1} − Q_i) / (u_{i+4} − u_{i+2})`, for `C'' = Σ N_{i+2,1} R_i`.
+    d2_ctrl: Vec<[f64; 3]>,
 }
 
 /// A point of the curve with its first and second derivatives.
@@ -41,6 +44,46 @@ impl Eval {
 }
 
 impl Curve {
+    /// The curve with these knots and control points (derivative control points computed here;
+    /// a zero-length knot interval gives a zero difference, P&T's 0/0 = 0).
+    pub fn new(knots: Vec<f64>, ctrl: Vec<[f64; 3]>) -> Self {
+        let diff = |pts: &[[f64; 3]], lo: usize, hi: usize, degree: f64| -> Vec<[f64; 3]> {
+            pts.windows(2)
+                .enumerate()
+                .map(|(i, w)| {
+                    let den = knots
+                        .get(i + hi)
+                        .zip(knots.get(i + lo))
+                        .map_or(0.0, |(b, a)| b - a);
+                    let f = if den > 0.0 { degree / den } else { 0.0 };
+                    [
+                        (w[1][0] - w[0][0]) * f,
+                        (w[1][1] - w[0][1]) * f,
+                        (w[1][2] - w[0][2]) * f,
+                    ]
+                })
+                .collect()
+        };
+        let d1_ctrl = diff(&ctrl, 1, 4, 3.0);
+        let d2_ctrl = diff(&d1_ctrl, 2, 4, 2.0);
+        Self {
+            knots,
+            ctrl,
+            d1_ctrl,
+            d2_ctrl,
+        }
+    }
+
+    /// Knot vector.
+    pub fn knots(&self) -> &[f64] {
+        &self.knots
+    }
+
+    /// Control points.
+    pub fn ctrl(&self) -> &[[f64; 3]] {
+        &self.ctrl
+    }
+
     /// First parameter.
     pub fn start(&self) -> f64 {
         self.knots.first().copied().unwrap_or(0.0)
@@ -51,8 +94,8 @@ impl Curve {
         self.knots.last().copied().unwrap_or(0.0)
     }
 
-    /// Point and derivatives at `u` (clamped to the curve's range).
-    #[allow(clippy::needless_range_loop)] // three coordinates, indexed in step
+    /// Point and derivatives at `u` (clamped to the curve's range): one pass of A2.2 gives
+    /// the basis functions of degrees 1, 2 and 3, which weigh `R`, `Q` and `P`.
     pub fn eval(&self, u: f64) -> Eval {
         let n = self.ctrl.len();
         let zero = Eval {
@@ -65,20 +108,57 @@ impl Curve {
         }
         let u = u.clamp(self.start(), self.end());
         let span = find_span(&self.knots, n - 1, u);
-        let ders = basis_ders(&self.knots, span, u);
-        let mut e = zero;
-        for (j, row) in ders[0].iter().enumerate() {
-            let Some(cp) = self.ctrl.get(span + j - DEGREE) else {
-                return zero;
-            };
-            for k in 0..3 {
-                e.p[k] += row * cp[k];
-                e.d1[k] += ders[1][j] * cp[k];
-                e.d2[k] += ders[2][j] * cp[k];
+        let (Some(p), Some(q), Some(r)) = (
+            self.ctrl.get(span - DEGREE..=span),
+            self.d1_ctrl.get(span - DEGREE..span),
+            self.d2_ctrl.get(span - DEGREE..span - 1),
+        ) else {
+            return zero;
+        };
+        let [n1, n2, n3] = basis_by_degree(&self.knots, span, u);
+        let weigh = |w: &[f64], pts: &[[f64; 3]]| -> [f64; 3] {
+            let mut out = [0.0; 3];
+            for (wi, pt) in w.iter().zip(pts) {
+                out[0] += wi * pt[0];
+                out[1] += wi * pt[1];
+                out[2] += wi * pt[2];
             }
+            out
+        };
+        Eval {
+            p: weigh(&n3, p),
+            d1: weigh(&n2[..3], q),
+            d2: weigh(&n1[..2], r),
         }
-        e
     }
+}
+
+/// The non-zero basis functions of degrees 1, 2 and 3 at `u` in span `span` (A2.2, keeping
+/// its intermediate rows): `[N_{span−1..=span,1}, N_{span−2..=span,2}, N_{span−3..=span,3}]`,
+/// each padded to four entries.
+#[inline]
+pub fn basis_by_degree(knots: &[f64], span: usize, u: f64) -> [[f64; 4]; 3] {
+    let mut out = [[0.0; 4]; 3];
+    if span < DEGREE || span + DEGREE >= knots.len() {
+        return out;
+    }
+    let mut n = [1.0, 0.0, 0.0, 0.0];
+    let mut left = [0.0f64; 4];
+    let mut right = [0.0f64; 4];
+    for j in 1..=DEGREE {
+        left[j] = u - knots[span + 1 - j];
+        right[j] = knots[span + j] - u;
+        let mut saved = 0.0;
+        for r in 0..j {
+            let den = right[r + 1] + left[j - r];
+            let temp = if den != 0.0 { n[r] / den } else { 0.0 };
+            n[r] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        n[j] = saved;
+        out[j - 1] = n;
+    }
+    out
 }
 
 /// Index of the knot span holding `u` (A2.1), for `n + 1` control points.
@@ -207,15 +287,15 @@ mod tests {
     /// A single Bézier span: C(u) = Σ B_i(u) P_i with Bernstein polynomials.
     #[test]
     fn bezier_span_matches_bernstein() {
-        let c = Curve {
-            knots: vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
-            ctrl: vec![
+        let c = Curve::new(
+            vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+            vec![
                 [0.0, 0.0, 0.0],
                 [1.0, 2.0, 0.0],
                 [3.0, 2.0, 0.0],
                 [4.0, 0.0, 1.0],
             ],
-        };
+        );
         for &u in &[0.0, 0.25, 0.5, 0.9, 1.0] {
             let e = c.eval(u);
             let b = [
@@ -237,9 +317,9 @@ mod tests {
                 6.0 * u,
             ];
             for k in 0..3 {
-                let p: f64 = (0..4).map(|i| b[i] * c.ctrl[i][k]).sum();
-                let d: f64 = (0..4).map(|i| db[i] * c.ctrl[i][k]).sum();
-                let dd: f64 = (0..4).map(|i| ddb[i] * c.ctrl[i][k]).sum();
+                let p: f64 = (0..4).map(|i| b[i] * c.ctrl()[i][k]).sum();
+                let d: f64 = (0..4).map(|i| db[i] * c.ctrl()[i][k]).sum();
+                let dd: f64 = (0..4).map(|i| ddb[i] * c.ctrl()[i][k]).sum();
                 assert!((e.p[k] - p).abs() < 1e-12);
                 assert!((e.d1[k] - d).abs() < 1e-12);
                 assert!((e.d2[k] - dd).abs() < 1e-12);
@@ -258,6 +338,38 @@ mod tests {
             assert!((d[0].iter().sum::<f64>() - 1.0).abs() < 1e-12);
             assert!(d[1].iter().sum::<f64>().abs() < 1e-9);
             assert!(d[2].iter().sum::<f64>().abs() < 1e-8);
+        }
+    }
+
+    /// The derivative control points agree with A2.3's basis derivatives everywhere, interior
+    /// double knot and ends included.
+    #[test]
+    #[allow(clippy::needless_range_loop)] // three coordinates, indexed in step
+    fn evaluation_matches_the_general_derivative_recursion() {
+        let knots = vec![
+            0.0, 0.0, 0.0, 0.0, 0.3, 0.35, 0.35, 0.9, 1.4, 2.0, 2.0, 2.0, 2.0,
+        ];
+        let ctrl: Vec<[f64; 3]> = (0..9)
+            .map(|i| {
+                let t = i as f64;
+                [t, (1.3 * t).sin() * 2.0, 0.1 * t * t]
+            })
+            .collect();
+        let c = Curve::new(knots.clone(), ctrl.clone());
+        for i in 0..=200 {
+            let u = i as f64 * 0.01;
+            let span = find_span(&knots, ctrl.len() - 1, u);
+            let d = basis_ders(&knots, span, u);
+            let e = c.eval(u);
+            for k in 0..3 {
+                let sum = |row: &[f64; 4]| -> f64 {
+                    (0..4).map(|j| row[j] * ctrl[span - 3 + j][k]).sum()
+                };
+                let scale = 1.0 + sum(&d[2]).abs();
+                assert!((e.p[k] - sum(&d[0])).abs() < 1e-12, "u {u}");
+                assert!((e.d1[k] - sum(&d[1])).abs() < 1e-10 * scale, "u {u}");
+                assert!((e.d2[k] - sum(&d[2])).abs() < 1e-9 * scale, "u {u}");
+            }
         }
     }
 }

@@ -2,15 +2,19 @@
 //!
 //! [`vtg`] reads a file, finds its extrusion paths (runs of consecutive printing moves within
 //! one feature), and rewrites each path that has a sharp corner (a turn above the critical
-//! angle δθ): a cubic B-spline is fitted to it within the tolerance ([`fit`]), walked with the
-//! second-order Taylor interpolator and Newton correction of Algorithm 1 ([`resample`]) in
-//! steps short enough that no new point turns by more than ¾ δθ, and the path's filament is
-//! spread over the new points ([`rewrite`]). Where the curvature stays above `K_cr` (eq. 30,
-//! [`kinematics`]) the feed is lowered so `a_n`, `j_n` and the interpolation chord error stay
-//! within eq. 29. Travels, retractions and every other line are kept byte for byte. The result
+//! angle δθ): its corners are blended with the largest fillets the tolerance and the legs
+//! allow ([`blend`]), a cubic B-spline is fitted to the blended path by least squares
+//! ([`fit`]), walked with the second-order Taylor interpolator and Newton correction of
+//! Algorithm 1 ([`resample`]) in steps that each turn by less than 0.9 δθ, and the path's
+//! filament is spread over the new points ([`rewrite`]). Where the curvature is above `K_cr`
+//! (eq. 30, [`kinematics`]) the feed is lowered so `a_n`, `j_n` and the interpolation chord
+//! error stay within eq. 29, never below the speed the machine had at the same place on the
+//! original, and on classic-jerk firmware rising feeds are ramped so no junction stalls
+//! ([`smooth`]). Travels, retractions and every other line are kept byte for byte. The result
 //! is checked against the original independently ([`deviation`]) and compared with
 //! [`metrics`] (Table 1) and the analysis (Table 2).
 
+pub mod blend;
 pub mod bspline;
 pub mod deviation;
 pub mod fit;
@@ -42,9 +46,16 @@ pub struct VtgOptions {
     pub critical_angle_deg: f64,
     /// Interpolation period `T_s` of eq. 30, s (default 0.001: a 1 kHz firmware step planner).
     pub interpolation_period_s: f64,
-    /// Normal jerk limit `J_n` of eq. 30, mm/s³ (default 500 000 = 500 m/s³, the middle of the
-    /// 100–1000 m/s³ range servo CNC controllers are set to).
-    pub normal_jerk_mm_s3: f64,
+    /// Normal jerk limit `J_n` of eq. 29–30, mm/s³. By default the machine's own: `A_n · f₁`,
+    /// with `f₁` the lowest natural frequency of its X and Y drives in the dynamics model
+    /// ([`crate::dynamics`], the parameter set that goes with the machine preset). An
+    /// acceleration that builds up over at least one period of the first mode leaves little
+    /// ringing behind (the reasoning of jerk-limited motion and input shaping); a rounded
+    /// corner taken faster delivers its whole change of direction within one period, and
+    /// excites the frame more than the sharp corner it replaced. For a Prusa-class belt
+    /// printer (`A_n` 1000 mm/s², 43 Hz) that is 43 m/s³; servo CNC controllers are set to
+    /// 100–1000 m/s³.
+    pub normal_jerk_mm_s3: Option<f64>,
     /// Nozzle diameter (`R_n` is half of it), mm (default 0.4).
     pub nozzle_diameter_mm: f64,
     /// Lower the feed rate where the curvature exceeds `K_cr` (default true).
@@ -61,7 +72,7 @@ impl Default for VtgOptions {
             tolerance_mm: 0.1,
             critical_angle_deg: metrics::DEFAULT_CRITICAL_ANGLE_DEG,
             interpolation_period_s: 0.001,
-            normal_jerk_mm_s3: 500_000.0,
+            normal_jerk_mm_s3: None,
             nozzle_diameter_mm: 0.4,
             limit_feed: true,
             dynamics: true,
@@ -85,7 +96,7 @@ impl VtgOptions {
         if !pos(self.interpolation_period_s) || self.interpolation_period_s > 1.0 {
             return bad("interpolation_period_s must be a number in (0, 1]");
         }
-        if !pos(self.normal_jerk_mm_s3) {
+        if !self.normal_jerk_mm_s3.is_none_or(pos) {
             return bad("normal_jerk_mm_s3 must be a positive number");
         }
         if !pos(self.nozzle_diameter_mm) || self.nozzle_diameter_mm > 10.0 {
@@ -112,7 +123,7 @@ pub fn vtg_with_progress(
     let (before, read) = crate::parallel::join(
         || crate::analyze::analyze(input, &options.analyze),
         || {
-            let path = crate::path::extract(input, &options.analyze, false)?;
+            let path = crate::path::extract(input, &options.analyze, options.limit_feed)?;
             let sources = source::move_sources(input, &options.analyze)?;
             Ok::<_, Error>((path, sources))
         },

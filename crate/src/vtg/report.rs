@@ -101,6 +101,16 @@ pub struct PathCounts {
     pub above_k_cr_segments: u64,
     /// Of those, segments written with a lower feed rate (eq. 29).
     pub lowered_feed_segments: u64,
+    /// Rewritten paths whose eq. 29 speeds were raised (up to 3×) so they cost no time.
+    pub raised_caps: u64,
+    /// Rewritten paths written without the eq. 29 feed caps because even raised they would
+    /// have made them slower than the original (the firmware's own cornering sets their
+    /// speed).
+    pub uncapped: u64,
+    /// Paths kept as they were because their rewrite plans slower, or costs more motor energy,
+    /// than the original even without caps (a firmware that takes sharp corners faster than
+    /// any fillet within the tolerance allows).
+    pub kept_for_time: u64,
     /// Mean speed fluctuation of the interpolation steps, percent (eq. 28).
     pub mean_speed_fluctuation_pct: f64,
 }
@@ -200,6 +210,9 @@ pub(crate) fn build(
             written_moves: rewritten.written_moves,
             above_k_cr_segments: rewritten.above_k_cr_segments,
             lowered_feed_segments: rewritten.lowered_segments,
+            raised_caps: rewritten.raised_caps_paths,
+            uncapped: rewritten.uncapped_paths,
+            kept_for_time: rewritten.kept_for_time,
             mean_speed_fluctuation_pct: if w.steps > 0 {
                 w.fluctuation_sum / w.steps as f64 * 100.0
             } else {

@@ -87,13 +87,18 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
         let mut step = step_for(kappa, w).min(left).max(w.min_step_mm);
         let remaining = norm(&sub(&end_p, &p));
         let mut accepted = None;
+        // The shortest step tried that did not fit.
+        let mut too_long: Option<f64> = None;
         for _ in 0..40 {
             // The end is near along the curve, not just in space (a closed loop ends where it
             // started).
             if remaining <= step && (u_end - u) * norm(&e.d1) <= 1.5 * step + 1e-9 {
-                // Try the end point as the next point.
+                // Try the end point as the next point: the turn and sagitta of the stretch are
+                // judged on its length along the curve, not on the chord, which is nothing at
+                // all when a closed loop comes back to its start.
                 let k = max_curvature(curve, u, u_end);
-                if fits(k, remaining, w) {
+                let along = arc_length(curve, u, u_end);
+                if remaining >= 0.5 * along && fits(k, along, w) {
                     accepted = Some((u_end, end_p, k, 0.0, None));
                     break;
                 }
@@ -108,6 +113,7 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
                     }
                 }
             }
+            too_long = Some(step);
             // Shrink to what the curvature met on the way allows (at least halving).
             let k = max_curvature(
                 curve,
@@ -120,6 +126,29 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
             step = (0.5 * step)
                 .min(step_for(k, w).max(0.25 * step))
                 .max(w.min_step_mm);
+        }
+        // The longest step that fits lies between the one accepted and the shortest that did
+        // not: a straight run up to a corner is then one step, not a series of ever shorter
+        // ones whose junctions the firmware would have to plan.
+        if let (Some((_, _, _, ok, Some(_))), Some(mut bad)) = (accepted, too_long) {
+            let mut ok = ok;
+            for _ in 0..BISECTIONS {
+                if bad - ok <= BISECT_RESOLUTION * ok {
+                    break;
+                }
+                let mid = 0.5 * (ok + bad);
+                let fitted = newton(curve, u, &e, &p, mid, w)
+                    .filter(|(un, _)| *un < u_end)
+                    .map(|(un, at)| (un, at, max_curvature(curve, u, un)))
+                    .filter(|(_, _, k)| fits(*k, mid, w));
+                match fitted {
+                    Some((un, at, k)) => {
+                        accepted = Some((un, at.p, k, mid, Some(at.d1)));
+                        ok = mid;
+                    }
+                    None => bad = mid,
+                }
+            }
         }
         let (mut un, mut pn, k, mut step, mut d1_next) = accepted?;
         // Do not leave a sliver before the end: stretch this step to it instead (it is then
@@ -164,6 +193,24 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
     None
 }
 
+/// Length of the curve between parameters `a` and `b`, as a polyline through 16 points on it
+/// (only used for the last step, which is short or checked to be nearly straight).
+fn arc_length(curve: &Curve, a: f64, b: f64) -> f64 {
+    let mut prev = curve.eval(a).p;
+    let mut sum = 0.0;
+    for i in 1..=16 {
+        let p = curve.eval(a + (b - a) * i as f64 / 16.0).p;
+        sum += norm(&sub(&p, &prev));
+        prev = p;
+    }
+    sum
+}
+
+/// Bisections between the longest step found to fit and the shortest that did not.
+const BISECTIONS: usize = 12;
+/// Bisection stops when the bracket is this fraction of the step.
+const BISECT_RESOLUTION: f64 = 0.02;
+
 /// The step the chord tolerance and the turn allow at curvature `kappa`.
 fn step_for(kappa: f64, w: &Walk) -> f64 {
     if kappa <= 1e-9 {
@@ -180,13 +227,17 @@ fn fits(kappa: f64, step: f64, w: &Walk) -> bool {
 
 /// Largest curvature of a curve over parameter intervals, sampled at the ends of the interval
 /// and at fixed points of every knot span it touches (each span is one cubic, so its curvature
-/// varies smoothly; sampling by span never steps over a short, tight span). The spans' own
-/// samples are computed once, so a long step over many spans costs only table reads.
+/// varies smoothly; sampling by span never steps over a short, tight span). The spans' samples
+/// are computed once: a long step over many spans costs only table reads, and a partly
+/// covered span its samples inside the interval and the curvature at the interval's ends.
 #[derive(Debug, Clone)]
 pub struct CurvatureIndex {
     /// Distinct knots.
     breaks: Vec<f64>,
-    /// Largest sampled curvature of span `i` (`breaks[i]..breaks[i+1]`).
+    /// Curvature of span `i` (`breaks[i]..breaks[i+1]`) at `SPAN_SAMPLES` equally spaced
+    /// points, ends included.
+    samples: Vec<[f64; SPAN_SAMPLES]>,
+    /// Largest of each span's samples.
     span_max: Vec<f64>,
 }
 
@@ -197,53 +248,60 @@ impl CurvatureIndex {
     /// Samples every span of `curve`.
     pub fn new(curve: &Curve) -> Self {
         let mut breaks: Vec<f64> = Vec::new();
-        for &k in &curve.knots {
+        for &k in curve.knots() {
             if breaks.last().is_none_or(|&b| k > b) {
                 breaks.push(k);
             }
         }
-        let span_max = breaks
+        let samples: Vec<[f64; SPAN_SAMPLES]> = breaks
             .windows(2)
             .map(|w| {
-                (0..SPAN_SAMPLES)
-                    .map(|i| {
-                        let t = i as f64 / (SPAN_SAMPLES - 1) as f64;
-                        curve.eval(w[0] + (w[1] - w[0]) * t).curvature()
-                    })
-                    .fold(0.0, f64::max)
+                std::array::from_fn(|i| {
+                    let t = i as f64 / (SPAN_SAMPLES - 1) as f64;
+                    curve.eval(w[0] + (w[1] - w[0]) * t).curvature()
+                })
             })
             .collect();
-        Self { breaks, span_max }
+        let span_max = samples
+            .iter()
+            .map(|s| s.iter().copied().fold(0.0, f64::max))
+            .collect();
+        Self {
+            breaks,
+            samples,
+            span_max,
+        }
     }
 
-    /// Largest curvature on `[a, b]`: the table for spans wholly inside, samples at the ends
-    /// and in the partly covered spans.
+    /// Largest curvature on `[a, b]`.
     pub fn max(&self, curve: &Curve, a: f64, b: f64) -> f64 {
-        let sample = |lo: f64, hi: f64| -> f64 {
-            (0..SPAN_SAMPLES)
-                .map(|i| {
-                    let t = i as f64 / (SPAN_SAMPLES - 1) as f64;
-                    curve.eval(lo + (hi - lo) * t).curvature()
-                })
-                .fold(0.0, f64::max)
-        };
         // Spans: i such that breaks[i] < b and breaks[i+1] > a.
         let first = self.breaks.partition_point(|&k| k <= a).saturating_sub(1);
         let mut best = 0.0f64;
+        let mut partial = false;
         let mut i = first;
         while i + 1 < self.breaks.len() {
             let (s0, s1) = (self.breaks[i], self.breaks[i + 1]);
             if s0 >= b {
                 break;
             }
-            let (lo, hi) = (s0.max(a), s1.min(b));
-            let m = if lo <= s0 && hi >= s1 {
-                self.span_max.get(i).copied().unwrap_or(0.0)
+            if a <= s0 && b >= s1 {
+                best = best.max(self.span_max.get(i).copied().unwrap_or(0.0));
             } else {
-                sample(lo, hi)
-            };
-            best = best.max(m);
+                partial = true;
+                for (k, &c) in self.samples.get(i).into_iter().flatten().enumerate() {
+                    let at = s0 + (s1 - s0) * k as f64 / (SPAN_SAMPLES - 1) as f64;
+                    if at >= a && at <= b {
+                        best = best.max(c);
+                    }
+                }
+            }
             i += 1;
+        }
+        if partial {
+            best = best
+                .max(curve.eval(a).curvature())
+                .max(curve.eval(b).curvature());
         }
         best
     }
@@ -305,13 +363,14 @@ fn newton(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::vtg::fit::{fit, sample};
+    use crate::vtg::blend;
+    use crate::vtg::fit::fit;
 
     #[test]
     fn walks_a_corner_in_gentle_equal_steps() {
         let pts = [[0.0, 0.0, 0.2], [10.0, 0.0, 0.2], [10.0, 10.0, 0.2]];
-        let (d, u) = sample(&pts, 0.05, 2.0);
-        let f = fit(&d, &u, 0.05).unwrap();
+        let (d, u) = blend::samples(&pts, &blend::plan(&pts, 0.05, 0.0), 2.0);
+        let f = fit(&d, &u, 0.02).unwrap();
         let w = Walk {
             chord_tol_mm: 0.01,
             max_turn_rad: 20f64.to_radians(),
@@ -356,12 +415,12 @@ mod tests {
                     }
                 }
                 prop_assume!(pts.len() >= 3);
-                let (d, u) = sample(&pts, 0.25, 3.0);
-                let Some(f) = fit(&d, &u, 0.06) else { return Ok(()) };
+                let (d, u) = blend::samples(&pts, &blend::plan(&pts, 0.06, 0.0), 3.0);
+                let Some(f) = fit(&d, &u, 0.02) else { return Ok(()) };
                 let w = Walk {
                     chord_tol_mm: 0.03,
                     max_turn_rad: 0.45,
-                    max_step_mm: 1e4,
+                            max_step_mm: 1e4,
                     min_step_mm: 0.03,
                     phi: 1.0,
                     newton_tol_mm: 1e-7,

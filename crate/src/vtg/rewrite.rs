@@ -15,14 +15,16 @@ use std::fmt::Write as _;
 
 use super::kinematics::KinematicLimits;
 use super::resample::WalkStats;
-use super::smooth::{smooth_path, Settings};
-use super::source::MoveSource;
+use super::smooth::{smooth_path, Path, Settings, Written};
+use super::source::{MoveSource, Sources};
 use super::VtgOptions;
+use crate::energy::Accumulator;
 use crate::error::{Error, ErrorKind};
 use crate::gcode::number::{push_trimmed, rounded};
 use crate::gcode::{apply_edits, Edit};
 use crate::machine::{ExtrusionMode, MoveKind};
 use crate::path::{PathMove, PrintPath};
+use crate::plan::{JunctionModel, Limits, Motion, Planner, Profile};
 
 /// What the rewrite did.
 #[derive(Debug, Clone, Default)]
@@ -43,13 +45,27 @@ pub struct Rewritten {
     pub above_k_cr_segments: u64,
     /// Largest measured distance of a rewritten path from its original, mm.
     pub max_deviation_mm: f64,
+    /// Rewritten paths whose eq. 29 feed caps were raised so they cost no time.
+    pub raised_caps_paths: u64,
+    /// Rewritten paths written without the eq. 29 feed caps, which even raised would have made
+    /// them slower than the original.
+    pub uncapped_paths: u64,
+    /// Paths kept as they were because even rounded without caps they plan slower or cost more
+    /// motor energy.
+    pub kept_for_time: u64,
     /// Algorithm 1 statistics.
     pub walk: WalkStats,
 }
 
-/// The eq. 30 limits for a file: `v_max` and `A_n` from the machine's X/Y limits (`M203`,
-/// `M201`: the hardware's, since the firmware's print acceleration only bounds the tangential
-/// part), `T_s`, `J_n`, `R_n` and `δ` from the options.
+/// The eq. 30 limits for a file: `v_max` from the machine's X/Y feed limits (`M203`), `A_n` the
+/// printing acceleration (`M204 P`, Klipper's `ACCEL`) within the X/Y acceleration limits
+/// (`M201`), `T_s`, `R_n` and `δ` from the options, `J_n` from the options or else from `A_n`
+/// and the machine's first natural frequency (see [`VtgOptions::normal_jerk_mm_s3`]).
+///
+/// `A_n` is the printing acceleration, not the `M201` maximum: it is what the user chose for
+/// the quality of the print, and what junction-deviation and Klipper planners themselves hold
+/// the centripetal acceleration of a curve to (`M201` is often far above it: 9000 mm/s² in
+/// PrusaSlicer's MK3S profile, printing at 1250).
 pub fn limits_for(path: &PrintPath, options: &VtgOptions) -> KinematicLimits {
     let l = &path.print_limits;
     let pick = |a: f64, b: f64, default: f64| {
@@ -60,17 +76,34 @@ pub fn limits_for(path: &PrintPath, options: &VtgOptions) -> KinematicLimits {
             default
         }
     };
+    let normal_accel_mm_s2 = pick(
+        l.max_acceleration[0].value.min(l.acceleration.value),
+        l.max_acceleration[1].value,
+        1000.0,
+    );
+    let normal_jerk_mm_s3 = options
+        .normal_jerk_mm_s3
+        .unwrap_or_else(|| normal_accel_mm_s2 * first_mode_hz(path));
     KinematicLimits {
         v_max_mm_s: pick(l.max_feedrate[0].value, l.max_feedrate[1].value, 200.0),
         interpolation_period_s: options.interpolation_period_s,
         chord_tolerance_mm: options.tolerance_mm,
-        normal_accel_mm_s2: pick(
-            l.max_acceleration[0].value,
-            l.max_acceleration[1].value,
-            1000.0,
-        ),
-        normal_jerk_mm_s3: options.normal_jerk_mm_s3,
+        normal_accel_mm_s2,
+        normal_jerk_mm_s3,
         nozzle_radius_mm: options.nozzle_diameter_mm / 2.0,
+    }
+}
+
+/// The machine's lowest natural frequency (see [`VtgOptions::normal_jerk_mm_s3`]), Hz.
+pub fn first_mode_hz(path: &PrintPath) -> f64 {
+    let name = crate::dynamics::parameters::preset_for_machine(&path.profile.name);
+    let f1 = crate::dynamics::parameters::MachineDynamics::preset(name)
+        .map_or(f64::NAN, |d| d.lowest_frequency_hz());
+    if f1.is_finite() && f1 > 0.0 {
+        f1
+    } else {
+        // No model to ask: a typical desktop frame's first mode.
+        40.0
     }
 }
 
@@ -78,13 +111,14 @@ pub fn limits_for(path: &PrintPath, options: &VtgOptions) -> KinematicLimits {
 pub fn rewrite(
     input: &[u8],
     path: &PrintPath,
-    sources: &[MoveSource],
+    all: &Sources,
     options: &VtgOptions,
     limits: &KinematicLimits,
     progress: crate::analyze::Progress<'_>,
 ) -> Result<Rewritten, Error> {
     let mut out = Rewritten::default();
     let moves = &path.moves;
+    let sources = &all.moves[..];
     let aligned =
         sources.len() == moves.len() && sources.iter().zip(moves).all(|(s, m)| s.line == m.line);
     if !aligned {
@@ -96,7 +130,33 @@ pub fn rewrite(
         critical_rad: options.critical_angle_deg.to_radians(),
         limits: *limits,
         limit_feed: options.limit_feed,
+        max_normal_accel_mm_s2: {
+            let a = &path.print_limits.max_acceleration;
+            let m = a[0].value.min(a[1].value);
+            if m.is_finite() && m > 0.0 {
+                m
+            } else {
+                limits.normal_accel_mm_s2
+            }
+        },
+        jerk_per_accel_hz: options
+            .normal_jerk_mm_s3
+            .is_none()
+            .then(|| first_mode_hz(path)),
+        min_step_mm: if path.junction_model == JunctionModel::Klipper {
+            super::smooth::MIN_STEP_MM
+        } else {
+            super::smooth::MARLIN_MIN_STEP_MM
+        },
+        classic_jerk_mm_s: (path.junction_model == JunctionModel::ClassicJerk).then(|| {
+            let j = &path.print_limits.max_jerk;
+            j[0].value.min(j[1].value)
+        }),
     };
+    let energy = Accumulator::new(
+        &options.analyze.energy.clone().unwrap_or_default(),
+        &path.profile.name,
+    );
     let cos_critical = crate::math::cos(settings.critical_rad);
     // The candidates first (cheap), then the paths rewritten in parallel batches: each path is
     // independent, results are merged in file order (the same output on any number of
@@ -127,7 +187,13 @@ pub fn rewrite(
                 .iter()
                 .map(|&(i, j)| {
                     let mut part = Rewritten::default();
-                    let e = rewrite_path(&moves[i..j], &sources[i..j], &settings, &mut part);
+                    let machine = Machine {
+                        limits: all.limits_at(i),
+                        model: path.junction_model,
+                        energy: &energy,
+                    };
+                    let e =
+                        rewrite_path(&moves[i..j], &sources[i..j], &settings, &machine, &mut part);
                     (e, part)
                 })
                 .collect()
@@ -153,6 +219,9 @@ impl Rewritten {
         self.lowered_segments += part.lowered_segments;
         self.above_k_cr_segments += part.above_k_cr_segments;
         self.max_deviation_mm = self.max_deviation_mm.max(part.max_deviation_mm);
+        self.raised_caps_paths += part.raised_caps_paths;
+        self.uncapped_paths += part.uncapped_paths;
+        self.kept_for_time += part.kept_for_time;
         self.walk.steps += part.walk.steps;
         self.walk.fluctuation_sum += part.walk.fluctuation_sum;
     }
@@ -199,13 +268,86 @@ fn has_sharp_corner(run: &[PathMove], cos_critical: f64) -> bool {
     })
 }
 
+/// Scales of the eq. 29 speeds tried in turn (`None`: no caps), until a rewrite costs no time.
+const CAP_SCALES: [Option<f64>; 8] = [
+    Some(1.0),
+    Some(1.2),
+    Some(1.44),
+    Some(1.73),
+    Some(2.07),
+    Some(2.5),
+    Some(3.0),
+    None,
+];
+
+/// The firmware a path runs on: the limits in force where it starts, the junction model, and
+/// the motor energy model.
+struct Machine<'a> {
+    limits: Option<&'a Limits>,
+    model: JunctionModel,
+    energy: &'a Accumulator,
+}
+
+impl Machine<'_> {
+    /// The settings for a path here: the jerk and acceleration ceilings of the limits in force.
+    fn settings(&self, file: &Settings) -> Settings {
+        let mut s = *file;
+        if let Some(l) = self.limits {
+            let a = l.max_acceleration[0].value.min(l.max_acceleration[1].value);
+            if a.is_finite() && a > 0.0 {
+                s.max_normal_accel_mm_s2 = a;
+            }
+            if s.classic_jerk_mm_s.is_some() {
+                s.classic_jerk_mm_s = Some(l.max_jerk[0].value.min(l.max_jerk[1].value));
+            }
+        }
+        s
+    }
+
+    /// Time (s) the firmware takes for the polyline from `start` through `points` (filament
+    /// `e` from 0 at `start`, feed `feed` per segment), planned on its own from rest to rest,
+    /// and the motor energy (J) it costs.
+    fn cost(&self, start: [f64; 3], points: &[[f64; 3]], e: &[f64], feed: &[f64]) -> (f64, f64) {
+        let Some(limits) = self.limits else {
+            return (f64::NAN, f64::NAN);
+        };
+        let mut planner = Planner::new(limits.clone(), self.model);
+        let mut energy = self.energy.clone();
+        let mut joules = 0.0;
+        let (mut from, mut e_from) = (start, 0.0);
+        for (k, ((p, &ek), &f)) in points.iter().zip(e).zip(feed).enumerate() {
+            let m = Motion {
+                line: 0,
+                delta: [p[0] - from[0], p[1] - from[1], p[2] - from[2], ek - e_from],
+                arc: None,
+                feed_mm_s: f,
+                rotary_time_s: 0.0,
+            };
+            planner.push(&m, k as u64, &mut |pm| joules += energy.planned(pm));
+            (from, e_from) = (*p, ek);
+        }
+        planner.flush(&mut |pm| joules += energy.planned(pm));
+        (planner.elapsed_s(), joules)
+    }
+}
+
 /// Rewrites one path; the edits replace its first line with the new block and delete the rest.
+///
+/// A rewrite must cost neither time nor motor energy: the new path and the original are planned
+/// on their own with the firmware's limits and costed with the energy model, and where the new
+/// one is dearer its eq. 29 speeds are raised step by step (each step trading a little of the
+/// vibration suppression for speed), then dropped (the firmware's own cornering then sets the
+/// speed), and the path is kept as it was if it is still dearer. (A machine whose planner takes sharp corners faster than a fillet within
+/// the tolerance allows, such as Klipper with a high square-corner velocity, gains nothing in
+/// time from rounding.)
 fn rewrite_path(
     run: &[PathMove],
     src: &[MoveSource],
-    settings: &Settings,
+    file_settings: &Settings,
+    machine: &Machine<'_>,
     out: &mut Rewritten,
 ) -> Option<Vec<Edit>> {
+    let settings = &machine.settings(file_settings);
     let (first, first_src) = (run.first()?, src.first()?);
     let last_src = src.last()?;
     let xyz = |p: &crate::machine::Pos| [p[0], p[1], p[2]];
@@ -232,19 +374,61 @@ fn rewrite_path(
         .zip(run)
         .map(|(s, m)| s.f_after.map_or(m.feed_mm_s, |f| f / 60.0))
         .collect();
-    let smoothed = smooth_path(&pts, &e, &feed, settings)?;
+    // How the planner ran each original move, when the path was planned.
+    let planned: Vec<Profile> = run
+        .iter()
+        .map_while(|m| m.timing.map(|t| t.profile))
+        .collect();
+    let path = Path {
+        pts: &pts,
+        e: &e,
+        feed: &feed,
+        planned: if planned.len() == run.len() {
+            &planned
+        } else {
+            &[]
+        },
+    };
+    let smoothed = smooth_path(&path, settings)?;
+    let (original_s, original_j) = machine.cost(pts[0], &pts[1..], &e[1..], &feed);
+    let no_dearer = |w: &Written| {
+        let (s, j) = machine.cost(pts[0], &w.points, &w.e, &w.feed_mm_s);
+        !(s > original_s * (1.0 + 1e-9) || j > original_j * (1.0 + 1e-9))
+    };
+    // The eq. 29 speeds as they are, then raised step by step, then no caps at all, each
+    // first as fast as the firmware will go elsewhere, then no faster than the original: the
+    // first that costs neither time nor energy.
+    let scales: &[Option<f64>] = if settings.limit_feed {
+        &CAP_SCALES
+    } else {
+        &[None]
+    };
+    let Some(((scale, _), written)) = scales
+        .iter()
+        .flat_map(|&k| [(k, false), (k, true)])
+        .map(|(k, ceiling)| ((k, ceiling), smoothed.written(k, ceiling, pts[0], settings)))
+        .find(|(_, w)| no_dearer(w))
+    else {
+        out.kept_for_time += 1;
+        return None;
+    };
+    match scale {
+        None if settings.limit_feed => out.uncapped_paths += 1,
+        Some(k) if k > 1.0 => out.raised_caps_paths += 1,
+        _ => {}
+    }
 
     // Write the block.
-    let mut text = String::with_capacity(smoothed.points.len() * 32);
+    let mut text = String::with_capacity(written.points.len() * 32);
     let mut z_now = first.from[2];
     let mut f_now = first_src.f_before;
     let mut e_written = 0.0; // relative mode: rounded running total written so far
-    let count = smoothed.points.len();
-    for (k, ((p, &ek), &v)) in smoothed
+    let count = written.points.len();
+    for (k, ((p, &ek), &v)) in written
         .points
         .iter()
-        .zip(&smoothed.e)
-        .zip(&smoothed.feed_mm_s)
+        .zip(&written.e)
+        .zip(&written.feed_mm_s)
         .enumerate()
     {
         if !text.is_empty() {
@@ -292,7 +476,7 @@ fn rewrite_path(
     out.rewritten_paths += 1;
     out.replaced_moves += run.len() as u64;
     out.written_moves += count as u64;
-    out.lowered_segments += smoothed.lowered;
+    out.lowered_segments += written.lowered;
     out.above_k_cr_segments += smoothed.above_k_cr;
     out.max_deviation_mm = out.max_deviation_mm.max(smoothed.deviation_mm);
     out.walk.steps += smoothed.stats.steps;

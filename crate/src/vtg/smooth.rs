@@ -1,29 +1,45 @@
-//! One extrusion path through the VTG pipeline: sample, fit (within tolerance), walk the curve
-//! with Algorithm 1, spread the path's filament over the new points, cap the feed where the
-//! curvature is above `K_cr`, and check the result against the original polyline.
+//! One extrusion path through the VTG pipeline: blend its corners, fit (within tolerance), walk
+//! the curve with Algorithm 1, spread the path's filament over the new points, cap the feed
+//! where the curvature is above `K_cr`, and check the result against the original polyline.
 //!
-//! The tolerance is shared: the fit may use `FIT_SHARE` of it and the chords of the walk the
-//! rest. If the measured deviation still exceeds the tolerance, the corner zones are halved and
-//! the path tried again; a path that cannot be rounded within the tolerance is kept as it was.
+//! The tolerance is shared: the corner blends ([`super::blend`]) may use `BLEND_SHARE` of it,
+//! the fit's residuals `FIT_SHARE` and the chords of the walk `CHORD_SHARE`. If the measured
+//! deviation still exceeds the tolerance, the blends are made smaller and the path tried again; a
+//! path that cannot be rounded within the tolerance is kept as it was.
 
+use super::blend;
 use super::bspline::{dot, norm, sub};
 use super::deviation::polyline_deviation;
-use super::fit::{fit, sample};
+use super::fit::fit;
 use super::kinematics::KinematicLimits;
 use super::resample::{walk, Walk, WalkStats};
+use crate::plan::Profile;
 
-/// Share of the tolerance the fit may use.
-const FIT_SHARE: f64 = 0.6;
-/// Share of the tolerance the walk's chords may use.
-const CHORD_SHARE: f64 = 0.3;
-/// Corner zone half-width per unit `1/sin(θ/2)`, in tolerances (first attempt).
-const ZONE_TOLERANCES: f64 = 2.5;
-/// Attempts, each with half the zone of the previous one.
-const ATTEMPTS: usize = 3;
-/// Shortest interpolation step, mm (see [`Walk::min_step_mm`]).
-const MIN_STEP_MM: f64 = 0.03;
+/// Share of the tolerance the corner blends may use: most of it, since the fillet's radius sets
+/// the corner speed (a firmware planner lets a curve of radius `r` be run at `√(a r)`).
+const BLEND_SHARE: f64 = 0.8;
+/// Share of the tolerance the fit may use (the blended data are smooth: a small share does).
+const FIT_SHARE: f64 = 0.1;
+/// Share of the tolerance the walk's chords may use. In a fillet the turn per step binds first
+/// (a step turning by φ on radius `r` sags `r (1 − cos(φ/2))`, 0.03 r at 27°), so little is
+/// needed.
+const CHORD_SHARE: f64 = 0.09;
+/// Attempts, each with blends `RETRY_SCALE` the size of the previous one.
+const ATTEMPTS: usize = 4;
+/// Blend size of a retry relative to the attempt before.
+const RETRY_SCALE: f64 = 0.7;
+/// Shortest interpolation step on firmware that plans every segment (Klipper), mm (see
+/// [`Walk::min_step_mm`]).
+pub const MIN_STEP_MM: f64 = 0.03;
+/// Shortest interpolation step on Marlin and Prusa firmware, mm: they drop a block of fewer than
+/// `MIN_STEPS_PER_SEGMENT` (6) steps, or of at most `DROP_SEGMENTS` (5), and fold its distance
+/// into the next, which at 80–100 steps/mm is anything under 0.05–0.075 mm. Shorter steps
+/// would be merged by the firmware into segments that turn twice as much as written.
+pub const MARLIN_MIN_STEP_MM: f64 = 0.06;
 /// Longest gap between data points on straight runs, mm.
 const STRAIGHT_SPACING_MM: f64 = 3.0;
+/// Largest turn of one interpolation step, as a share of the critical angle.
+const STEP_TURN_SHARE: f64 = 0.9;
 
 /// Settings for [`smooth_path`].
 #[derive(Debug, Clone, Copy)]
@@ -34,21 +50,32 @@ pub struct Settings {
     pub critical_rad: f64,
     /// Kinematic limits (eq. 29–30).
     pub limits: KinematicLimits,
-    /// Lower the feed where the curvature exceeds what the limits allow at the programmed feed.
+    /// Lower the feed where the curvature is above what the limits allow (eq. 29).
     pub limit_feed: bool,
+    /// The machine's X/Y acceleration limit (`M201`), mm/s²: the ceiling of `A_n`. Where the
+    /// original's planned moves are known, `A_n` of a stretch is the acceleration the firmware
+    /// used there (files change it per feature), within this.
+    pub max_normal_accel_mm_s2: f64,
+    /// `f₁` when `J_n` follows `A_n` (`J_n = A_n f₁`, the default), Hz; `None` keeps
+    /// `limits.normal_jerk_mm_s3` everywhere.
+    pub jerk_per_accel_hz: Option<f64>,
+    /// Shortest interpolation step, mm ([`MIN_STEP_MM`] or [`MARLIN_MIN_STEP_MM`]).
+    pub min_step_mm: f64,
+    /// The per-axis jerk of a classic-jerk firmware, mm/s (`None` on junction-deviation and
+    /// Klipper planners): rising feeds are then ramped, since such a planner counts a rise of
+    /// the feed from one block to the next as jerk against the new block's full speed.
+    pub classic_jerk_mm_s: Option<f64>,
 }
 
-/// A rewritten path.
+/// A rewritten path: the new geometry, and what the feed of each new segment is made of.
 #[derive(Debug, Clone, Default)]
 pub struct Smoothed {
     /// New points after the start point (the last equals the original end).
     pub points: Vec<[f64; 3]>,
     /// Filament pushed from the path start to each point, mm.
     pub e: Vec<f64>,
-    /// Feed of the segment ending at each point, mm/s.
-    pub feed_mm_s: Vec<f64>,
-    /// Segments whose feed was lowered.
-    pub lowered: u64,
+    /// The speed terms of the segment ending at each point.
+    pub steps: Vec<StepSpeed>,
     /// Segments whose curvature stays above `K_cr`.
     pub above_k_cr: u64,
     /// Measured largest distance to the original polyline, mm.
@@ -57,19 +84,141 @@ pub struct Smoothed {
     pub stats: WalkStats,
 }
 
-/// Rewrites the polyline `pts` whose cumulative filament at each vertex is `e` (from 0) and
-/// whose segment `i` (from `pts[i]` to `pts[i+1]`) runs at `feed[i]` mm/s. `None`: keep it.
+/// The speed terms of one new segment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepSpeed {
+    /// The original's programmed feed there, mm/s.
+    pub programmed: f64,
+    /// The speed eq. 29 allows for the segment's curvature, mm/s (infinite below `K_cr`).
+    pub limit: f64,
+    /// The original's planned speed over the stretch the segment replaces, mm/s: the feed is
+    /// never lowered below it.
+    pub floor: f64,
+    /// The original's highest planned speed over that stretch, mm/s (infinite when unknown).
+    pub ceiling: f64,
+    /// The acceleration the firmware used there, mm/s² (0: unknown).
+    pub accel: f64,
+}
+
+/// A rewritten path as it is written: points, filament and feed of each segment.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Written {
+    /// Points after the start point.
+    pub points: Vec<[f64; 3]>,
+    /// Filament pushed from the path start to each point, mm.
+    pub e: Vec<f64>,
+    /// Feed of the segment ending at each point, mm/s.
+    pub feed_mm_s: Vec<f64>,
+    /// Segments written with a lowered feed.
+    pub lowered: u64,
+}
+
+impl Smoothed {
+    /// The path as written with the eq. 29 speeds scaled by `scale` (`None`: no caps, the
+    /// firmware's own cornering sets the speed), from `start` on; with `ceiling`, no faster
+    /// than the original went over the same stretch either (rounded corners let the machine
+    /// carry more speed into each leg, so it peaks higher on it: faster, but dearer in motor
+    /// energy). On a classic-jerk firmware rising feeds are ramped: such a planner counts a
+    /// rise of the feed from one block to the next as jerk against the new block's full speed,
+    /// so the segment where it rises is cut into pieces that each rise by a share of the jerk.
+    pub fn written(
+        &self,
+        scale: Option<f64>,
+        ceiling: bool,
+        start: [f64; 3],
+        s: &Settings,
+    ) -> Written {
+        let mut out = Written {
+            points: self.points.clone(),
+            e: self.e.clone(),
+            feed_mm_s: Vec::with_capacity(self.steps.len()),
+            lowered: 0,
+        };
+        for st in &self.steps {
+            let mut cap = f64::INFINITY;
+            if let Some(k) = scale {
+                cap = (st.limit * k).max(st.floor);
+            }
+            if ceiling {
+                cap = cap.min(st.ceiling);
+            }
+            let v = if cap < st.programmed * 0.99 {
+                out.lowered += 1;
+                cap.max(1.0)
+            } else {
+                st.programmed
+            };
+            out.feed_mm_s.push(v);
+        }
+        if let (Some(jerk), Some(first)) = (s.classic_jerk_mm_s, self.steps.first()) {
+            let accel: Vec<f64> = self.steps.iter().map(|st| st.accel).collect();
+            ramp_up(&mut out, start, first.programmed, jerk, &accel);
+        }
+        out
+    }
+}
+
+/// A path to rewrite: its points, and what the original asks of each stretch.
+#[derive(Debug, Clone, Copy)]
+pub struct Path<'a> {
+    /// The polyline.
+    pub pts: &'a [[f64; 3]],
+    /// Filament pushed from the path start to each point, mm (from 0).
+    pub e: &'a [f64],
+    /// Feed of segment `i` (from `pts[i]` to `pts[i+1]`), mm/s.
+    pub feed: &'a [f64],
+    /// How the firmware's planner runs each original segment (empty when not known): the eq.
+    /// 29 feed cap never asks for less than the speed the machine had at the same place on the
+    /// original. At that speed the sharp corner is a step in velocity and the rounded one a
+    /// finite acceleration, so capping below it would only cost time (on a Klipper machine
+    /// with a high square-corner velocity, eq. 29's normal-jerk term would slow every corner
+    /// down, and even at a classic-jerk corner the machine is back at speed within a few
+    /// tenths of a millimetre on either side of the vertex).
+    pub planned: &'a [Profile],
+}
+
+impl<'a> Path<'a> {
+    /// Whether the arrays agree with each other.
+    fn consistent(&self) -> bool {
+        let n = self.pts.len();
+        self.e.len() == n
+            && self.feed.len() + 1 == n
+            && (self.planned.is_empty() || self.planned.len() + 1 == n)
+    }
+
+    /// The piece from point `a` to point `b` (both included).
+    fn piece(&self, a: usize, b: usize) -> Option<Path<'a>> {
+        Some(Path {
+            pts: self.pts.get(a..=b)?,
+            e: self.e.get(a..=b)?,
+            feed: self.feed.get(a..b)?,
+            planned: if self.planned.is_empty() {
+                &[]
+            } else {
+                self.planned.get(a..b)?
+            },
+        })
+    }
+}
+
+/// Rewrites `path`; `None`: keep it.
 ///
 /// Corners too sharp to be rounded within the tolerance in steps that each turn less than the
 /// critical angle are kept as they are: the path is split there and each piece is fitted on its
 /// own with its ends pinned (rounding such a corner would only trade one sharp turn for
 /// several). Pieces without a sharp corner, and pieces that cannot be fitted within the
 /// tolerance, keep their original points.
-pub fn smooth_path(pts: &[[f64; 3]], e: &[f64], feed: &[f64], s: &Settings) -> Option<Smoothed> {
-    if pts.len() < 3 || e.len() != pts.len() || feed.len() + 1 != pts.len() {
+pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
+    let pts = path.pts;
+    if pts.len() < 3 || !path.consistent() {
         return None;
     }
     let cos_critical = crate::math::cos(s.critical_rad);
+    let blends = blend::plan(
+        pts,
+        BLEND_SHARE * s.tolerance_mm,
+        s.limits.critical_curvature(),
+    );
     let mut cuts = vec![0usize];
     let mut sharp = vec![false; pts.len()];
     for i in 1..pts.len() - 1 {
@@ -85,7 +234,7 @@ pub fn smooth_path(pts: &[[f64; 3]], e: &[f64], feed: &[f64], s: &Settings) -> O
             continue;
         }
         sharp[i] = true;
-        if !roundable(cos, la.min(lb), s) {
+        if !roundable(&blends[i], s) || !pays(&blends[i], path.planned.get(i - 1), s) {
             cuts.push(i);
             sharp[i] = false;
         }
@@ -95,104 +244,109 @@ pub fn smooth_path(pts: &[[f64; 3]], e: &[f64], feed: &[f64], s: &Settings) -> O
     let mut changed = false;
     for w in cuts.windows(2) {
         let (a, b) = (w[0], w[1]);
-        let piece = smooth_piece(
-            pts.get(a..=b)?,
-            e.get(a..=b)?,
-            feed.get(a..b)?,
-            s,
-            sharp.get(a + 1..b).is_some_and(|v| v.iter().any(|&x| x)),
-        );
-        match piece {
+        let piece = path.piece(a, b)?;
+        let has_sharp = sharp.get(a + 1..b).is_some_and(|v| v.iter().any(|&x| x));
+        match smooth_piece(&piece, s, has_sharp) {
             Some(p) => {
                 changed = true;
                 out.points.extend(p.points);
                 out.e.extend(p.e);
-                out.feed_mm_s.extend(p.feed_mm_s);
-                out.lowered += p.lowered;
+                out.steps.extend(p.steps);
                 out.above_k_cr += p.above_k_cr;
                 out.deviation_mm = out.deviation_mm.max(p.deviation_mm);
                 out.stats.steps += p.stats.steps;
                 out.stats.fluctuation_sum += p.stats.fluctuation_sum;
             }
             None => {
-                out.points.extend(pts.get(a + 1..=b)?.iter().copied());
-                out.e.extend(e.get(a + 1..=b)?.iter().copied());
-                out.feed_mm_s.extend(feed.get(a..b)?.iter().copied());
+                out.points.extend(piece.pts.iter().skip(1).copied());
+                out.e.extend(piece.e.iter().skip(1).copied());
+                out.steps
+                    .extend(piece.feed.iter().enumerate().map(|(k, &f)| {
+                        let planned = piece.planned.get(k);
+                        StepSpeed {
+                            programmed: f,
+                            limit: f64::INFINITY,
+                            floor: 0.0,
+                            ceiling: planned.map_or(f64::INFINITY, |p| p.peak),
+                            accel: planned.map_or(0.0, |p| p.acceleration),
+                        }
+                    }));
             }
         }
     }
     changed.then_some(out)
 }
 
-/// Whether a corner turning by `acos(cos)` between legs at least `leg` long can be rounded
-/// within the fit's share of the tolerance by a circle whose walk needs steps of at least the
-/// minimum step, each turning less than the critical angle.
-fn roundable(cos: f64, leg: f64, s: &Settings) -> bool {
-    let half = 0.5 * crate::math::acos(cos);
-    // Circular fillet of radius r: the arc's midpoint lies r(1/cos(θ/2) − 1) inside the corner,
-    // its ends r·tan(θ/2) from it.
-    let sec = 1.0 / libm::cos(half).max(1e-9);
-    let r_max = FIT_SHARE * s.tolerance_mm / (sec - 1.0).max(1e-12);
-    let r_min = 1.2 * MIN_STEP_MM / (0.9 * s.critical_rad);
-    r_min <= r_max && r_min * libm::tan(half) <= 0.45 * leg
+/// Whether a corner's blend can be walked in steps of at least the minimum step, each turning
+/// less than the critical angle (a tighter blend would only trade one sharp turn for several).
+fn roundable(b: &blend::Blend, s: &Settings) -> bool {
+    b.extent_mm > 0.0 && b.max_curvature * s.min_step_mm <= STEP_TURN_SHARE * s.critical_rad
+}
+
+/// Whether rounding a corner leaves the machine at least as fast through it, given how the
+/// firmware ran the original move `before` that ends at the corner (unknown: assume it does).
+///
+/// A junction-deviation or Klipper planner takes a sharp corner as if it were an arc (Klipper's
+/// of radius `jd sin(θ/2) / (1 − sin(θ/2))`, `jd = scv² (√2 − 1) / a`), and holds a real curve
+/// of radius `r` to `√(a r)`. Where the square-corner velocity is high (Creality's K1 profiles
+/// set 50–100 mm/s) that virtual arc is larger than any fillet the tolerance allows, and the
+/// fillet would only slow the machine down: such a corner is kept. (A classic-jerk planner
+/// has no such rule: the feed written on the fillet is never below the original's speed.)
+fn pays(b: &blend::Blend, before: Option<&Profile>, s: &Settings) -> bool {
+    let Some(p) = before.filter(|_| s.classic_jerk_mm_s.is_none()) else {
+        return true;
+    };
+    let a = p.acceleration.min(s.max_normal_accel_mm_s2);
+    let on_fillet = (a / b.max_curvature).sqrt();
+    on_fillet >= p.exit
 }
 
 /// One piece between kept corners.
-fn smooth_piece(
-    pts: &[[f64; 3]],
-    e: &[f64],
-    feed: &[f64],
-    s: &Settings,
-    has_sharp: bool,
-) -> Option<Smoothed> {
-    if pts.len() < 3 || !has_sharp {
+fn smooth_piece(path: &Path<'_>, s: &Settings, has_sharp: bool) -> Option<Smoothed> {
+    if path.pts.len() < 3 || !has_sharp {
         return None;
     }
-    let e0 = *e.first()?;
-    let e: Vec<f64> = e.iter().map(|x| x - e0).collect();
-    let mut arc = Vec::with_capacity(pts.len());
-    let mut acc = 0.0;
-    arc.push(0.0);
-    for w in pts.windows(2) {
-        acc += norm(&sub(&w[1], &w[0]));
-        arc.push(acc);
-    }
-    let k_cr = s.limits.critical_curvature();
-    let tol = s.tolerance_mm;
-    // Room for the 3-decimal rounding of written coordinates.
-    let budget = tol - 0.001;
-    let mut zone = ZONE_TOLERANCES * tol;
+    let e0 = *path.e.first()?;
+    let e: Vec<f64> = path.e.iter().map(|x| x - e0).collect();
+    let from_zero = Path { e: &e, ..*path };
+    let mut share = BLEND_SHARE;
     for _ in 0..ATTEMPTS {
-        if let Some(mut r) = attempt(pts, &arc, &e, feed, s, zone, k_cr, budget) {
+        if let Some(mut r) = attempt(&from_zero, s, share * s.tolerance_mm) {
             for x in &mut r.e {
                 *x += e0;
             }
             return Some(r);
         }
-        zone *= 0.5;
+        share *= RETRY_SCALE;
     }
     None
 }
 
-#[allow(clippy::too_many_arguments)]
-fn attempt(
-    pts: &[[f64; 3]],
-    arc: &[f64],
-    e: &[f64],
-    feed: &[f64],
-    s: &Settings,
-    zone: f64,
-    k_cr: f64,
-    budget: f64,
-) -> Option<Smoothed> {
+/// Blend, fit, walk and check `path` (filament from 0) with blends within `blend_tol`.
+fn attempt(path: &Path<'_>, s: &Settings, blend_tol: f64) -> Option<Smoothed> {
+    let Path {
+        pts,
+        e,
+        feed,
+        planned,
+    } = *path;
     let tol = s.tolerance_mm;
-    let (data, params) = sample(pts, zone, STRAIGHT_SPACING_MM);
+    // Room for the 3-decimal rounding of written coordinates.
+    let budget = tol - 0.001;
+    let k_cr = s.limits.critical_curvature();
+    let mut arc = Vec::with_capacity(pts.len());
+    arc.push(0.0);
+    for w in pts.windows(2) {
+        arc.push(arc[arc.len() - 1] + norm(&sub(&w[1], &w[0])));
+    }
+    let blends = blend::plan(pts, blend_tol, k_cr);
+    let (data, params) = blend::samples(pts, &blends, STRAIGHT_SPACING_MM);
     let f = fit(&data, &params, FIT_SHARE * tol)?;
     let w = Walk {
         chord_tol_mm: CHORD_SHARE * tol,
-        max_turn_rad: 0.9 * s.critical_rad,
+        max_turn_rad: STEP_TURN_SHARE * s.critical_rad,
         max_step_mm: 1e4,
-        min_step_mm: MIN_STEP_MM,
+        min_step_mm: s.min_step_mm,
         phi: 1.0,
         newton_tol_mm: 1e-7,
     };
@@ -222,7 +376,36 @@ fn attempt(
         stats,
         ..Smoothed::default()
     };
+    // The original segment at arc length `u`.
+    let segment = |u: f64| arc.partition_point(|&a| a <= u).clamp(1, feed.len()) - 1;
+    // The original's planned speed at arc length `u`.
+    let original_speed = |u: f64| -> f64 {
+        let seg = segment(u);
+        planned.get(seg).map_or(0.0, |p| p.speed_at(u - arc[seg]))
+    };
+    // The original's highest planned speed between arc lengths `u0 ≤ u1`.
+    let original_top = |u0: f64, u1: f64| -> f64 {
+        (segment(u0)..=segment(u1))
+            .map(|k| {
+                planned.get(k).map_or(f64::INFINITY, |p| {
+                    p.max_speed_between(u0 - arc[k], u1 - arc[k])
+                })
+            })
+            .fold(0.0, f64::max)
+    };
+    // The limits of original segment `seg`: `A_n` the acceleration the firmware ran it with.
+    let limits_at = |seg: usize| -> KinematicLimits {
+        let mut l = s.limits;
+        if let Some(p) = planned.get(seg).filter(|p| p.acceleration > 0.0) {
+            l.normal_accel_mm_s2 = p.acceleration.min(s.max_normal_accel_mm_s2);
+            if let Some(f1) = s.jerk_per_accel_hz {
+                l.normal_jerk_mm_s3 = l.normal_accel_mm_s2 * f1;
+            }
+        }
+        l
+    };
     let mut seg = 0usize;
+    let mut u_prev = 0.0;
     for x in walked.iter().skip(1) {
         // The original segment this parameter (an arc length of the original) falls in.
         while seg + 1 < feed.len() && arc.get(seg + 1).is_some_and(|&a| a <= x.u) {
@@ -235,20 +418,24 @@ fn attempt(
             1.0
         };
         let (e0, e1) = (e.get(seg).copied()?, e.get(seg + 1).copied()?);
-        let programmed = feed.get(seg).copied()?;
-        let mut v = programmed;
+        let local = limits_at(seg);
+        let mut step = StepSpeed {
+            programmed: feed.get(seg).copied()?,
+            limit: f64::INFINITY,
+            floor: 0.0,
+            ceiling: original_top(u_prev, x.u),
+            accel: local.normal_accel_mm_s2,
+        };
         if x.mean_kappa > k_cr {
             out.above_k_cr += 1;
             if s.limit_feed {
-                let cap = s.limits.feed_limit(x.mean_kappa);
-                if cap < v * 0.99 {
-                    v = cap.max(1.0);
-                    out.lowered += 1;
-                }
+                step.limit = local.feed_limit(x.mean_kappa);
+                step.floor = original_speed(u_prev).min(original_speed(x.u));
             }
         }
+        u_prev = x.u;
         out.e.push(e0 + (e1 - e0) * t);
-        out.feed_mm_s.push(v);
+        out.steps.push(step);
     }
     points.remove(0);
     if let Some(last) = out.e.last_mut() {
@@ -256,6 +443,81 @@ fn attempt(
     }
     out.points = points;
     Some(out)
+}
+
+/// Share of the jerk limit a ramp's feed may rise by from one piece to the next (the rest is
+/// left for the change of direction at the same junction).
+const RAMP_JERK_SHARE: f64 = 0.7;
+/// Shortest ramp piece, mm.
+const MIN_RAMP_PIECE_MM: f64 = 0.02;
+
+/// Splits segments where the written feed rises by more than a classic-jerk planner takes
+/// without slowing down.
+///
+/// Such a planner (Marlin's and Prusa firmware's classic jerk, and the slicers' estimators
+/// that copy it) compares the *nominal* speeds of the two blocks at a junction: where the
+/// feed falls, the previous block's speed is scaled down to the junction speed first, but
+/// where it rises, the new block's full feed counts against the old one's, and a rise from
+/// 30 to 80 mm/s against a 7 mm/s jerk limit brings the junction down to 4 mm/s. Lowering the
+/// feed on a curve (eq. 29) would cost a near-stop wherever the feed rises again. So a segment
+/// whose feed rises by more than the limit is cut into collinear pieces whose feeds rise by
+/// `RAMP_JERK_SHARE` of it at a time, each as long as the machine needs to accelerate through
+/// it at `accel[i]` (segment `i`'s acceleration): the speed profile is the one it would have
+/// had anyway, and no junction is penalised. The pieces lie on the segment and share its
+/// filament by length.
+fn ramp_up(out: &mut Written, start: [f64; 3], start_feed: f64, jerk: f64, accel: &[f64]) {
+    let rise = RAMP_JERK_SHARE * jerk;
+    if rise <= 0.0
+        || accel.len() != out.points.len()
+        || out.feed_mm_s.windows(2).all(|w| w[1] <= w[0] + jerk)
+    {
+        return;
+    }
+    let n = out.points.len();
+    let mut points = Vec::with_capacity(n + 16);
+    let mut e = Vec::with_capacity(n + 16);
+    let mut feeds = Vec::with_capacity(n + 16);
+    let (mut from, mut e_from, mut now) = (start, 0.0, start_feed);
+    // `e` of the first point is the filament up to it from the piece's start.
+    let segments = out.points.iter().zip(&out.e).zip(&out.feed_mm_s).zip(accel);
+    for (i, (((&to, &e_to), &target), &a)) in segments.enumerate() {
+        let len = norm(&sub(&to, &from));
+        let mut done = 0.0;
+        if i > 0 && target > now + jerk && len > 0.0 && a > 0.0 {
+            loop {
+                let next = (now + rise).min(target);
+                let piece = ((next * next - now * now) / (2.0 * a)).max(MIN_RAMP_PIECE_MM);
+                if next >= target || done + piece >= len - MIN_RAMP_PIECE_MM {
+                    break;
+                }
+                done += piece;
+                let t = done / len;
+                points.push([
+                    from[0] + (to[0] - from[0]) * t,
+                    from[1] + (to[1] - from[1]) * t,
+                    from[2] + (to[2] - from[2]) * t,
+                ]);
+                e.push(e_from + (e_to - e_from) * t);
+                feeds.push(next);
+                now = next;
+            }
+        }
+        // The rest of the segment: at its own feed if the ramp got there, else still ramping.
+        let last = if target > now + jerk && i > 0 {
+            (now + rise).min(target)
+        } else {
+            target
+        };
+        points.push(to);
+        e.push(e_to);
+        feeds.push(last);
+        now = last;
+        from = to;
+        e_from = e_to;
+    }
+    out.points = points;
+    out.e = e;
+    out.feed_mm_s = feeds;
 }
 
 #[cfg(test)]
@@ -275,6 +537,10 @@ mod tests {
                 nozzle_radius_mm: 0.2,
             },
             limit_feed: true,
+            max_normal_accel_mm_s2: 1000.0,
+            jerk_per_accel_hz: None,
+            min_step_mm: MIN_STEP_MM,
+            classic_jerk_mm_s: None,
         }
     }
 
@@ -295,7 +561,13 @@ mod tests {
         }
         let feed = vec![20.0; pts.len() - 1];
         let s = settings();
-        let r = smooth_path(&pts, &e, &feed, &s).expect("smoothed");
+        let path = Path {
+            pts: &pts,
+            e: &e,
+            feed: &feed,
+            planned: &[],
+        };
+        let r = smooth_path(&path, &s).expect("smoothed");
         assert!(r.deviation_mm <= 0.1);
         // Filament is conserved and the end is the original end.
         assert!((r.e.last().unwrap() - e.last().unwrap()).abs() < 1e-12);
@@ -312,5 +584,80 @@ mod tests {
             })
             .count();
         assert!(sharp < 4, "{sharp}");
+    }
+
+    #[test]
+    fn ramp_rises_within_the_jerk_and_keeps_geometry_and_filament() {
+        // A slow 1 mm stretch, then 20 mm at 60 mm/s: the rise from 10 to 60 mm/s is split
+        // into pieces rising by 0.7 · 8 mm/s, each as long as 1000 mm/s² needs.
+        let mut out = Written {
+            points: vec![[1.0, 0.0, 0.2], [21.0, 0.0, 0.2]],
+            e: vec![0.05, 1.05],
+            feed_mm_s: vec![10.0, 60.0],
+            lowered: 0,
+        };
+        ramp_up(&mut out, [0.0, 0.0, 0.2], 10.0, 8.0, &[1000.0; 2]);
+        let n = out.points.len();
+        assert!(n > 8, "{n}");
+        assert_eq!(out.e.len(), n);
+        assert_eq!(out.feed_mm_s.len(), n);
+        // The original points stay, with their filament; the new ones lie on the segment.
+        assert_eq!(out.points[0], [1.0, 0.0, 0.2]);
+        assert_eq!(out.points[n - 1], [21.0, 0.0, 0.2]);
+        assert_eq!((out.e[0], out.e[n - 1]), (0.05, 1.05));
+        let mut prev = 10.0;
+        for (i, (p, e)) in out.points.iter().zip(&out.e).enumerate() {
+            assert!(p[1] == 0.0 && p[2] == 0.2 && p[0] >= 1.0 && p[0] <= 21.0);
+            // Filament in proportion to the distance along the segment.
+            assert!((e - (0.05 + (p[0] - 1.0) * 0.05)).abs() < 1e-12, "{i}: {e}");
+            let f = out.feed_mm_s[i];
+            assert!(f <= prev + 0.7 * 8.0 + 1e-9, "{i}: {prev} -> {f}");
+            prev = f;
+        }
+        assert_eq!(out.feed_mm_s[n - 1], 60.0);
+        // Each piece is as long as accelerating from its predecessor's feed to its own takes.
+        let piece = |i: usize| out.points[i][0] - out.points[i - 1][0];
+        let (f0, f1) = (out.feed_mm_s[1], out.feed_mm_s[2]);
+        assert!((piece(2) - (f1 * f1 - f0 * f0) / 2000.0).abs() < 1e-9);
+        // Falling feeds need nothing.
+        let mut down = Written {
+            points: vec![[1.0, 0.0, 0.2], [2.0, 0.0, 0.2]],
+            e: vec![0.05, 0.1],
+            feed_mm_s: vec![60.0, 10.0],
+            lowered: 0,
+        };
+        ramp_up(&mut down, [0.0, 0.0, 0.2], 60.0, 8.0, &[1000.0; 2]);
+        assert_eq!(down.points.len(), 2);
+    }
+
+    /// On a classic-jerk machine the rewritten corners are no slower than the sharp ones and
+    /// the ramps leave no junction stalled, with the real planner.
+    #[test]
+    fn classic_jerk_rectangle_is_not_slower_through_the_planner() {
+        let mut src = String::from("M83\nM201 X1000 Y1000\nM204 P1250\nM205 X8 Y8\n");
+        src.push_str("G1 X100 Y100 F6000\nG1 Z0.2\n");
+        for _ in 0..10 {
+            for (x, y) in [
+                (120.0, 100.0),
+                (120.0, 110.0),
+                (100.0, 110.0),
+                (100.0, 100.0),
+            ] {
+                src.push_str(&format!("G1 X{x} Y{y} E0.5 F3600\n"));
+            }
+        }
+        let options = crate::vtg::VtgOptions {
+            dynamics: false,
+            ..Default::default()
+        };
+        let r = crate::vtg::vtg(src.as_bytes(), &options).expect("vtg");
+        assert!(r.paths.rewritten > 0);
+        assert!(
+            r.table1.n_turning.change_pct <= -40.0,
+            "{:?}",
+            r.table1.n_turning
+        );
+        let t = &r.table2.time_s;
+        assert!(t.after <= t.before * 1.01, "{t:?}");
     }
 }

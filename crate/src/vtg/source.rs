@@ -9,6 +9,7 @@ use crate::analyze::{prepare, AnalyzeOptions};
 use crate::error::Error;
 use crate::gcode::{self, Line};
 use crate::machine::{axis, Event, ExtrusionMode};
+use crate::plan::Limits;
 
 /// A move's source line as the rewriter sees it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -30,14 +31,33 @@ pub struct MoveSource {
     pub f_after: Option<f64>,
 }
 
-/// One entry per move, in the order `path::extract` lists them.
-pub fn move_sources(input: &[u8], options: &AnalyzeOptions) -> Result<Vec<MoveSource>, Error> {
+/// The source of every move, and the machine limits along the file.
+#[derive(Debug, Clone, Default)]
+pub struct Sources {
+    /// One entry per move, in the order `path::extract` lists them.
+    pub moves: Vec<MoveSource>,
+    /// `(k, limits)`: the limits in force from move `k` on (the first at 0), as the file's
+    /// own commands (`M201`–`M205`, `SET_VELOCITY_LIMIT`) change them.
+    pub limits: Vec<(usize, Limits)>,
+}
+
+impl Sources {
+    /// The limits in force at move `k`.
+    pub fn limits_at(&self, k: usize) -> Option<&Limits> {
+        let i = self.limits.partition_point(|(from, _)| *from <= k);
+        self.limits.get(i.checked_sub(1)?).map(|(_, l)| l)
+    }
+}
+
+/// Reads the source of every move and the limits along the file.
+pub fn move_sources(input: &[u8], options: &AnalyzeOptions) -> Result<Sources, Error> {
     let setup = prepare(input, options)?;
     let mut machine = setup.machine();
     let mut warnings = setup.warnings;
     let mut limits = setup.limits;
     let mut f_modal: Option<f64> = None;
     let mut out = Vec::new();
+    let mut changes = vec![(0usize, limits.clone())];
     gcode::for_each_line(
         input,
         setup.strictness,
@@ -45,6 +65,11 @@ pub fn move_sources(input: &[u8], options: &AnalyzeOptions) -> Result<Vec<MoveSo
         |raw, line, warnings| {
             let Some(line) = line else { return Ok(()) };
             if limits.apply_command(line, setup.units) {
+                // Several commands in a row before the next move: keep the last.
+                if changes.last().is_some_and(|(k, _)| *k == out.len()) {
+                    changes.pop();
+                }
+                changes.push((out.len(), limits.clone()));
                 return Ok(());
             }
             let mode = machine.extrusion_mode();
@@ -73,7 +98,10 @@ pub fn move_sources(input: &[u8], options: &AnalyzeOptions) -> Result<Vec<MoveSo
             Ok(())
         },
     )?;
-    Ok(out)
+    Ok(Sources {
+        moves: out,
+        limits: changes,
+    })
 }
 
 fn is_plain(line: &Line<'_>, to: &crate::machine::Pos) -> bool {

@@ -389,7 +389,8 @@ export interface VtgOptions {
   /** Critical angle δθ, degrees (default 30). */
   critical_angle_deg?: number;
   interpolation_period_s?: number;
-  normal_jerk_mm_s3?: number;
+  /** Normal jerk limit J_n, mm/s³ (default: A_n × the machine's first natural frequency). */
+  normal_jerk_mm_s3?: number | null;
   nozzle_diameter_mm?: number;
   /** Lower the feed where the curvature exceeds K_cr (eq. 29–30; default true). */
   limit_feed?: boolean;
@@ -418,6 +419,12 @@ export interface VtgReport {
     written_moves: number;
     above_k_cr_segments: number;
     lowered_feed_segments: number;
+    /** Paths whose eq. 29 speeds were raised (up to 3×) so they cost no time. */
+    raised_caps: number;
+    /** Paths written without eq. 29 feed caps (even raised, they would have made them slower). */
+    uncapped: number;
+    /** Paths kept as they were: slower when rounded, even without caps. */
+    kept_for_time: number;
     mean_speed_fluctuation_pct: number;
   };
   /** The VTG paper's Table 1. */

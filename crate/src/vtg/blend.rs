@@ -1,0 +1,335 @@
+//! Corner blends: the shape a sharp corner is rounded to before the path is fitted.
+//!
+//! Fitting a B-spline by least squares straight to a polyline's corners lets the fit bend as
+//! tightly as its tolerance allows, wherever the residuals put the knots: the curvature peaks
+//! high, varies from step to step (and with it the eq. 29 feed caps), and the curve rings along
+//! the legs. So each corner is first replaced by a transition of known shape and size, and the
+//! fit is given points of the blended path: its curvature is then what the tolerance permits
+//! at best, and smooth.
+//!
+//! The transition is a circular fillet tangent to both legs. Of all curves that turn by `θ`
+//! and pass within `ε` of the vertex, the circle has the lowest peak curvature, and the peak
+//! curvature is what sets the corner speed (`v = √(A_n/κ)`, eq. 29): a curvature-continuous
+//! (G2) transition of the same deviation peaks higher (the symmetric five-point cubic B-spline
+//! corner of CNC smoothing by 1.7× at 90°), so the machine would have to slow down more. G2
+//! continuity buys little on G-code anyway: the firmware executes the written polyline, whose
+//! acceleration arrives as velocity steps at the junctions whatever the curve's continuity; the
+//! walk of a circle spreads the turn in equal steps, and the cubic fit (C²) smooths the
+//! curvature where the fillet meets the legs.
+//!
+//! With extent `L` (the distance from the vertex to where the fillet meets each leg) the radius
+//! is `r = L / tan(θ/2)`, the distance from the vertex to the fillet `ε = r (sec(θ/2) − 1)` and
+//! the curvature `1/r`.
+//!
+//! Each leg is shared by the corners at its two ends: each corner asks for the `L` its share of
+//! the tolerance allows, and a leg too short for both requests is split between them so the
+//! larger of their curvatures is least (a gentle corner beside a sharp one leaves the sharp
+//! one the room it needs).
+
+use super::bspline::{dot, norm, sub};
+
+/// Samples per blend given to the fit (its ends included).
+pub const SAMPLES: usize = 9;
+/// Turns at or below this are treated as straight, rad (0.5°: nothing to round).
+const STRAIGHT_RAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
+/// Turns above this are not blended, rad (160°: the fillet's radius falls towards nothing and
+/// such reversals cannot be rounded within any useful tolerance anyway).
+pub const MAX_TURN_RAD: f64 = 160.0 * std::f64::consts::PI / 180.0;
+/// Share of a leg the blends at its two ends may use together (the rest stays straight, so the
+/// fit sees where one blend ends and the next begins).
+const LEG_SHARE: f64 = 0.9;
+
+/// A corner transition at one vertex.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Blend {
+    /// Extent along each leg from the vertex, mm (0: the vertex is kept as it is).
+    pub extent_mm: f64,
+    /// Turn of the path at the vertex, rad.
+    pub turn_rad: f64,
+    /// Largest distance of the transition from the vertex, mm.
+    pub deviation_mm: f64,
+    /// Largest curvature of the transition, 1/mm.
+    pub max_curvature: f64,
+}
+
+impl Blend {
+    const NONE: Blend = Blend {
+        extent_mm: 0.0,
+        turn_rad: 0.0,
+        deviation_mm: 0.0,
+        max_curvature: 0.0,
+    };
+}
+
+/// The shape constants of a fillet turning by `turn` (rad) for `L = 1`: the distance from the
+/// vertex to the fillet, and the curvature.
+pub fn shape(turn: f64) -> (f64, f64) {
+    let half = 0.5 * turn;
+    let tan = libm::tan(half);
+    let radius = 1.0 / tan;
+    (radius * (1.0 / crate::math::cos(half) - 1.0), tan)
+}
+
+/// The fillet at vertex `v` between unit directions `a` (in) and `b` (out) turning by `turn`,
+/// extent `l`: its point at fraction `t` of the turn.
+fn fillet_point(v: &[f64; 3], a: &[f64; 3], b: &[f64; 3], turn: f64, l: f64, t: f64) -> [f64; 3] {
+    let half = 0.5 * turn;
+    let r = l / libm::tan(half);
+    // The centre lies on the inner bisector, r / cos(θ/2) from the vertex.
+    let m = sub(b, a);
+    let lm = norm(&m);
+    let reach = r / crate::math::cos(half) / lm;
+    let c = [
+        v[0] + m[0] * reach,
+        v[1] + m[1] * reach,
+        v[2] + m[2] * reach,
+    ];
+    // Unit vectors from the centre to the two tangent points, and the slerp between them.
+    let t1 = [v[0] - a[0] * l, v[1] - a[1] * l, v[2] - a[2] * l];
+    let t2 = [v[0] + b[0] * l, v[1] + b[1] * l, v[2] + b[2] * l];
+    let (u1, u2) = (sub(&t1, &c), sub(&t2, &c));
+    let s = libm::sin(turn);
+    let (w1, w2) = (libm::sin((1.0 - t) * turn) / s, libm::sin(t * turn) / s);
+    [
+        c[0] + u1[0] * w1 + u2[0] * w2,
+        c[1] + u1[1] * w1 + u2[1] * w2,
+        c[2] + u1[2] * w1 + u2[2] * w2,
+    ]
+}
+
+/// The blend at every vertex of `pts` (none at the two ends) for a deviation of at most
+/// `tolerance_mm` from each vertex. No blend asks for more than it needs to bring its peak
+/// curvature down to `enough_curvature` (1/mm; the curvature at which the machine's limits no
+/// longer slow it, `K_cr`): a gentle turn could be spread over metres within the tolerance, and
+/// would take the leg a sharp neighbour needs.
+pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64) -> Vec<Blend> {
+    let n = pts.len();
+    let mut out = vec![Blend::NONE; n];
+    if n < 3 {
+        return out;
+    }
+    let lens: Vec<f64> = pts.windows(2).map(|w| norm(&sub(&w[1], &w[0]))).collect();
+    // What each corner asks for.
+    let mut want = vec![0.0f64; n];
+    let mut shapes = vec![(0.0, 0.0); n];
+    for i in 1..n - 1 {
+        let (la, lb) = (lens[i - 1], lens[i]);
+        if la <= 0.0 || lb <= 0.0 {
+            continue;
+        }
+        let a = sub(&pts[i], &pts[i - 1]);
+        let b = sub(&pts[i + 1], &pts[i]);
+        let turn = crate::math::acos((dot(&a, &b) / (la * lb)).clamp(-1.0, 1.0));
+        if turn <= STRAIGHT_RAD || turn > MAX_TURN_RAD {
+            continue;
+        }
+        let (c, k) = shape(turn);
+        if c <= 0.0 {
+            continue;
+        }
+        out[i].turn_rad = turn;
+        shapes[i] = (c, k);
+        want[i] = tolerance_mm / c;
+        if enough_curvature > 0.0 {
+            want[i] = want[i].min(k / enough_curvature);
+        }
+    }
+    // Each leg shared between the corners at its ends so that the larger of their two
+    // curvatures is as small as it can be: a blend's curvature is k(θ)/L, so in proportion to
+    // k(θ), each at most what it asked for, and what one does not need goes to the other.
+    let share = |leg: usize, me: usize, other: Option<usize>| -> f64 {
+        let room = LEG_SHARE * lens[leg];
+        let Some(j) = other.filter(|&j| want[j] > 0.0) else {
+            return room;
+        };
+        let (ki, kj) = (shapes[me].1, shapes[j].1);
+        let fair = room * ki / (ki + kj);
+        if want[j] < room - fair {
+            room - want[j]
+        } else {
+            fair
+        }
+    };
+    for i in 1..n - 1 {
+        if want[i] <= 0.0 {
+            continue;
+        }
+        // The path's own ends take no room.
+        let before = share(i - 1, i, (i >= 2).then(|| i - 1));
+        let after = share(i, i, (i + 2 < n).then_some(i + 1));
+        let l = want[i].min(before).min(after);
+        let (c, k) = shapes[i];
+        out[i].extent_mm = l;
+        out[i].deviation_mm = c * l;
+        out[i].max_curvature = k / l;
+    }
+    out
+}
+
+/// Points of the blended path for the fit, with parameters: the arc length of the original
+/// polyline at the point each one stands for (a blend point at fraction `u` of the transition
+/// stands for the original point at the same fraction of the stretch it replaces), so the
+/// filament pushed up to a point is read off the original. Straight stretches get points at
+/// most `spacing_mm` apart, denser near the blends so the knot spans grow gradually.
+pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64; 3]>, Vec<f64>) {
+    let n = pts.len();
+    let mut data = Vec::with_capacity(n * (SAMPLES + 4));
+    let mut par = Vec::with_capacity(n * (SAMPLES + 4));
+    if n == 0 || blends.len() != n {
+        return (data, par);
+    }
+    let mut s = 0.0; // arc length of the original at pts[i]
+    let push = |p: [f64; 3], u: f64, data: &mut Vec<[f64; 3]>, par: &mut Vec<f64>| {
+        if par.last().is_none_or(|&last| u > last + 1e-9) {
+            data.push(p);
+            par.push(u);
+        }
+    };
+    push(pts[0], 0.0, &mut data, &mut par);
+    for i in 0..n - 1 {
+        let (a, b) = (pts[i], pts[i + 1]);
+        let len = norm(&sub(&b, &a));
+        let dir = if len > 0.0 {
+            [
+                (b[0] - a[0]) / len,
+                (b[1] - a[1]) / len,
+                (b[2] - a[2]) / len,
+            ]
+        } else {
+            [0.0; 3]
+        };
+        let at = |t: f64| [a[0] + dir[0] * t, a[1] + dir[1] * t, a[2] + dir[2] * t];
+        // The straight stretch of this leg, between the blends at its ends.
+        let (t0, t1) = (blends[i].extent_mm, len - blends[i + 1].extent_mm);
+        if t1 > t0 {
+            straight(t0, t1, spacing_mm, |t| {
+                push(at(t), s + t, &mut data, &mut par)
+            });
+        }
+        // The blend at the far end of the leg.
+        let bl = &blends[i + 1];
+        if i + 2 < n && bl.extent_mm > 0.0 {
+            let c = pts[i + 2];
+            let lc = norm(&sub(&c, &b));
+            let out_dir = [(c[0] - b[0]) / lc, (c[1] - b[1]) / lc, (c[2] - b[2]) / lc];
+            let l = bl.extent_mm;
+            for k in 0..SAMPLES {
+                let u = k as f64 / (SAMPLES - 1) as f64;
+                push(
+                    fillet_point(&b, &dir, &out_dir, bl.turn_rad, l, u),
+                    s + len - l + 2.0 * l * u,
+                    &mut data,
+                    &mut par,
+                );
+            }
+        } else {
+            push(b, s + len, &mut data, &mut par);
+        }
+        s += len;
+    }
+    (data, par)
+}
+
+/// Points of a straight stretch `t0..t1` (both ends included): dense at the ends, gaps growing
+/// geometrically towards the middle, at most `spacing` apart.
+fn straight(t0: f64, t1: f64, spacing: f64, mut each: impl FnMut(f64)) {
+    let len = t1 - t0;
+    let half = 0.5 * len;
+    let first = (spacing.min(half) / 8.0).max(1e-3);
+    let mut offsets = vec![0.0];
+    let (mut t, mut gap) = (first, first);
+    while t < half && offsets.len() < 64 {
+        offsets.push(t);
+        gap = (2.0 * gap).min(spacing);
+        t += gap;
+    }
+    for &o in &offsets {
+        each(t0 + o);
+    }
+    if half > 0.0 {
+        each(t0 + half);
+    }
+    for &o in offsets.iter().rev() {
+        each(t1 - o);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn right_angle_fillet_matches_its_closed_form() {
+        // L = 1 at 90°: radius 1, the fillet passes √2 − 1 from the vertex.
+        let (c, k) = shape(std::f64::consts::FRAC_PI_2);
+        assert!((c - (std::f64::consts::SQRT_2 - 1.0)).abs() < 1e-12, "{c}");
+        assert!((k - 1.0).abs() < 1e-12, "{k}");
+        // The fillet runs from tangent point to tangent point at constant radius.
+        let (a, b) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        let p0 = fillet_point(&[0.0; 3], &a, &b, half_pi, 2.0, 0.0);
+        let p1 = fillet_point(&[0.0; 3], &a, &b, half_pi, 2.0, 1.0);
+        assert!(norm(&sub(&p0, &[-2.0, 0.0, 0.0])) < 1e-12, "{p0:?}");
+        assert!(norm(&sub(&p1, &[0.0, 2.0, 0.0])) < 1e-12, "{p1:?}");
+        for i in 0..=8 {
+            let p = fillet_point(&[0.0; 3], &a, &b, half_pi, 2.0, i as f64 / 8.0);
+            assert!((norm(&sub(&p, &[-2.0, 2.0, 0.0])) - 2.0).abs() < 1e-12);
+        }
+        let mid = fillet_point(&[0.0; 3], &a, &b, half_pi, 2.0, 0.5);
+        assert!((norm(&mid) - 2.0 * c).abs() < 1e-12);
+    }
+
+    #[test]
+    fn size_follows_the_tolerance_and_shares_short_legs() {
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [10.0, 0.0, 0.0],
+            [10.0, 0.4, 0.0],
+            [0.0, 0.4, 0.0],
+        ];
+        // Within 0.1 mm a right angle asks for 0.1 / (√2 − 1) = 0.241 mm of each leg; two of
+        // them share the 0.4 mm leg: 0.9 · 0.2 each.
+        let b = plan(&pts, 0.1, 0.0);
+        assert_eq!(b[0].extent_mm, 0.0);
+        for bl in &b[1..3] {
+            assert!((bl.extent_mm - 0.18).abs() < 1e-12, "{}", bl.extent_mm);
+            assert!(bl.deviation_mm < 0.1);
+        }
+        // With room, the blend uses the whole tolerance.
+        let wide = [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0]];
+        let b = plan(&wide, 0.05, 0.0);
+        assert!((b[1].deviation_mm - 0.05).abs() < 1e-12);
+        // The samples stay within the tolerance of the polyline and run forward.
+        let (data, par) = samples(&wide, &b, 2.0);
+        assert!(par.windows(2).all(|w| w[1] > w[0]));
+        for p in &data {
+            let d = super::super::deviation::point_polyline(p, &wide);
+            assert!(d <= 0.05 + 1e-12, "{d}");
+        }
+        assert_eq!(data.first(), wide.first());
+        assert_eq!(data.last(), wide.last());
+    }
+
+    #[test]
+    fn a_sharp_corner_beside_a_gentle_one_gets_the_room_it_needs() {
+        // A 4° turn and a 113° turn 0.514 mm apart (an infill line's end on an oval): sharing
+        // the leg in proportion to what each asks for would give the sharp one a fifth of its
+        // fillet; shared by curvature, it gets all it asks for and the gentle one the rest.
+        let pts = [
+            [100.926, 103.954, 0.0],
+            [101.13, 102.87, 0.0],
+            [101.348, 102.165, 0.0],
+            [101.539, 101.688, 0.0],
+            [116.313, 116.462, 0.0],
+        ];
+        let tol = 0.072;
+        let b = plan(&pts, tol, 0.05);
+        let sharp = &b[3];
+        assert!(sharp.turn_rad.to_degrees() > 110.0);
+        let (c, _) = shape(sharp.turn_rad);
+        assert!((sharp.extent_mm - tol / c).abs() < 1e-12, "{sharp:?}");
+        let leg = super::norm(&super::sub(&pts[3], &pts[2]));
+        assert!(b[2].extent_mm + sharp.extent_mm <= LEG_SHARE * leg + 1e-12);
+        assert!(b[2].extent_mm > 0.0);
+    }
+}
