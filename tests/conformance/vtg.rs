@@ -1,16 +1,25 @@
-//! Conformance of `vtg` on real slicer output: our PrusaSlicer slices and two corpus files.
+//! Conformance of `vtg` on real slicer output: every PrusaSlicer slice of ours and every corpus
+//! file but the 34 MB one (its speed test is in the README) and the 5-axis toolpath (whose
+//! lines carry rotary axes and are left alone).
 //!
 //! Each rewrite is checked independently of the optimiser: both files are read back as moves
 //! ([`quietpath::path::extract`]) and every printing move of the output, sampled finely, must
 //! lie within the tolerance of the original's printing moves of the same layer. Filament is
-//! conserved, every line that is not a replaced move is kept, and sharp corners fall.
+//! conserved to 0.5 %, every line that is not a replaced move is kept, and, as the issue asks:
+//! sharp corners (turns over 30°) fall by at least 40 %, the modelled energy falls, the print
+//! time rises by at most 1 % and the simulated mean deviation falls. Where a file cannot meet
+//! one of these, it is named below with the reason, and what does hold for it is asserted.
+//!
+//! `cargo test -p quietpath-conformance --test vtg -- --nocapture` prints the table.
 #![allow(clippy::unwrap_used)]
 
 use quietpath::gcode::{parse_line, Lines};
 use quietpath::path::extract;
 use quietpath::vtg::deviation::file_deviation;
 use quietpath::vtg::{vtg, VtgOptions};
-use quietpath_conformance::{corpus_dir, fixtures_dir};
+use std::path::PathBuf;
+
+use quietpath_conformance::{corpus, corpus_dir, fixtures_dir};
 
 /// Lines that are not `G0`/`G1` moves, in order.
 fn non_motion_lines(bytes: &[u8]) -> Vec<Vec<u8>> {
@@ -25,9 +34,17 @@ fn non_motion_lines(bytes: &[u8]) -> Vec<Vec<u8>> {
         .collect()
 }
 
+/// What one rewrite did, in percent of the original.
+#[derive(Debug)]
 struct Outcome {
-    turning_change_pct: f64,
-    time_change_pct: f64,
+    name: String,
+    max_deviation_mm: f64,
+    turning_pct: f64,
+    energy_pct: f64,
+    time_pct: f64,
+    mean_deviation_pct: f64,
+    filament_pct: f64,
+    kept_for_time: u64,
 }
 
 fn check(bytes: &[u8], name: &str, options: &VtgOptions) -> Outcome {
@@ -67,8 +84,18 @@ fn check(bytes: &[u8], name: &str, options: &VtgOptions) -> Outcome {
     );
     assert_eq!(r.before.layers, r.after.layers, "{name}: layers");
     Outcome {
-        turning_change_pct: r.table1.n_turning.change_pct,
-        time_change_pct: r.table2.time_s.change_pct,
+        name: name.to_string(),
+        max_deviation_mm: measured,
+        turning_pct: r.table1.n_turning.change_pct,
+        energy_pct: r.table2.energy_j.change_pct,
+        time_pct: r.table2.time_s.change_pct,
+        mean_deviation_pct: r
+            .table2
+            .deviation
+            .as_ref()
+            .map_or(f64::NAN, |d| d.mean_mm.change_pct),
+        filament_pct: (fa - fb) / fb * 100.0,
+        kept_for_time: r.paths.kept_for_time,
     }
 }
 
@@ -80,49 +107,161 @@ fn options(tolerance_mm: f64, limit_feed: bool) -> VtgOptions {
     }
 }
 
-#[test]
-fn prusaslicer_cube_within_tolerance_with_fewer_sharp_corners() {
-    let bytes =
-        std::fs::read(fixtures_dir().join("gcode/prusaslicer-2.5.0_cube_marlin2_defaults.gcode"))
-            .unwrap();
-    let o = check(&bytes, "cube", &options(0.1, true));
-    assert!(o.turning_change_pct <= -40.0, "{}", o.turning_change_pct);
-    assert!(o.time_change_pct <= 1.0, "{}", o.time_change_pct);
+/// Files whose sharp corners cannot fall by 40 %, and why. For them the corners must still
+/// fall, and where the reason is the firmware's cornering, paths must have been kept for it.
+const TURNING_EXCEPTIONS: [(&str, &str); 5] = [
+    (
+        "prusaslicer-2.5.0_vase_marlin-legacy_absE.gcode",
+        "most sharp turns are infill hairpins of 135° and more: no fillet within 0.1 mm rounds \
+         them in steps of at least Marlin's 0.06 mm minimum segment",
+    ),
+    (
+        "prusaslicer-2.7.4_screw_arcfit.gcode",
+        "arc-fitted: corners between a line and a G2/G3 arc are not rewritten, and the \
+         remaining ones are mostly hairpins",
+    ),
+    (
+        "crealityprint-4.3.4_k1_benchy_m83_arcs.gcode",
+        "Klipper at a square-corner velocity of 50-100 mm/s takes sharp corners faster than \
+         any fillet within 0.1 mm allows: rounded, most paths would cost time, so they are kept",
+    ),
+    (
+        "crealityprint-4.3.8_k1se_accessory_m82_arcs_exclude-object.gcode",
+        "arc-fitted, and on Klipper: corners next to arcs are not rewritten, and some paths are \
+         kept because rounded they would cost time",
+    ),
+    (
+        "crealityprint-5_k1c_benchy_klipper_exclude-object.gcode",
+        "Klipper at a square-corner velocity of 50-100 mm/s (see the K1 above): nearly every \
+         rounded path would cost time, so they are kept",
+    ),
+];
+
+/// Files whose simulated mean deviation does not fall, and why (bounded here).
+const DEVIATION_EXCEPTIONS: [(&str, &str, f64); 1] = [(
+    "prusaslicer-2.5.0_thesis_triangle.gcode",
+    "its 60° perimeter corners, rounded, are run by eq. 29 at about twice the speed the \
+     firmware took the sharp ones; the mean rises by about 1 %",
+    2.0,
+)];
+
+/// Runs `vtg` with the defaults on each file and checks every criterion; returns the table rows.
+fn check_all(files: &[(String, PathBuf)]) {
+    let mut failures = Vec::new();
+    eprintln!(
+        "{:<62} {:>7} {:>8} {:>8} {:>7} {:>9} {:>9}",
+        "file", "dev mm", "turns %", "energy %", "time %", "mean dev %", "filament %"
+    );
+    for (name, path) in files {
+        let bytes = std::fs::read(path).unwrap();
+        let o = check(&bytes, name, &VtgOptions::default());
+        eprintln!(
+            "{:<62} {:>7.3} {:>8.1} {:>8.2} {:>7.2} {:>9.1} {:>9.4}",
+            o.name,
+            o.max_deviation_mm,
+            o.turning_pct,
+            o.energy_pct,
+            o.time_pct,
+            o.mean_deviation_pct,
+            o.filament_pct
+        );
+        let mut fail = |what: String| failures.push(format!("{name}: {what}"));
+        match TURNING_EXCEPTIONS.iter().find(|(n, _)| n == name) {
+            None if o.turning_pct > -40.0 => {
+                fail(format!(
+                    "sharp corners {:+.1} % (at least -40 %)",
+                    o.turning_pct
+                ));
+            }
+            Some((_, why)) if o.turning_pct >= 0.0 => {
+                fail(format!("sharp corners {:+.1} % ({why})", o.turning_pct));
+            }
+            Some((_, why)) if why.contains("kept") && o.kept_for_time == 0 => {
+                fail(format!("no path kept for time ({why})"));
+            }
+            _ => {}
+        }
+        if !(o.energy_pct < 0.0) {
+            fail(format!("energy {:+.2} %", o.energy_pct));
+        }
+        if !(o.time_pct <= 1.0) {
+            fail(format!("time {:+.2} %", o.time_pct));
+        }
+        let bound = DEVIATION_EXCEPTIONS
+            .iter()
+            .find(|(n, _, _)| n == name)
+            .map_or(0.0, |(_, _, b)| *b);
+        if !(o.mean_deviation_pct < bound) {
+            fail(format!(
+                "simulated mean deviation {:+.1} %",
+                o.mean_deviation_pct
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Our PrusaSlicer slices (tests/fixtures/gcode).
+fn fixture_files() -> Vec<(String, PathBuf)> {
+    let mut v: Vec<(String, PathBuf)> = std::fs::read_dir(fixtures_dir().join("gcode"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "gcode"))
+        .map(|p| (p.file_name().unwrap().to_string_lossy().into_owned(), p))
+        .collect();
+    v.sort();
+    assert!(v.len() >= 14, "{} fixtures", v.len());
+    v
+}
+
+/// The corpus, but for the 34 MB file and the 5-axis toolpath; `part` of two halves.
+fn corpus_files(part: usize) -> Vec<(String, PathBuf)> {
+    let all: Vec<_> = corpus()
+        .into_iter()
+        .filter(|f| !f.name.contains("_large") && !f.name.starts_with("multiaxis"))
+        .map(|f| (f.name.clone(), f.path()))
+        .collect();
+    assert_eq!(all.len(), 17);
+    all.into_iter()
+        .enumerate()
+        .filter(|(i, _)| i % 2 == part)
+        .map(|(_, f)| f)
+        .collect()
 }
 
 #[test]
-fn prusaslicer_absolute_e_tower_keeps_later_lines_valid() {
-    let bytes =
-        std::fs::read(fixtures_dir().join("gcode/prusaslicer-2.5.0_tower_slowdown_minfeed.gcode"))
-            .unwrap();
-    let o = check(&bytes, "tower", &options(0.1, true));
-    assert!(o.turning_change_pct <= -40.0, "{}", o.turning_change_pct);
-    assert!(o.time_change_pct <= 1.0, "{}", o.time_change_pct);
+fn every_fixture_meets_the_criteria() {
+    check_all(&fixture_files());
 }
 
 #[test]
-fn prusaslicer_vase_absolute_e() {
+fn corpus_first_half_meets_the_criteria() {
+    check_all(&corpus_files(0));
+}
+
+#[test]
+fn corpus_second_half_meets_the_criteria() {
+    check_all(&corpus_files(1));
+}
+
+#[test]
+fn a_tighter_tolerance_is_kept() {
     let bytes =
         std::fs::read(fixtures_dir().join("gcode/prusaslicer-2.5.0_vase_marlin-legacy_absE.gcode"))
             .unwrap();
     let o = check(&bytes, "vase", &options(0.05, true));
-    assert!(o.turning_change_pct < 0.0, "{}", o.turning_change_pct);
+    assert!(o.turning_pct < 0.0, "{}", o.turning_pct);
 }
 
 #[test]
-fn corpus_slic3r_and_cura() {
+fn keeping_the_feed_rounds_corners_without_costing_time() {
     for name in [
         "slic3r-1.3.1-dev_multi-object.gcode",
         "cura-4.10.0_multi-object.gcode",
     ] {
         let bytes = std::fs::read(corpus_dir().join(name)).unwrap();
         let o = check(&bytes, name, &options(0.1, false));
-        assert!(
-            o.turning_change_pct < 0.0,
-            "{name}: {}",
-            o.turning_change_pct
-        );
-        // Without feed lowering the rounded corners only speed the machine up.
-        assert!(o.time_change_pct <= 1.0, "{name}: {}", o.time_change_pct);
+        assert!(o.turning_pct <= -40.0, "{name}: {}", o.turning_pct);
+        assert!(o.time_pct <= 1.0, "{name}: {}", o.time_pct);
     }
 }

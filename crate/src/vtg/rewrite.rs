@@ -421,6 +421,14 @@ fn rewrite_path(
     // Write the block.
     let mut text = String::with_capacity(written.points.len() * 32);
     let mut z_now = first.from[2];
+    // A path whose Z changes along it (spiral vase, FullControl designs) keeps a Z on every
+    // point, finely enough that each step still climbs: written to 3 decimals, a slow spiral's
+    // short steps would come out flat, and the file would read as a stack of flat layers.
+    let (z_step, z_decimals) = if run.iter().any(|m| (m.to[2] - m.from[2]).abs() > 1e-9) {
+        (5e-6, 5)
+    } else {
+        (5e-4, 3)
+    };
     let mut f_now = first_src.f_before;
     let mut e_written = 0.0; // relative mode: rounded running total written so far
     let count = written.points.len();
@@ -438,9 +446,9 @@ fn rewrite_path(
         push_trimmed(&mut text, p[0], 3);
         text.push_str(" Y");
         push_trimmed(&mut text, p[1], 3);
-        if (p[2] - z_now).abs() > 5e-4 {
+        if (p[2] - z_now).abs() > z_step {
             text.push_str(" Z");
-            push_trimmed(&mut text, p[2], 3);
+            push_trimmed(&mut text, p[2], z_decimals);
             z_now = p[2];
         }
         let last = k + 1 == count;
