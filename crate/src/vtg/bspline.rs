@@ -10,10 +10,13 @@ pub const DEGREE: usize = 3;
 /// A clamped cubic B-spline: `knots.len() == ctrl.len() + 4`, first and last knots repeated
 /// four times. The control points of its first and second derivative curves are kept beside
 /// it (P&T eq. 3.8), so a point and both derivatives cost one pass of the basis recursion.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct Curve {
     knots: Vec<f64>,
     ctrl: Vec<[f64; 3]>,
+    /// The span of the last evaluation: the walk evaluates near it again and again, so the
+    /// span search starts there (a curve is used by one thread).
+    last_span: std::cell::Cell<usize>,
     /// `Q_i = 3 (P_{i+1} − P_i) / (u_{i+4} − u_{i+1})`, for `C' = Σ N_{i+1,2} Q_i`.
     d1_ctrl: Vec<[f64; 3]>,
     /// `R_i = 2 (Q_{i+1} − Q_i) / (u_{i+4} − u_{i+2})`, for `C'' = Σ N_{i+2,1} R_i`.
@@ -43,6 +46,12 @@ impl Eval {
     }
 }
 
+impl PartialEq for Curve {
+    fn eq(&self, other: &Self) -> bool {
+        self.knots == other.knots && self.ctrl == other.ctrl
+    }
+}
+
 impl Curve {
     /// The curve with these knots and control points (derivative control points computed here;
     /// a zero-length knot interval gives a zero difference, P&T's 0/0 = 0).
@@ -69,9 +78,28 @@ impl Curve {
         Self {
             knots,
             ctrl,
+            last_span: std::cell::Cell::new(DEGREE),
             d1_ctrl,
             d2_ctrl,
         }
+    }
+
+    /// The knot span holding `u`, from the last one if it (or the next) still does.
+    #[inline]
+    fn span(&self, u: f64) -> usize {
+        let n = self.ctrl.len() - 1;
+        let k = &self.knots;
+        let last = self.last_span.get();
+        let holds = |s: usize| s <= n && k[s] <= u && (u < k[s + 1] || s == n);
+        let span = if holds(last) {
+            last
+        } else if holds(last + 1) {
+            last + 1
+        } else {
+            find_span(k, n, u)
+        };
+        self.last_span.set(span);
+        span
     }
 
     /// Knot vector.
@@ -107,7 +135,7 @@ impl Curve {
             return zero;
         }
         let u = u.clamp(self.start(), self.end());
-        let span = find_span(&self.knots, n - 1, u);
+        let span = self.span(u);
         let (Some(p), Some(q), Some(r)) = (
             self.ctrl.get(span - DEGREE..=span),
             self.d1_ctrl.get(span - DEGREE..span),
