@@ -102,7 +102,7 @@ impl Accounts {
         self.features.len() - 1
     }
 
-    /// A move was read; returns its sequence number (the planner's tag).
+    /// A move was read; returns the message that times it.
     pub fn read_move(&mut self, m: &Move) -> TimeMsg {
         account_move(m, &mut self.totals);
         let slot = if m.is_extruding() {
@@ -130,13 +130,23 @@ impl Accounts {
         s.distance_mm += m.length_mm;
         s.filament_mm += m.extrusion();
         self.layers.motion(m);
-        let seq = self.moves_read;
         self.moves_read += 1;
-        TimeMsg::Move {
-            m: Motion::from(m),
-            seq,
-            slot,
-            layers: self.layers.current(),
+        let layers = self.layers.current();
+        let motion = Motion::from(m);
+        if motion.arc.is_none() && motion.rotary_time_s == 0.0 {
+            TimeMsg::Move {
+                delta: motion.delta,
+                feed_mm_s: motion.feed_mm_s,
+                line: motion.line,
+                slot,
+                layers,
+            }
+        } else {
+            TimeMsg::Motion {
+                m: Box::new(motion),
+                slot,
+                layers,
+            }
         }
     }
 
@@ -199,15 +209,25 @@ impl Accounts {
 
 /// What the read side tells the timing side, in file order.
 ///
-/// Moves travel by value in batches: boxing them would cost an allocation per move, and the
-/// batches are recycled, so the size of the largest variant costs nothing extra.
-#[allow(clippy::large_enum_variant)]
+/// Straight moves, nearly every message, travel by value in a form that keeps the message at
+/// 64 bytes (one cache line; a whole [`Motion`] would double it, and every message is written
+/// by one thread and read by the other). Arcs and rotary-only moves, rare, carry their
+/// [`Motion`] boxed. Moves are numbered on each side by counting them, so no sequence number
+/// travels.
 #[derive(Debug, Clone)]
 pub enum TimeMsg {
-    /// A move, with its sequence number, feature slot and layers (marker count, Z count).
+    /// A straight move (no arc, no rotary-only time): its X, Y, Z, E displacement, feed rate
+    /// and source line, with its feature slot and layers (marker count, Z count).
     Move {
-        m: Motion,
-        seq: u64,
+        delta: [f64; 4],
+        feed_mm_s: f64,
+        line: u32,
+        slot: u32,
+        layers: (u32, u32),
+    },
+    /// Any other move, with its feature slot and layers.
+    Motion {
+        m: Box<Motion>,
         slot: u32,
         layers: (u32, u32),
     },
@@ -226,6 +246,8 @@ pub enum TimeMsg {
 pub struct Timing {
     pub planner: Planner,
     pub book: TimeBook,
+    /// Moves received so far: the next move's sequence number.
+    moves: u64,
 }
 
 /// Times, energies and timed events, as planned moves are finalised.
@@ -268,19 +290,43 @@ impl Timing {
             temperatures: Vec::new(),
             fans: Vec::new(),
         };
-        Self { planner, book }
+        Self {
+            planner,
+            book,
+            moves: 0,
+        }
     }
 
     /// Handles one message from the read side.
     pub fn handle(&mut self, msg: TimeMsg) {
-        let Timing { planner, book } = self;
+        let Timing {
+            planner,
+            book,
+            moves,
+        } = self;
         match msg {
             TimeMsg::Move {
-                m,
-                seq,
+                delta,
+                feed_mm_s,
+                line,
                 slot,
                 layers,
             } => {
+                let seq = *moves;
+                *moves += 1;
+                book.tags.push_back((seq, slot, layers));
+                let m = Motion {
+                    line,
+                    delta,
+                    arc: None,
+                    feed_mm_s,
+                    rotary_time_s: 0.0,
+                };
+                planner.push(&m, seq, &mut |pm| book.planned(pm));
+            }
+            TimeMsg::Motion { m, slot, layers } => {
+                let seq = *moves;
+                *moves += 1;
                 book.tags.push_back((seq, slot, layers));
                 planner.push(&m, seq, &mut |pm| book.planned(pm));
             }
@@ -392,5 +438,15 @@ fn account_move(m: &Move, totals: &mut Totals) {
         if m.extrusion() < -1e-12 {
             totals.retractions += 1;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::TimeMsg;
+
+    #[test]
+    fn messages_fit_a_cache_line() {
+        assert!(std::mem::size_of::<TimeMsg>() <= 64);
     }
 }

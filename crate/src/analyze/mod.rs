@@ -258,15 +258,16 @@ pub fn analyze_with_progress(
             let Some(event) = machine.apply(raw.number, line, warnings) else {
                 return Ok(());
             };
-            match event {
+            // By reference: a move is a few hundred bytes, not worth a copy.
+            match &event {
                 Event::Move(m) => {
                     if print_limits.is_none() && m.is_extruding() {
                         print_limits = Some(limits_now.clone());
                     }
-                    to_timing(acc.read_move(&m));
+                    to_timing(acc.read_move(m));
                 }
-                Event::Dwell(secs) => to_timing(acc.dwell(secs)),
-                Event::Temperature {
+                &Event::Dwell(secs) => to_timing(acc.dwell(secs)),
+                &Event::Temperature {
                     heater,
                     target_c,
                     wait,
@@ -277,7 +278,7 @@ pub fn analyze_with_progress(
                         to_timing(TimeMsg::Flush);
                     }
                 }
-                Event::Fan { index, speed } => to_timing(acc.fan(raw.number, index, speed)),
+                &Event::Fan { index, speed } => to_timing(acc.fan(raw.number, index, speed)),
             }
             Ok(())
         })
@@ -298,7 +299,7 @@ pub fn analyze_with_progress(
         toolpath,
         ..
     } = acc;
-    let Timing { planner, book } = timing;
+    let Timing { planner, book, .. } = timing;
     let TimeBook {
         energy: energy_acc,
         temperatures,

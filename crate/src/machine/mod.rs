@@ -511,8 +511,13 @@ impl Machine {
         }
     }
 
-    /// Target logical position of a motion command.
-    fn target(&self, line: &Line<'_>) -> Pos {
+    /// Target logical position of a motion command, or the first coordinate (in axis order)
+    /// beyond [`MAX_COORDINATE`].
+    ///
+    /// Only the axes the line names are checked: every other axis keeps its logical position,
+    /// which is always within range (each way of setting it, here, in `G92` and in `G28`,
+    /// checks or zeroes it).
+    fn target(&self, line: &Line<'_>) -> Result<Pos, f64> {
         let mut target = self.logical;
         for (i, letter) in AXIS_LETTERS.iter().enumerate() {
             if let Some(v) = line.params.get(*letter) {
@@ -523,9 +528,12 @@ impl Machine {
                     self.relative_axes
                 };
                 target[i] = if relative { self.logical[i] + v } else { v };
+                if target[i].abs() > MAX_COORDINATE {
+                    return Err(target[i]);
+                }
             }
         }
-        target
+        Ok(target)
     }
 
     /// Moves the state to `target` (logical) and returns the physical start and end.
@@ -557,14 +565,18 @@ impl Machine {
         if line.params.has_bare_word() {
             warnings.push(line_no, "axis word without a value ignored");
         }
-        let target = self.target(line);
-        if let Some(bad) = target.iter().find(|v| v.abs() > MAX_COORDINATE) {
-            warnings.push(
-                line_no,
-                format!("coordinate {bad:e} out of range (|v| > {MAX_COORDINATE:e}); line ignored"),
-            );
-            return None;
-        }
+        let target = match self.target(line) {
+            Ok(target) => target,
+            Err(bad) => {
+                warnings.push(
+                    line_no,
+                    format!(
+                        "coordinate {bad:e} out of range (|v| > {MAX_COORDINATE:e}); line ignored"
+                    ),
+                );
+                return None;
+            }
+        };
         let mut kind = match g {
             0 => MoveKind::Rapid,
             1 => MoveKind::Linear,
