@@ -92,6 +92,26 @@ impl Params {
         self.bare != 0
     }
 
+    /// The words that have a number, as a bit set: bit `i` for letter `b'A' + i`.
+    #[inline]
+    pub fn numbered(&self) -> u32 {
+        self.present & !self.bare
+    }
+
+    /// The words among `letters` (a bit set like [`Params::numbered`]) that have a number,
+    /// with their values, in alphabetical order.
+    #[inline]
+    pub fn numbers_in(&self, letters: u32) -> impl Iterator<Item = (u8, f64)> + '_ {
+        let mut bits = self.numbered() & letters;
+        std::iter::from_fn(move || {
+            (bits != 0).then(|| {
+                let i = bits.trailing_zeros();
+                bits &= bits - 1;
+                (b'A' + i as u8, self.values[i as usize])
+            })
+        })
+    }
+
     /// Whether the line has no words.
     #[inline]
     pub fn is_empty(&self) -> bool {
