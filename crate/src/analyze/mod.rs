@@ -255,11 +255,11 @@ pub fn analyze_with_progress(
                 to_timing(TimeMsg::Limits(Box::new(limits_now.clone())));
                 return Ok(());
             }
-            let Some(event) = machine.apply(raw.number, line, warnings) else {
+            // By reference: a move is a few hundred bytes, not worth a copy.
+            let Some(event) = &machine.apply(raw.number, line, warnings) else {
                 return Ok(());
             };
-            // By reference: a move is a few hundred bytes, not worth a copy.
-            match &event {
+            match event {
                 Event::Move(m) => {
                     if print_limits.is_none() && m.is_extruding() {
                         print_limits = Some(limits_now.clone());
