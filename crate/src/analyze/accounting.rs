@@ -56,7 +56,8 @@ pub struct Accounts {
     pub totals: Totals,
     pub features: Vec<FeatureSummary>,
     feature_names: HashMap<String, usize>,
-    current_feature: Option<usize>,
+    /// The feature extruding moves belong to, as slot and whether it is infill.
+    current_feature: Option<(u32, bool)>,
     pub travel: FeatureSummary,
     pub layers: LayerTracker,
     /// Material named in the file's comments, if any.
@@ -64,6 +65,8 @@ pub struct Accounts {
     /// Toolpath metrics of the VTG paper (eq. 24–26, 31).
     pub toolpath: MetricsAccumulator,
     moves_read: u64,
+    /// The last point put into the bounds, while moves keep extruding.
+    bounded: Option<[f64; 3]>,
 }
 
 impl Accounts {
@@ -78,6 +81,7 @@ impl Accounts {
             material: None,
             toolpath: MetricsAccumulator::new(DEFAULT_CRITICAL_ANGLE_DEG),
             moves_read: 0,
+            bounded: None,
         }
     }
 
@@ -90,7 +94,19 @@ impl Accounts {
 
     /// The slicer names the feature that follows.
     pub fn feature(&mut self, name: &str) {
-        self.current_feature = Some(self.feature_index(name));
+        self.set_feature(name);
+    }
+
+    /// Makes `name` the current feature; returns its slot and whether it is infill.
+    fn set_feature(&mut self, name: &str) -> (u32, bool) {
+        let i = self.feature_index(name);
+        let infill = matches!(
+            self.features[i].kind,
+            Some(FeatureKind::SparseInfill | FeatureKind::SolidInfill)
+        );
+        let current = (u32::try_from(i).unwrap_or(TRAVEL - 1), infill);
+        self.current_feature = Some(current);
+        current
     }
 
     fn feature_index(&mut self, name: &str) -> usize {
@@ -103,41 +119,41 @@ impl Accounts {
         self.features.len() - 1
     }
 
-    /// A move was read; returns its sequence number (the planner's tag).
+    /// A move was read; returns the message that times it.
     pub fn read_move(&mut self, m: &Move) -> TimeMsg {
-        account_move(m, &mut self.totals);
-        let slot = if m.is_extruding() {
-            let i = match self.current_feature {
-                Some(i) => i,
-                None => {
-                    let i = self.feature_index("unmarked");
-                    self.current_feature = Some(i);
-                    i
-                }
-            };
-            u32::try_from(i).unwrap_or(TRAVEL - 1)
+        let extruding = m.is_extruding();
+        account_move(m, extruding, &mut self.totals, &mut self.bounded);
+        let (slot, infill) = if extruding {
+            match self.current_feature {
+                Some(current) => current,
+                None => self.set_feature("unmarked"),
+            }
         } else {
-            TRAVEL
+            (TRAVEL, false)
         };
-        let infill = slot != TRAVEL
-            && matches!(
-                self.features.get(slot as usize).and_then(|f| f.kind),
-                Some(FeatureKind::SparseInfill | FeatureKind::SolidInfill)
-            );
-        self.toolpath
-            .push(&m.from, &m.to, slot != TRAVEL, slot, infill);
+        self.toolpath.push(&m.from, &m.to, extruding, slot, infill);
         let s = self.slot(slot);
         s.moves += 1;
         s.distance_mm += m.length_mm;
         s.filament_mm += m.extrusion();
         self.layers.motion(m);
-        let seq = self.moves_read;
         self.moves_read += 1;
-        TimeMsg::Move {
-            m: Motion::from(m),
-            seq,
-            slot,
-            layers: self.layers.current(),
+        let layers = self.layers.current();
+        let motion = Motion::from(m);
+        if motion.arc.is_none() && motion.rotary_time_s == 0.0 {
+            TimeMsg::Move {
+                delta: motion.delta,
+                feed_mm_s: motion.feed_mm_s,
+                line: motion.line,
+                slot,
+                layers,
+            }
+        } else {
+            TimeMsg::Motion {
+                m: Box::new(motion),
+                slot,
+                layers,
+            }
         }
     }
 
@@ -201,15 +217,25 @@ impl Accounts {
 
 /// What the read side tells the timing side, in file order.
 ///
-/// Moves travel by value in batches: boxing them would cost an allocation per move, and the
-/// batches are recycled, so the size of the largest variant costs nothing extra.
-#[allow(clippy::large_enum_variant)]
+/// Straight moves, nearly every message, travel by value in a form that keeps the message at
+/// 64 bytes (one cache line; a whole [`Motion`] would double it, and every message is written
+/// by one thread and read by the other). Arcs and rotary-only moves, rare, carry their
+/// [`Motion`] boxed. Moves are numbered on each side by counting them, so no sequence number
+/// travels.
 #[derive(Debug, Clone)]
 pub enum TimeMsg {
-    /// A move, with its sequence number, feature slot and layers (marker count, Z count).
+    /// A straight move (no arc, no rotary-only time): its X, Y, Z, E displacement, feed rate
+    /// and source line, with its feature slot and layers (marker count, Z count).
     Move {
-        m: Motion,
-        seq: u64,
+        delta: [f64; 4],
+        feed_mm_s: f64,
+        line: u32,
+        slot: u32,
+        layers: (u32, u32),
+    },
+    /// Any other move, with its feature slot and layers.
+    Motion {
+        m: Box<Motion>,
         slot: u32,
         layers: (u32, u32),
     },
@@ -228,6 +254,8 @@ pub enum TimeMsg {
 pub struct Timing {
     pub planner: Planner,
     pub book: TimeBook,
+    /// Moves received so far: the next move's sequence number.
+    moves: u64,
 }
 
 /// Times, energies and timed events, as planned moves are finalised.
@@ -270,19 +298,43 @@ impl Timing {
             temperatures: Vec::new(),
             fans: Vec::new(),
         };
-        Self { planner, book }
+        Self {
+            planner,
+            book,
+            moves: 0,
+        }
     }
 
     /// Handles one message from the read side.
     pub fn handle(&mut self, msg: TimeMsg) {
-        let Timing { planner, book } = self;
+        let Timing {
+            planner,
+            book,
+            moves,
+        } = self;
         match msg {
             TimeMsg::Move {
-                m,
-                seq,
+                delta,
+                feed_mm_s,
+                line,
                 slot,
                 layers,
             } => {
+                let seq = *moves;
+                *moves += 1;
+                book.tags.push_back((seq, slot, layers));
+                let m = Motion {
+                    line,
+                    delta,
+                    arc: None,
+                    feed_mm_s,
+                    rotary_time_s: 0.0,
+                };
+                planner.push(&m, seq, &mut |pm| book.planned(pm));
+            }
+            TimeMsg::Motion { m, slot, layers } => {
+                let seq = *moves;
+                *moves += 1;
                 book.tags.push_back((seq, slot, layers));
                 planner.push(&m, seq, &mut |pm| book.planned(pm));
             }
@@ -373,26 +425,49 @@ fn summary(name: &str, kind_of: Option<&str>) -> FeatureSummary {
     }
 }
 
-fn account_move(m: &Move, totals: &mut Totals) {
+/// `bounded`: the last point put into the bounds while moves keep extruding.
+fn account_move(m: &Move, extruding: bool, totals: &mut Totals, bounded: &mut Option<[f64; 3]>) {
     totals.moves += 1;
     totals.distance_mm += m.length_mm;
-    if m.is_extruding() {
+    if extruding {
         totals.extruding_moves += 1;
         totals.extrude_distance_mm += m.length_mm;
         let b = totals.bounds.get_or_insert(Bounds {
             min: [f64::INFINITY; 3],
             max: [f64::NEG_INFINITY; 3],
         });
-        for p in [&m.from, &m.to] {
-            for ((lo, hi), v) in b.min.iter_mut().zip(b.max.iter_mut()).zip(&p[..3]) {
+        let mut include = |p: &[f64; 3]| {
+            for ((lo, hi), v) in b.min.iter_mut().zip(b.max.iter_mut()).zip(p) {
                 *lo = lo.at_most(*v);
                 *hi = hi.at_least(*v);
             }
+        };
+        let from = [m.from[0], m.from[1], m.from[2]];
+        let to = [m.to[0], m.to[1], m.to[2]];
+        // A move starts where the one before ended: if that one extruded, its end is the last
+        // point bounded, and bounding the same point (same bits) again changes nothing.
+        let same_bits =
+            |a: &[f64; 3], b: &[f64; 3]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+        if !bounded.is_some_and(|p| same_bits(&p, &from)) {
+            include(&from);
         }
+        include(&to);
+        *bounded = Some(to);
     } else {
+        *bounded = None;
         totals.travel_distance_mm += m.length_mm;
         if m.extrusion() < -1e-12 {
             totals.retractions += 1;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::TimeMsg;
+
+    #[test]
+    fn messages_fit_a_cache_line() {
+        assert!(std::mem::size_of::<TimeMsg>() <= 64);
     }
 }

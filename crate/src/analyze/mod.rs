@@ -255,7 +255,8 @@ pub fn analyze_with_progress(
                 to_timing(TimeMsg::Limits(Box::new(limits_now.clone())));
                 return Ok(());
             }
-            let Some(event) = machine.apply(raw.number, line, warnings) else {
+            // By reference: a move is a few hundred bytes, not worth a copy.
+            let Some(event) = &machine.apply(raw.number, line, warnings) else {
                 return Ok(());
             };
             match event {
@@ -263,10 +264,10 @@ pub fn analyze_with_progress(
                     if print_limits.is_none() && m.is_extruding() {
                         print_limits = Some(limits_now.clone());
                     }
-                    to_timing(acc.read_move(&m));
+                    to_timing(acc.read_move(m));
                 }
-                Event::Dwell(secs) => to_timing(acc.dwell(secs)),
-                Event::Temperature {
+                &Event::Dwell(secs) => to_timing(acc.dwell(secs)),
+                &Event::Temperature {
                     heater,
                     target_c,
                     wait,
@@ -277,7 +278,7 @@ pub fn analyze_with_progress(
                         to_timing(TimeMsg::Flush);
                     }
                 }
-                Event::Fan { index, speed } => to_timing(acc.fan(raw.number, index, speed)),
+                &Event::Fan { index, speed } => to_timing(acc.fan(raw.number, index, speed)),
             }
             Ok(())
         })
@@ -298,7 +299,7 @@ pub fn analyze_with_progress(
         toolpath,
         ..
     } = acc;
-    let Timing { planner, book } = timing;
+    let Timing { planner, book, .. } = timing;
     let TimeBook {
         energy: energy_acc,
         temperatures,

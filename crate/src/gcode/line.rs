@@ -92,6 +92,26 @@ impl Params {
         self.bare != 0
     }
 
+    /// The words that have a number, as a bit set: bit `i` for letter `b'A' + i`.
+    #[inline]
+    pub fn numbered(&self) -> u32 {
+        self.present & !self.bare
+    }
+
+    /// The words among `letters` (a bit set like [`Params::numbered`]) that have a number,
+    /// with their values, in alphabetical order.
+    #[inline]
+    pub fn numbers_in(&self, letters: u32) -> impl Iterator<Item = (u8, f64)> + '_ {
+        let mut bits = self.numbered() & letters;
+        std::iter::from_fn(move || {
+            (bits != 0).then(|| {
+                let i = bits.trailing_zeros();
+                bits &= bits - 1;
+                (b'A' + i as u8, self.values[i as usize])
+            })
+        })
+    }
+
     /// Whether the line has no words.
     #[inline]
     pub fn is_empty(&self) -> bool {
@@ -109,6 +129,21 @@ impl Params {
                 )
             })
         })
+    }
+
+    /// Whether the word at `slot` (0 for `A`) is present.
+    #[inline]
+    fn has_slot(&self, slot: u8) -> bool {
+        self.present & (1 << slot) != 0
+    }
+
+    /// Sets the word at `slot` (0 for `A`) to `v`.
+    #[inline]
+    fn insert_value(&mut self, slot: u8, v: f64) {
+        let bit = 1u32 << slot;
+        self.present |= bit;
+        self.bare &= !bit;
+        self.values[usize::from(slot)] = v;
     }
 
     fn insert(&mut self, letter: u8, value: Option<f64>) -> bool {
@@ -347,6 +382,134 @@ fn parse_number(s: &[u8], upper_letter: bool) -> (usize, Option<f64>) {
     (len, parse_f64(&s[..len]))
 }
 
+/// Parses the line at the start of `rest` (the input from the line's first byte to its end)
+/// if it is a plain G-code line: `G` and a number of at most four digits, then plain words
+/// (see [`plain_words`]) and spaces up to the newline or the end of the input. Returns where
+/// it stopped (the newline, or the end of `rest`), having filled `line` exactly as
+/// [`parse_line_into`] fills it for that line's text; `None` for any other line (a comment,
+/// anything unusual, or a duplicate word, which the general parser reports), with `line` to
+/// be parsed again.
+///
+/// Such lines are nearly all of a slicer's file, and this finds a line's end and parses it in
+/// one pass instead of a search for the newline, one for a comment and the parse.
+pub(crate) fn parse_plain_line<'a>(rest: &'a [u8], line: &mut Line<'a>) -> Option<usize> {
+    if rest.first() != Some(&b'G') {
+        return None;
+    }
+    let mut pos = 1;
+    let mut number: u16 = 0;
+    while let Some(d) = rest
+        .get(pos)
+        .map(|c| c.wrapping_sub(b'0'))
+        .filter(|d| *d <= 9)
+    {
+        if pos > 4 {
+            return None;
+        }
+        number = number * 10 + u16::from(d);
+        pos += 1;
+    }
+    if pos == 1 {
+        return None;
+    }
+    line.params.clear();
+    loop {
+        while rest.get(pos).is_some_and(|&b| is_space(b)) {
+            pos += 1;
+        }
+        let Some(&letter) = rest.get(pos).filter(|&&b| b != b'\n') else {
+            break;
+        };
+        if !letter.is_ascii_uppercase() || pos > MAX_COMMAND_BYTES {
+            return None;
+        }
+        let (len, v) = plain_decimal(&rest[pos + 1..])?;
+        let after = pos + 1 + len;
+        let clean = rest
+            .get(after)
+            .is_none_or(|&n| is_space(n) || n.is_ascii_uppercase() || n == b'\n');
+        let slot = letter - b'A';
+        if !clean || line.params.has_slot(slot) {
+            return None;
+        }
+        line.params.insert_value(slot, v);
+        pos = after;
+    }
+    line.command = Command::Code(Code {
+        letter: b'G',
+        number,
+        sub: None,
+    });
+    line.text = &[];
+    line.comment = None;
+    line.line_number = None;
+    line.checksum = None;
+    Some(pos)
+}
+
+/// Reads the words of a line from `pos` as long as they are plain: an upper-case letter
+/// glued to a plain decimal (see [`plain_decimal`]) and followed by a separator, another word
+/// or the end, and not already given. Returns where it stopped: the end of `code`, or the first
+/// word that is not plain, for the general loop of [`parse_line_into`] to read (it gives the
+/// same result for plain words, only slower: nearly every word of a slicer's file is plain).
+#[inline]
+fn plain_words(code: &[u8], mut pos: usize, params: &mut Params) -> usize {
+    loop {
+        while code.get(pos).is_some_and(|&b| is_space(b)) {
+            pos += 1;
+        }
+        let Some(&letter) = code.get(pos).filter(|b| b.is_ascii_uppercase()) else {
+            return pos;
+        };
+        let Some((len, v)) = code.get(pos + 1..).and_then(plain_decimal) else {
+            return pos;
+        };
+        let after = pos + 1 + len;
+        let clean = code
+            .get(after)
+            .is_none_or(|&n| is_space(n) || n.is_ascii_alphabetic() || n == b'(');
+        let slot = letter - b'A';
+        if !clean || params.has_slot(slot) {
+            return pos;
+        }
+        params.insert_value(slot, v);
+        pos = after;
+    }
+}
+
+/// The number at the start of `s` if it is a plain decimal, `[+-] digits [. digits]` with at
+/// most 15 digits and no exponent after it: its length and value, exactly as [`parse_number`]
+/// reads it (Clinger's fast path). `None` for anything else, which [`parse_number`] handles.
+#[inline(always)]
+fn plain_decimal(s: &[u8]) -> Option<(usize, f64)> {
+    let (negative, mut i) = match s.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
+    };
+    let mut mantissa: u64 = 0;
+    let mut digits = 0usize;
+    while let Some(d) = s.get(i).map(|c| c.wrapping_sub(b'0')).filter(|d| *d <= 9) {
+        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+        digits += 1;
+        i += 1;
+    }
+    let mut frac_digits = 0usize;
+    if s.get(i) == Some(&b'.') {
+        i += 1;
+        while let Some(d) = s.get(i).map(|c| c.wrapping_sub(b'0')).filter(|d| *d <= 9) {
+            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+            frac_digits += 1;
+            i += 1;
+        }
+    }
+    if digits + frac_digits == 0 || digits + frac_digits > 15 || s.get(i) == Some(&b'e') {
+        return None;
+    }
+    let v = mantissa as f64 / POW10[frac_digits];
+    Some((i, if negative { -v } else { v }))
+}
+
 #[inline]
 fn parse_f64(token: &[u8]) -> Option<f64> {
     let token = token.strip_prefix(b"+").unwrap_or(token);
@@ -518,8 +681,10 @@ pub fn parse_line_into<'a>(text: &'a [u8], line: &mut Line<'a>) -> Result<(), Li
     }
 
     // Words.
+    let code = &text[..end];
+    pos = plain_words(code, pos, &mut line.params);
     while pos < end {
-        let b = text[pos];
+        let b = code[pos];
         if is_space(b) {
             pos += 1;
             continue;

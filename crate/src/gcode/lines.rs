@@ -4,6 +4,8 @@
 //! a last line without a final newline. Text plus terminator of every line, concatenated, is the
 //! input again byte for byte: this is what makes lossless rewriting possible.
 
+use super::line::{parse_plain_line, Line, MAX_COMMAND_BYTES};
+
 /// One line of the input, borrowed from it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RawLine<'a> {
@@ -38,6 +40,35 @@ impl<'a> Lines<'a> {
     /// Byte offset of the next line; equals the input length once exhausted.
     pub fn position(&self) -> usize {
         self.pos
+    }
+
+    /// The next line, parsed into `line`, if it is a plain G-code line (see
+    /// [`parse_plain_line`]): found and parsed in one pass. `None`, with nothing consumed,
+    /// for any other line, which [`Iterator::next`] and [`super::parse_line_into`] then read.
+    #[inline]
+    pub(crate) fn next_plain(&mut self, line: &mut Line<'a>) -> Option<RawLine<'a>> {
+        let rest = self.input.get(self.pos..)?;
+        let stop = parse_plain_line(rest, line)?;
+        // As `next` splits: `stop` is the newline, or the end of a last line without one.
+        let (text, terminator) = if stop < rest.len() {
+            let with_cr = stop > 0 && rest[stop - 1] == b'\r';
+            let text_end = if with_cr { stop - 1 } else { stop };
+            (&rest[..text_end], &rest[text_end..=stop])
+        } else {
+            (rest, &rest[rest.len()..])
+        };
+        if text.len() > MAX_COMMAND_BYTES {
+            return None;
+        }
+        let offset = self.pos;
+        self.pos += text.len() + terminator.len();
+        self.number = self.number.saturating_add(1);
+        Some(RawLine {
+            number: self.number,
+            offset,
+            text,
+            terminator,
+        })
     }
 }
 
@@ -92,6 +123,7 @@ pub fn looks_like_utf16(input: &[u8]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gcode::Line;
 
     fn concat(input: &[u8]) -> Vec<u8> {
         Lines::new(input)
@@ -119,6 +151,32 @@ mod tests {
     fn empty_input_has_no_lines() {
         assert_eq!(Lines::new(b"").count(), 0);
         assert_eq!(Lines::new(b"\n").count(), 1);
+    }
+
+    #[test]
+    fn plain_lines_read_in_one_pass_as_the_general_parser_reads_them() {
+        let input = b"G1 X1 Y2\r\nG0X1Y-2.5 E.5 F1800\nG1 X1 X2\nG1 X1 ; c\nG10\nG1.1 X1\n\
+G00001 X1\nG12345 X1\ng1 x1\nG1 X1e3\nG1  X1  \t\nG1 X1\r\r\nG1 X 1\nG1 X1(c)\nG1 Xa\n\
+G1 X1.2.3\nG1 X0.1234567890123456\nM104 S200\n;G1 X1\n\nG28\nG1 X1\r";
+        let reference = Lines::new(input);
+        let mut lines = Lines::new(input);
+        let mut line = Line::default();
+        let mut plain = 0;
+        for expected in reference {
+            let parsed = super::super::parse_line(expected.text);
+            match lines.next_plain(&mut line) {
+                Some(raw) => {
+                    plain += 1;
+                    assert_eq!(raw, expected);
+                    // (Compared as printed: a reused line keeps stale values of absent words.)
+                    let parsed = parsed.map(|l| format!("{l:?}"));
+                    assert_eq!(Ok(format!("{line:?}")), parsed);
+                }
+                None => assert_eq!(lines.next(), Some(expected)),
+            }
+        }
+        assert_eq!(lines.next(), None);
+        assert_eq!(plain, 7);
     }
 
     #[test]

@@ -43,7 +43,16 @@ where
 {
     check_encoding(input)?;
     let mut line = Line::default();
-    for raw in Lines::new(input) {
+    let mut lines = Lines::new(input);
+    loop {
+        // Plain G-code lines, nearly all of a file, are split and parsed in one pass.
+        if let Some(raw) = lines.next_plain(&mut line) {
+            each(&raw, Some(&line), warnings)?;
+            continue;
+        }
+        let Some(raw) = lines.next() else {
+            break;
+        };
         match parse_line_into(raw.text, &mut line) {
             Ok(()) => each(&raw, Some(&line), warnings)?,
             Err(e) => {

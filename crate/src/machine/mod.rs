@@ -41,6 +41,38 @@ pub mod axis {
 }
 /// Word letter of each axis index.
 pub const AXIS_LETTERS: [u8; AXES] = *b"XYZEABCUVW";
+/// The axis letters as a bit set of [`crate::gcode::Params::numbered`].
+const AXIS_WORDS: u32 = {
+    let mut bits = 0;
+    let mut i = 0;
+    while i < AXES {
+        bits |= letter_bit(AXIS_LETTERS[i]);
+        i += 1;
+    }
+    bits
+};
+
+/// The bit of an upper-case word letter in [`crate::gcode::Params::numbered`].
+const fn letter_bit(letter: u8) -> u32 {
+    1 << (letter - b'A')
+}
+
+/// The axis index of an axis letter (one of [`AXIS_LETTERS`]).
+#[inline]
+fn axis_of(letter: u8) -> usize {
+    match letter {
+        b'X' => axis::X,
+        b'Y' => axis::Y,
+        b'Z' => axis::Z,
+        b'E' => axis::E,
+        b'A' => axis::A,
+        b'B' => axis::B,
+        b'C' => axis::C,
+        b'U' => 7,
+        b'V' => 8,
+        _ => 9,
+    }
+}
 const LINEAR: [bool; AXES] = [
     true, true, true, true, false, false, false, true, true, true,
 ];
@@ -511,39 +543,54 @@ impl Machine {
         }
     }
 
-    /// Target logical position of a motion command.
-    fn target(&self, line: &Line<'_>) -> Pos {
-        let mut target = self.logical;
-        for (i, letter) in AXIS_LETTERS.iter().enumerate() {
-            if let Some(v) = line.params.get(*letter) {
-                let v = if LINEAR[i] { v * self.unit() } else { v };
-                let relative = if i == axis::E {
-                    self.extrusion_mode() == ExtrusionMode::Relative
-                } else {
-                    self.relative_axes
-                };
-                target[i] = if relative { self.logical[i] + v } else { v };
+    /// Sets the axes a motion command names in `target` (the logical position before it) to
+    /// where the command goes; returns the first coordinate (in axis order) beyond
+    /// [`MAX_COORDINATE`], if any.
+    ///
+    /// Only the axes the line names are checked: every other axis keeps its logical position,
+    /// which is always within range (each way of setting it, here, in `G92` and in `G28`,
+    /// checks or zeroes it). (`target` is filled in place: a position is 80 bytes, and a
+    /// returned one is copied more than once on the per-move path.)
+    fn target(&self, line: &Line<'_>, target: &mut Pos) -> Result<(), f64> {
+        // The axis words present, in alphabetical order (a line names two or three of ten).
+        let mut out_of_range = false;
+        for (letter, v) in line.params.numbers_in(AXIS_WORDS) {
+            let i = axis_of(letter);
+            let v = if LINEAR[i] { v * self.unit() } else { v };
+            let relative = if i == axis::E {
+                self.extrusion_mode() == ExtrusionMode::Relative
+            } else {
+                self.relative_axes
+            };
+            target[i] = if relative { self.logical[i] + v } else { v };
+            out_of_range |= target[i].abs() > MAX_COORDINATE;
+        }
+        if out_of_range {
+            // Report the first in axis order.
+            let named = line.params.numbered();
+            for (i, letter) in AXIS_LETTERS.iter().enumerate() {
+                if named & letter_bit(*letter) != 0 && target[i].abs() > MAX_COORDINATE {
+                    return Err(target[i]);
+                }
             }
         }
-        target
+        Ok(())
     }
 
-    /// Moves the state to `target` (logical) and returns the physical start and end.
-    fn go_to(&mut self, target: Pos) -> (Pos, Pos) {
-        let from = self.physical;
+    /// Moves the state to `target` (logical).
+    fn go_to(&mut self, target: &Pos) {
         let flow = self.flow_factor;
         for (i, ((phys, logical), t)) in self
             .physical
             .iter_mut()
             .zip(&self.logical)
-            .zip(&target)
+            .zip(target)
             .enumerate()
         {
             let delta = t - logical;
             *phys += if i == axis::E { delta * flow } else { delta };
         }
-        self.logical = target;
-        (from, self.physical)
+        self.logical = *target;
     }
 
     fn motion(
@@ -557,13 +604,18 @@ impl Machine {
         if line.params.has_bare_word() {
             warnings.push(line_no, "axis word without a value ignored");
         }
-        let target = self.target(line);
-        if let Some(bad) = target.iter().find(|v| v.abs() > MAX_COORDINATE) {
-            warnings.push(
-                line_no,
-                format!("coordinate {bad:e} out of range (|v| > {MAX_COORDINATE:e}); line ignored"),
-            );
-            return None;
+        let mut target = self.logical;
+        match self.target(line, &mut target) {
+            Ok(()) => {}
+            Err(bad) => {
+                warnings.push(
+                    line_no,
+                    format!(
+                        "coordinate {bad:e} out of range (|v| > {MAX_COORDINATE:e}); line ignored"
+                    ),
+                );
+                return None;
+            }
         }
         let mut kind = match g {
             0 => MoveKind::Rapid,
@@ -573,7 +625,9 @@ impl Machine {
                 None => MoveKind::Linear,
             },
         };
-        let (from, to) = self.go_to(target);
+        let from = self.physical;
+        self.go_to(&target);
+        let to = self.physical;
         let d = |i: usize| to[i] - from[i];
         let straight = (d(0).powi(2) + d(1).powi(2) + d(2).powi(2)).sqrt();
         let length_mm = match &kind {
@@ -587,7 +641,9 @@ impl Machine {
             warnings.push(line_no, "move length is not finite; move skipped");
             return None;
         }
-        if from == to && !matches!(kind, MoveKind::Arc(_)) {
+        // A move with a straight length cannot end where it started: only others need the
+        // comparison of every axis.
+        if straight == 0.0 && !matches!(kind, MoveKind::Arc(_)) && from == to {
             return None;
         }
         if let MoveKind::Arc(a) = &kind {

@@ -101,7 +101,22 @@ fn set(limit: &mut Limit, value: Option<f64>, source: LimitSource) {
 
 impl Limits {
     /// Applies a limit command; returns whether the line was one.
+    ///
+    /// Analysis asks this of every line: the test that rules out all other lines is inlined
+    /// into the caller, the commands themselves are read out of line.
+    #[inline]
     pub fn apply_command(&mut self, line: &Line<'_>, units: FeedUnits) -> bool {
+        let candidate = match line.command {
+            crate::gcode::Command::Code(code) => {
+                code.letter == b'M' && matches!(code.number, 201 | 203 | 204 | 205 | 566)
+            }
+            crate::gcode::Command::Extended(_) => true,
+            _ => false,
+        };
+        candidate && self.apply_limit_command(line, units)
+    }
+
+    fn apply_limit_command(&mut self, line: &Line<'_>, units: FeedUnits) -> bool {
         let src = LimitSource::Command;
         let p = &line.params;
         let per_s = |v: Option<f64>| match units {

@@ -209,6 +209,8 @@ pub struct Planner {
     limits: Limits,
     model: JunctionModel,
     blocks: Vec<Block>,
+    /// Profiles of the blocks being finalised (kept to reuse its allocation).
+    profiles: Vec<Profile>,
     prev: Option<Segment>,
     elapsed_s: f64,
     finalized: u64,
@@ -221,6 +223,7 @@ impl Planner {
             limits,
             model,
             blocks: Vec::with_capacity(REFRESH_THRESHOLD + 1),
+            profiles: Vec::with_capacity(REFRESH_THRESHOLD + 1),
             prev: None,
             elapsed_s: 0.0,
             finalized: 0,
@@ -501,8 +504,12 @@ impl Planner {
             last.recalculate = false;
         }
         let finalize = n.saturating_sub(keep);
-        for b in self.blocks.drain(..finalize) {
-            let profile = b.profile();
+        // The profiles first, in a loop of their own: they are independent of each other, and
+        // their divisions overlap there instead of waiting, block by block, between sink calls.
+        self.profiles.clear();
+        self.profiles
+            .extend(self.blocks[..finalize].iter().map(Block::profile));
+        for (b, &profile) in self.blocks.drain(..finalize).zip(&self.profiles) {
             let pm = PlannedMove {
                 line: b.line,
                 tag: b.tag,
