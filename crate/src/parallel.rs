@@ -1,7 +1,7 @@
 //! Order-preserving parallel map over independent work items, and a two-way join.
 //!
-//! Natively the items are split into one contiguous chunk per core and mapped on scoped
-//! threads; the results come back in the items' order, so the outcome is the same bit for bit
+//! Natively the items are cut into contiguous blocks that scoped threads claim one after
+//! another; the results come back in the items' order, so the outcome is the same bit for bit
 //! as a sequential run. In wasm (one thread) and for short lists, the map runs in place.
 
 /// Threads to use natively: the cores available (at most 8), or `QUIETPATH_THREADS` when set
@@ -30,6 +30,12 @@ pub fn threads() -> usize {
 #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
 const MIN_ITEMS: usize = 64;
 
+/// Blocks per thread the items are cut into: threads claim the next block as they finish one,
+/// so a run of costly items (a part's dense layers) does not leave the other threads idle, as
+/// one fixed chunk per thread would.
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
+const BLOCKS_PER_THREAD: usize = 16;
+
 /// `f` applied to every item, in order; `f` sees a contiguous slice at a time.
 pub fn map_chunks<T, R, F>(items: &[T], f: F) -> Vec<R>
 where
@@ -39,28 +45,35 @@ where
 {
     #[cfg(not(target_arch = "wasm32"))]
     {
+        use std::sync::atomic::{AtomicUsize, Ordering};
         let threads = threads();
         if threads > 1 && items.len() >= MIN_ITEMS {
-            let chunk = items.len().div_ceil(threads);
-            let parts: Option<Vec<Vec<R>>> = std::thread::scope(|scope| {
-                let handles: Vec<_> = items
-                    .chunks(chunk)
-                    .map(|c| {
-                        let f = &f;
-                        scope.spawn(move || f(c))
-                    })
-                    .collect();
-                handles
-                    .into_iter()
-                    .map(|h| match h.join() {
-                        Ok(r) => Some(r),
+            let block = items.len().div_ceil(threads * BLOCKS_PER_THREAD);
+            let blocks: Vec<&[T]> = items.chunks(block).collect();
+            let next = AtomicUsize::new(0);
+            let claim = || {
+                let mut done: Vec<(usize, Vec<R>)> = Vec::new();
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(b) = blocks.get(i) else {
+                        return done;
+                    };
+                    done.push((i, f(b)));
+                }
+            };
+            let mut parts: Vec<(usize, Vec<R>)> = std::thread::scope(|scope| {
+                let handles: Vec<_> = (1..threads).map(|_| scope.spawn(claim)).collect();
+                let mut all = claim();
+                for h in handles {
+                    match h.join() {
+                        Ok(r) => all.extend(r),
                         Err(panic) => std::panic::resume_unwind(panic),
-                    })
-                    .collect()
+                    }
+                }
+                all
             });
-            if let Some(parts) = parts {
-                return parts.into_iter().flatten().collect();
-            }
+            parts.sort_unstable_by_key(|(i, _)| *i);
+            return parts.into_iter().flat_map(|(_, r)| r).collect();
         }
     }
     f(items)
