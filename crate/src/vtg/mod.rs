@@ -119,16 +119,18 @@ pub fn vtg_with_progress(
 ) -> Result<VtgReport, Error> {
     options.validate()?;
     let cancelled = || Error::new(0, 0, ErrorKind::Cancelled);
-    // Independent reads of the same bytes, side by side where there are threads.
-    let (before, read) = crate::parallel::join(
-        || crate::analyze::analyze(input, &options.analyze),
+    // Independent reads of the same bytes, side by side where there are threads. Extracting
+    // the planned path costs about as much as the other two together (34 MB: 550 ms against
+    // 150 + 220 ms), so it runs on its own.
+    let (read, path) = crate::parallel::join(
         || {
-            let path = crate::path::extract(input, &options.analyze, options.limit_feed)?;
+            let before = crate::analyze::analyze(input, &options.analyze)?;
             let sources = source::move_sources(input, &options.analyze)?;
-            Ok::<_, Error>((path, sources))
+            Ok::<_, Error>((before, sources))
         },
+        || crate::path::extract(input, &options.analyze, options.limit_feed),
     );
-    let (before, (path, sources)) = (before?, read?);
+    let ((before, sources), path) = (read?, path?);
     if !progress(0.3) {
         return Err(cancelled());
     }
