@@ -58,23 +58,9 @@ pub fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit> {
         let last = curve.ctrl().len() - 1;
         // Residuals at the data and halfway between consecutive data (consecutive samples lie
         // on one segment of the polyline, so the midpoint is on it too): ringing between data
-        // points is caught as well.
-        let mids = data.windows(2).zip(params.windows(2)).map(|(q, u)| {
-            (
-                [
-                    0.5 * (q[0][0] + q[1][0]),
-                    0.5 * (q[0][1] + q[1][1]),
-                    0.5 * (q[0][2] + q[1][2]),
-                ],
-                0.5 * (u[0] + u[1]),
-            )
-        });
-        let mut checks: Vec<([f64; 3], f64)> =
-            data.iter().copied().zip(params.iter().copied()).collect();
-        checks.extend(mids);
-        checks.sort_by(|a, b| a.1.total_cmp(&b.1));
-        for (q, u) in &checks {
-            let (q, u) = (q, *u);
+        // points is caught as well. In parameter order, so each evaluation finds its span
+        // where the last one was.
+        let mut check = |q: &[f64; 3], u: f64| {
             let r = norm(&sub(&curve.eval(u).p, q));
             worst = worst.max(r);
             if r > tol_mm {
@@ -83,6 +69,16 @@ pub fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit> {
                     bad_spans.push(s);
                 }
             }
+        };
+        check(&data[0], params[0]);
+        for (q, u) in data.windows(2).zip(params.windows(2)) {
+            let mid = [
+                0.5 * (q[0][0] + q[1][0]),
+                0.5 * (q[0][1] + q[1][1]),
+                0.5 * (q[0][2] + q[1][2]),
+            ];
+            check(&mid, 0.5 * (u[0] + u[1]));
+            check(&q[1], u[1]);
         }
         if !worst.is_finite() {
             return None;

@@ -72,9 +72,11 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
         mean_kappa: 0.0,
         step_mm: 0.0,
     }];
-    let end_p = curve.eval(u_end).p;
+    let end = curve.eval(u_end);
+    let (end_p, end_kappa) = (end.p, Some(end.curvature()));
     let index = CurvatureIndex::new(curve);
-    let max_curvature = |_: &Curve, a: f64, b: f64| index.max(curve, a, b);
+    let max_curvature =
+        |a: f64, b: f64, ends: [Option<f64>; 2]| index.max_with_ends(curve, a, b, ends);
     let mut u = u_start;
     let mut p = first.p;
     // Bounded: each accepted step advances u by at least a minimum amount.
@@ -96,7 +98,7 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
                 // Try the end point as the next point: the turn and sagitta of the stretch are
                 // judged on its length along the curve, not on the chord, which is nothing at
                 // all when a closed loop comes back to its start.
-                let k = max_curvature(curve, u, u_end);
+                let k = max_curvature(u, u_end, [Some(kappa), end_kappa]);
                 let along = arc_length(curve, u, u_end);
                 if remaining >= 0.5 * along && fits(k, along, w) {
                     accepted = Some((u_end, end_p, k, 0.0, None));
@@ -106,7 +108,7 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
             let floor = step <= w.min_step_mm;
             if let Some((un, at)) = newton(curve, u, &e, &p, step, w) {
                 if un < u_end {
-                    let k = max_curvature(curve, u, un);
+                    let k = max_curvature(u, un, [Some(kappa), Some(at.curvature())]);
                     if floor || fits(k, step, w) {
                         accepted = Some((un, at.p, k, step, Some(at.d1)));
                         break;
@@ -116,9 +118,9 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
             too_long = Some(step);
             // Shrink to what the curvature met on the way allows (at least halving).
             let k = max_curvature(
-                curve,
                 u,
                 (u + 2.0 * step / norm(&e.d1).max(1e-9)).min(u_end),
+                [Some(kappa), None],
             );
             if floor {
                 break;
@@ -139,7 +141,10 @@ pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample
                 let mid = 0.5 * (ok + bad);
                 let fitted = newton(curve, u, &e, &p, mid, w)
                     .filter(|(un, _)| *un < u_end)
-                    .map(|(un, at)| (un, at, max_curvature(curve, u, un)))
+                    .map(|(un, at)| {
+                        let k = max_curvature(u, un, [Some(kappa), Some(at.curvature())]);
+                        (un, at, k)
+                    })
                     .filter(|(_, _, k)| fits(*k, mid, w));
                 match fitted {
                     Some((un, at, k)) => {
@@ -275,6 +280,13 @@ impl CurvatureIndex {
 
     /// Largest curvature on `[a, b]`.
     pub fn max(&self, curve: &Curve, a: f64, b: f64) -> f64 {
+        self.max_with_ends(curve, a, b, [None, None])
+    }
+
+    /// [`Self::max`] given the curvature at `a` and/or `b` where the caller has already
+    /// evaluated the curve there (the walk has, at its current point and at the Newton
+    /// solution): the same figure without evaluating again.
+    pub fn max_with_ends(&self, curve: &Curve, a: f64, b: f64, ends: [Option<f64>; 2]) -> f64 {
         // Spans: i such that breaks[i] < b and breaks[i+1] > a.
         let first = self.breaks.partition_point(|&k| k <= a).saturating_sub(1);
         let mut best = 0.0f64;
@@ -299,9 +311,10 @@ impl CurvatureIndex {
             i += 1;
         }
         if partial {
+            let [ka, kb] = ends;
             best = best
-                .max(curve.eval(a).curvature())
-                .max(curve.eval(b).curvature());
+                .max(ka.unwrap_or_else(|| curve.eval(a).curvature()))
+                .max(kb.unwrap_or_else(|| curve.eval(b).curvature()));
         }
         best
     }
