@@ -57,11 +57,13 @@ test-wasm: setup
 test-js: pkg cli
 	npm test
 
-## Throughput on the 34 MB corpus file (parse and analyze), plus sha256sum for scale.
+## Throughput on the 34 MB corpus file (parse and analyze), plus sha256sum for scale, and the
+## infill search's timing test (240 candidates under 10 s).
 bench: cli
 	@echo "sha256sum:"; time -p sha256sum "$(LARGE)" > /dev/null
 	target/release/quietpath bench "$(LARGE)"
 	cargo bench -p quietpath --bench parse
+	cargo test --release -p quietpath-conformance --test infill -- --ignored --nocapture
 
 ## Short, reproducible (seeded, fixed-count) fuzzing smoke run of every target (make test).
 test-fuzz:
