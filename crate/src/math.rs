@@ -18,6 +18,12 @@ pub fn sin(x: f64) -> f64 {
     libm::sin(x)
 }
 
+/// Tangent, radians.
+#[inline]
+pub fn tan(x: f64) -> f64 {
+    libm::tan(x)
+}
+
 /// Cosine, radians.
 #[inline]
 pub fn cos(x: f64) -> f64 {

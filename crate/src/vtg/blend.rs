@@ -65,7 +65,7 @@ impl Blend {
 /// vertex to the fillet, and the curvature.
 pub fn shape(turn: f64) -> (f64, f64) {
     let half = 0.5 * turn;
-    let tan = libm::tan(half);
+    let tan = crate::math::tan(half);
     let radius = 1.0 / tan;
     (radius * (1.0 / crate::math::cos(half) - 1.0), tan)
 }
@@ -74,7 +74,7 @@ pub fn shape(turn: f64) -> (f64, f64) {
 /// extent `l`: its point at fraction `t` of the turn.
 fn fillet_point(v: &[f64; 3], a: &[f64; 3], b: &[f64; 3], turn: f64, l: f64, t: f64) -> [f64; 3] {
     let half = 0.5 * turn;
-    let r = l / libm::tan(half);
+    let r = l / crate::math::tan(half);
     // The centre lies on the inner bisector, r / cos(θ/2) from the vertex.
     let m = sub(b, a);
     let lm = norm(&m);
@@ -88,8 +88,9 @@ fn fillet_point(v: &[f64; 3], a: &[f64; 3], b: &[f64; 3], turn: f64, l: f64, t: 
     let t1 = [v[0] - a[0] * l, v[1] - a[1] * l, v[2] - a[2] * l];
     let t2 = [v[0] + b[0] * l, v[1] + b[1] * l, v[2] + b[2] * l];
     let (u1, u2) = (sub(&t1, &c), sub(&t2, &c));
-    let s = libm::sin(turn);
-    let (w1, w2) = (libm::sin((1.0 - t) * turn) / s, libm::sin(t * turn) / s);
+    let sin = crate::math::sin;
+    let s = sin(turn);
+    let (w1, w2) = (sin((1.0 - t) * turn) / s, sin(t * turn) / s);
     [
         c[0] + u1[0] * w1 + u2[0] * w2,
         c[1] + u1[1] * w1 + u2[1] * w2,

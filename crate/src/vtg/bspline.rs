@@ -1,8 +1,9 @@
 //! Cubic B-spline curves in 3-D (the VTG paper's NURBS, eq. 21–22, with unit weights).
 //!
 //! The fitted data are polylines; rational weights only pay off for exact conics, so every
-//! weight is 1 and eq. 21 reduces to a B-spline. Basis functions and their derivatives follow
-//! Piegl & Tiller's A2.2/A2.3 (the Cox–de Boor recursion of eq. 22).
+//! weight is 1 and eq. 21 reduces to a B-spline. Basis functions follow Piegl & Tiller's A2.2
+//! (the Cox–de Boor recursion of eq. 22), derivatives the derivative curves' control points
+//! (P&T eq. 3.8); the tests check them against A2.3.
 
 /// Degree of the curves.
 pub const DEGREE: usize = 3;
@@ -210,84 +211,6 @@ pub fn find_span(knots: &[f64], n: usize, u: f64) -> usize {
     mid.max(DEGREE)
 }
 
-/// The four non-zero cubic basis functions at `u` in span `span` and their first and second
-/// derivatives (A2.3): `ders[k][j]` is the k-th derivative of `N_{span−3+j,3}`.
-#[allow(clippy::needless_range_loop)] // A2.3 as Piegl & Tiller write it
-pub fn basis_ders(knots: &[f64], span: usize, u: f64) -> [[f64; 4]; 3] {
-    const P: usize = DEGREE;
-    let mut ders = [[0.0; 4]; 3];
-    if span < P || span + P >= knots.len() {
-        return ders;
-    }
-    let mut ndu = [[0.0f64; 4]; 4];
-    let mut left = [0.0f64; 4];
-    let mut right = [0.0f64; 4];
-    ndu[0][0] = 1.0;
-    for j in 1..=P {
-        left[j] = u - knots[span + 1 - j];
-        right[j] = knots[span + j] - u;
-        let mut saved = 0.0;
-        for r in 0..j {
-            ndu[j][r] = right[r + 1] + left[j - r];
-            let temp = if ndu[j][r] != 0.0 {
-                ndu[r][j - 1] / ndu[j][r]
-            } else {
-                0.0
-            };
-            ndu[r][j] = saved + right[r + 1] * temp;
-            saved = left[j - r] * temp;
-        }
-        ndu[j][j] = saved;
-    }
-    for j in 0..=P {
-        ders[0][j] = ndu[j][P];
-    }
-    let mut a = [[0.0f64; 4]; 2];
-    for r in 0..=P {
-        let (mut s1, mut s2) = (0usize, 1usize);
-        a[0][0] = 1.0;
-        for k in 1..=2usize {
-            let mut d = 0.0;
-            let rk = r as isize - k as isize;
-            let pk = P - k;
-            if r >= k {
-                let den = ndu[pk + 1][rk as usize];
-                a[s2][0] = if den != 0.0 { a[s1][0] / den } else { 0.0 };
-                d = a[s2][0] * ndu[rk as usize][pk];
-            }
-            let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
-            let j2 = if r as isize - 1 <= pk as isize {
-                k - 1
-            } else {
-                P - r
-            };
-            for j in j1..=j2 {
-                let idx = (rk + j as isize) as usize;
-                let den = ndu[pk + 1][idx];
-                a[s2][j] = if den != 0.0 {
-                    (a[s1][j] - a[s1][j - 1]) / den
-                } else {
-                    0.0
-                };
-                d += a[s2][j] * ndu[idx][pk];
-            }
-            if r <= pk {
-                let den = ndu[pk + 1][r];
-                a[s2][k] = if den != 0.0 { -a[s1][k - 1] / den } else { 0.0 };
-                d += a[s2][k] * ndu[r][pk];
-            }
-            ders[k][r] = d;
-            std::mem::swap(&mut s1, &mut s2);
-        }
-    }
-    // Multiply by p!/(p−k)!.
-    for j in 0..=P {
-        ders[1][j] *= P as f64;
-        ders[2][j] *= (P * (P - 1)) as f64;
-    }
-    ders
-}
-
 pub(crate) fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
@@ -298,6 +221,16 @@ pub(crate) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 
 pub(crate) fn norm(a: &[f64; 3]) -> f64 {
     dot(a, a).sqrt()
+}
+
+/// The point at fraction `t` of the way from `a` to `b`.
+#[inline]
+pub(crate) fn lerp(a: &[f64; 3], b: &[f64; 3], t: f64) -> [f64; 3] {
+    [
+        a[0] + (b[0] - a[0]) * t,
+        a[1] + (b[1] - a[1]) * t,
+        a[2] + (b[2] - a[2]) * t,
+    ]
 }
 
 pub(crate) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
@@ -311,6 +244,86 @@ pub(crate) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The reference [`Curve::eval`] is checked against: the four non-zero cubic basis
+    /// functions at `u` in span `span` and their first and second derivatives (A2.3, computed
+    /// independently of the derivative control points): `ders[k][j]` is the k-th derivative of
+    /// `N_{span−3+j,3}`.
+    #[allow(clippy::needless_range_loop)] // A2.3 as Piegl & Tiller write it
+    fn basis_ders(knots: &[f64], span: usize, u: f64) -> [[f64; 4]; 3] {
+        const P: usize = DEGREE;
+        let mut ders = [[0.0; 4]; 3];
+        if span < P || span + P >= knots.len() {
+            return ders;
+        }
+        let mut ndu = [[0.0f64; 4]; 4];
+        let mut left = [0.0f64; 4];
+        let mut right = [0.0f64; 4];
+        ndu[0][0] = 1.0;
+        for j in 1..=P {
+            left[j] = u - knots[span + 1 - j];
+            right[j] = knots[span + j] - u;
+            let mut saved = 0.0;
+            for r in 0..j {
+                ndu[j][r] = right[r + 1] + left[j - r];
+                let temp = if ndu[j][r] != 0.0 {
+                    ndu[r][j - 1] / ndu[j][r]
+                } else {
+                    0.0
+                };
+                ndu[r][j] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            ndu[j][j] = saved;
+        }
+        for j in 0..=P {
+            ders[0][j] = ndu[j][P];
+        }
+        let mut a = [[0.0f64; 4]; 2];
+        for r in 0..=P {
+            let (mut s1, mut s2) = (0usize, 1usize);
+            a[0][0] = 1.0;
+            for k in 1..=2usize {
+                let mut d = 0.0;
+                let rk = r as isize - k as isize;
+                let pk = P - k;
+                if r >= k {
+                    let den = ndu[pk + 1][rk as usize];
+                    a[s2][0] = if den != 0.0 { a[s1][0] / den } else { 0.0 };
+                    d = a[s2][0] * ndu[rk as usize][pk];
+                }
+                let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
+                let j2 = if r as isize - 1 <= pk as isize {
+                    k - 1
+                } else {
+                    P - r
+                };
+                for j in j1..=j2 {
+                    let idx = (rk + j as isize) as usize;
+                    let den = ndu[pk + 1][idx];
+                    a[s2][j] = if den != 0.0 {
+                        (a[s1][j] - a[s1][j - 1]) / den
+                    } else {
+                        0.0
+                    };
+                    d += a[s2][j] * ndu[idx][pk];
+                }
+                if r <= pk {
+                    let den = ndu[pk + 1][r];
+                    a[s2][k] = if den != 0.0 { -a[s1][k - 1] / den } else { 0.0 };
+                    d += a[s2][k] * ndu[r][pk];
+                }
+                ders[k][r] = d;
+                std::mem::swap(&mut s1, &mut s2);
+            }
+        }
+        // Multiply by p!/(p−k)!.
+        for j in 0..=P {
+            ders[1][j] *= P as f64;
+            ders[2][j] *= (P * (P - 1)) as f64;
+        }
+        ders
+    }
 
     /// A single Bézier span: C(u) = Σ B_i(u) P_i with Bernstein polynomials.
     #[test]

@@ -7,7 +7,7 @@
 
 use std::collections::HashMap;
 
-use super::bspline::{dot, norm, sub};
+use super::bspline::{dot, lerp, norm, sub};
 use crate::path::PrintPath;
 
 /// Distance from `p` to segment `a`–`b`.
@@ -20,8 +20,7 @@ pub fn point_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
     } else {
         0.0
     };
-    let q = [a[0] + ab[0] * t, a[1] + ab[1] * t, a[2] + ab[2] * t];
-    norm(&sub(p, &q))
+    norm(&sub(p, &lerp(a, b, t)))
 }
 
 /// Distance from `p` to the polyline `poly`.
@@ -45,12 +44,7 @@ fn samples(poly: &[[f64; 3]], step: f64, mut each: impl FnMut(&[f64; 3])) {
         let len = norm(&sub(&w[1], &w[0]));
         let k = ((len / step).ceil() as usize).clamp(1, 100_000);
         for i in 1..=k {
-            let t = i as f64 / k as f64;
-            each(&[
-                w[0][0] + (w[1][0] - w[0][0]) * t,
-                w[0][1] + (w[1][1] - w[0][1]) * t,
-                w[0][2] + (w[1][2] - w[0][2]) * t,
-            ]);
+            each(&lerp(&w[0], &w[1], i as f64 / k as f64));
         }
     }
 }
@@ -121,15 +115,14 @@ pub fn polyline_deviation(out: &[[f64; 3]], orig: &[[f64; 3]], step: f64, accept
                 // Walk the segment. Distance is 1-Lipschitz, so from a point at distance d the
                 // next `accept − d` mm cannot exceed `accept`: the walk strides there and steps
                 // `step` mm only where the segment comes close to the limit.
-                let dir = sub(p, &q);
-                let len = norm(&dir);
+                let len = norm(&sub(p, &q));
                 let mut m = 0.0f64;
                 let mut t = 0.0f64;
                 let mut c = jq;
                 let mut guard = 0usize;
                 loop {
                     let f = if len > 0.0 { (t / len).min(1.0) } else { 1.0 };
-                    let x = [q[0] + dir[0] * f, q[1] + dir[1] * f, q[2] + dir[2] * f];
+                    let x = lerp(&q, p, f);
                     let (mut jj, mut dx) = nearest(&x, c);
                     if dx > m.max(accept) {
                         (jj, dx) = nearest_anywhere(&x);

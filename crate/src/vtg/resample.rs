@@ -433,7 +433,7 @@ mod tests {
                 let w = Walk {
                     chord_tol_mm: 0.03,
                     max_turn_rad: 0.45,
-                            max_step_mm: 1e4,
+                    max_step_mm: 1e4,
                     min_step_mm: 0.03,
                     phi: 1.0,
                     newton_tol_mm: 1e-7,

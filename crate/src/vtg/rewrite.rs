@@ -130,15 +130,8 @@ pub fn rewrite(
         critical_rad: options.critical_angle_deg.to_radians(),
         limits: *limits,
         limit_feed: options.limit_feed,
-        max_normal_accel_mm_s2: {
-            let a = &path.print_limits.max_acceleration;
-            let m = a[0].value.min(a[1].value);
-            if m.is_finite() && m > 0.0 {
-                m
-            } else {
-                limits.normal_accel_mm_s2
-            }
-        },
+        max_normal_accel_mm_s2: xy_acceleration(&path.print_limits)
+            .unwrap_or(limits.normal_accel_mm_s2),
         jerk_per_accel_hz: options
             .normal_jerk_mm_s3
             .is_none()
@@ -148,10 +141,8 @@ pub fn rewrite(
         } else {
             super::smooth::MARLIN_MIN_STEP_MM
         },
-        classic_jerk_mm_s: (path.junction_model == JunctionModel::ClassicJerk).then(|| {
-            let j = &path.print_limits.max_jerk;
-            j[0].value.min(j[1].value)
-        }),
+        classic_jerk_mm_s: (path.junction_model == JunctionModel::ClassicJerk)
+            .then(|| xy_jerk(&path.print_limits)),
     };
     let energy = Accumulator::new(
         &options.analyze.energy.clone().unwrap_or_default(),
@@ -268,6 +259,19 @@ fn has_sharp_corner(run: &[PathMove], cos_critical: f64) -> bool {
     })
 }
 
+/// The X/Y acceleration ceiling of `limits` (`M201`, the lower of the two axes), if it is a
+/// usable number.
+fn xy_acceleration(limits: &Limits) -> Option<f64> {
+    let a = &limits.max_acceleration;
+    let m = a[0].value.min(a[1].value);
+    (m.is_finite() && m > 0.0).then_some(m)
+}
+
+/// The X/Y jerk of a classic-jerk planner (`M205 X Y`, the lower of the two axes), mm/s.
+fn xy_jerk(limits: &Limits) -> f64 {
+    limits.max_jerk[0].value.min(limits.max_jerk[1].value)
+}
+
 /// Scales of the eq. 29 speeds tried in turn (`None`: no caps), until a rewrite costs no time.
 const CAP_SCALES: [Option<f64>; 8] = [
     Some(1.0),
@@ -293,12 +297,11 @@ impl Machine<'_> {
     fn settings(&self, file: &Settings) -> Settings {
         let mut s = *file;
         if let Some(l) = self.limits {
-            let a = l.max_acceleration[0].value.min(l.max_acceleration[1].value);
-            if a.is_finite() && a > 0.0 {
+            if let Some(a) = xy_acceleration(l) {
                 s.max_normal_accel_mm_s2 = a;
             }
             if s.classic_jerk_mm_s.is_some() {
-                s.classic_jerk_mm_s = Some(l.max_jerk[0].value.min(l.max_jerk[1].value));
+                s.classic_jerk_mm_s = Some(xy_jerk(l));
             }
         }
         s
@@ -337,9 +340,9 @@ impl Machine<'_> {
 /// on their own with the firmware's limits and costed with the energy model, and where the new
 /// one is dearer its eq. 29 speeds are raised step by step (each step trading a little of the
 /// vibration suppression for speed), then dropped (the firmware's own cornering then sets the
-/// speed), and the path is kept as it was if it is still dearer. (A machine whose planner takes sharp corners faster than a fillet within
-/// the tolerance allows, such as Klipper with a high square-corner velocity, gains nothing in
-/// time from rounding.)
+/// speed), and the path is kept as it was if it is still dearer. (A machine whose planner takes
+/// sharp corners faster than a fillet within the tolerance allows, such as Klipper with a high
+/// square-corner velocity, gains nothing in time from rounding.)
 fn rewrite_path(
     run: &[PathMove],
     src: &[MoveSource],

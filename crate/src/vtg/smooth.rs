@@ -8,7 +8,7 @@
 //! path that cannot be rounded within the tolerance is kept as it was.
 
 use super::blend;
-use super::bspline::{dot, norm, sub};
+use super::bspline::{dot, lerp, norm, sub};
 use super::deviation::polyline_deviation;
 use super::fit::fit;
 use super::kinematics::KinematicLimits;
@@ -492,11 +492,7 @@ fn ramp_up(out: &mut Written, start: [f64; 3], start_feed: f64, jerk: f64, accel
                 }
                 done += piece;
                 let t = done / len;
-                points.push([
-                    from[0] + (to[0] - from[0]) * t,
-                    from[1] + (to[1] - from[1]) * t,
-                    from[2] + (to[2] - from[2]) * t,
-                ]);
+                points.push(lerp(&from, &to, t));
                 e.push(e_from + (e_to - e_from) * t);
                 feeds.push(next);
                 now = next;
