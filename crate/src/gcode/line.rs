@@ -423,17 +423,9 @@ pub(crate) fn parse_plain_line<'a>(rest: &'a [u8], line: &mut Line<'a>) -> Optio
         if !letter.is_ascii_uppercase() || pos > MAX_COMMAND_BYTES {
             return None;
         }
-        let (len, v) = plain_decimal(&rest[pos + 1..])?;
-        let after = pos + 1 + len;
-        let clean = rest
-            .get(after)
-            .is_none_or(|&n| is_space(n) || n.is_ascii_uppercase() || n == b'\n');
-        let slot = letter - b'A';
-        if !clean || line.params.has_slot(slot) {
-            return None;
-        }
-        line.params.insert_value(slot, v);
-        pos = after;
+        pos = plain_word(rest, pos, &mut line.params, |n| {
+            is_space(n) || n.is_ascii_uppercase() || n == b'\n'
+        })?;
     }
     line.command = Command::Code(Code {
         letter: b'G',
@@ -458,23 +450,39 @@ fn plain_words(code: &[u8], mut pos: usize, params: &mut Params) -> usize {
         while code.get(pos).is_some_and(|&b| is_space(b)) {
             pos += 1;
         }
-        let Some(&letter) = code.get(pos).filter(|b| b.is_ascii_uppercase()) else {
-            return pos;
-        };
-        let Some((len, v)) = code.get(pos + 1..).and_then(plain_decimal) else {
-            return pos;
-        };
-        let after = pos + 1 + len;
-        let clean = code
-            .get(after)
-            .is_none_or(|&n| is_space(n) || n.is_ascii_alphabetic() || n == b'(');
-        let slot = letter - b'A';
-        if !clean || params.has_slot(slot) {
+        if !code.get(pos).is_some_and(|b| b.is_ascii_uppercase()) {
             return pos;
         }
-        params.insert_value(slot, v);
-        pos = after;
+        match plain_word(code, pos, params, |n| {
+            is_space(n) || n.is_ascii_alphabetic() || n == b'('
+        }) {
+            Some(after) => pos = after,
+            None => return pos,
+        }
     }
+}
+
+/// Reads the word whose upper-case letter is at `pos` of `s` into `params` if it is plain: a
+/// plain decimal glued to the letter (see [`plain_decimal`]), then the end of `s` or a byte
+/// for which `ends_word` holds, and no word of that letter yet. Returns where the word ends;
+/// `None`, with `params` untouched, for any other word. (The one-pass line reader and the
+/// general parser differ only in what may follow a word: a newline, or a comment.)
+#[inline(always)]
+fn plain_word(
+    s: &[u8],
+    pos: usize,
+    params: &mut Params,
+    ends_word: impl Fn(u8) -> bool,
+) -> Option<usize> {
+    let letter = *s.get(pos)?;
+    let (len, v) = plain_decimal(s.get(pos + 1..)?)?;
+    let after = pos + 1 + len;
+    let slot = letter - b'A';
+    if !s.get(after).is_none_or(|&n| ends_word(n)) || params.has_slot(slot) {
+        return None;
+    }
+    params.insert_value(slot, v);
+    Some(after)
 }
 
 /// The number at the start of `s` if it is a plain decimal, `[+-] digits [. digits]` with at
