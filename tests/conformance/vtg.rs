@@ -109,7 +109,7 @@ fn options(tolerance_mm: f64, limit_feed: bool) -> VtgOptions {
 
 /// Files whose sharp corners cannot fall by 40 %, and why. For them the corners must still
 /// fall, and where the reason is the firmware's cornering, paths must have been kept for it.
-const TURNING_EXCEPTIONS: [(&str, &str); 5] = [
+const TURNING_EXCEPTIONS: [(&str, &str); 4] = [
     (
         "prusaslicer-2.5.0_vase_marlin-legacy_absE.gcode",
         "most sharp turns are infill hairpins of 135° and more: no fillet within 0.1 mm rounds \
@@ -124,11 +124,6 @@ const TURNING_EXCEPTIONS: [(&str, &str); 5] = [
         "crealityprint-4.3.4_k1_benchy_m83_arcs.gcode",
         "Klipper at a square-corner velocity of 50-100 mm/s takes sharp corners faster than \
          any fillet within 0.1 mm allows: rounded, most paths would cost time, so they are kept",
-    ),
-    (
-        "crealityprint-4.3.8_k1se_accessory_m82_arcs_exclude-object.gcode",
-        "arc-fitted, and on Klipper: corners next to arcs are not rewritten, and some paths are \
-         kept because rounded they would cost time",
     ),
     (
         "crealityprint-5_k1c_benchy_klipper_exclude-object.gcode",

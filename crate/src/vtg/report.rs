@@ -107,9 +107,11 @@ pub struct PathCounts {
     /// have made them slower than the original (the firmware's own cornering sets their
     /// speed).
     pub uncapped: u64,
-    /// Paths kept as they were because their rewrite plans slower, or costs more motor energy,
-    /// than the original even without caps (a firmware that takes sharp corners faster than
-    /// any fillet within the tolerance allows).
+    /// Rewritten paths that plan slower, or cost more motor energy, than the original even
+    /// without caps, paid for out of half of what the other rewrites saved (a firmware that
+    /// takes sharp corners faster than any fillet within the tolerance allows).
+    pub paid_from_savings: u64,
+    /// Paths like those that the savings could not pay for, kept as they were.
     pub kept_for_time: u64,
     /// Mean speed fluctuation of the interpolation steps, percent (eq. 28).
     pub mean_speed_fluctuation_pct: f64,
@@ -212,6 +214,7 @@ pub(crate) fn build(
             lowered_feed_segments: rewritten.lowered_segments,
             raised_caps: rewritten.raised_caps_paths,
             uncapped: rewritten.uncapped_paths,
+            paid_from_savings: rewritten.paid_paths,
             kept_for_time: rewritten.kept_for_time,
             mean_speed_fluctuation_pct: if w.steps > 0 {
                 w.fluctuation_sum / w.steps as f64 * 100.0

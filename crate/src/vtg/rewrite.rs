@@ -13,6 +13,7 @@
 
 use std::fmt::Write as _;
 
+use super::bspline::{dot, norm, sub};
 use super::kinematics::KinematicLimits;
 use super::resample::WalkStats;
 use super::smooth::{smooth_path, Path, Settings, Written};
@@ -50,8 +51,11 @@ pub struct Rewritten {
     /// Rewritten paths written without the eq. 29 feed caps, which even raised would have made
     /// them slower than the original.
     pub uncapped_paths: u64,
+    /// Rewritten paths that plan slower or cost more motor energy than the original, paid for
+    /// out of what the other rewrites saved (see [`SPEND_SHARE`]).
+    pub paid_paths: u64,
     /// Paths kept as they were because even rounded without caps they plan slower or cost more
-    /// motor energy.
+    /// motor energy, and the savings elsewhere could not pay for them.
     pub kept_for_time: u64,
     /// Algorithm 1 statistics.
     pub walk: WalkStats,
@@ -167,6 +171,8 @@ pub fn rewrite(
     }
     out.candidate_paths = candidates.len() as u64;
     let mut edits: Vec<Edit> = Vec::new();
+    let mut dearer: Vec<Outcome> = Vec::new();
+    let mut saved = [0.0f64; 2];
     for (b, batch) in candidates.chunks(BATCH_PATHS).enumerate() {
         if !progress((b * BATCH_PATHS) as f64 / candidates.len().max(1) as f64) {
             return Err(Error::new(0, 0, ErrorKind::Cancelled));
@@ -177,25 +183,104 @@ pub fn rewrite(
             chunk
                 .iter()
                 .map(|&(i, j)| {
-                    let mut part = Rewritten::default();
                     let machine = Machine {
                         limits: all.limits_at(i),
                         model: path.junction_model,
                         energy: &energy,
+                        context: [
+                            i.checked_sub(1).map(|k| motion_of(&moves[k])),
+                            moves.get(j).map(motion_of),
+                        ],
                     };
-                    let e =
-                        rewrite_path(&moves[i..j], &sources[i..j], &settings, &machine, &mut part);
-                    (e, part)
+                    rewrite_path(&moves[i..j], &sources[i..j], &settings, &machine)
                 })
                 .collect()
         });
-        for (path_edits, part) in parts {
-            edits.extend(path_edits.into_iter().flatten());
-            out.add(&part);
+        for outcome in parts.into_iter().flatten() {
+            if outcome.dearer {
+                dearer.push(outcome);
+            } else {
+                saved[0] -= outcome.added[0];
+                saved[1] -= outcome.added[1];
+                edits.extend(outcome.edits);
+                out.add(&outcome.part);
+            }
         }
+    }
+    pay_from_savings(&mut dearer, saved);
+    for outcome in &dearer {
+        if outcome.paid {
+            out.add(&outcome.part);
+            out.paid_paths += 1;
+        } else {
+            out.kept_for_time += 1;
+        }
+    }
+    if dearer.iter().any(|o| o.paid) {
+        edits.extend(dearer.into_iter().filter(|o| o.paid).flat_map(|o| o.edits));
+        edits.sort_unstable_by_key(|e| e.line);
     }
     out.output = apply_edits(input, &edits);
     Ok(out)
+}
+
+/// Share of what the rewrites that cost nothing saved (time and motor energy, each) that may be
+/// spent on rewrites that cost something.
+///
+/// On a firmware that takes sharp corners faster than a fillet within the tolerance allows
+/// (Klipper with a high square-corner velocity, a junction-deviation planner with a large
+/// deviation), rounding a corner costs a little time; elsewhere in the same file rounding
+/// saves time, because a fillet lets the machine carry more speed through the corner than
+/// the firmware's own rule for the sharp one. Half of those savings may buy the dearer
+/// rewrites that remove the most sharp corners for what they cost, so the file as a whole
+/// still prints faster and on less energy than the original, by at least half of what the
+/// cheap rewrites saved.
+pub const SPEND_SHARE: f64 = 0.5;
+
+/// One path's rewrite, before the file-level choice.
+struct Outcome {
+    /// The edits that write it.
+    edits: Vec<Edit>,
+    /// Its counts.
+    part: Rewritten,
+    /// Time (s) and motor energy (J) the rewrite adds to the path's own (negative: saves).
+    added: [f64; 2],
+    /// Whether it costs more time or energy than the original.
+    dearer: bool,
+    /// Sharp corners it removes.
+    corners_removed: u64,
+    /// Whether it is written (a dearer rewrite only if [`pay_from_savings`] chose it).
+    paid: bool,
+}
+
+/// Chooses the dearer rewrites to pay for out of `saved` (time s, energy J, by the rewrites
+/// that cost nothing): [`SPEND_SHARE`] of each, spent on the rewrites with the most sharp
+/// corners removed for their cost first (a knapsack's greedy order; a rewrite that does not
+/// fit is skipped and cheaper ones after it still tried). Ties go to file order, so the choice
+/// is the same on any number of threads.
+fn pay_from_savings(dearer: &mut [Outcome], saved: [f64; 2]) {
+    let budget = saved.map(|x| SPEND_SHARE * x.max(0.0));
+    if budget.iter().any(|&b| b <= 0.0) {
+        return;
+    }
+    // The cost of a rewrite as shares of the two budgets (what it saves in one counts for it).
+    let cost = |o: &Outcome| o.added[0] / budget[0] + o.added[1] / budget[1];
+    let mut order: Vec<usize> = (0..dearer.len())
+        .filter(|&k| dearer[k].corners_removed > 0 && cost(&dearer[k]).is_finite())
+        .collect();
+    order.sort_by(|&a, &b| {
+        let key = |k: usize| cost(&dearer[k]) / dearer[k].corners_removed as f64;
+        key(a).total_cmp(&key(b)).then(a.cmp(&b))
+    });
+    let mut left = budget;
+    for k in order {
+        let o = &mut dearer[k];
+        if o.added[0] <= left[0] && o.added[1] <= left[1] {
+            left[0] -= o.added[0];
+            left[1] -= o.added[1];
+            o.paid = true;
+        }
+    }
 }
 
 /// Candidate paths per batch between progress reports.
@@ -212,6 +297,7 @@ impl Rewritten {
         self.max_deviation_mm = self.max_deviation_mm.max(part.max_deviation_mm);
         self.raised_caps_paths += part.raised_caps_paths;
         self.uncapped_paths += part.uncapped_paths;
+        self.paid_paths += part.paid_paths;
         self.kept_for_time += part.kept_for_time;
         self.walk.steps += part.walk.steps;
         self.walk.fluctuation_sum += part.walk.fluctuation_sum;
@@ -285,11 +371,27 @@ const CAP_SCALES: [Option<f64>; 8] = [
 ];
 
 /// The firmware a path runs on: the limits in force where it starts, the junction model, and
-/// the motor energy model.
+/// the motor energy model; and the moves just before and after the path, which are planned
+/// with it.
 struct Machine<'a> {
     limits: Option<&'a Limits>,
     model: JunctionModel,
     energy: &'a Accumulator,
+    context: [Option<Motion>; 2],
+}
+
+/// The planner's motion for a move of the file.
+fn motion_of(m: &PathMove) -> Motion {
+    Motion {
+        line: m.line,
+        delta: [0, 1, 2, 3].map(|k| m.to[k] - m.from[k]),
+        arc: match m.kind {
+            MoveKind::Arc(a) => Some(a),
+            _ => None,
+        },
+        feed_mm_s: m.feed_mm_s,
+        rotary_time_s: 0.0,
+    }
 }
 
 impl Machine<'_> {
@@ -308,8 +410,10 @@ impl Machine<'_> {
     }
 
     /// Time (s) the firmware takes for the polyline from `start` through `points` (filament
-    /// `e` from 0 at `start`, feed `feed` per segment), planned on its own from rest to rest,
-    /// and the motor energy (J) it costs.
+    /// `e` from 0 at `start`, feed `feed` per segment), and the motor energy (J) it costs:
+    /// planned from rest to rest, with the moves before and after the path, so what a rewrite
+    /// changes at the path's two junctions with the rest of the file is counted too (a short
+    /// last step meeting the next move at an angle slows a Klipper machine down there).
     fn cost(&self, start: [f64; 3], points: &[[f64; 3]], e: &[f64], feed: &[f64]) -> (f64, f64) {
         let Some(limits) = self.limits else {
             return (f64::NAN, f64::NAN);
@@ -318,7 +422,8 @@ impl Machine<'_> {
         let mut energy = self.energy.clone();
         let mut joules = 0.0;
         let (mut from, mut e_from) = (start, 0.0);
-        for (k, ((p, &ek), &f)) in points.iter().zip(e).zip(feed).enumerate() {
+        let [before, after] = &self.context;
+        let path = points.iter().zip(e).zip(feed).map(|((p, &ek), &f)| {
             let m = Motion {
                 line: 0,
                 delta: [p[0] - from[0], p[1] - from[1], p[2] - from[2], ek - e_from],
@@ -326,8 +431,16 @@ impl Machine<'_> {
                 feed_mm_s: f,
                 rotary_time_s: 0.0,
             };
-            planner.push(&m, k as u64, &mut |pm| joules += energy.planned(pm));
             (from, e_from) = (*p, ek);
+            m
+        });
+        let all = before
+            .iter()
+            .copied()
+            .chain(path)
+            .chain(after.iter().copied());
+        for (k, m) in all.enumerate() {
+            planner.push(&m, k as u64, &mut |pm| joules += energy.planned(pm));
         }
         planner.flush(&mut |pm| joules += energy.planned(pm));
         (planner.elapsed_s(), joules)
@@ -336,20 +449,20 @@ impl Machine<'_> {
 
 /// Rewrites one path; the edits replace its first line with the new block and delete the rest.
 ///
-/// A rewrite must cost neither time nor motor energy: the new path and the original are planned
-/// on their own with the firmware's limits and costed with the energy model, and where the new
-/// one is dearer its eq. 29 speeds are raised step by step (each step trading a little of the
-/// vibration suppression for speed), then dropped (the firmware's own cornering then sets the
-/// speed), and the path is kept as it was if it is still dearer. (A machine whose planner takes
-/// sharp corners faster than a fillet within the tolerance allows, such as Klipper with a high
-/// square-corner velocity, gains nothing in time from rounding.)
+/// A rewrite should cost neither time nor motor energy: the new path and the original are
+/// planned on their own with the firmware's limits and costed with the energy model, and where
+/// the new one is dearer its eq. 29 speeds are raised step by step (each step trading a little
+/// of the vibration suppression for speed), then dropped (the firmware's own cornering then
+/// sets the speed). If every variant is still dearer (a machine whose planner takes sharp
+/// corners faster than a fillet within the tolerance allows, such as Klipper with a high
+/// square-corner velocity, gains nothing in time from rounding), the cheapest in energy is
+/// returned marked dearer, for [`pay_from_savings`] to take or leave.
 fn rewrite_path(
     run: &[PathMove],
     src: &[MoveSource],
     file_settings: &Settings,
     machine: &Machine<'_>,
-    out: &mut Rewritten,
-) -> Option<Vec<Edit>> {
+) -> Option<Outcome> {
     let settings = &machine.settings(file_settings);
     let (first, first_src) = (run.first()?, src.first()?);
     let last_src = src.last()?;
@@ -394,32 +507,51 @@ fn rewrite_path(
     };
     let smoothed = smooth_path(&path, settings)?;
     let (original_s, original_j) = machine.cost(pts[0], &pts[1..], &e[1..], &feed);
-    let no_dearer = |w: &Written| {
+    let added = |w: &Written| {
         let (s, j) = machine.cost(pts[0], &w.points, &w.e, &w.feed_mm_s);
-        !(s > original_s * (1.0 + 1e-9) || j > original_j * (1.0 + 1e-9))
+        [s - original_s, j - original_j]
     };
+    let dearer = |a: &[f64; 2]| a[0] > original_s * 1e-9 || a[1] > original_j * 1e-9;
     // The eq. 29 speeds as they are, then raised step by step, then no caps at all, each
     // first as fast as the firmware will go elsewhere, then no faster than the original: the
-    // first that costs neither time nor energy.
+    // first that costs neither time nor energy, else the one that costs least energy.
     let scales: &[Option<f64>] = if settings.limit_feed {
         &CAP_SCALES
     } else {
         &[None]
     };
-    let Some(((scale, _), written)) = scales
-        .iter()
-        .flat_map(|&k| [(k, false), (k, true)])
-        .map(|(k, ceiling)| ((k, ceiling), smoothed.written(k, ceiling, pts[0], settings)))
-        .find(|(_, w)| no_dearer(w))
-    else {
-        out.kept_for_time += 1;
-        return None;
-    };
+    let mut cheapest: Option<(Option<f64>, Written, [f64; 2])> = None;
+    for (k, ceiling) in scales.iter().flat_map(|&k| [(k, false), (k, true)]) {
+        let w = smoothed.written(k, ceiling, pts[0], settings);
+        let a = added(&w);
+        if a.iter().any(|x| x.is_nan()) {
+            continue;
+        }
+        let better = cheapest
+            .as_ref()
+            .is_none_or(|c| (a[1], a[0]) < (c.2[1], c.2[0]));
+        let stop = !dearer(&a);
+        if stop || better {
+            cheapest = Some((k, w, a));
+        }
+        if stop {
+            break;
+        }
+    }
+    let (scale, written, added) = cheapest?;
+    let mut part = Rewritten::default();
     match scale {
-        None if settings.limit_feed => out.uncapped_paths += 1,
-        Some(k) if k > 1.0 => out.raised_caps_paths += 1,
+        None if settings.limit_feed => part.uncapped_paths += 1,
+        Some(k) if k > 1.0 => part.raised_caps_paths += 1,
         _ => {}
     }
+    let cos_critical = crate::math::cos(settings.critical_rad);
+    let removed = sharp_turns(&pts, cos_critical).saturating_sub(sharp_turns_after(
+        pts[0],
+        &written.points,
+        cos_critical,
+    ));
+    let out = &mut part;
 
     // Write the block.
     let mut text = String::with_capacity(written.points.len() * 32);
@@ -501,5 +633,79 @@ fn rewrite_path(
         line: s.line,
         replacement: Vec::new(),
     }));
-    Some(edits)
+    let dearer = dearer(&added);
+    Some(Outcome {
+        edits,
+        part,
+        added,
+        dearer,
+        corners_removed: removed as u64,
+        paid: !dearer,
+    })
+}
+
+/// Turns above the critical angle (cosine `cos_critical`) along the polyline `pts`.
+fn sharp_turns(pts: &[[f64; 3]], cos_critical: f64) -> usize {
+    pts.windows(3)
+        .filter(|w| {
+            let (a, b) = (sub(&w[1], &w[0]), sub(&w[2], &w[1]));
+            let (la, lb) = (norm(&a), norm(&b));
+            la > 0.0 && lb > 0.0 && dot(&a, &b) / (la * lb) < cos_critical
+        })
+        .count()
+}
+
+/// [`sharp_turns`] of the polyline from `start` through `points`.
+fn sharp_turns_after(start: [f64; 3], points: &[[f64; 3]], cos_critical: f64) -> usize {
+    let mut all = Vec::with_capacity(points.len() + 1);
+    all.push(start);
+    all.extend_from_slice(points);
+    sharp_turns(&all, cos_critical)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn outcome(added_s: f64, added_j: f64, corners: u64) -> Outcome {
+        Outcome {
+            edits: Vec::new(),
+            part: Rewritten::default(),
+            added: [added_s, added_j],
+            dearer: true,
+            corners_removed: corners,
+            paid: false,
+        }
+    }
+
+    #[test]
+    fn dearer_rewrites_are_paid_from_half_the_savings_best_value_first() {
+        // Saved 10 s and 100 J: 5 s and 50 J may be spent.
+        let mut d = vec![
+            outcome(4.0, 10.0, 1),  // 0.8 + 0.2 = 1.0 per corner
+            outcome(2.0, 10.0, 4),  // 0.6 / 4 = 0.15 per corner: third
+            outcome(2.0, 45.0, 10), // 1.3 / 10 = 0.13 per corner: second
+            outcome(0.5, 0.0, 0),   // removes nothing: never paid
+            outcome(1.0, -20.0, 2), // saves energy: -0.2 / 2 = -0.1 per corner, first
+        ];
+        pay_from_savings(&mut d, [10.0, 100.0]);
+        let paid: Vec<bool> = d.iter().map(|o| o.paid).collect();
+        // Order: #4 (1 s, -20 J; left 4 s, 70 J), #2 (2 s, 45 J; left 2 s, 25 J), #1 (2 s,
+        // 10 J; left 0 s, 15 J), #0 does not fit.
+        assert_eq!(paid, [false, true, true, false, true]);
+        let spent = d
+            .iter()
+            .filter(|o| o.paid)
+            .fold([0.0, 0.0], |a, o| [a[0] + o.added[0], a[1] + o.added[1]]);
+        assert!(spent[0] <= 5.0 && spent[1] <= 50.0, "{spent:?}");
+    }
+
+    #[test]
+    fn nothing_is_paid_without_savings_in_both_time_and_energy() {
+        for saved in [[0.0, 100.0], [10.0, 0.0], [-1.0, 100.0]] {
+            let mut d = vec![outcome(0.001, 0.001, 5)];
+            pay_from_savings(&mut d, saved);
+            assert!(!d[0].paid, "{saved:?}");
+        }
+    }
 }

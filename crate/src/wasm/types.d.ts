@@ -423,7 +423,9 @@ export interface VtgReport {
     raised_caps: number;
     /** Paths written without eq. 29 feed caps (even raised, they would have made them slower). */
     uncapped: number;
-    /** Paths kept as they were: slower when rounded, even without caps. */
+    /** Paths slower or dearer when rounded, even without caps, paid for out of half of what the other rewrites saved. */
+    paid_from_savings: number;
+    /** Paths kept as they were: slower or dearer when rounded, and not paid for. */
     kept_for_time: number;
     mean_speed_fluctuation_pct: number;
   };
