@@ -37,7 +37,7 @@ const STRAIGHT_RAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
 pub const MAX_TURN_RAD: f64 = 160.0 * std::f64::consts::PI / 180.0;
 /// Share of a leg the blends at its two ends may use together (the rest stays straight, so the
 /// fit sees where one blend ends and the next begins).
-const LEG_SHARE: f64 = 0.9;
+pub const LEG_SHARE: f64 = 0.9;
 
 /// A corner transition at one vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -3,7 +3,8 @@
 //! [`vtg`] reads a file, finds its extrusion paths (runs of consecutive printing moves within
 //! one feature), and rewrites each path that has a sharp corner (a turn above the critical
 //! angle δθ): its corners are blended with the largest fillets the tolerance and the legs
-//! allow ([`blend`]), a cubic B-spline is fitted to the blended path by least squares
+//! allow ([`blend`]; two sharp corners across a short leg, such as infill turning back, are
+//! rounded as one arc, [`hairpin`]), a cubic B-spline is fitted to the blended path by least squares
 //! ([`fit`]), walked with the second-order Taylor interpolator and Newton correction of
 //! Algorithm 1 ([`resample`]) in steps that each turn by less than 0.9 δθ, and the path's
 //! filament is spread over the new points ([`rewrite`]). Where the curvature is above `K_cr`
@@ -18,6 +19,7 @@ pub mod blend;
 pub mod bspline;
 pub mod deviation;
 pub mod fit;
+pub mod hairpin;
 pub mod kinematics;
 pub mod metrics;
 pub mod report;

@@ -11,6 +11,7 @@ use super::blend;
 use super::bspline::{dot, lerp, norm, sub};
 use super::deviation::polyline_deviation;
 use super::fit::fit;
+use super::hairpin;
 use super::kinematics::KinematicLimits;
 use super::resample::{walk, Walk, WalkStats};
 use crate::plan::Profile;
@@ -219,14 +220,17 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
         BLEND_SHARE * s.tolerance_mm,
         s.limits.critical_curvature(),
     );
-    let mut cuts = vec![0usize];
-    let mut sharp = vec![false; pts.len()];
-    for i in 1..pts.len() - 1 {
+    let n = pts.len();
+    // Each corner: sharp, and whether it can be rounded on its own.
+    let mut sharp = vec![false; n];
+    let mut alone = vec![true; n];
+    let mut degenerate = vec![false; n];
+    for i in 1..n - 1 {
         let a = sub(&pts[i], &pts[i - 1]);
         let b = sub(&pts[i + 1], &pts[i]);
         let (la, lb) = (norm(&a), norm(&b));
         if la <= 0.0 || lb <= 0.0 {
-            cuts.push(i);
+            degenerate[i] = true;
             continue;
         }
         let cos = (dot(&a, &b) / (la * lb)).clamp(-1.0, 1.0);
@@ -234,7 +238,35 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
             continue;
         }
         sharp[i] = true;
-        if !roundable(&blends[i], s) || !pays(&blends[i], path.planned.get(i - 1), s) {
+        alone[i] = roundable(&blends[i], s) && pays(&blends[i], path.planned.get(i - 1), s);
+    }
+    // Two sharp corners across a short leg, at least one of them too tight alone: a hairpin,
+    // rounded as one turn if it can be.
+    let mut pinned = vec![false; n];
+    let mut pins: Vec<hairpin::Hairpin> = Vec::new();
+    let mut i = 1;
+    while i + 2 < n {
+        if sharp[i] && sharp[i + 1] && !(alone[i] && alone[i + 1]) {
+            let fits = hairpin::find(
+                pts,
+                i,
+                BLEND_SHARE * s.tolerance_mm,
+                hairpin_min_radius(s),
+                hairpin_room(pts, i),
+            );
+            if let Some(pin) = fits {
+                pinned[i] = true;
+                pinned[i + 1] = true;
+                pins.push(pin);
+                i += 2;
+                continue;
+            }
+        }
+        i += 1;
+    }
+    let mut cuts = vec![0usize];
+    for i in 1..n - 1 {
+        if degenerate[i] || (sharp[i] && !alone[i] && !pinned[i]) {
             cuts.push(i);
             sharp[i] = false;
         }
@@ -246,7 +278,15 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
         let (a, b) = (w[0], w[1]);
         let piece = path.piece(a, b)?;
         let has_sharp = sharp.get(a + 1..b).is_some_and(|v| v.iter().any(|&x| x));
-        match smooth_piece(&piece, s, has_sharp) {
+        let here: Vec<hairpin::Hairpin> = pins
+            .iter()
+            .filter(|p| p.at > a && p.at < b)
+            .map(|p| hairpin::Hairpin {
+                at: p.at - a,
+                ..p.clone()
+            })
+            .collect();
+        match smooth_piece(&piece, s, has_sharp, &here) {
             Some(p) => {
                 changed = true;
                 out.points.extend(p.points);
@@ -301,8 +341,14 @@ fn pays(b: &blend::Blend, before: Option<&Profile>, s: &Settings) -> bool {
     on_fillet >= p.exit
 }
 
-/// One piece between kept corners.
-fn smooth_piece(path: &Path<'_>, s: &Settings, has_sharp: bool) -> Option<Smoothed> {
+/// One piece between kept corners, with its hairpins (`at` counted in the piece) as found with
+/// the full blend share of the tolerance.
+fn smooth_piece(
+    path: &Path<'_>,
+    s: &Settings,
+    has_sharp: bool,
+    pins: &[hairpin::Hairpin],
+) -> Option<Smoothed> {
     if path.pts.len() < 3 || !has_sharp {
         return None;
     }
@@ -311,7 +357,13 @@ fn smooth_piece(path: &Path<'_>, s: &Settings, has_sharp: bool) -> Option<Smooth
     let from_zero = Path { e: &e, ..*path };
     let mut share = BLEND_SHARE;
     for _ in 0..ATTEMPTS {
-        if let Some(mut r) = attempt(&from_zero, s, share * s.tolerance_mm) {
+        let tol = share * s.tolerance_mm;
+        let done = if pins.is_empty() {
+            attempt(&from_zero, path.pts, s, tol)
+        } else {
+            with_hairpins(&from_zero, s, tol, pins, share < BLEND_SHARE)
+        };
+        if let Some(mut r) = done {
             for x in &mut r.e {
                 *x += e0;
             }
@@ -322,8 +374,71 @@ fn smooth_piece(path: &Path<'_>, s: &Settings, has_sharp: bool) -> Option<Smooth
     None
 }
 
-/// Blend, fit, walk and check `path` (filament from 0) with blends within `blend_tol`.
-fn attempt(path: &Path<'_>, s: &Settings, blend_tol: f64) -> Option<Smoothed> {
+/// Smallest radius of a hairpin's arc: one the walk can follow in steps of at least the minimum
+/// step, each turning by less than its share of the critical angle (with 5 % to spare).
+fn hairpin_min_radius(s: &Settings) -> f64 {
+    1.05 * s.min_step_mm / (STEP_TURN_SHARE * s.critical_rad)
+}
+
+/// How far the arc of the hairpin at corners `i`, `i + 1` of `pts` may reach along its two
+/// long legs: [`blend::LEG_SHARE`] of a leg that ends the path, half that of one shared with
+/// another corner.
+fn hairpin_room(pts: &[[f64; 3]], i: usize) -> [f64; 2] {
+    let n = pts.len();
+    let room = |leg: usize, far_end: usize| {
+        let l = norm(&sub(&pts[leg + 1], &pts[leg]));
+        let shared = far_end != 0 && far_end + 1 != n;
+        blend::LEG_SHARE * l * if shared { 0.5 } else { 1.0 }
+    };
+    [room(i - 1, i - 1), room(i + 1, i + 2)]
+}
+
+/// [`attempt`] on `path` with its hairpins `pins` replaced by their arcs, checked against the
+/// original; with `again`, the arcs are found anew within the smaller `blend_tol`.
+fn with_hairpins(
+    path: &Path<'_>,
+    s: &Settings,
+    blend_tol: f64,
+    pins: &[hairpin::Hairpin],
+    again: bool,
+) -> Option<Smoothed> {
+    let pts = path.pts;
+    let found: Vec<hairpin::Hairpin>;
+    let pins = if again {
+        found = pins
+            .iter()
+            .map(|p| {
+                hairpin::find(
+                    pts,
+                    p.at,
+                    blend_tol,
+                    hairpin_min_radius(s),
+                    hairpin_room(pts, p.at),
+                )
+            })
+            .collect::<Option<_>>()?;
+        &found
+    } else {
+        pins
+    };
+    let sub = hairpin::substitute(pts, path.e, path.feed, path.planned, pins);
+    let replaced = Path {
+        pts: &sub.pts,
+        e: &sub.e,
+        feed: &sub.feed,
+        planned: &sub.planned,
+    };
+    attempt(&replaced, pts, s, blend_tol)
+}
+
+/// Blend, fit, walk `path` (filament from 0) with blends within `blend_tol`, and check the
+/// result against the polyline `original` (the same path, or the one it stands for).
+fn attempt(
+    path: &Path<'_>,
+    original: &[[f64; 3]],
+    s: &Settings,
+    blend_tol: f64,
+) -> Option<Smoothed> {
     let Path {
         pts,
         e,
@@ -361,12 +476,8 @@ fn attempt(path: &Path<'_>, s: &Settings, blend_tol: f64) -> Option<Smoothed> {
         *last = *pn;
     }
     // Both ways: the new path stays near the old, and the old is covered by the new.
-    let deviation = polyline_deviation(&points, pts, tol / 10.0, budget).max(polyline_deviation(
-        pts,
-        &points,
-        tol / 10.0,
-        budget,
-    ));
+    let deviation = polyline_deviation(&points, original, tol / 10.0, budget)
+        .max(polyline_deviation(original, &points, tol / 10.0, budget));
     if deviation.is_nan() || deviation > budget {
         return None;
     }

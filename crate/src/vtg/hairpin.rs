@@ -1,0 +1,348 @@
+//! Hairpins: two sharp corners joined by a short leg, rounded as one turn.
+//!
+//! Infill that zig-zags turns back at the end of each line in two corners a line spacing apart
+//! (lines at 45° and a connector along the wall: 45° then 135°; square to the wall: 90° and
+//! 90°). A fillet within the tolerance at each corner alone is far too tight to walk in steps
+//! the firmware keeps (at 135° and 0.1 mm, radius 0.05 mm; Marlin drops blocks under about
+//! 0.06 mm), so both corners would stay sharp. Taken together they are one turn of up to 180°
+//! across the line spacing: a circular arc tangent to the two long legs, of about half the
+//! spacing in radius (0.2 mm for 0.45 mm lines), bulging past the connector by no more than
+//! the tolerance, and that can be walked.
+//!
+//! The arc's centre is equidistant from the two legs' lines, on the inside of the turn, so it
+//! lies on one line (their bisector, or for parallel legs the midline); of the arcs with their
+//! centre on it, the one with the largest radius whose distance to the original polyline, both
+//! ways, stays within the tolerance is taken. It replaces the two corners and the connector by
+//! a fine polygon of the arc, which the rest of the pipeline blends, fits and walks like any
+//! other path.
+
+use super::bspline::{dot, norm, sub};
+use super::deviation::{point_polyline, polyline_deviation};
+
+/// Longest connector between the two corners of a hairpin, mm.
+pub const MAX_CONNECTOR_MM: f64 = 2.0;
+/// Smallest combined turn of a hairpin, rad (90°: below it the corners are separate turns).
+const MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_2;
+/// Largest combined turn, rad (200°: legs that diverge a little past parallel).
+const MAX_TURN_RAD: f64 = 200.0 * std::f64::consts::PI / 180.0;
+/// Turn of one side of the polygon that stands for the arc, rad (15°: its sagitta is 0.009 r,
+/// and the blends at its corners round it back towards the circle).
+const POLYGON_TURN_RAD: f64 = 15.0 * std::f64::consts::PI / 180.0;
+/// Centres tried along the bisector on the coarse pass, each side of the closest one.
+const COARSE_STEPS: i32 = 16;
+
+/// The arc a hairpin is rounded to.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Hairpin {
+    /// Index of the first of the two corners (the second is the next point).
+    pub at: usize,
+    /// Radius, mm.
+    pub radius_mm: f64,
+    /// Points of the arc, from where it leaves the first long leg to where it meets the second.
+    pub arc: Vec<[f64; 3]>,
+    /// Distance from the first corner back along the first leg to where the arc starts, mm
+    /// (negative: on the leg's extension past the corner).
+    pub before_mm: f64,
+    /// Distance from the second corner along the second leg to where the arc ends, mm.
+    pub after_mm: f64,
+}
+
+fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
+    let l = norm(&v);
+    (l > 1e-12).then(|| [v[0] / l, v[1] / l, v[2] / l])
+}
+
+fn cross_z(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[1] - a[1] * b[0]
+}
+
+/// The hairpin at corners `i` and `i + 1` of `pts`, if the two corners turn the same way by 90°
+/// to 200° together across a connector of at most [`MAX_CONNECTOR_MM`], lie in one plane of
+/// constant Z, and an arc of radius at least `min_radius_mm` rounds them within `tolerance_mm`
+/// starting no more than `room_mm[0]` before corner `i` and ending no more than `room_mm[1]`
+/// after corner `i + 1`.
+pub fn find(
+    pts: &[[f64; 3]],
+    i: usize,
+    tolerance_mm: f64,
+    min_radius_mm: f64,
+    room_mm: [f64; 2],
+) -> Option<Hairpin> {
+    let (p0, v1, v2, p3) = (
+        *pts.get(i.checked_sub(1)?)?,
+        *pts.get(i)?,
+        *pts.get(i + 1)?,
+        *pts.get(i + 2)?,
+    );
+    let z = v1[2];
+    if [p0, v2, p3].iter().any(|p| (p[2] - z).abs() > 1e-9) {
+        return None;
+    }
+    let a = unit(sub(&v1, &p0))?;
+    let b = unit(sub(&p3, &v2))?;
+    let connector = sub(&v2, &v1);
+    let c_len = norm(&connector);
+    if !(c_len > 0.0 && c_len <= MAX_CONNECTOR_MM) {
+        return None;
+    }
+    let c = unit(connector)?;
+    // Both corners turn the same way.
+    let (t1, t2) = (cross_z(&a, &c), cross_z(&c, &b));
+    if t1 * t2 <= 0.0 {
+        return None;
+    }
+    let side = t1.signum();
+    let mut turn = (side * cross_z(&a, &b)).atan2(dot(&a, &b));
+    if turn < 0.0 {
+        turn += 2.0 * std::f64::consts::PI;
+    }
+    if !(MIN_TURN_RAD..=MAX_TURN_RAD).contains(&turn) {
+        return None;
+    }
+    // Normals towards the inside of the turn; the centre `C` has n_a·(C − v1) = n_b·(C − v2)
+    // = r > 0, a line m·C = k.
+    let (na, nb) = (
+        [-a[1] * side, a[0] * side, 0.0],
+        [-b[1] * side, b[0] * side, 0.0],
+    );
+    let m = sub(&na, &nb);
+    let m2 = dot(&m, &m);
+    if m2 < 1e-12 {
+        return None;
+    }
+    let k = dot(&na, &v1) - dot(&nb, &v2);
+    let s0 = (k - dot(&m, &v1)) / m2;
+    let c0 = [v1[0] + m[0] * s0, v1[1] + m[1] * s0, z];
+    let ml = m2.sqrt();
+    let along = [-m[1] / ml, m[0] / ml, 0.0];
+    // The original around the hairpin, and the same stretch with the arc in place.
+    let (la, lb) = (norm(&sub(&v1, &p0)), norm(&sub(&p3, &v2)));
+    let (room_a, room_b) = (room_mm[0].min(la), room_mm[1].min(lb));
+    let pa = [v1[0] - a[0] * room_a, v1[1] - a[1] * room_a, z];
+    let pb = [v2[0] + b[0] * room_b, v2[1] + b[1] * room_b, z];
+    let original = [pa, v1, v2, pb];
+    let segments = (turn / POLYGON_TURN_RAD).ceil().max(2.0) as usize;
+    let candidate =
+        |t: f64| -> Option<(f64, Hairpin)> {
+            let centre = [c0[0] + along[0] * t, c0[1] + along[1] * t, z];
+            let r = dot(&na, &sub(&centre, &v1));
+            if !(r >= min_radius_mm && r.is_finite()) {
+                return None;
+            }
+            let ta = [centre[0] - na[0] * r, centre[1] - na[1] * r, z];
+            let tb = [centre[0] - nb[0] * r, centre[1] - nb[1] * r, z];
+            let before = dot(&a, &sub(&v1, &ta));
+            let after = dot(&b, &sub(&tb, &v2));
+            if before > room_a || after > room_b {
+                return None;
+            }
+            // The arc from ta, its radius vector turned step by step.
+            let u = sub(&ta, &centre);
+            let mut arc = Vec::with_capacity(segments + 1);
+            for j in 0..=segments {
+                let phi = side * turn * j as f64 / segments as f64;
+                let (sin, cos) = (crate::math::sin(phi), crate::math::cos(phi));
+                arc.push([
+                    centre[0] + u[0] * cos - u[1] * sin,
+                    centre[1] + u[0] * sin + u[1] * cos,
+                    z,
+                ]);
+            }
+            let mut new = Vec::with_capacity(arc.len() + 2);
+            new.push(pa);
+            new.extend_from_slice(&arc);
+            new.push(pb);
+            // Points the full measurement below would take anyway, first: the middle of the arc
+            // and the two corners (most centres fail on one of them).
+            if point_polyline(&arc[segments / 2], &original) > tolerance_mm
+                || point_polyline(&v1, &new) > tolerance_mm
+                || point_polyline(&v2, &new) > tolerance_mm
+            {
+                return None;
+            }
+            let step = tolerance_mm / 10.0;
+            let dev = polyline_deviation(&new, &original, step, tolerance_mm)
+                .max(polyline_deviation(&original, &new, step, tolerance_mm));
+            (dev <= tolerance_mm).then_some((
+                r,
+                Hairpin {
+                    at: i,
+                    radius_mm: r,
+                    arc,
+                    before_mm: before,
+                    after_mm: after,
+                },
+            ))
+        };
+    // Coarse then fine: centres every `span / COARSE_STEPS` either side of the one closest to
+    // the first corner, then around the best of those.
+    let span = 2.0 * (c_len + tolerance_mm + min_radius_mm);
+    let coarse = span / COARSE_STEPS as f64;
+    let best = |from: f64, step: f64, n: i32| {
+        (-n..=n)
+            .filter_map(|j| candidate(from + step * j as f64).map(|c| (j, c)))
+            .max_by(|x, y| x.1 .0.total_cmp(&y.1 .0).then(y.0.abs().cmp(&x.0.abs())))
+            .map(|(j, c)| (from + step * j as f64, c))
+    };
+    let (t, first) = best(0.0, coarse, COARSE_STEPS)?;
+    Some(best(t, coarse / 8.0, 8).map_or(first, |(_, c)| c).1)
+}
+
+/// A path with its hairpins replaced by their arcs: points, filament at each, and the feed and
+/// planned profile of each segment (those of the original segment its middle stands for).
+#[derive(Debug, Clone, Default)]
+pub struct Substituted {
+    /// The points.
+    pub pts: Vec<[f64; 3]>,
+    /// Filament pushed from the path start to each point.
+    pub e: Vec<f64>,
+    /// Feed of each segment, mm/s.
+    pub feed: Vec<f64>,
+    /// Planned profile of each segment (empty if the original had none).
+    pub planned: Vec<crate::plan::Profile>,
+}
+
+/// `pts` (filament `e`, feeds `feed`, profiles `planned`) with each of `pins` (sorted, apart)
+/// in place of its two corners. Each arc point stands for the original point at the same
+/// fraction of the stretch the arc replaces, so the filament pushed up to it is read off the
+/// original and the path's total is unchanged.
+pub fn substitute(
+    pts: &[[f64; 3]],
+    e: &[f64],
+    feed: &[f64],
+    planned: &[crate::plan::Profile],
+    pins: &[Hairpin],
+) -> Substituted {
+    let mut arc_len = Vec::with_capacity(pts.len());
+    arc_len.push(0.0);
+    for w in pts.windows(2) {
+        arc_len.push(arc_len[arc_len.len() - 1] + norm(&sub(&w[1], &w[0])));
+    }
+    let segment = |u: f64| {
+        arc_len
+            .partition_point(|&a| a <= u)
+            .clamp(1, feed.len().max(1))
+            - 1
+    };
+    let e_at = |u: f64| {
+        let k = segment(u);
+        let (a0, a1) = (arc_len[k], arc_len[k + 1]);
+        let t = if a1 > a0 {
+            ((u - a0) / (a1 - a0)).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        e[k] + (e[k + 1] - e[k]) * t
+    };
+    let mut out = Substituted::default();
+    let mut at = Vec::with_capacity(pts.len()); // original arc length of each new point
+    let mut next = 0usize;
+    for pin in pins {
+        for k in next..pin.at.min(pts.len()) {
+            out.pts.push(pts[k]);
+            out.e.push(e[k]);
+            at.push(arc_len[k]);
+        }
+        let u0 = arc_len[pin.at] - pin.before_mm.max(0.0);
+        let u1 = arc_len[pin.at + 1] + pin.after_mm.max(0.0);
+        let n = (pin.arc.len() - 1).max(1) as f64;
+        for (j, p) in pin.arc.iter().enumerate() {
+            let u = u0 + (u1 - u0) * j as f64 / n;
+            out.pts.push(*p);
+            out.e.push(e_at(u));
+            at.push(u);
+        }
+        next = pin.at + 2;
+    }
+    for k in next..pts.len() {
+        out.pts.push(pts[k]);
+        out.e.push(e[k]);
+        at.push(arc_len[k]);
+    }
+    for w in at.windows(2) {
+        let k = segment(0.5 * (w[0] + w[1]));
+        out.feed.push(feed[k]);
+        if let Some(p) = planned.get(k) {
+            out.planned.push(*p);
+        }
+    }
+    if out.planned.len() != out.feed.len() {
+        out.planned.clear();
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vtg::deviation::polyline_deviation;
+
+    /// Two infill lines 0.45 mm apart joined square to them: 90° and 90°.
+    fn square_u() -> Vec<[f64; 3]> {
+        vec![
+            [10.0, 0.0, 0.2],
+            [0.0, 0.0, 0.2],
+            [0.0, 0.45, 0.2],
+            [10.0, 0.45, 0.2],
+        ]
+    }
+
+    #[test]
+    fn a_square_u_turn_becomes_a_half_circle_across_the_spacing() {
+        let p = square_u();
+        let h = find(&p, 1, 0.08, 0.13, [4.0, 4.0]).expect("hairpin");
+        // Radius half the spacing (the legs are parallel), a half turn.
+        assert!((h.radius_mm - 0.225).abs() < 1e-9, "{}", h.radius_mm);
+        let (first, last) = (h.arc[0], h.arc[h.arc.len() - 1]);
+        assert!(first[1].abs() < 1e-9 && (last[1] - 0.45).abs() < 1e-9);
+        assert!((first[0] - last[0]).abs() < 1e-9);
+        // Within the tolerance of the original both ways, and every arc point on the circle.
+        let mut new = vec![p[0]];
+        new.extend_from_slice(&h.arc);
+        new.push(p[3]);
+        let d =
+            polyline_deviation(&new, &p, 1e-3, 0.0).max(polyline_deviation(&p, &new, 1e-3, 0.0));
+        assert!(d <= 0.08 + 1e-3, "{d}");
+        let centre = [first[0], 0.225, 0.2];
+        for q in &h.arc {
+            assert!((norm(&sub(q, &centre)) - 0.225).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn no_hairpin_where_the_arc_would_be_too_tight_or_the_corners_turn_apart() {
+        let p = square_u();
+        // Radius 0.225 is all the spacing allows.
+        assert!(find(&p, 1, 0.08, 0.3, [4.0, 4.0]).is_none());
+        // A zig-zag step (left then right) is no hairpin.
+        let z = [
+            [0.0, 0.0, 0.2],
+            [5.0, 0.0, 0.2],
+            [5.0, 0.45, 0.2],
+            [10.0, 0.45, 0.2],
+        ];
+        assert!(find(&z, 1, 0.08, 0.1, [4.0, 4.0]).is_none());
+        // Not in one plane.
+        let mut q = square_u();
+        q[2][2] = 0.4;
+        assert!(find(&q, 1, 0.08, 0.1, [4.0, 4.0]).is_none());
+    }
+
+    #[test]
+    fn the_arc_keeps_the_filament_of_the_stretch_it_replaces() {
+        let p = square_u();
+        let e = [0.0, 0.4, 0.418, 0.818];
+        let feed = [40.0, 20.0, 40.0];
+        let h = find(&p, 1, 0.08, 0.13, [4.0, 4.0]).expect("hairpin");
+        let s = substitute(&p, &e, &feed, &[], std::slice::from_ref(&h));
+        assert_eq!(s.pts.len(), 2 + h.arc.len());
+        assert_eq!(s.feed.len() + 1, s.pts.len());
+        assert_eq!(*s.e.last().unwrap(), 0.818);
+        assert!(s.e.windows(2).all(|w| w[1] >= w[0]));
+        // The arc starts where the original had pushed 0.4 − (what `before` mm of the first
+        // leg carries) and its middle segment takes the connector's feed.
+        let expect = 0.4 - 0.04 * h.before_mm;
+        assert!((s.e[1] - expect).abs() < 1e-12, "{} {}", s.e[1], expect);
+        assert_eq!(s.feed[h.arc.len() / 2], 20.0);
+    }
+}
