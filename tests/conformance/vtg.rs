@@ -112,13 +112,14 @@ fn options(tolerance_mm: f64, limit_feed: bool) -> VtgOptions {
 const TURNING_EXCEPTIONS: [(&str, &str); 4] = [
     (
         "prusaslicer-2.5.0_vase_marlin-legacy_absE.gcode",
-        "most sharp turns are infill hairpins of 135° and more: no fillet within 0.1 mm rounds \
-         them in steps of at least Marlin's 0.06 mm minimum segment",
+        "most sharp turns are 45° + 135° infill hairpins with staggered line ends: the arc \
+         across one needs 0.13 mm, and no fillet within 0.1 mm rounds the 135° corner alone \
+         in steps of at least Marlin's 0.06 mm minimum segment",
     ),
     (
         "prusaslicer-2.7.4_screw_arcfit.gcode",
         "arc-fitted: corners between a line and a G2/G3 arc are not rewritten, and the \
-         remaining ones are mostly hairpins",
+         remaining ones are mostly staggered hairpins (as the vase above)",
     ),
     (
         "crealityprint-4.3.4_k1_benchy_m83_arcs.gcode",
