@@ -233,6 +233,24 @@ pub(crate) fn lerp(a: &[f64; 3], b: &[f64; 3], t: f64) -> [f64; 3] {
     ]
 }
 
+/// Arc length of the polyline `pts` at each of its points (from 0).
+pub(crate) fn arc_lengths(pts: &[[f64; 3]]) -> Vec<f64> {
+    let mut arc = Vec::with_capacity(pts.len());
+    let mut s = 0.0;
+    arc.push(s);
+    for w in pts.windows(2) {
+        s += norm(&sub(&w[1], &w[0]));
+        arc.push(s);
+    }
+    arc
+}
+
+/// The segment of a polyline of `segments` segments (arc lengths `arc` at its points) that arc
+/// length `u` falls in (the first or the last beyond the ends).
+pub(crate) fn segment_at(arc: &[f64], u: f64, segments: usize) -> usize {
+    arc.partition_point(|&a| a <= u).clamp(1, segments.max(1)) - 1
+}
+
 pub(crate) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],

@@ -211,6 +211,12 @@ impl Grid {
     }
 }
 
+/// The larger of [`polyline_deviation`] from `a` to `b` and from `b` to `a`: `a` stays near
+/// `b`, and `b` is covered by `a` (a path that cuts a corner short fails the second).
+pub fn both_ways(a: &[[f64; 3]], b: &[[f64; 3]], step: f64, accept: f64) -> f64 {
+    polyline_deviation(a, b, step, accept).max(polyline_deviation(b, a, step, accept))
+}
+
 /// Largest distance from any printing move of `output` to the printing moves of the same layer
 /// of `original`, sampled every `step` mm: the whole-file check, reading both files as moves
 /// (nothing of the optimiser is used). Moves identical in both are skipped cheaply by the grid

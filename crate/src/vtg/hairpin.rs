@@ -16,8 +16,8 @@
 //! a fine polygon of the arc, which the rest of the pipeline blends, fits and walks like any
 //! other path.
 
-use super::bspline::{dot, norm, sub};
-use super::deviation::{point_polyline, polyline_deviation};
+use super::bspline::{arc_lengths, cross, dot, norm, segment_at, sub};
+use super::deviation::{both_ways, point_polyline};
 
 /// Longest connector between the two corners of a hairpin, mm.
 pub const MAX_CONNECTOR_MM: f64 = 2.0;
@@ -47,13 +47,16 @@ pub struct Hairpin {
     pub after_mm: f64,
 }
 
+/// `v / |v|`, or `None` for a tiny vector. (Divides: `orient::vec3::normalize` multiplies by
+/// the reciprocal, which rounds differently and would move the arcs in the last bit.)
 fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
     let l = norm(&v);
     (l > 1e-12).then(|| [v[0] / l, v[1] / l, v[2] / l])
 }
 
+/// The Z component of `a × b` (the turn's sense, seen from above).
 fn cross_z(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[1] - a[1] * b[0]
+    cross(a, b)[2]
 }
 
 /// The hairpin at corners `i` and `i + 1` of `pts`, if the two corners turn the same way by 90°
@@ -122,58 +125,52 @@ pub fn find(
     let pb = [v2[0] + b[0] * room_b, v2[1] + b[1] * room_b, z];
     let original = [pa, v1, v2, pb];
     let segments = (turn / POLYGON_TURN_RAD).ceil().max(2.0) as usize;
-    let candidate =
-        |t: f64| -> Option<(f64, Hairpin)> {
-            let centre = [c0[0] + along[0] * t, c0[1] + along[1] * t, z];
-            let r = dot(&na, &sub(&centre, &v1));
-            if !(r >= min_radius_mm && r.is_finite()) {
-                return None;
-            }
-            let ta = [centre[0] - na[0] * r, centre[1] - na[1] * r, z];
-            let tb = [centre[0] - nb[0] * r, centre[1] - nb[1] * r, z];
-            let before = dot(&a, &sub(&v1, &ta));
-            let after = dot(&b, &sub(&tb, &v2));
-            if before > room_a || after > room_b {
-                return None;
-            }
-            // The arc from ta, its radius vector turned step by step.
-            let u = sub(&ta, &centre);
-            let mut arc = Vec::with_capacity(segments + 1);
-            for j in 0..=segments {
-                let phi = side * turn * j as f64 / segments as f64;
-                let (sin, cos) = (crate::math::sin(phi), crate::math::cos(phi));
-                arc.push([
-                    centre[0] + u[0] * cos - u[1] * sin,
-                    centre[1] + u[0] * sin + u[1] * cos,
-                    z,
-                ]);
-            }
-            let mut new = Vec::with_capacity(arc.len() + 2);
-            new.push(pa);
-            new.extend_from_slice(&arc);
-            new.push(pb);
-            // Points the full measurement below would take anyway, first: the middle of the arc
-            // and the two corners (most centres fail on one of them).
-            if point_polyline(&arc[segments / 2], &original) > tolerance_mm
-                || point_polyline(&v1, &new) > tolerance_mm
-                || point_polyline(&v2, &new) > tolerance_mm
-            {
-                return None;
-            }
-            let step = tolerance_mm / 10.0;
-            let dev = polyline_deviation(&new, &original, step, tolerance_mm)
-                .max(polyline_deviation(&original, &new, step, tolerance_mm));
-            (dev <= tolerance_mm).then_some((
-                r,
-                Hairpin {
-                    at: i,
-                    radius_mm: r,
-                    arc,
-                    before_mm: before,
-                    after_mm: after,
-                },
-            ))
-        };
+    let candidate = |t: f64| -> Option<Hairpin> {
+        let centre = [c0[0] + along[0] * t, c0[1] + along[1] * t, z];
+        let r = dot(&na, &sub(&centre, &v1));
+        if !(r >= min_radius_mm && r.is_finite()) {
+            return None;
+        }
+        let ta = [centre[0] - na[0] * r, centre[1] - na[1] * r, z];
+        let tb = [centre[0] - nb[0] * r, centre[1] - nb[1] * r, z];
+        let before = dot(&a, &sub(&v1, &ta));
+        let after = dot(&b, &sub(&tb, &v2));
+        if before > room_a || after > room_b {
+            return None;
+        }
+        // The arc from ta, its radius vector turned step by step.
+        let u = sub(&ta, &centre);
+        let mut arc = Vec::with_capacity(segments + 1);
+        for j in 0..=segments {
+            let phi = side * turn * j as f64 / segments as f64;
+            let (sin, cos) = (crate::math::sin(phi), crate::math::cos(phi));
+            arc.push([
+                centre[0] + u[0] * cos - u[1] * sin,
+                centre[1] + u[0] * sin + u[1] * cos,
+                z,
+            ]);
+        }
+        let mut new = Vec::with_capacity(arc.len() + 2);
+        new.push(pa);
+        new.extend_from_slice(&arc);
+        new.push(pb);
+        // Points the full measurement below would take anyway, first: the middle of the arc
+        // and the two corners (most centres fail on one of them).
+        if point_polyline(&arc[segments / 2], &original) > tolerance_mm
+            || point_polyline(&v1, &new) > tolerance_mm
+            || point_polyline(&v2, &new) > tolerance_mm
+        {
+            return None;
+        }
+        let step = tolerance_mm / 10.0;
+        (both_ways(&new, &original, step, tolerance_mm) <= tolerance_mm).then_some(Hairpin {
+            at: i,
+            radius_mm: r,
+            arc,
+            before_mm: before,
+            after_mm: after,
+        })
+    };
     // Coarse then fine: centres every `span / COARSE_STEPS` either side of the one closest to
     // the first corner, then around the best of those.
     let span = 2.0 * (c_len + tolerance_mm + min_radius_mm);
@@ -181,11 +178,15 @@ pub fn find(
     let best = |from: f64, step: f64, n: i32| {
         (-n..=n)
             .filter_map(|j| candidate(from + step * j as f64).map(|c| (j, c)))
-            .max_by(|x, y| x.1 .0.total_cmp(&y.1 .0).then(y.0.abs().cmp(&x.0.abs())))
+            .max_by(|x, y| {
+                (x.1.radius_mm)
+                    .total_cmp(&y.1.radius_mm)
+                    .then(y.0.abs().cmp(&x.0.abs()))
+            })
             .map(|(j, c)| (from + step * j as f64, c))
     };
     let (t, first) = best(0.0, coarse, COARSE_STEPS)?;
-    Some(best(t, coarse / 8.0, 8).map_or(first, |(_, c)| c).1)
+    Some(best(t, coarse / 8.0, 8).map_or(first, |(_, c)| c))
 }
 
 /// A path with its hairpins replaced by their arcs: points, filament at each, and the feed and
@@ -213,17 +214,8 @@ pub fn substitute(
     planned: &[crate::plan::Profile],
     pins: &[Hairpin],
 ) -> Substituted {
-    let mut arc_len = Vec::with_capacity(pts.len());
-    arc_len.push(0.0);
-    for w in pts.windows(2) {
-        arc_len.push(arc_len[arc_len.len() - 1] + norm(&sub(&w[1], &w[0])));
-    }
-    let segment = |u: f64| {
-        arc_len
-            .partition_point(|&a| a <= u)
-            .clamp(1, feed.len().max(1))
-            - 1
-    };
+    let arc_len = arc_lengths(pts);
+    let segment = |u: f64| segment_at(&arc_len, u, feed.len());
     let e_at = |u: f64| {
         let k = segment(u);
         let (a0, a1) = (arc_len[k], arc_len[k + 1]);
@@ -275,7 +267,7 @@ pub fn substitute(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::vtg::deviation::polyline_deviation;
+    use crate::vtg::deviation::both_ways;
 
     /// Two infill lines 0.45 mm apart joined square to them: 90° and 90°.
     fn square_u() -> Vec<[f64; 3]> {
@@ -300,8 +292,7 @@ mod tests {
         let mut new = vec![p[0]];
         new.extend_from_slice(&h.arc);
         new.push(p[3]);
-        let d =
-            polyline_deviation(&new, &p, 1e-3, 0.0).max(polyline_deviation(&p, &new, 1e-3, 0.0));
+        let d = both_ways(&new, &p, 1e-3, 0.0);
         assert!(d <= 0.08 + 1e-3, "{d}");
         let centre = [first[0], 0.225, 0.2];
         for q in &h.arc {

@@ -208,16 +208,19 @@ pub fn rewrite(
         }
     }
     pay_from_savings(&mut dearer, saved);
-    for outcome in &dearer {
+    let mut paid_any = false;
+    for outcome in dearer {
         if outcome.paid {
             out.add(&outcome.part);
             out.paid_paths += 1;
+            edits.extend(outcome.edits);
+            paid_any = true;
         } else {
             out.kept_for_time += 1;
         }
     }
-    if dearer.iter().any(|o| o.paid) {
-        edits.extend(dearer.into_iter().filter(|o| o.paid).flat_map(|o| o.edits));
+    if paid_any {
+        // Paid rewrites come after the others: back into line order.
         edits.sort_unstable_by_key(|e| e.line);
     }
     out.output = apply_edits(input, &edits);
@@ -329,20 +332,16 @@ fn path_end(moves: &[PathMove], sources: &[MoveSource], i: usize) -> Option<usiz
 }
 
 fn has_sharp_corner(run: &[PathMove], cos_critical: f64) -> bool {
-    run.windows(2).any(|w| {
-        let a = [
-            w[0].to[0] - w[0].from[0],
-            w[0].to[1] - w[0].from[1],
-            w[0].to[2] - w[0].from[2],
-        ];
-        let b = [
-            w[1].to[0] - w[1].from[0],
-            w[1].to[1] - w[1].from[1],
-            w[1].to[2] - w[1].from[2],
-        ];
-        let (la, lb) = (super::bspline::norm(&a), super::bspline::norm(&b));
-        la > 0.0 && lb > 0.0 && super::bspline::dot(&a, &b) / (la * lb) < cos_critical
-    })
+    let xyz = |m: &PathMove| [0, 1, 2].map(|k| m.to[k] - m.from[k]);
+    run.windows(2)
+        .any(|w| is_sharp(&xyz(&w[0]), &xyz(&w[1]), cos_critical))
+}
+
+/// Whether the turn from direction `a` to direction `b` (neither normalised) is above the
+/// critical angle (cosine `cos_critical`); a zero-length side turns nothing.
+fn is_sharp(a: &[f64; 3], b: &[f64; 3], cos_critical: f64) -> bool {
+    let (la, lb) = (norm(a), norm(b));
+    la > 0.0 && lb > 0.0 && dot(a, b) / (la * lb) < cos_critical
 }
 
 /// The X/Y acceleration ceiling of `limits` (`M201`, the lower of the two axes), if it is a
@@ -546,9 +545,8 @@ fn rewrite_path(
         _ => {}
     }
     let cos_critical = crate::math::cos(settings.critical_rad);
-    let removed = sharp_turns(&pts, cos_critical).saturating_sub(sharp_turns_after(
-        pts[0],
-        &written.points,
+    let removed = sharp_turns(&pts, cos_critical).saturating_sub(sharp_turns(
+        std::iter::once(&pts[0]).chain(&written.points),
         cos_critical,
     ));
     let out = &mut part;
@@ -644,23 +642,18 @@ fn rewrite_path(
     })
 }
 
-/// Turns above the critical angle (cosine `cos_critical`) along the polyline `pts`.
-fn sharp_turns(pts: &[[f64; 3]], cos_critical: f64) -> usize {
-    pts.windows(3)
-        .filter(|w| {
-            let (a, b) = (sub(&w[1], &w[0]), sub(&w[2], &w[1]));
-            let (la, lb) = (norm(&a), norm(&b));
-            la > 0.0 && lb > 0.0 && dot(&a, &b) / (la * lb) < cos_critical
-        })
-        .count()
-}
-
-/// [`sharp_turns`] of the polyline from `start` through `points`.
-fn sharp_turns_after(start: [f64; 3], points: &[[f64; 3]], cos_critical: f64) -> usize {
-    let mut all = Vec::with_capacity(points.len() + 1);
-    all.push(start);
-    all.extend_from_slice(points);
-    sharp_turns(&all, cos_critical)
+/// Turns above the critical angle (cosine `cos_critical`) along the polyline through `pts`.
+fn sharp_turns<'a>(pts: impl IntoIterator<Item = &'a [f64; 3]>, cos_critical: f64) -> usize {
+    let mut pts = pts.into_iter();
+    let (Some(mut p0), Some(mut p1)) = (pts.next(), pts.next()) else {
+        return 0;
+    };
+    let mut count = 0;
+    for p2 in pts {
+        count += usize::from(is_sharp(&sub(p1, p0), &sub(p2, p1), cos_critical));
+        (p0, p1) = (p1, p2);
+    }
+    count
 }
 
 #[cfg(test)]

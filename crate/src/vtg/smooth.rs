@@ -8,8 +8,8 @@
 //! path that cannot be rounded within the tolerance is kept as it was.
 
 use super::blend;
-use super::bspline::{dot, lerp, norm, sub};
-use super::deviation::polyline_deviation;
+use super::bspline::{arc_lengths, dot, lerp, norm, segment_at, sub};
+use super::deviation::both_ways;
 use super::fit::fit;
 use super::hairpin;
 use super::kinematics::KinematicLimits;
@@ -247,14 +247,7 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
     let mut i = 1;
     while i + 2 < n {
         if sharp[i] && sharp[i + 1] && !(alone[i] && alone[i + 1]) {
-            let fits = hairpin::find(
-                pts,
-                i,
-                BLEND_SHARE * s.tolerance_mm,
-                hairpin_min_radius(s),
-                hairpin_room(pts, i),
-            );
-            if let Some(pin) = fits {
+            if let Some(pin) = find_hairpin(pts, i, BLEND_SHARE * s.tolerance_mm, s) {
                 pinned[i] = true;
                 pinned[i + 1] = true;
                 pins.push(pin);
@@ -374,23 +367,25 @@ fn smooth_piece(
     None
 }
 
-/// Smallest radius of a hairpin's arc: one the walk can follow in steps of at least the minimum
-/// step, each turning by less than its share of the critical angle (with 5 % to spare).
-fn hairpin_min_radius(s: &Settings) -> f64 {
-    1.05 * s.min_step_mm / (STEP_TURN_SHARE * s.critical_rad)
-}
-
-/// How far the arc of the hairpin at corners `i`, `i + 1` of `pts` may reach along its two
-/// long legs: [`blend::LEG_SHARE`] of a leg that ends the path, half that of one shared with
-/// another corner.
-fn hairpin_room(pts: &[[f64; 3]], i: usize) -> [f64; 2] {
+/// [`hairpin::find`] at corners `i`, `i + 1` of `pts` within `blend_tol`, for an arc the walk
+/// can follow in steps of at least the minimum step each turning by less than its share of the
+/// critical angle (with 5 % to spare), reaching along each long leg [`blend::LEG_SHARE`] of it
+/// where the leg ends the path and half that where another corner shares it.
+fn find_hairpin(
+    pts: &[[f64; 3]],
+    i: usize,
+    blend_tol: f64,
+    s: &Settings,
+) -> Option<hairpin::Hairpin> {
     let n = pts.len();
     let room = |leg: usize, far_end: usize| {
-        let l = norm(&sub(&pts[leg + 1], &pts[leg]));
+        let l = norm(&sub(pts.get(leg + 1)?, pts.get(leg)?));
         let shared = far_end != 0 && far_end + 1 != n;
-        blend::LEG_SHARE * l * if shared { 0.5 } else { 1.0 }
+        Some(blend::LEG_SHARE * l * if shared { 0.5 } else { 1.0 })
     };
-    [room(i - 1, i - 1), room(i + 1, i + 2)]
+    let min_radius = 1.05 * s.min_step_mm / (STEP_TURN_SHARE * s.critical_rad);
+    let rooms = [room(i.checked_sub(1)?, i - 1)?, room(i + 1, i + 2)?];
+    hairpin::find(pts, i, blend_tol, min_radius, rooms)
 }
 
 /// [`attempt`] on `path` with its hairpins `pins` replaced by their arcs, checked against the
@@ -407,15 +402,7 @@ fn with_hairpins(
     let pins = if again {
         found = pins
             .iter()
-            .map(|p| {
-                hairpin::find(
-                    pts,
-                    p.at,
-                    blend_tol,
-                    hairpin_min_radius(s),
-                    hairpin_room(pts, p.at),
-                )
-            })
+            .map(|p| find_hairpin(pts, p.at, blend_tol, s))
             .collect::<Option<_>>()?;
         &found
     } else {
@@ -449,11 +436,7 @@ fn attempt(
     // Room for the 3-decimal rounding of written coordinates.
     let budget = tol - 0.001;
     let k_cr = s.limits.critical_curvature();
-    let mut arc = Vec::with_capacity(pts.len());
-    arc.push(0.0);
-    for w in pts.windows(2) {
-        arc.push(arc[arc.len() - 1] + norm(&sub(&w[1], &w[0])));
-    }
+    let arc = arc_lengths(pts);
     let blends = blend::plan(pts, blend_tol, k_cr);
     let (data, params) = blend::samples(pts, &blends, STRAIGHT_SPACING_MM);
     let f = fit(&data, &params, FIT_SHARE * tol)?;
@@ -476,8 +459,7 @@ fn attempt(
         *last = *pn;
     }
     // Both ways: the new path stays near the old, and the old is covered by the new.
-    let deviation = polyline_deviation(&points, original, tol / 10.0, budget)
-        .max(polyline_deviation(original, &points, tol / 10.0, budget));
+    let deviation = both_ways(&points, original, tol / 10.0, budget);
     if deviation.is_nan() || deviation > budget {
         return None;
     }
@@ -488,7 +470,7 @@ fn attempt(
         ..Smoothed::default()
     };
     // The original segment at arc length `u`.
-    let segment = |u: f64| arc.partition_point(|&a| a <= u).clamp(1, feed.len()) - 1;
+    let segment = |u: f64| segment_at(&arc, u, feed.len());
     // The original's planned speed at arc length `u`.
     let original_speed = |u: f64| -> f64 {
         let seg = segment(u);
