@@ -133,14 +133,6 @@ const TURNING_EXCEPTIONS: [(&str, &str); 4] = [
     ),
 ];
 
-/// Files whose simulated mean deviation does not fall, and why (bounded here).
-const DEVIATION_EXCEPTIONS: [(&str, &str, f64); 1] = [(
-    "prusaslicer-2.5.0_thesis_triangle.gcode",
-    "its 60° perimeter corners, rounded, are run by eq. 29 at about twice the speed the \
-     firmware took the sharp ones; the mean rises by about 1 %",
-    2.0,
-)];
-
 /// Runs `vtg` with the defaults on each file and checks every criterion; returns the table rows.
 fn check_all(files: &[(String, PathBuf)]) {
     let mut failures = Vec::new();
@@ -183,11 +175,7 @@ fn check_all(files: &[(String, PathBuf)]) {
         if o.time_pct.is_nan() || o.time_pct > 1.0 {
             fail(format!("time {:+.2} %", o.time_pct));
         }
-        let bound = DEVIATION_EXCEPTIONS
-            .iter()
-            .find(|(n, _, _)| n == name)
-            .map_or(0.0, |(_, _, b)| *b);
-        if o.mean_deviation_pct.is_nan() || o.mean_deviation_pct >= bound {
+        if o.mean_deviation_pct.is_nan() || o.mean_deviation_pct >= 0.0 {
             fail(format!(
                 "simulated mean deviation {:+.1} %",
                 o.mean_deviation_pct
@@ -238,6 +226,43 @@ fn corpus_first_half_meets_the_criteria() {
 #[test]
 fn corpus_second_half_meets_the_criteria() {
     check_all(&corpus_files(1));
+}
+
+/// The triangle's 75° infill corners, rounded at eq. 29's speeds, leave the machine ringing a
+/// little more than the sharp ones did; the dynamics model sees it, and `vtg` rewrites the file
+/// again from faster speeds, which ring less, and keeps that.
+#[test]
+fn the_dynamics_model_closes_the_loop() {
+    let bytes = std::fs::read(fixtures_dir().join("gcode/prusaslicer-2.5.0_thesis_triangle.gcode"))
+        .unwrap();
+    let open = vtg(
+        &bytes,
+        &VtgOptions {
+            dynamics: false,
+            ..VtgOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(open.paths.feed_cap_scale, 1.0);
+    let model = quietpath::dynamics::VibrationOptions::default();
+    let mean = |b: &[u8]| {
+        quietpath::dynamics::vibration(b, &model)
+            .unwrap()
+            .printing_deviation_mm
+            .mean
+    };
+    let (before, open_loop) = (mean(&bytes), mean(&open.output));
+    assert!(open_loop > before, "{open_loop} vs {before}");
+    let closed = vtg(&bytes, &VtgOptions::default()).unwrap();
+    assert!(closed.paths.feed_cap_scale > 1.0);
+    let d = closed.table2.deviation.as_ref().unwrap();
+    assert_eq!(d.mean_mm.before, before);
+    assert_eq!(d.mean_mm.after, mean(&closed.output));
+    assert!(d.mean_mm.after < before);
+    // Same geometry; still faster and cheaper.
+    assert_eq!(closed.table1.n_turning, open.table1.n_turning);
+    assert!(closed.table2.time_s.change_pct < 0.0);
+    assert!(closed.table2.energy_j.change_pct < 0.0);
 }
 
 #[test]

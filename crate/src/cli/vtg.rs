@@ -24,7 +24,8 @@ pub struct Args {
     /// Keep the programmed feed rates even where the curvature is above K_cr.
     #[arg(long)]
     pub keep_feed: bool,
-    /// Skip the dynamics simulation of both files (Table 2's deviation rows).
+    /// Skip the dynamics simulation of both files (Table 2's deviation rows, and the second
+    /// rewrite with faster fillet speeds it asks for when the first one rings more).
     #[arg(long)]
     pub no_dynamics: bool,
     /// Overwrite the input file if OUT names it.

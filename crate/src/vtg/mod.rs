@@ -30,7 +30,7 @@ pub mod source;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analyze::{AnalyzeOptions, Progress};
+use crate::analyze::{AnalyzeOptions, Progress, Report};
 use crate::error::{Error, ErrorKind};
 pub use report::{Comparison, Table1, Table2, VtgReport};
 
@@ -63,7 +63,9 @@ pub struct VtgOptions {
     /// Lower the feed rate where the curvature exceeds `K_cr` (default true).
     pub limit_feed: bool,
     /// Run the dynamics model ([`crate::dynamics`]) on both files for the deviation rows of
-    /// Table 2 (default true; it costs about as much as the rewrite itself).
+    /// Table 2, and rewrite again with faster eq. 29 speeds if the rewrite rings more than the
+    /// original (default true; it costs about as much as the rewrite itself, more when it
+    /// rewrites again). See `with_simulated_deviation`.
     pub dynamics: bool,
 }
 
@@ -137,61 +139,114 @@ pub fn vtg_with_progress(
         return Err(cancelled());
     }
     let limits = rewrite::limits_for(&path, options);
-    let mut step = |f: f64| progress(0.3 + 0.4 * f);
-    let rewritten = rewrite::rewrite(input, &path, &sources, options, &limits, &mut step)?;
+    // One rewrite with the eq. 29 speeds starting at `scale`, analysed and reported.
+    let attempt = |scale: f64, before: Report, progress: Progress<'_>| {
+        let mut step = |f: f64| progress(0.8 * f);
+        let rewritten =
+            rewrite::rewrite(input, &path, &sources, options, &limits, scale, &mut step)?;
+        if !progress(0.8) {
+            return Err(cancelled());
+        }
+        // The output's metrics streamed, not from a kept move list: rounding corners can
+        // multiply the moves tenfold.
+        let (after, after_metrics) = crate::parallel::join(
+            || crate::analyze::analyze(&rewritten.output, &options.analyze),
+            || {
+                metrics::from_input(
+                    &rewritten.output,
+                    &options.analyze,
+                    options.critical_angle_deg,
+                )
+            },
+        );
+        let (after, after_metrics) = (after?, after_metrics?);
+        Ok(report::build(
+            options,
+            &limits,
+            before,
+            after,
+            &path,
+            after_metrics,
+            rewritten,
+        ))
+    };
+    let mut report = attempt(1.0, before, &mut |f| progress(0.3 + 0.4 * f))?;
     if !progress(0.7) {
         return Err(cancelled());
     }
-    // The output's metrics streamed, not from a kept move list: rounding corners can multiply
-    // the moves tenfold.
-    let (after, after_metrics) = crate::parallel::join(
-        || crate::analyze::analyze(&rewritten.output, &options.analyze),
-        || {
-            metrics::from_input(
-                &rewritten.output,
-                &options.analyze,
-                options.critical_angle_deg,
-            )
-        },
-    );
-    let (after, after_metrics) = (after?, after_metrics?);
-    if !progress(0.9) {
-        return Err(cancelled());
-    }
-    let mut report = report::build(
-        options,
-        &limits,
-        before,
-        after,
-        &path,
-        after_metrics,
-        rewritten,
-    );
     if options.dynamics {
-        report.table2.deviation = simulated_deviation(input, &report.output, &options.analyze);
+        report = with_simulated_deviation(input, report, options, &mut |scale, before, f| {
+            attempt(scale, before, &mut |g| progress(f + 0.1 * g))
+        })?;
     }
     progress(1.0);
     Ok(report)
 }
 
-/// Table 2's deviation rows: the dynamics model on the original and on the rewritten file,
-/// over printing moves (travels are not rewritten). `None` when the model cannot run (a print
-/// too long to simulate, for instance): the rest of the report stands without it.
-fn simulated_deviation(
+/// Scales of the eq. 29 speeds tried, in turn, when the rewrite at 1 leaves the machine
+/// ringing more than the original did.
+const QUIETER_SCALES: [f64; 2] = [1.5, 2.0];
+
+/// Fills Table 2's deviation rows with the dynamics model, run on the original and on the
+/// rewritten file over printing moves (travels are not rewritten), and closes the loop on it.
+///
+/// Eq. 29's speeds (`J_n = A_n f₁`) are meant to keep a rounded corner from exciting the frame
+/// more than the sharp one did, and on nearly every file they do. They are a rule of thumb,
+/// though: the ringing a corner leaves depends on how its timing falls against the modes,
+/// which no bound on `a_n` and `j_n` sees. On the thesis triangle, whose 75° infill corners the
+/// firmware takes at 14 mm/s, fillets at eq. 29's 20 mm/s raised the mean deviation by 1.2 %,
+/// while at 1.5× (30 mm/s) it fell by 1.1 % (and at 0.5× it rose by 4 %: not monotonic). So
+/// when the simulated mean deviation does not fall, the file is rewritten again with the speeds
+/// starting at each of [`QUIETER_SCALES`] in turn, and the rewrite with the lowest simulated
+/// mean deviation is kept: every variant still passes the no-dearer check path by path, so
+/// time and energy fall as before. `None` rows when the model cannot run (a print too long to
+/// simulate, for instance): the rest of the report stands without them.
+fn with_simulated_deviation(
     input: &[u8],
-    output: &[u8],
-    analyze: &AnalyzeOptions,
-) -> Option<report::DeviationComparison> {
-    let options = crate::dynamics::VibrationOptions {
-        analyze: analyze.clone(),
+    first: VtgReport,
+    options: &VtgOptions,
+    again: &mut dyn FnMut(f64, Report, f64) -> Result<VtgReport, Error>,
+) -> Result<VtgReport, Error> {
+    let vibration = crate::dynamics::VibrationOptions {
+        analyze: options.analyze.clone(),
         ..Default::default()
     };
-    let before = crate::dynamics::vibration(input, &options).ok()?;
-    let after = crate::dynamics::vibration(output, &options).ok()?;
-    let (b, a) = (before.printing_deviation_mm, after.printing_deviation_mm);
-    Some(report::DeviationComparison {
+    let mean = |bytes: &[u8]| {
+        crate::dynamics::vibration(bytes, &vibration)
+            .ok()
+            .map(|r| r.printing_deviation_mm)
+    };
+    let Some(b) = mean(input) else {
+        return Ok(first);
+    };
+    let rows = |a: crate::dynamics::Deviation| report::DeviationComparison {
         max_mm: Comparison::new(b.max, a.max),
         min_mm: Comparison::new(b.min, a.min),
         mean_mm: Comparison::new(b.mean, a.mean),
-    })
+    };
+    let mut best = first;
+    let Some(a) = mean(&best.output) else {
+        return Ok(best);
+    };
+    best.table2.deviation = Some(rows(a));
+    if !options.limit_feed {
+        return Ok(best);
+    }
+    let mut best_mean = a.mean;
+    for (k, &scale) in QUIETER_SCALES.iter().enumerate() {
+        if best_mean < b.mean {
+            break;
+        }
+        let f = 0.7 + 0.1 * k as f64;
+        let mut next = again(scale, best.before.clone(), f)?;
+        let Some(a) = mean(&next.output) else {
+            break;
+        };
+        if a.mean < best_mean {
+            next.table2.deviation = Some(rows(a));
+            best_mean = a.mean;
+            best = next;
+        }
+    }
+    Ok(best)
 }

@@ -115,6 +115,10 @@ pub struct PathCounts {
     pub kept_for_time: u64,
     /// Mean speed fluctuation of the interpolation steps, percent (eq. 28).
     pub mean_speed_fluctuation_pct: f64,
+    /// The scale the eq. 29 speeds of every rewrite started from: 1, or higher where the
+    /// dynamics model found that the rewrite at 1 left the machine ringing more than the
+    /// original (see [`crate::vtg::VtgOptions::dynamics`]).
+    pub feed_cap_scale: f64,
 }
 
 /// Per-layer toolpath metrics before and after.
@@ -221,6 +225,7 @@ pub(crate) fn build(
             } else {
                 0.0
             },
+            feed_cap_scale: rewritten.feed_cap_scale,
         },
         table1,
         table2,

@@ -59,6 +59,8 @@ pub struct Rewritten {
     pub kept_for_time: u64,
     /// Algorithm 1 statistics.
     pub walk: WalkStats,
+    /// The first scale of the eq. 29 speeds each rewrite was tried with.
+    pub feed_cap_scale: f64,
 }
 
 /// The eq. 30 limits for a file: `v_max` from the machine's X/Y feed limits (`M203`), `A_n` the
@@ -118,9 +120,13 @@ pub fn rewrite(
     all: &Sources,
     options: &VtgOptions,
     limits: &KinematicLimits,
+    feed_cap_scale: f64,
     progress: crate::analyze::Progress<'_>,
 ) -> Result<Rewritten, Error> {
-    let mut out = Rewritten::default();
+    let mut out = Rewritten {
+        feed_cap_scale,
+        ..Rewritten::default()
+    };
     let moves = &path.moves;
     let sources = &all.moves[..];
     let aligned =
@@ -147,6 +153,7 @@ pub fn rewrite(
         },
         classic_jerk_mm_s: (path.junction_model == JunctionModel::ClassicJerk)
             .then(|| xy_jerk(&path.print_limits)),
+        feed_cap_scale,
     };
     let energy = Accumulator::new(
         &options.analyze.energy.clone().unwrap_or_default(),
@@ -514,8 +521,10 @@ fn rewrite_path(
     // The eq. 29 speeds as they are, then raised step by step, then no caps at all, each
     // first as fast as the firmware will go elsewhere, then no faster than the original: the
     // first that costs neither time nor energy, else the one that costs least energy.
+    let base = settings.feed_cap_scale;
+    let capped = CAP_SCALES.map(|k| k.map(|k| k * base));
     let scales: &[Option<f64>] = if settings.limit_feed {
-        &CAP_SCALES
+        &capped
     } else {
         &[None]
     };
@@ -541,7 +550,7 @@ fn rewrite_path(
     let mut part = Rewritten::default();
     match scale {
         None if settings.limit_feed => part.uncapped_paths += 1,
-        Some(k) if k > 1.0 => part.raised_caps_paths += 1,
+        Some(k) if k > base => part.raised_caps_paths += 1,
         _ => {}
     }
     let cos_critical = crate::math::cos(settings.critical_rad);

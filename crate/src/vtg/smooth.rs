@@ -66,6 +66,10 @@ pub struct Settings {
     /// Klipper planners): rising feeds are then ramped, since such a planner counts a rise of
     /// the feed from one block to the next as jerk against the new block's full speed.
     pub classic_jerk_mm_s: Option<f64>,
+    /// The first scale of the eq. 29 speeds a rewrite is tried with (1: the speeds as they
+    /// are); [`crate::vtg::vtg`] raises it where the dynamics model finds the rewrite at 1
+    /// rings more than the original.
+    pub feed_cap_scale: f64,
 }
 
 /// A rewritten path: the new geometry, and what the feed of each new segment is made of.
@@ -630,6 +634,7 @@ mod tests {
             jerk_per_accel_hz: None,
             min_step_mm: MIN_STEP_MM,
             classic_jerk_mm_s: None,
+            feed_cap_scale: 1.0,
         }
     }
 

@@ -428,6 +428,8 @@ export interface VtgReport {
     /** Paths kept as they were: slower or dearer when rounded, and not paid for. */
     kept_for_time: number;
     mean_speed_fluctuation_pct: number;
+    /** Scale the eq. 29 speeds started from: 1, or 1.5 / 2 where the dynamics model found the rewrite at 1 rang more than the original. */
+    feed_cap_scale: number;
   };
   /** The VTG paper's Table 1. */
   table1: {
