@@ -199,7 +199,7 @@ pub fn rewrite(
                             moves.get(j).map(motion_of),
                         ],
                     };
-                    rewrite_path(&moves[i..j], &sources[i..j], &settings, &machine)
+                    rewrite_path(input, &moves[i..j], &sources[i..j], &settings, &machine)
                 })
                 .collect()
         });
@@ -330,7 +330,7 @@ fn path_end(moves: &[PathMove], sources: &[MoveSource], i: usize) -> Option<usiz
         && moves[j].feature == first.feature
         && moves[j].layer == first.layer
         && sources[j].mode == sources[i].mode
-        && sources[j].line == sources[j - 1].line + 1
+        && sources[j].line == sources[j - 1].line + 1 + sources[j].notes.lines
         && j - i < 100_000
     {
         j += 1;
@@ -464,6 +464,7 @@ impl Machine<'_> {
 /// square-corner velocity, gains nothing in time from rounding), the cheapest in energy is
 /// returned marked dearer, for [`pay_from_savings`] to take or leave.
 fn rewrite_path(
+    input: &[u8],
     run: &[PathMove],
     src: &[MoveSource],
     file_settings: &Settings,
@@ -559,6 +560,18 @@ fn rewrite_path(
         cos_critical,
     ));
     let out = &mut part;
+    // Annotation lines between the original moves (`;WIDTH:`), each with the filament pushed
+    // where it stood: written again before the first new point past that place.
+    let mut notes = Vec::new();
+    for (s, &at) in src.iter().zip(&e).skip(1) {
+        if s.notes.lines > 0 {
+            notes.push((
+                at,
+                std::str::from_utf8(input.get(s.notes.from..s.notes.to)?).ok()?,
+            ));
+        }
+    }
+    let mut notes = notes.into_iter().peekable();
 
     // Write the block.
     let mut text = String::with_capacity(written.points.len() * 32);
@@ -581,6 +594,12 @@ fn rewrite_path(
         .zip(&written.feed_mm_s)
         .enumerate()
     {
+        while let Some((_, note)) = notes.next_if(|&(at, _)| ek > at + 1e-12) {
+            if !text.is_empty() {
+                text.push('\n');
+            }
+            text.push_str(note);
+        }
         if !text.is_empty() {
             text.push('\n');
         }
@@ -616,6 +635,10 @@ fn rewrite_path(
             }
         }
     }
+    for (_, note) in notes {
+        text.push('\n');
+        text.push_str(note);
+    }
     // Leave the modal feed where the original left it.
     if let (Some(now), Some(after)) = (f_now, last_src.f_after) {
         if (now - after).abs() > 1e-9 {
@@ -636,10 +659,12 @@ fn rewrite_path(
         line: first_src.line,
         replacement: text.into_bytes(),
     });
-    edits.extend(src.iter().skip(1).map(|s| Edit {
-        line: s.line,
-        replacement: Vec::new(),
-    }));
+    for s in src.iter().skip(1) {
+        edits.extend((s.line - s.notes.lines..=s.line).map(|line| Edit {
+            line,
+            replacement: Vec::new(),
+        }));
+    }
     let dearer = dearer(&added);
     Some(Outcome {
         edits,
@@ -708,6 +733,64 @@ mod tests {
             let mut d = vec![outcome(0.001, 0.001, 5)];
             pay_from_savings(&mut d, saved);
             assert!(!d[0].paid, "{saved:?}");
+        }
+    }
+
+    /// Filament (relative E) pushed before each `;WIDTH:` line, in order, and the total.
+    fn filament_at_notes(g: &str) -> (Vec<(String, f64)>, f64) {
+        let mut e = 0.0;
+        let mut at = Vec::new();
+        for l in g.lines() {
+            if l.starts_with(";WIDTH:") {
+                at.push((l.to_string(), e));
+            } else if let Some(w) = l.split_whitespace().find(|w| w.starts_with('E')) {
+                if l.starts_with("G1 ") {
+                    e += w[1..].parse::<f64>().unwrap();
+                }
+            }
+        }
+        (at, e)
+    }
+
+    #[test]
+    fn paths_run_across_width_annotations_and_keep_them_in_place() {
+        let mut src = String::from("M83\nM201 X1000 Y1000\nM204 P1250\nM205 X8 Y8\n");
+        src.push_str("G1 X100 Y100 F6000\nG1 Z0.2\n;TYPE:Solid infill\n");
+        for k in 0..6 {
+            for (j, (x, y)) in [
+                (120.0, 100.0),
+                (120.0, 110.0),
+                (100.0, 110.0),
+                (100.0, 100.0),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                src.push_str(&format!("G1 X{x} Y{y} E0.5 F3600\n"));
+                if j % 2 == 0 {
+                    src.push_str(&format!(";WIDTH:0.4{k}{j}\n"));
+                }
+            }
+        }
+        let options = crate::vtg::VtgOptions {
+            dynamics: false,
+            ..Default::default()
+        };
+        let r = crate::vtg::vtg(src.as_bytes(), &options).expect("vtg");
+        // One path, across the notes (each would otherwise cut it into pieces of two moves).
+        assert_eq!((r.paths.candidates, r.paths.rewritten), (1, 1));
+        assert!(r.table1.n_turning.change_pct <= -40.0);
+        let out = String::from_utf8(r.output).unwrap();
+        let (before, total_before) = filament_at_notes(&src);
+        let (after, total_after) = filament_at_notes(&out);
+        assert_eq!(before.len(), 12);
+        assert!((total_after - total_before).abs() < 1e-4);
+        // The same notes, in order, each where the same filament has been pushed: no later than
+        // the original's vertex, and no earlier than one new step (at most 0.5 mm of filament
+        // per side here; the new steps near a vertex are short).
+        for ((nb, eb), (na, ea)) in before.iter().zip(&after) {
+            assert_eq!(nb, na);
+            assert!(*ea <= eb + 1e-4 && *ea > eb - 0.05, "{nb}: {ea} vs {eb}");
         }
     }
 }

@@ -7,7 +7,7 @@
 
 use crate::analyze::{prepare, AnalyzeOptions};
 use crate::error::Error;
-use crate::gcode::{self, Line};
+use crate::gcode::{self, Command, Line};
 use crate::machine::{axis, Event, ExtrusionMode};
 use crate::plan::Limits;
 
@@ -29,6 +29,36 @@ pub struct MoveSource {
     pub f_before: Option<f64>,
     /// The modal `F` word after the line, mm/min (`None` before any `F`).
     pub f_after: Option<f64>,
+    /// Annotation lines right before this one (see [`is_annotation`]): how many, and their
+    /// bytes in the input (from the first one's start to the last one's end, terminators
+    /// between them included).
+    pub notes: Notes,
+}
+
+/// A run of annotation lines (see [`is_annotation`]) in the input.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Notes {
+    /// Lines.
+    pub lines: u32,
+    /// Byte range in the input.
+    pub from: usize,
+    /// End of the byte range.
+    pub to: usize,
+}
+
+/// A comment-only line that describes the extrusion for a viewer, and nothing the machine
+/// does: PrusaSlicer's, SuperSlicer's and Slic3r's `;WIDTH:` and `;HEIGHT:`, which they write
+/// between the moves of one path wherever the line width changes (variable-width gap fill and
+/// thin walls, arc-fitted infill). A path may run across them: a rewrite deletes them and
+/// writes them again inside the new block, at the same place along the path.
+pub fn is_annotation(line: &Line<'_>) -> bool {
+    matches!(line.command, Command::None)
+        && line.params.is_empty()
+        && line.text.is_empty()
+        && line.line_number.is_none()
+        && line
+            .comment
+            .is_some_and(|c| c.starts_with(b"WIDTH:") || c.starts_with(b"HEIGHT:"))
 }
 
 /// The source of every move, and the machine limits along the file.
@@ -58,12 +88,34 @@ pub fn move_sources(input: &[u8], options: &AnalyzeOptions) -> Result<Sources, E
     let mut f_modal: Option<f64> = None;
     let mut out = Vec::new();
     let mut changes = vec![(0usize, limits.clone())];
+    let mut notes = Notes::default();
     gcode::for_each_line(
         input,
         setup.strictness,
         &mut warnings,
         |raw, line, warnings| {
-            let Some(line) = line else { return Ok(()) };
+            let Some(line) = line else {
+                notes = Notes::default();
+                return Ok(());
+            };
+            if is_annotation(line) {
+                let end = raw.offset + raw.text.len();
+                notes = if notes.lines > 0 {
+                    Notes {
+                        lines: notes.lines + 1,
+                        to: end,
+                        ..notes
+                    }
+                } else {
+                    Notes {
+                        lines: 1,
+                        from: raw.offset,
+                        to: end,
+                    }
+                };
+                return Ok(());
+            }
+            let notes = std::mem::take(&mut notes);
             if limits.apply_command(line, setup.units) {
                 // Several commands in a row before the next move: keep the last.
                 if changes.last().is_some_and(|(k, _)| *k == out.len()) {
@@ -93,6 +145,7 @@ pub fn move_sources(input: &[u8], options: &AnalyzeOptions) -> Result<Sources, E
                     e_before,
                     f_before,
                     f_after: f_modal,
+                    notes,
                 });
             }
             Ok(())
