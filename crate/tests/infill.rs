@@ -213,7 +213,14 @@ fn pattern_length_and_turning_match_the_written_file() {
             let infill = path.feature_kind(m) == Some(FeatureKind::SparseInfill);
             // Only the new infill, and its travels (which break paths as in the replay).
             if infill || !m.is_extruding() {
-                acc.push(&m.from, &m.to, infill && m.is_extruding(), 0, true);
+                acc.push(
+                    &m.from,
+                    &m.to,
+                    quietpath::vtg::metrics::arc_of(&m.kind),
+                    infill && m.is_extruding(),
+                    0,
+                    true,
+                );
             }
         }
         let back = acc.finish();

@@ -109,17 +109,13 @@ fn options(tolerance_mm: f64, limit_feed: bool) -> VtgOptions {
 
 /// Files whose sharp corners cannot fall by 40 %, and why. For them the corners must still
 /// fall, and where the reason is the firmware's cornering, paths must have been kept for it.
-const TURNING_EXCEPTIONS: [(&str, &str); 4] = [
+const TURNING_EXCEPTIONS: [(&str, &str); 3] = [
     (
         "prusaslicer-2.5.0_vase_marlin-legacy_absE.gcode",
-        "most sharp turns are 45° + 135° infill hairpins with staggered line ends: the arc \
-         across one needs 0.13 mm, and no fillet within 0.1 mm rounds the 135° corner alone \
-         in steps of at least Marlin's 0.06 mm minimum segment",
-    ),
-    (
-        "prusaslicer-2.7.4_screw_arcfit.gcode",
-        "arc-fitted: corners between a line and a G2/G3 arc are not rewritten, and the \
-         remaining ones are mostly staggered hairpins (as the vase above)",
+        "most sharp turns left are thin walls filled by a variable-width line that turns back \
+         on itself in 0.07 mm steps, and 45° + 135° infill hairpins with staggered line ends \
+         (the arc across one needs 0.13 mm): neither can be rounded within 0.1 mm in steps of \
+         at least Marlin's 0.06 mm minimum segment, each turning under δθ",
     ),
     (
         "crealityprint-4.3.4_k1_benchy_m83_arcs.gcode",

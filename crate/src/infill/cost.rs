@@ -237,7 +237,14 @@ pub(crate) fn replay_blocks(
                                 filament += m.delta[3];
                                 let to =
                                     [at[0] + m.delta[0], at[1] + m.delta[1], at[2] + m.delta[2]];
-                                infill_metrics.push(&at, &to, m.delta[3] > 0.0, b as u32, true);
+                                infill_metrics.push(
+                                    &at,
+                                    &to,
+                                    None,
+                                    m.delta[3] > 0.0,
+                                    b as u32,
+                                    true,
+                                );
                                 at = to;
                                 push!(*m, b as u32);
                             }

@@ -141,6 +141,23 @@ impl Arc {
         ]
     }
 
+    /// Direction of travel at fraction `t` of the sweep with `rise` along the helix axis, as
+    /// (X, Y, Z) (not normalised: its length is the helix length per radian).
+    pub fn tangent_at(&self, t: f64, rise: f64) -> [f64; 3] {
+        let a = self.start_angle + self.sweep * t;
+        let s = self.sweep.signum();
+        let (i, j, k) = self.plane.axes();
+        let mut d = [0.0; 3];
+        d[i] = -s * self.radius * sin(a);
+        d[j] = s * self.radius * cos(a);
+        d[k] = if self.sweep != 0.0 {
+            rise / self.sweep.abs()
+        } else {
+            0.0
+        };
+        d
+    }
+
     /// Displacement in the plane from the start point to fraction `t` of the sweep (free of
     /// the absolute coordinates, so it holds after `G92` shifts too).
     pub fn offset_at(&self, t: f64) -> [f64; 2] {

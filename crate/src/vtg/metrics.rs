@@ -7,13 +7,16 @@
 //! first move and the end of every move. Turning angles (eq. 26) and chord errors (eq. 31) are
 //! taken at the interior points of paths only: the corner between a travel and a print is not a
 //! trajectory corner. "Infill" is sparse and solid infill (the paper's Table 1 calls the majority
-//! region inside the walls infill). Arcs count by their end points.
+//! region inside the walls infill). Arcs (`G2`/`G3`) count by their end points and by their
+//! length along the arc, and turn by their tangents at those points: an arc-fitted file meets
+//! its lines tangentially, where its chords would show a corner of half the sweep at each end.
 //!
 //! The accumulator costs a handful of multiplications, one `acos` and one `sqrt` per move, so
 //! `analyze` runs it on its read side.
 
 use serde::Serialize;
 
+use crate::machine::{Arc, MoveKind};
 use crate::math;
 use crate::math::Bound;
 
@@ -91,18 +94,45 @@ impl MetricsAccumulator {
         }
     }
 
-    /// One move from `from` to `to` (XYZ, mm). `extruding`: it lays down material; `feature`:
-    /// any identifier of the feature it belongs to; `infill`: the feature is infill.
+    /// One move from `from` to `to` (XYZ, mm), along `arc` if it is one. `extruding`: it lays
+    /// down material; `feature`: any identifier of the feature it belongs to; `infill`: the
+    /// feature is infill.
     #[inline]
-    pub fn push(&mut self, from: &[f64], to: &[f64], extruding: bool, feature: u32, infill: bool) {
+    pub fn push(
+        &mut self,
+        from: &[f64],
+        to: &[f64],
+        arc: Option<&Arc>,
+        extruding: bool,
+        feature: u32,
+        infill: bool,
+    ) {
         if !extruding || from.len() < 3 || to.len() < 3 {
             self.last = None;
             return;
         }
         let end = [to[0], to[1], to[2]];
-        let seg = [to[0] - from[0], to[1] - from[1], to[2] - from[2]];
-        let len = (seg[0] * seg[0] + seg[1] * seg[1] + seg[2] * seg[2]).sqrt();
-        if !len.is_finite() || len <= 1e-9 {
+        let chord = [to[0] - from[0], to[1] - from[1], to[2] - from[2]];
+        let chord_len = norm(&chord);
+        // A line is its own direction at both ends; an arc leaves and arrives along its
+        // tangents, taken as long as its chord so eq. 31 sees a segment of the same size.
+        let (start_seg, seg, len) = match arc {
+            Some(a) => {
+                let rise = chord[a.plane.axes().2];
+                let along = |t: f64| {
+                    let d = a.tangent_at(t, rise);
+                    let n = norm(&d);
+                    if n > 0.0 && n.is_finite() {
+                        d.map(|x| x / n * chord_len)
+                    } else {
+                        chord
+                    }
+                };
+                (along(0.0), along(1.0), a.length(rise))
+            }
+            None => (chord, chord, chord_len),
+        };
+        if !len.is_finite() || len <= 1e-9 || chord_len <= 1e-9 {
             self.last = None;
             return;
         }
@@ -121,13 +151,13 @@ impl MetricsAccumulator {
         }
         if continues {
             if let Some(o) = self.last {
-                self.corner(&o.seg, o.len, &seg, len);
+                self.corner(&o.seg, o.len, &start_seg, chord_len);
             }
         }
         self.last = Some(Open {
             end,
             seg,
-            len,
+            len: chord_len,
             feature,
         });
     }
@@ -184,6 +214,19 @@ pub fn fast_acos(x: f64) -> f64 {
     }
 }
 
+/// The arc a move runs along, if it is one.
+#[inline]
+pub fn arc_of(kind: &MoveKind) -> Option<&Arc> {
+    match kind {
+        MoveKind::Arc(a) => Some(a),
+        _ => None,
+    }
+}
+
+fn norm(a: &[f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
 fn same_point(a: &[f64; 3], b: &[f64]) -> bool {
     (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9 && (a[2] - b[2]).abs() < 1e-9
 }
@@ -230,14 +273,14 @@ pub fn from_path(
         );
         let extruding = m.is_extruding();
         let feature = u32::from(m.feature);
-        file.push(&m.from, &m.to, extruding, feature, infill);
+        file.push(&m.from, &m.to, arc_of(&m.kind), extruding, feature, infill);
         let li = m.layer as usize;
         if m.layer != crate::path::NO_LAYER && li < path.layers.len() {
             while layers.len() <= li {
                 layers.push(MetricsAccumulator::new(critical_angle_deg));
             }
             if let Some(l) = layers.get_mut(li) {
-                l.push(&m.from, &m.to, extruding, feature, infill);
+                l.push(&m.from, &m.to, arc_of(&m.kind), extruding, feature, infill);
             }
         }
     }
@@ -285,10 +328,11 @@ impl crate::path::MoveSink for MetricsSink {
             Some(FeatureKind::SparseInfill | FeatureKind::SolidInfill)
         );
         let (extruding, feature) = (m.is_extruding(), u32::from(m.feature));
-        self.file.push(&m.from, &m.to, extruding, feature, infill);
+        self.file
+            .push(&m.from, &m.to, arc_of(&m.kind), extruding, feature, infill);
         for (marker, layer) in [(true, layers.0), (false, layers.1)] {
             if let Some(l) = self.layer(marker, layer) {
-                l.push(&m.from, &m.to, extruding, feature, infill);
+                l.push(&m.from, &m.to, arc_of(&m.kind), extruding, feature, infill);
             }
         }
     }
@@ -341,7 +385,7 @@ mod tests {
             [0.0, 10.0, 0.2],
         ];
         for w in pts.windows(2) {
-            acc.push(&w[0], &w[1], true, 0, false);
+            acc.push(&w[0], &w[1], None, true, 0, false);
         }
         let m = acc.finish();
         assert_eq!(m.n_total, 4);
@@ -386,10 +430,10 @@ G1 X10 Y0 E0.5 F1200\nG1 X10 Y10 E0.5\nG1 X0 Y10 E0.5\n";
     #[test]
     fn paths_break_at_travel_and_feature() {
         let mut acc = MetricsAccumulator::new(30.0);
-        acc.push(&[0.0, 0.0, 0.0], &[1.0, 0.0, 0.0], true, 0, true);
-        acc.push(&[1.0, 0.0, 0.0], &[1.0, 1.0, 0.0], true, 1, false);
-        acc.push(&[1.0, 1.0, 0.0], &[2.0, 1.0, 0.0], false, 1, false);
-        acc.push(&[2.0, 1.0, 0.0], &[3.0, 1.0, 0.0], true, 1, false);
+        acc.push(&[0.0, 0.0, 0.0], &[1.0, 0.0, 0.0], None, true, 0, true);
+        acc.push(&[1.0, 0.0, 0.0], &[1.0, 1.0, 0.0], None, true, 1, false);
+        acc.push(&[1.0, 1.0, 0.0], &[2.0, 1.0, 0.0], None, false, 1, false);
+        acc.push(&[2.0, 1.0, 0.0], &[3.0, 1.0, 0.0], None, true, 1, false);
         let m = acc.finish();
         assert_eq!(m.n_total, 6);
         assert_eq!(m.n_infill, 2);
@@ -407,7 +451,7 @@ G1 X10 Y0 E0.5 F1200\nG1 X10 Y10 E0.5\nG1 X0 Y10 E0.5\n";
             [5.0 * t.cos(), 5.0 * t.sin(), 0.0]
         };
         for i in 0..n {
-            acc.push(&p(i), &p(i + 1), true, 0, false);
+            acc.push(&p(i), &p(i + 1), None, true, 0, false);
         }
         let m = acc.finish();
         let half = std::f64::consts::PI / n as f64;
@@ -415,5 +459,35 @@ G1 X10 Y0 E0.5 F1200\nG1 X10 Y10 E0.5\nG1 X0 Y10 E0.5\n";
         assert!((m.mean_chord_error_mm - sagitta).abs() < 1e-9);
         assert!((m.mean_turn_deg - 10.0).abs() < 1e-2);
         assert_eq!(m.n_turning, 0);
+    }
+
+    /// Metrics of G-code read the way `analyze` reads it.
+    fn of(g: &str) -> ToolpathMetrics {
+        let options = crate::analyze::AnalyzeOptions::default();
+        from_input(g.as_bytes(), &options, 30.0).expect("metrics").0
+    }
+
+    #[test]
+    fn arcs_turn_by_their_tangents_and_count_their_length() {
+        // A line, a quarter circle of radius 5 that leaves it tangentially (G3 from (10,0) to
+        // (15,5), centre (10,5)), and a line leaving the arc tangentially: no corner at all,
+        // where the arc's chord would show two 45° corners.
+        let smooth = "M83\nG1 X0 Y0 Z0.2 F3000\nG1 X10 Y0 E1\nG3 X15 Y5 I0 J5 E1\nG1 X15 Y15 E1\n";
+        let m = of(smooth);
+        assert_eq!((m.n_total, m.n_corners, m.n_turning), (4, 2, 0));
+        assert!(m.mean_turn_deg < 1e-3, "{}", m.mean_turn_deg);
+        assert!(m.mean_chord_error_mm < 1e-9, "{}", m.mean_chord_error_mm);
+        let quarter = std::f64::consts::FRAC_PI_2 * 5.0;
+        assert!(
+            (m.l_total_mm - (20.0 + quarter)).abs() < 1e-9,
+            "{}",
+            m.l_total_mm
+        );
+        // The same arc entered at a right angle (from below) and left backwards (its end
+        // tangent points +Y; the line goes −X, a 90° turn): two turning points of 90°.
+        let sharp = "M83\nG1 X10 Y-10 Z0.2 F3000\nG1 X10 Y0 E1\nG3 X15 Y5 I0 J5 E1\nG1 X5 Y5 E1\n";
+        let m = of(sharp);
+        assert_eq!((m.n_corners, m.n_turning), (2, 2));
+        assert!((m.mean_turn_deg - 90.0).abs() < 0.01, "{}", m.mean_turn_deg);
     }
 }
