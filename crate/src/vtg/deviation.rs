@@ -8,7 +8,7 @@
 use std::collections::HashMap;
 
 use super::bspline::{dot, lerp, norm, sub};
-use crate::path::PrintPath;
+use crate::path::{PathMove, PrintPath};
 
 /// Distance from `p` to segment `a`–`b`.
 pub fn point_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
@@ -228,16 +228,16 @@ pub fn file_deviation(original: &PrintPath, output: &PrintPath, step: f64) -> f6
     let xyz = |p: &crate::machine::Pos| [p[0], p[1], p[2]];
     let mut worst = 0.0f64;
     for li in 0..original.layers.len() {
-        let orig: Vec<([f64; 3], [f64; 3])> = original
-            .layer_moves(li)
-            .iter()
-            .filter(|m| m.is_extruding())
-            .map(|m| (xyz(&m.from), xyz(&m.to)))
-            .collect();
+        let mut orig: Vec<([f64; 3], [f64; 3])> = Vec::new();
+        for m in original.layer_moves(li).iter().filter(|m| m.is_extruding()) {
+            match arc_points(m, step) {
+                Some(pts) => orig.extend(pts.windows(2).map(|w| (w[0], w[1]))),
+                None => orig.push((xyz(&m.from), xyz(&m.to))),
+            }
+        }
         let grid = Grid::new(orig.iter().copied(), 1.0);
-        for m in output.layer_moves(li).iter().filter(|m| m.is_extruding()) {
-            let seg = [xyz(&m.from), xyz(&m.to)];
-            samples(&seg, step, |p| {
+        let mut measure = |seg: &[[f64; 3]]| {
+            samples(seg, step, |p| {
                 let d = grid.distance(p).unwrap_or_else(|| {
                     orig.iter()
                         .map(|(a, b)| point_segment(p, a, b))
@@ -245,9 +245,42 @@ pub fn file_deviation(original: &PrintPath, output: &PrintPath, step: f64) -> f6
                 });
                 worst = worst.max(d);
             });
+        };
+        for m in output.layer_moves(li).iter().filter(|m| m.is_extruding()) {
+            match arc_points(m, step) {
+                Some(pts) => measure(&pts),
+                None => measure(&[xyz(&m.from), xyz(&m.to)]),
+            }
         }
     }
     worst
+}
+
+/// Points along an arc move (`G2`/`G3`) from its start to its end, the chords between them
+/// within `step / 10` of the arc; `None` for any other move.
+pub fn arc_points(m: &PathMove, step: f64) -> Option<Vec<[f64; 3]>> {
+    let crate::machine::MoveKind::Arc(a) = &m.kind else {
+        return None;
+    };
+    let (i, j, k) = a.plane.axes();
+    let rise = m.to[k] - m.from[k];
+    // A chord spanning δ is r (1 − cos(δ/2)) from its arc.
+    let sagitta = (0.1 * step).max(1e-9);
+    let span = 2.0 * crate::math::acos((1.0 - sagitta / a.radius.max(sagitta)).max(-1.0));
+    let n = (a.sweep.abs() / span.max(1e-6)).ceil().clamp(1.0, 1e5) as usize;
+    Some(
+        (0..=n)
+            .map(|s| {
+                let t = s as f64 / n as f64;
+                let o = a.offset_at(t);
+                let mut p = [m.from[0], m.from[1], m.from[2]];
+                p[i] += o[0];
+                p[j] += o[1];
+                p[k] += rise * t;
+                p
+            })
+            .collect(),
+    )
 }
 
 #[cfg(test)]
@@ -267,5 +300,24 @@ mod tests {
         // The chord's midpoint is 0.05 from both legs.
         let depth = 0.05;
         assert!((d - depth).abs() < 1e-3, "{d}");
+    }
+
+    #[test]
+    fn an_arc_is_measured_along_the_arc_not_its_chord() {
+        // A half circle of radius 5 (G3 from (0,0) to (10,0), centre (5,0), through (5,-5)) and, in the other
+        // file, its chord: 5 mm apart at the middle, where a chord-only reading sees 0.
+        let arc = "G1 X0 Y0 Z0.2 F3000\nG3 X10 Y0 I5 J0 E1\n";
+        let chord = "G1 X0 Y0 Z0.2 F3000\nG1 X10 Y0 E1\n";
+        let options = crate::analyze::AnalyzeOptions::default();
+        let read = |g: &str| crate::path::extract(g.as_bytes(), &options, false).unwrap();
+        let (a, c) = (read(arc), read(chord));
+        let d = file_deviation(&c, &a, 0.01);
+        assert!((d - 5.0).abs() < 0.01, "{d}");
+        assert!(file_deviation(&a, &a, 0.01) < 1e-9);
+        let pts = arc_points(&a.moves[1], 0.01).unwrap();
+        for p in &pts {
+            let r = ((p[0] - 5.0).powi(2) + p[1].powi(2)).sqrt();
+            assert!((r - 5.0).abs() < 1e-9 && p[1] <= 1e-9, "{p:?}");
+        }
     }
 }
