@@ -21,13 +21,13 @@ use std::path::PathBuf;
 
 use quietpath_conformance::{corpus, corpus_dir, fixtures_dir};
 
-/// Lines that are not `G0`/`G1` moves, in order.
+/// Lines that are not `G0`–`G3` moves, in order.
 fn non_motion_lines(bytes: &[u8]) -> Vec<Vec<u8>> {
     Lines::new(bytes)
         .filter(|l| {
             parse_line(l.text).map_or(true, |p| {
                 !p.code()
-                    .is_some_and(|c| c.letter == b'G' && c.number <= 1 && c.sub.is_none())
+                    .is_some_and(|c| c.letter == b'G' && c.number <= 3 && c.sub.is_none())
             })
         })
         .map(|l| l.text.to_vec())
@@ -45,6 +45,8 @@ struct Outcome {
     mean_deviation_pct: f64,
     filament_pct: f64,
     kept_for_time: u64,
+    arcs_written: u64,
+    lines: usize,
 }
 
 fn check(bytes: &[u8], name: &str, options: &VtgOptions) -> Outcome {
@@ -96,6 +98,8 @@ fn check(bytes: &[u8], name: &str, options: &VtgOptions) -> Outcome {
             .map_or(f64::NAN, |d| d.mean_mm.change_pct),
         filament_pct: (fa - fb) / fb * 100.0,
         kept_for_time: r.paths.kept_for_time,
+        arcs_written: r.paths.arcs_written,
+        lines: r.output.split(|&b| b == b'\n').count(),
     }
 }
 
@@ -259,6 +263,47 @@ fn the_dynamics_model_closes_the_loop() {
     assert_eq!(closed.table1.n_turning, open.table1.n_turning);
     assert!(closed.table2.time_s.change_pct < 0.0);
     assert!(closed.table2.energy_j.change_pct < 0.0);
+}
+
+/// With `arcs`, runs on a circle are written as `G2`/`G3` where the firmware would cut them at
+/// least as finely as the walk did and they cost nothing: fewer lines, every criterion still
+/// met (the deviation is measured on the arcs themselves).
+#[test]
+fn arcs_cut_lines_and_keep_every_criterion() {
+    for (name, path) in [
+        (
+            "prusaslicer-2.6.1_benchy_marlin2.gcode",
+            corpus_dir().join("prusaslicer-2.6.1_benchy_marlin2.gcode"),
+        ),
+        (
+            "prusaslicer-2.5.0_cube_marlin2_defaults.gcode",
+            fixtures_dir().join("gcode/prusaslicer-2.5.0_cube_marlin2_defaults.gcode"),
+        ),
+        (
+            "crealityprint-4.3.8_k1se_accessory_m82_arcs_exclude-object.gcode",
+            corpus_dir().join("crealityprint-4.3.8_k1se_accessory_m82_arcs_exclude-object.gcode"),
+        ),
+    ] {
+        let bytes = std::fs::read(path).unwrap();
+        let lines = check(&bytes, name, &VtgOptions::default()).lines;
+        let o = check(
+            &bytes,
+            name,
+            &VtgOptions {
+                arcs: true,
+                ..VtgOptions::default()
+            },
+        );
+        assert!(o.arcs_written > 0, "{name}: no arcs");
+        assert!(
+            o.lines < lines,
+            "{name}: {} lines, {lines} without arcs",
+            o.lines
+        );
+        assert!(o.turning_pct <= -40.0, "{name}: {}", o.turning_pct);
+        assert!(o.energy_pct < 0.0 && o.time_pct <= 1.0, "{name}: {o:?}");
+        assert!(o.mean_deviation_pct < 0.0, "{name}: {o:?}");
+    }
 }
 
 #[test]

@@ -28,6 +28,10 @@ pub struct Args {
     /// rewrite with faster fillet speeds it asks for when the first one rings more).
     #[arg(long)]
     pub no_dynamics: bool,
+    /// Write runs of new points that lie on a circle as arcs (G2/G3): fewer lines. Needs a
+    /// firmware with arcs enabled (Marlin's ARC_SUPPORT, Klipper's [gcode_arcs]).
+    #[arg(long)]
+    pub arcs: bool,
     /// Overwrite the input file if OUT names it.
     #[arg(long)]
     pub force: bool,
@@ -47,6 +51,7 @@ pub fn run(args: Args) -> Result<(), String> {
         critical_angle_deg: args.critical_angle,
         limit_feed: !args.keep_feed,
         dynamics: !args.no_dynamics,
+        arcs: args.arcs,
         ..VtgOptions::default()
     };
     let mut bar = output::ProgressBar::for_input(input.len());

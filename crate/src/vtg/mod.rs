@@ -15,7 +15,9 @@
 //! is checked against the original independently ([`deviation`]) and compared with
 //! [`metrics`] (Table 1) and the analysis (Table 2).
 
+pub mod arcs;
 pub mod blend;
+pub mod block;
 pub mod bspline;
 pub mod deviation;
 pub mod fit;
@@ -67,6 +69,10 @@ pub struct VtgOptions {
     /// original (default true; it costs about as much as the rewrite itself, more when it
     /// rewrites again). See `with_simulated_deviation`.
     pub dynamics: bool,
+    /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`arcs`]) to cut the
+    /// line count (default false: the firmware must have arcs enabled, Marlin's `ARC_SUPPORT`
+    /// or Klipper's `[gcode_arcs]`).
+    pub arcs: bool,
 }
 
 impl Default for VtgOptions {
@@ -80,6 +86,7 @@ impl Default for VtgOptions {
             nozzle_diameter_mm: 0.4,
             limit_feed: true,
             dynamics: true,
+            arcs: false,
         }
     }
 }

@@ -119,6 +119,8 @@ pub struct PathCounts {
     /// dynamics model found that the rewrite at 1 left the machine ringing more than the
     /// original (see [`crate::vtg::VtgOptions::dynamics`]).
     pub feed_cap_scale: f64,
+    /// Arcs (`G2`/`G3`) written (with the `arcs` option), each in place of several steps.
+    pub arcs_written: u64,
 }
 
 /// Per-layer toolpath metrics before and after.
@@ -226,6 +228,7 @@ pub(crate) fn build(
                 0.0
             },
             feed_cap_scale: rewritten.feed_cap_scale,
+            arcs_written: rewritten.arcs_written,
         },
         table1,
         table2,

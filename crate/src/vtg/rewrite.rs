@@ -11,9 +11,10 @@
 //! last `E` word exactly, so every later line stays valid; in relative mode the written amounts
 //! are differences of rounded running totals and add up to the original total.
 
-use std::fmt::Write as _;
-
+use super::arcs::{self, Piece};
+use super::block::{self, Frame};
 use super::bspline::{dot, norm, sub};
+use super::deviation::both_ways;
 use super::kinematics::KinematicLimits;
 use super::resample::WalkStats;
 use super::smooth::{smooth_path, Path, Settings, Written};
@@ -21,7 +22,6 @@ use super::source::{MoveSource, Sources};
 use super::VtgOptions;
 use crate::energy::Accumulator;
 use crate::error::{Error, ErrorKind};
-use crate::gcode::number::{push_trimmed, rounded};
 use crate::gcode::{apply_edits, Edit};
 use crate::machine::{ExtrusionMode, MoveKind};
 use crate::path::{PathMove, PrintPath};
@@ -61,6 +61,8 @@ pub struct Rewritten {
     pub walk: WalkStats,
     /// The first scale of the eq. 29 speeds each rewrite was tried with.
     pub feed_cap_scale: f64,
+    /// Arcs (`G2`/`G3`) written.
+    pub arcs_written: u64,
 }
 
 /// The eq. 30 limits for a file: `v_max` from the machine's X/Y feed limits (`M203`), `A_n` the
@@ -154,6 +156,7 @@ pub fn rewrite(
         classic_jerk_mm_s: (path.junction_model == JunctionModel::ClassicJerk)
             .then(|| xy_jerk(&path.print_limits)),
         feed_cap_scale,
+        arcs: options.arcs,
     };
     let energy = Accumulator::new(
         &options.analyze.energy.clone().unwrap_or_default(),
@@ -311,6 +314,7 @@ impl Rewritten {
         self.kept_for_time += part.kept_for_time;
         self.walk.steps += part.walk.steps;
         self.walk.fluctuation_sum += part.walk.fluctuation_sum;
+        self.arcs_written += part.arcs_written;
     }
 }
 
@@ -363,6 +367,10 @@ fn xy_acceleration(limits: &Limits) -> Option<f64> {
 fn xy_jerk(limits: &Limits) -> f64 {
     limits.max_jerk[0].value.min(limits.max_jerk[1].value)
 }
+
+/// Share of the tolerance within which a run of new points must lie on a circle to be written
+/// as an arc (the path with its arcs is then measured against the original as a whole).
+const ARC_SHARE: f64 = 0.05;
 
 /// Scales of the eq. 29 speeds tried in turn (`None`: no caps), until a rewrite costs no time.
 const CAP_SCALES: [Option<f64>; 8] = [
@@ -421,6 +429,24 @@ impl Machine<'_> {
     /// changes at the path's two junctions with the rest of the file is counted too (a short
     /// last step meeting the next move at an angle slows a Klipper machine down there).
     fn cost(&self, start: [f64; 3], points: &[[f64; 3]], e: &[f64], feed: &[f64]) -> (f64, f64) {
+        let lines: Vec<Piece> = (1..=points.len().min(feed.len()))
+            .map(|end| Piece {
+                end,
+                arc: None,
+                feed: feed[end - 1],
+            })
+            .collect();
+        self.cost_pieces(start, points, e, &lines)
+    }
+
+    /// [`Machine::cost`] of the path written as `pieces` (lines and arcs) through `points`.
+    fn cost_pieces(
+        &self,
+        start: [f64; 3],
+        points: &[[f64; 3]],
+        e: &[f64],
+        pieces: &[Piece],
+    ) -> (f64, f64) {
         let Some(limits) = self.limits else {
             return (f64::NAN, f64::NAN);
         };
@@ -429,16 +455,18 @@ impl Machine<'_> {
         let mut joules = 0.0;
         let (mut from, mut e_from) = (start, 0.0);
         let [before, after] = &self.context;
-        let path = points.iter().zip(e).zip(feed).map(|((p, &ek), &f)| {
+        let path = pieces.iter().filter_map(|piece| {
+            let k = piece.end.checked_sub(1)?;
+            let (p, &ek) = (points.get(k)?, e.get(k)?);
             let m = Motion {
                 line: 0,
                 delta: [p[0] - from[0], p[1] - from[1], p[2] - from[2], ek - e_from],
-                arc: None,
-                feed_mm_s: f,
+                arc: piece.arc.map(|a| a.resolve(&from, p)),
+                feed_mm_s: piece.feed,
                 rotary_time_s: 0.0,
             };
             (from, e_from) = (*p, ek);
-            m
+            Some(m)
         });
         let all = before
             .iter()
@@ -561,7 +589,7 @@ fn rewrite_path(
     ));
     let out = &mut part;
     // Annotation lines between the original moves (`;WIDTH:`), each with the filament pushed
-    // where it stood: written again before the first new point past that place.
+    // where it stood.
     let mut notes = Vec::new();
     for (s, &at) in src.iter().zip(&e).skip(1) {
         if s.notes.lines > 0 {
@@ -571,87 +599,47 @@ fn rewrite_path(
             ));
         }
     }
-    let mut notes = notes.into_iter().peekable();
-
-    // Write the block.
-    let mut text = String::with_capacity(written.points.len() * 32);
-    let mut z_now = first.from[2];
-    // A path whose Z changes along it (spiral vase, FullControl designs) keeps a Z on every
-    // point, finely enough that each step still climbs: written to 3 decimals, a slow spiral's
-    // short steps would come out flat, and the file would read as a stack of flat layers.
-    let (z_step, z_decimals) = if run.iter().any(|m| (m.to[2] - m.from[2]).abs() > 1e-9) {
-        (5e-6, 5)
-    } else {
-        (5e-4, 3)
+    // Runs on a circle as arcs, if asked for and if the path with them still keeps the
+    // tolerance both ways (measured on the arcs themselves).
+    let all: Vec<[f64; 3]> = std::iter::once(pts[0])
+        .chain(written.points.iter().copied())
+        .collect();
+    let lines = || -> Vec<Piece> {
+        (1..all.len())
+            .map(|end| Piece {
+                end,
+                arc: None,
+                feed: written.feed_mm_s[end - 1],
+            })
+            .collect()
     };
-    let mut f_now = first_src.f_before;
-    let mut e_written = 0.0; // relative mode: rounded running total written so far
-    let count = written.points.len();
-    for (k, ((p, &ek), &v)) in written
-        .points
-        .iter()
-        .zip(&written.e)
-        .zip(&written.feed_mm_s)
-        .enumerate()
-    {
-        while let Some((_, note)) = notes.next_if(|&(at, _)| ek > at + 1e-12) {
-            if !text.is_empty() {
-                text.push('\n');
-            }
-            text.push_str(note);
-        }
-        if !text.is_empty() {
-            text.push('\n');
-        }
-        text.push_str("G1 X");
-        push_trimmed(&mut text, p[0], 3);
-        text.push_str(" Y");
-        push_trimmed(&mut text, p[1], 3);
-        if (p[2] - z_now).abs() > z_step {
-            text.push_str(" Z");
-            push_trimmed(&mut text, p[2], z_decimals);
-            z_now = p[2];
-        }
-        let last = k + 1 == count;
-        text.push_str(" E");
-        match mode {
-            ExtrusionMode::Absolute if last => {
-                let _ = write!(text, "{}", last_src.e_word);
-            }
-            ExtrusionMode::Absolute => push_trimmed(&mut text, first_src.e_before + ek, 5),
-            ExtrusionMode::Relative => {
-                let target = if last { sum } else { ek };
-                let written = rounded(target, 5);
-                push_trimmed(&mut text, written - e_written, 5);
-                e_written = written;
-            }
-        }
-        if f_now.is_some() {
-            let f = rounded(v * 60.0, 1);
-            if f_now.is_none_or(|now| (now - f).abs() > 0.05) {
-                text.push_str(" F");
-                push_trimmed(&mut text, f, 1);
-                f_now = Some(f);
-            }
+    let mut pieces = lines();
+    let mut deviation = smoothed.deviation_mm;
+    if settings.arcs {
+        if let Some((with_arcs, d)) = with_arcs(&all, &written, &pts, settings, machine) {
+            out.arcs_written += with_arcs.iter().filter(|p| p.arc.is_some()).count() as u64;
+            deviation = deviation.max(d);
+            pieces = with_arcs;
         }
     }
-    for (_, note) in notes {
-        text.push('\n');
-        text.push_str(note);
-    }
-    // Leave the modal feed where the original left it.
-    if let (Some(now), Some(after)) = (f_now, last_src.f_after) {
-        if (now - after).abs() > 1e-9 {
-            text.push_str("\nG1 F");
-            push_trimmed(&mut text, after, 3);
-        }
-    }
+    let frame = Frame {
+        start: pts[0],
+        climbs: run.iter().any(|m| (m.to[2] - m.from[2]).abs() > 1e-9),
+        mode,
+        e_before: first_src.e_before,
+        last_e_word: last_src.e_word,
+        total_e: sum,
+        f_before: first_src.f_before,
+        f_after: last_src.f_after,
+        notes,
+    };
+    let text = block::write(&frame, &written.points, &written.e, &pieces);
     out.rewritten_paths += 1;
     out.replaced_moves += run.len() as u64;
-    out.written_moves += count as u64;
+    out.written_moves += pieces.len() as u64;
     out.lowered_segments += written.lowered;
     out.above_k_cr_segments += smoothed.above_k_cr;
-    out.max_deviation_mm = out.max_deviation_mm.max(smoothed.deviation_mm);
+    out.max_deviation_mm = out.max_deviation_mm.max(deviation);
     out.walk.steps += smoothed.stats.steps;
     out.walk.fluctuation_sum += smoothed.stats.fluctuation_sum;
     let mut edits = Vec::with_capacity(src.len());
@@ -674,6 +662,52 @@ fn rewrite_path(
         corners_removed: removed as u64,
         paid: !dearer,
     })
+}
+
+/// The written path `all` (start point first; `written` after it) with its runs on a circle as
+/// arcs, if there are any, the firmware cuts them at least as finely as δθ asks, the path with
+/// them stays within the tolerance of the original `orig` both ways (returned: the distance),
+/// and it plans no slower and costs no more motor energy than the path in lines.
+fn with_arcs(
+    all: &[[f64; 3]],
+    written: &Written,
+    orig: &[[f64; 3]],
+    settings: &Settings,
+    machine: &Machine<'_>,
+) -> Option<(Vec<Piece>, f64)> {
+    let limits = machine.limits?;
+    let max_segment = limits.arc_segment_mm.value;
+    let klipper = machine.model == JunctionModel::Klipper;
+    // Klipper's [gcode_arcs] cuts an arc into pieces of `resolution` (1 mm unless set), Marlin 2
+    // by chord deviation and segment rate.
+    let segments = move |r: f64, len: f64, feed: f64| {
+        if klipper {
+            (len / max_segment.max(1e-3)).floor().max(1.0) as usize
+        } else {
+            crate::plan::arc_segments(r, len, feed, max_segment)
+        }
+    };
+    let firmware = arcs::Firmware {
+        segments: &segments,
+        max_turn_rad: super::smooth::STEP_TURN_SHARE * settings.critical_rad,
+    };
+    let tol = settings.tolerance_mm;
+    let pieces = arcs::pieces(all, &written.feed_mm_s, ARC_SHARE * tol, &firmware);
+    if pieces.iter().all(|p| p.arc.is_none()) {
+        return None;
+    }
+    let d = both_ways(
+        &arcs::flatten(all, &pieces, 0.01 * tol),
+        orig,
+        tol / 10.0,
+        tol,
+    );
+    if d.is_nan() || d > tol {
+        return None;
+    }
+    let (s_lines, j_lines) = machine.cost(all[0], &written.points, &written.e, &written.feed_mm_s);
+    let (s, j) = machine.cost_pieces(all[0], &written.points, &written.e, &pieces);
+    (s <= s_lines * (1.0 + 1e-9) && j <= j_lines * (1.0 + 1e-9)).then_some((pieces, d))
 }
 
 /// Turns above the critical angle (cosine `cos_critical`) along the polyline through `pts`.

@@ -40,7 +40,7 @@ pub const MARLIN_MIN_STEP_MM: f64 = 0.06;
 /// Longest gap between data points on straight runs, mm.
 const STRAIGHT_SPACING_MM: f64 = 3.0;
 /// Largest turn of one interpolation step, as a share of the critical angle.
-const STEP_TURN_SHARE: f64 = 0.9;
+pub(crate) const STEP_TURN_SHARE: f64 = 0.9;
 
 /// Settings for [`smooth_path`].
 #[derive(Debug, Clone, Copy)]
@@ -70,6 +70,8 @@ pub struct Settings {
     /// are); [`crate::vtg::vtg`] raises it where the dynamics model finds the rewrite at 1
     /// rings more than the original.
     pub feed_cap_scale: f64,
+    /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`super::arcs`]).
+    pub arcs: bool,
 }
 
 /// A rewritten path: the new geometry, and what the feed of each new segment is made of.
@@ -635,6 +637,7 @@ mod tests {
             min_step_mm: MIN_STEP_MM,
             classic_jerk_mm_s: None,
             feed_cap_scale: 1.0,
+            arcs: false,
         }
     }
 

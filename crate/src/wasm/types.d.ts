@@ -396,6 +396,8 @@ export interface VtgOptions {
   limit_feed?: boolean;
   /** Simulate both files for Table 2's deviation rows (default true). */
   dynamics?: boolean;
+  /** Write runs of new points on a circle as G2/G3 arcs (default false: the firmware must have arcs enabled). */
+  arcs?: boolean;
 }
 /** before, after and the relative change in percent. */
 export interface Comparison { before: number; after: number; change_pct: number }
@@ -430,6 +432,8 @@ export interface VtgReport {
     mean_speed_fluctuation_pct: number;
     /** Scale the eq. 29 speeds started from: 1, or 1.5 / 2 where the dynamics model found the rewrite at 1 rang more than the original. */
     feed_cap_scale: number;
+    /** Arcs (G2/G3) written in place of runs of steps on a circle (option `arcs`). */
+    arcs_written: number;
   };
   /** The VTG paper's Table 1. */
   table1: {

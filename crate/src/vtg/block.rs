@@ -1,0 +1,119 @@
+//! The G-code block a rewritten path is written as: one `G1` per new point (or one `G2`/`G3`
+//! per run of points on a circle, [`super::arcs`]), filament as the original's extrusion mode
+//! writes it, feed rates only where they change, the original's annotation lines back in place,
+//! and the modal feed left where the original left it.
+
+use std::fmt::Write as _;
+
+use super::arcs::Piece;
+use crate::gcode::number::{push_trimmed, rounded};
+use crate::machine::ExtrusionMode;
+
+/// What the block must agree with in the file around it.
+#[derive(Debug, Clone)]
+pub struct Frame<'a> {
+    /// Where the path starts (the position before its first move).
+    pub start: [f64; 3],
+    /// The path climbs along its length (spiral vase): every point keeps a fine Z.
+    pub climbs: bool,
+    /// The original's extrusion mode.
+    pub mode: ExtrusionMode,
+    /// Logical E before the path (absolute mode).
+    pub e_before: f64,
+    /// The original's last `E` word (absolute mode: the block ends on it exactly).
+    pub last_e_word: f64,
+    /// Filament of the whole path (relative mode: the rounded words add up to it).
+    pub total_e: f64,
+    /// The modal feed before the path, mm/min (`None`: no `F` so far, none is written).
+    pub f_before: Option<f64>,
+    /// The modal feed the original leaves behind, mm/min.
+    pub f_after: Option<f64>,
+    /// Annotation lines with the filament pushed where each stood; each is written before the
+    /// first new point past it.
+    pub notes: Vec<(f64, &'a str)>,
+}
+
+/// The block for new `points` after the start (filament `e` from the path start to each), as
+/// `pieces` (each ending at point `end`, counted with the start point as 0).
+pub fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &[Piece]) -> String {
+    let mut text = String::with_capacity(pieces.len() * 40);
+    let mut z_now = frame.start[2];
+    // A path whose Z changes along it (spiral vase, FullControl designs) keeps a Z on every
+    // point, finely enough that each step still climbs: written to 3 decimals, a slow spiral's
+    // short steps would come out flat, and the file would read as a stack of flat layers.
+    let (z_step, z_decimals) = if frame.climbs { (5e-6, 5) } else { (5e-4, 3) };
+    let mut f_now = frame.f_before;
+    let mut e_written = 0.0; // relative mode: rounded running total written so far
+    let mut from_xy = [rounded(frame.start[0], 3), rounded(frame.start[1], 3)];
+    let mut notes = frame.notes.iter().peekable();
+    for (k, piece) in pieces.iter().enumerate() {
+        let w = piece.end.saturating_sub(1);
+        let (Some(p), Some(&ek)) = (points.get(w), e.get(w)) else {
+            break;
+        };
+        while let Some((_, note)) = notes.next_if(|&&(at, _)| ek > at + 1e-12) {
+            if !text.is_empty() {
+                text.push('\n');
+            }
+            text.push_str(note);
+        }
+        if !text.is_empty() {
+            text.push('\n');
+        }
+        text.push_str(match piece.arc {
+            None => "G1 X",
+            Some(a) if a.ccw => "G3 X",
+            Some(_) => "G2 X",
+        });
+        push_trimmed(&mut text, p[0], 3);
+        text.push_str(" Y");
+        push_trimmed(&mut text, p[1], 3);
+        if (p[2] - z_now).abs() > z_step {
+            text.push_str(" Z");
+            push_trimmed(&mut text, p[2], z_decimals);
+            z_now = p[2];
+        }
+        if let Some(a) = piece.arc {
+            // Offsets from the start as written, so the firmware's centre is the fitted one.
+            text.push_str(" I");
+            push_trimmed(&mut text, rounded(a.center[0] - from_xy[0], 4), 4);
+            text.push_str(" J");
+            push_trimmed(&mut text, rounded(a.center[1] - from_xy[1], 4), 4);
+        }
+        from_xy = [rounded(p[0], 3), rounded(p[1], 3)];
+        let last = k + 1 == pieces.len();
+        text.push_str(" E");
+        match frame.mode {
+            ExtrusionMode::Absolute if last => {
+                let _ = write!(text, "{}", frame.last_e_word);
+            }
+            ExtrusionMode::Absolute => push_trimmed(&mut text, frame.e_before + ek, 5),
+            ExtrusionMode::Relative => {
+                let target = if last { frame.total_e } else { ek };
+                let written = rounded(target, 5);
+                push_trimmed(&mut text, written - e_written, 5);
+                e_written = written;
+            }
+        }
+        if f_now.is_some() {
+            let f = rounded(piece.feed * 60.0, 1);
+            if f_now.is_none_or(|now| (now - f).abs() > 0.05) {
+                text.push_str(" F");
+                push_trimmed(&mut text, f, 1);
+                f_now = Some(f);
+            }
+        }
+    }
+    for (_, note) in notes {
+        text.push('\n');
+        text.push_str(note);
+    }
+    // Leave the modal feed where the original left it.
+    if let (Some(now), Some(after)) = (f_now, frame.f_after) {
+        if (now - after).abs() > 1e-9 {
+            text.push_str("\nG1 F");
+            push_trimmed(&mut text, after, 3);
+        }
+    }
+    text
+}
