@@ -348,7 +348,7 @@ function resultLine(job, r) {
   const pct = (a, b) => (isNum(a) && isNum(b) && b !== 0 ? signedPercent(a / b - 1) : '—');
   switch (job) {
     case 'vtg':
-      return `Tolerance ${n(r.tolerance_mm)} mm, largest deviation from the original path ${n(r.max_deviation_mm, 4)} mm; energy ${pct(r.after?.energy?.total_j, r.before?.energy?.total_j)}, time ${pct(r.after?.time_s, r.before?.time_s)}.`;
+      return `Tolerance ${n(r.tolerance_mm)} mm, largest deviation from the original path ${n(r.max_deviation_mm, 4)} mm; energy ${pct(r.after?.energy?.total_j, r.before?.energy?.total_j)}, time ${pct(r.after?.time_s, r.before?.time_s)}${isNum(r.paths?.arcs_written) && r.paths.arcs_written > 0 ? `; ${r.paths.arcs_written} arcs` : ''}.`;
     case 'infill': {
       const b = r.best ?? {};
       return `Best: ${b.pattern ?? '—'} at ${n(b.angle_deg, 1)}°${isNum(b.rotation_deg) ? ` (rotation ${n(b.rotation_deg, 1)}°)` : ''} of ${Array.isArray(r.candidates) ? r.candidates.length : '—'} candidates; energy ${pct(r.after?.energy?.total_j, r.before?.energy?.total_j)}.`;

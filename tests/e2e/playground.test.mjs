@@ -512,6 +512,7 @@ export function vtg(input, options = {}, progress) {
   const after = real.analyze(output);
   return {
     tolerance_mm: options.tolerance_mm ?? 0.05, max_deviation_mm: 0.0421, before, after,
+    options_seen: options,
     table1: { time_s: { before: before.time_s, after: after.time_s, change: 0 } },
     table2: [{ metric: 'energy_j', before: before.energy.total_j, after: after.energy.total_j }],
     output,
@@ -570,10 +571,12 @@ test('the job UI with every capability: tables, charts, downloads, before/after 
 
   // VTG: before/after table, paper tables, download, viewer side by side.
   await id('opt-vtg-tolerance').fill('0.05');
+  await id('opt-vtg-arcs').check();
   await id('run-vtg').click();
   await idle();
   const vtgJson = JSON.parse(await id('report-json').textContent());
   assert.equal(vtgJson.tolerance_mm, 0.05);
+  assert.equal(vtgJson.options_seen.arcs, true, 'the arcs box reaches the job');
   assert.ok(!('output' in vtgJson));
   const rows = await id('compare-table').locator('tbody tr').allTextContents();
   const metrics = ['Print time', 'Energy', 'CO₂', 'Material', 'Deviation'];
@@ -588,6 +591,7 @@ test('the job UI with every capability: tables, charts, downloads, before/after 
   assert.equal(await id('view-mode').inputValue(), 'side');
   await tab.waitForFunction(() => /after/.test(document.querySelector('[data-testid="layer-info"]').textContent));
   assert.match(tab.url(), /vtg\.tolerance_mm=0\.05/);
+  assert.match(tab.url(), /vtg\.arcs=1/);
   assert.match(tab.url(), /view=side/);
 
   // Infill: one energy line per pattern.
