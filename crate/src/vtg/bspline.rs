@@ -1,9 +1,10 @@
-//! Cubic B-spline curves in 3-D (the VTG paper's NURBS, eq. 21–22, with unit weights).
+//! Cubic NURBS curves in 3-D (the VTG paper's eq. 21–22).
 //!
-//! The fitted data are polylines; rational weights only pay off for exact conics, so every
-//! weight is 1 and eq. 21 reduces to a B-spline. Basis functions follow Piegl & Tiller's A2.2
-//! (the Cox–de Boor recursion of eq. 22), derivatives the derivative curves' control points
-//! (P&T eq. 3.8); the tests check them against A2.3.
+//! Most fits keep every weight 1, and eq. 21 reduces to a B-spline; [`Curve::rational`] takes
+//! weights where the fit finds they help ([`super::fit`]). Basis functions follow Piegl &
+//! Tiller's A2.2 (the Cox–de Boor recursion of eq. 22), derivatives the derivative curves'
+//! control points (P&T eq. 3.8); a rational curve is evaluated in homogeneous coordinates and
+//! projected with the quotient rule (P&T eq. 4.8). The tests check both against A2.3.
 
 /// Degree of the curves.
 pub const DEGREE: usize = 3;
@@ -22,6 +23,16 @@ pub struct Curve {
     d1_ctrl: Vec<[f64; 3]>,
     /// `R_i = 2 (Q_{i+1} − Q_i) / (u_{i+4} − u_{i+2})`, for `C'' = Σ N_{i+2,1} R_i`.
     d2_ctrl: Vec<[f64; 3]>,
+    /// A rational curve's weights `w_i` and their derivative control points (as `Q`, `R`);
+    /// `ctrl`, `d1_ctrl` and `d2_ctrl` then hold the weighted points `w_i P_i` and theirs.
+    weights: Option<Weights>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct Weights {
+    w: Vec<f64>,
+    d1: Vec<f64>,
+    d2: Vec<f64>,
 }
 
 /// A point of the curve with its first and second derivatives.
@@ -49,40 +60,75 @@ impl Eval {
 
 impl PartialEq for Curve {
     fn eq(&self, other: &Self) -> bool {
-        self.knots == other.knots && self.ctrl == other.ctrl
+        self.knots == other.knots && self.ctrl == other.ctrl && self.weights == other.weights
     }
+}
+
+/// Control points of the derivative of a cubic's `lo`/`hi` knot offsets and `degree` (P&T eq.
+/// 3.8; a zero-length knot interval gives a zero difference, P&T's 0/0 = 0), for points with
+/// `D` coordinates.
+fn diff<const D: usize>(
+    knots: &[f64],
+    pts: &[[f64; D]],
+    lo: usize,
+    hi: usize,
+    degree: f64,
+) -> Vec<[f64; D]> {
+    pts.windows(2)
+        .enumerate()
+        .map(|(i, w)| {
+            let den = knots
+                .get(i + hi)
+                .zip(knots.get(i + lo))
+                .map_or(0.0, |(b, a)| b - a);
+            let f = if den > 0.0 { degree / den } else { 0.0 };
+            std::array::from_fn(|k| (w[1][k] - w[0][k]) * f)
+        })
+        .collect()
 }
 
 impl Curve {
     /// The curve with these knots and control points (derivative control points computed here;
     /// a zero-length knot interval gives a zero difference, P&T's 0/0 = 0).
     pub fn new(knots: Vec<f64>, ctrl: Vec<[f64; 3]>) -> Self {
-        let diff = |pts: &[[f64; 3]], lo: usize, hi: usize, degree: f64| -> Vec<[f64; 3]> {
-            pts.windows(2)
-                .enumerate()
-                .map(|(i, w)| {
-                    let den = knots
-                        .get(i + hi)
-                        .zip(knots.get(i + lo))
-                        .map_or(0.0, |(b, a)| b - a);
-                    let f = if den > 0.0 { degree / den } else { 0.0 };
-                    [
-                        (w[1][0] - w[0][0]) * f,
-                        (w[1][1] - w[0][1]) * f,
-                        (w[1][2] - w[0][2]) * f,
-                    ]
-                })
-                .collect()
-        };
-        let d1_ctrl = diff(&ctrl, 1, 4, 3.0);
-        let d2_ctrl = diff(&d1_ctrl, 2, 4, 2.0);
+        let d1_ctrl = diff(&knots, &ctrl, 1, 4, 3.0);
+        let d2_ctrl = diff(&knots, &d1_ctrl, 2, 4, 2.0);
         Self {
             knots,
             ctrl,
             last_span: std::cell::Cell::new(DEGREE),
             d1_ctrl,
             d2_ctrl,
+            weights: None,
         }
+    }
+
+    /// The rational curve (eq. 21) with these knots, control points and positive weights (one
+    /// per control point; all 1 gives [`Curve::new`]'s curve).
+    pub fn rational(knots: Vec<f64>, ctrl: Vec<[f64; 3]>, weights: Vec<f64>) -> Self {
+        if weights.len() != ctrl.len() || weights.iter().all(|&w| w == 1.0) {
+            return Self::new(knots, ctrl);
+        }
+        let weighted: Vec<[f64; 3]> = ctrl
+            .iter()
+            .zip(&weights)
+            .map(|(p, &w)| [p[0] * w, p[1] * w, p[2] * w])
+            .collect();
+        let mut curve = Self::new(knots, weighted);
+        let w1: Vec<[f64; 1]> = weights.iter().map(|&w| [w]).collect();
+        let d1 = diff(&curve.knots, &w1, 1, 4, 3.0);
+        let d2 = diff(&curve.knots, &d1, 2, 4, 2.0);
+        curve.weights = Some(Weights {
+            w: weights,
+            d1: d1.into_iter().map(|[x]| x).collect(),
+            d2: d2.into_iter().map(|[x]| x).collect(),
+        });
+        curve
+    }
+
+    /// The weights (`None`: all 1).
+    pub fn weights(&self) -> Option<&[f64]> {
+        self.weights.as_ref().map(|w| &w.w[..])
     }
 
     /// The knot span holding `u`, from the last one if it (or the next) still does.
@@ -108,7 +154,7 @@ impl Curve {
         &self.knots
     }
 
-    /// Control points.
+    /// Control points (of a rational curve: weighted, `w_i P_i`).
     pub fn ctrl(&self) -> &[[f64; 3]] {
         &self.ctrl
     }
@@ -154,10 +200,34 @@ impl Curve {
             }
             out
         };
+        let (a, a1, a2) = (weigh(&n3, p), weigh(&n2[..3], q), weigh(&n1[..2], r));
+        let Some(wt) = &self.weights else {
+            return Eval {
+                p: a,
+                d1: a1,
+                d2: a2,
+            };
+        };
+        // P&T eq. 4.8: C = A/W, C' = (A' − W'C)/W, C'' = (A'' − 2W'C' − W''C)/W.
+        let (Some(w), Some(w1), Some(w2)) = (
+            wt.w.get(span - DEGREE..=span),
+            wt.d1.get(span - DEGREE..span),
+            wt.d2.get(span - DEGREE..span - 1),
+        ) else {
+            return zero;
+        };
+        let dot_n = |b: &[f64], v: &[f64]| -> f64 { b.iter().zip(v).map(|(x, y)| x * y).sum() };
+        let (ww, ww1, ww2) = (dot_n(&n3, w), dot_n(&n2[..3], w1), dot_n(&n1[..2], w2));
+        if ww.abs() < 1e-300 {
+            return zero;
+        }
+        let c: [f64; 3] = std::array::from_fn(|k| a[k] / ww);
+        let c1: [f64; 3] = std::array::from_fn(|k| (a1[k] - ww1 * c[k]) / ww);
+        let c2: [f64; 3] = std::array::from_fn(|k| (a2[k] - 2.0 * ww1 * c1[k] - ww2 * c[k]) / ww);
         Eval {
-            p: weigh(&n3, p),
-            d1: weigh(&n2[..3], q),
-            d2: weigh(&n1[..2], r),
+            p: c,
+            d1: c1,
+            d2: c2,
         }
     }
 }
@@ -430,5 +500,55 @@ mod tests {
                 assert!((e.d2[k] - sum(&d[2])).abs() < 1e-9 * scale, "u {u}");
             }
         }
+    }
+
+    /// The quarter circle of radius 2 as a rational cubic (the rational quadratic arc with
+    /// middle weight cos 45°, raised to degree 3): every point on the circle, and
+    /// the curvature from the quotient-rule derivatives exactly 1/2.
+    #[test]
+    fn rational_quarter_circle_is_exact() {
+        let h = std::f64::consts::SQRT_2;
+        let m = h / (1.0 + h);
+        let r = 2.0;
+        let ctrl = vec![
+            [r, 0.0, 0.0],
+            [r, r * m, 0.0],
+            [r * m, r, 0.0],
+            [0.0, r, 0.0],
+        ];
+        let w = (1.0 + h) / 3.0;
+        let c = Curve::rational(
+            vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+            ctrl,
+            vec![1.0, w, w, 1.0],
+        );
+        assert!(c.weights().is_some());
+        for i in 0..=100 {
+            let u = i as f64 / 100.0;
+            let e = c.eval(u);
+            assert!((norm(&e.p) - r).abs() < 1e-12, "{u}: {:?}", e.p);
+            assert!(
+                (e.curvature() - 1.0 / r).abs() < 1e-9,
+                "{u}: {}",
+                e.curvature()
+            );
+            // The derivative against a central difference.
+            if i > 0 && i < 100 {
+                let (a, b) = (c.eval(u - 1e-6).p, c.eval(u + 1e-6).p);
+                for k in 0..2 {
+                    assert!(((b[k] - a[k]) / 2e-6 - e.d1[k]).abs() < 1e-5);
+                }
+            }
+        }
+        // Unit weights are the plain B-spline.
+        let ctrl = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 2.0, 0.0],
+            [3.0, 2.0, 0.0],
+            [4.0, 0.0, 0.0],
+        ];
+        let knots = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        let plain = Curve::new(knots.clone(), ctrl.clone());
+        assert_eq!(Curve::rational(knots, ctrl, vec![1.0; 4]), plain);
     }
 }
