@@ -216,7 +216,7 @@ fn pattern_length_and_turning_match_the_written_file() {
                 acc.push(
                     &m.from,
                     &m.to,
-                    quietpath::vtg::metrics::arc_of(&m.kind),
+                    m.kind.arc(),
                     infill && m.is_extruding(),
                     0,
                     true,

@@ -131,14 +131,8 @@ impl Accounts {
         } else {
             (TRAVEL, false)
         };
-        self.toolpath.push(
-            &m.from,
-            &m.to,
-            crate::vtg::metrics::arc_of(&m.kind),
-            extruding,
-            slot,
-            infill,
-        );
+        self.toolpath
+            .push(&m.from, &m.to, m.kind.arc(), extruding, slot, infill);
         let s = self.slot(slot);
         s.moves += 1;
         s.distance_mm += m.length_mm;

@@ -141,6 +141,14 @@ impl Arc {
         ]
     }
 
+    /// How many equal chords the arc takes for each to stay within `sagitta` of it (a chord
+    /// spanning δ lies `r (1 − cos(δ/2))` from its arc); at least 1, at most 100 000.
+    pub fn chords_within(&self, sagitta: f64) -> usize {
+        let sagitta = sagitta.max(1e-9);
+        let span = 2.0 * crate::math::acos((1.0 - sagitta / self.radius.max(sagitta)).max(-1.0));
+        (self.sweep.abs() / span.max(1e-6)).ceil().clamp(1.0, 1e5) as usize
+    }
+
     /// Direction of travel at fraction `t` of the sweep with `rise` along the helix axis, as
     /// (X, Y, Z) (not normalised: its length is the helix length per radian).
     pub fn tangent_at(&self, t: f64, rise: f64) -> [f64; 3] {

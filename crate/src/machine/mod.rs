@@ -117,6 +117,17 @@ pub enum MoveKind {
     Home,
 }
 
+impl MoveKind {
+    /// The arc a `G2`/`G3` runs along (`None` for every other kind).
+    #[inline]
+    pub fn arc(&self) -> Option<&Arc> {
+        match self {
+            MoveKind::Arc(a) => Some(a),
+            _ => None,
+        }
+    }
+}
+
 /// One motion, in machine coordinates.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Move {

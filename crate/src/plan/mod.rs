@@ -19,7 +19,7 @@ pub mod trapezoid;
 
 use serde::Serialize;
 
-use crate::machine::{axis, Move, MoveKind};
+use crate::machine::{axis, Move};
 use crate::math::Bound;
 use junction::Segment;
 pub use limits::{FeedUnits, JunctionModel, Limit, LimitSource, Limits};
@@ -58,10 +58,7 @@ impl From<&Move> for Motion {
             m.to[axis::Z] - m.from[axis::Z],
             m.to[axis::E] - m.from[axis::E],
         ];
-        let arc = match m.kind {
-            MoveKind::Arc(a) => Some(a),
-            _ => None,
-        };
+        let arc = m.kind.arc().copied();
         let rotary_time_s = if arc.is_none() && delta.iter().all(|v| v.abs() < 1e-12) {
             m.nominal_time()
         } else {

@@ -15,6 +15,7 @@
 //! before it keeps them ([`super::deviation::both_ways`]), so the tolerance holds as before.
 
 use super::bspline::{norm, sub};
+use crate::gcode::number::rounded;
 use crate::machine::{Arc, Plane};
 
 /// Fewest steps an arc replaces: below that the file gains little.
@@ -75,12 +76,6 @@ pub struct Piece {
     pub arc: Option<ArcShape>,
     /// Feed, mm/s.
     pub feed: f64,
-}
-
-/// Rounds as the writer writes: coordinates to 3 decimals, centre offsets to 4.
-fn round(v: f64, decimals: i32) -> f64 {
-    let s = 10f64.powi(decimals);
-    (v * s).round() / s
 }
 
 /// The circle through three points in the XY plane: centre and radius.
@@ -174,10 +169,11 @@ fn arc_over(
     {
         return None;
     }
-    // As written: the end stays on the circle the start and the offsets define.
-    let (sx, sy) = (round(first[0], 3), round(first[1], 3));
-    let (ci, cj) = (round(center[0] - sx, 4), round(center[1] - sy, 4));
-    let (ex, ey) = (round(last[0], 3), round(last[1], 3));
+    // As written (the block writer's rounding): the end stays on the circle the start and the
+    // offsets define.
+    let (sx, sy) = (rounded(first[0], 3), rounded(first[1], 3));
+    let (ci, cj) = (rounded(center[0] - sx, 4), rounded(center[1] - sy, 4));
+    let (ex, ey) = (rounded(last[0], 3), rounded(last[1], 3));
     let r_start = ci.hypot(cj);
     let r_end = (ex - sx - ci).hypot(ey - sy - cj);
     if (r_end - r_start).abs() > RADIUS_MISMATCH * r_start {
@@ -187,6 +183,19 @@ fn arc_over(
         center,
         ccw: sign > 0.0,
     })
+}
+
+/// A polyline written as it is: one straight piece per segment, `feed[k]` on the one ending at
+/// point `k + 1`.
+pub fn lines(feed: &[f64]) -> Vec<Piece> {
+    feed.iter()
+        .enumerate()
+        .map(|(k, &feed)| Piece {
+            end: k + 1,
+            arc: None,
+            feed,
+        })
+        .collect()
 }
 
 /// The polyline `pts` (the start point first) as pieces: the longest runs that make arcs
@@ -242,16 +251,10 @@ pub fn flatten(pts: &[[f64; 3]], pieces: &[Piece], sagitta: f64) -> Vec<[f64; 3]
         let Some(&to) = pts.get(p.end) else { break };
         if let Some(shape) = p.arc {
             let a = shape.resolve(&from, &to);
-            let r = a.radius;
-            let span = 2.0 * (1.0 - sagitta / r.max(sagitta)).clamp(-1.0, 1.0).acos();
-            let n = (a.sweep.abs() / span.max(1e-6)).ceil().clamp(1.0, 1e4) as usize;
+            let n = a.chords_within(sagitta);
             for s in 1..n {
-                let t = a.start_angle + a.sweep * s as f64 / n as f64;
-                out.push([
-                    a.center[0] + r * t.cos(),
-                    a.center[1] + r * t.sin(),
-                    from[2],
-                ]);
+                let [x, y] = a.point_at(s as f64 / n as f64);
+                out.push([x, y, from[2]]);
             }
         }
         out.push(to);

@@ -95,9 +95,10 @@ pub fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &[Piece]
                 e_written = written;
             }
         }
-        if f_now.is_some() {
+        // No F is written into a file that has none yet.
+        if let Some(now) = f_now {
             let f = rounded(piece.feed * 60.0, 1);
-            if f_now.is_none_or(|now| (now - f).abs() > 0.05) {
+            if (now - f).abs() > 0.05 {
                 text.push_str(" F");
                 push_trimmed(&mut text, f, 1);
                 f_now = Some(f);

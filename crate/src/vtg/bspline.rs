@@ -15,24 +15,51 @@ pub const DEGREE: usize = 3;
 #[derive(Debug, Clone)]
 pub struct Curve {
     knots: Vec<f64>,
-    ctrl: Vec<[f64; 3]>,
+    /// The control points (of a rational curve: the weighted points `w_i P_i`).
+    ctrl: Net<3>,
+    /// A rational curve's weights `w_i`, as a net of their own (`None`: all 1).
+    weights: Option<Net<1>>,
     /// The span of the last evaluation: the walk evaluates near it again and again, so the
     /// span search starts there (a curve is used by one thread).
     last_span: std::cell::Cell<usize>,
-    /// `Q_i = 3 (P_{i+1} − P_i) / (u_{i+4} − u_{i+1})`, for `C' = Σ N_{i+1,2} Q_i`.
-    d1_ctrl: Vec<[f64; 3]>,
-    /// `R_i = 2 (Q_{i+1} − Q_i) / (u_{i+4} − u_{i+2})`, for `C'' = Σ N_{i+2,1} R_i`.
-    d2_ctrl: Vec<[f64; 3]>,
-    /// A rational curve's weights `w_i` and their derivative control points (as `Q`, `R`);
-    /// `ctrl`, `d1_ctrl` and `d2_ctrl` then hold the weighted points `w_i P_i` and theirs.
-    weights: Option<Weights>,
 }
 
+/// Control points with `D` coordinates and those of the first and second derivative curves.
 #[derive(Debug, Clone, PartialEq)]
-struct Weights {
-    w: Vec<f64>,
-    d1: Vec<f64>,
-    d2: Vec<f64>,
+struct Net<const D: usize> {
+    /// `P_i`.
+    p: Vec<[f64; D]>,
+    /// `Q_i = 3 (P_{i+1} − P_i) / (u_{i+4} − u_{i+1})`, for `C' = Σ N_{i+1,2} Q_i`.
+    q: Vec<[f64; D]>,
+    /// `R_i = 2 (Q_{i+1} − Q_i) / (u_{i+4} − u_{i+2})`, for `C'' = Σ N_{i+2,1} R_i`.
+    r: Vec<[f64; D]>,
+}
+
+impl<const D: usize> Net<D> {
+    fn new(knots: &[f64], p: Vec<[f64; D]>) -> Self {
+        let q = diff(knots, &p, 1, 4, 3.0);
+        let r = diff(knots, &q, 2, 4, 2.0);
+        Self { p, q, r }
+    }
+
+    /// The point and both derivatives in `span` from the basis functions of degrees 1–3.
+    #[inline]
+    fn at(&self, span: usize, [n1, n2, n3]: &[[f64; 4]; 3]) -> Option<[[f64; D]; 3]> {
+        let weigh = |w: &[f64], pts: &[[f64; D]]| -> [f64; D] {
+            let mut out = [0.0; D];
+            for (wi, pt) in w.iter().zip(pts) {
+                for k in 0..D {
+                    out[k] += wi * pt[k];
+                }
+            }
+            out
+        };
+        Some([
+            weigh(n3, self.p.get(span - DEGREE..=span)?),
+            weigh(&n2[..3], self.q.get(span - DEGREE..span)?),
+            weigh(&n1[..2], self.r.get(span - DEGREE..span - 1)?),
+        ])
+    }
 }
 
 /// A point of the curve with its first and second derivatives.
@@ -60,7 +87,7 @@ impl Eval {
 
 impl PartialEq for Curve {
     fn eq(&self, other: &Self) -> bool {
-        self.knots == other.knots && self.ctrl == other.ctrl && self.weights == other.weights
+        self.knots == other.knots && self.ctrl.p == other.ctrl.p && self.weights == other.weights
     }
 }
 
@@ -91,15 +118,11 @@ impl Curve {
     /// The curve with these knots and control points (derivative control points computed here;
     /// a zero-length knot interval gives a zero difference, P&T's 0/0 = 0).
     pub fn new(knots: Vec<f64>, ctrl: Vec<[f64; 3]>) -> Self {
-        let d1_ctrl = diff(&knots, &ctrl, 1, 4, 3.0);
-        let d2_ctrl = diff(&knots, &d1_ctrl, 2, 4, 2.0);
         Self {
+            ctrl: Net::new(&knots, ctrl),
             knots,
-            ctrl,
-            last_span: std::cell::Cell::new(DEGREE),
-            d1_ctrl,
-            d2_ctrl,
             weights: None,
+            last_span: std::cell::Cell::new(DEGREE),
         }
     }
 
@@ -114,27 +137,22 @@ impl Curve {
             .zip(&weights)
             .map(|(p, &w)| [p[0] * w, p[1] * w, p[2] * w])
             .collect();
-        let mut curve = Self::new(knots, weighted);
-        let w1: Vec<[f64; 1]> = weights.iter().map(|&w| [w]).collect();
-        let d1 = diff(&curve.knots, &w1, 1, 4, 3.0);
-        let d2 = diff(&curve.knots, &d1, 2, 4, 2.0);
-        curve.weights = Some(Weights {
-            w: weights,
-            d1: d1.into_iter().map(|[x]| x).collect(),
-            d2: d2.into_iter().map(|[x]| x).collect(),
-        });
-        curve
+        let w = Net::new(&knots, weights.iter().map(|&w| [w]).collect());
+        Self {
+            weights: Some(w),
+            ..Self::new(knots, weighted)
+        }
     }
 
-    /// The weights (`None`: all 1).
-    pub fn weights(&self) -> Option<&[f64]> {
-        self.weights.as_ref().map(|w| &w.w[..])
+    /// Whether the curve has weights other than 1.
+    pub fn is_rational(&self) -> bool {
+        self.weights.is_some()
     }
 
     /// The knot span holding `u`, from the last one if it (or the next) still does.
     #[inline]
     fn span(&self, u: f64) -> usize {
-        let n = self.ctrl.len() - 1;
+        let n = self.ctrl.p.len() - 1;
         let k = &self.knots;
         let last = self.last_span.get();
         let holds = |s: usize| s <= n && k[s] <= u && (u < k[s + 1] || s == n);
@@ -156,7 +174,7 @@ impl Curve {
 
     /// Control points (of a rational curve: weighted, `w_i P_i`).
     pub fn ctrl(&self) -> &[[f64; 3]] {
-        &self.ctrl
+        &self.ctrl.p
     }
 
     /// First parameter.
@@ -172,7 +190,7 @@ impl Curve {
     /// Point and derivatives at `u` (clamped to the curve's range): one pass of A2.2 gives
     /// the basis functions of degrees 1, 2 and 3, which weigh `R`, `Q` and `P`.
     pub fn eval(&self, u: f64) -> Eval {
-        let n = self.ctrl.len();
+        let n = self.ctrl.p.len();
         let zero = Eval {
             p: [0.0; 3],
             d1: [0.0; 3],
@@ -183,25 +201,11 @@ impl Curve {
         }
         let u = u.clamp(self.start(), self.end());
         let span = self.span(u);
-        let (Some(p), Some(q), Some(r)) = (
-            self.ctrl.get(span - DEGREE..=span),
-            self.d1_ctrl.get(span - DEGREE..span),
-            self.d2_ctrl.get(span - DEGREE..span - 1),
-        ) else {
+        let basis = basis_by_degree(&self.knots, span, u);
+        let Some([a, a1, a2]) = self.ctrl.at(span, &basis) else {
             return zero;
         };
-        let [n1, n2, n3] = basis_by_degree(&self.knots, span, u);
-        let weigh = |w: &[f64], pts: &[[f64; 3]]| -> [f64; 3] {
-            let mut out = [0.0; 3];
-            for (wi, pt) in w.iter().zip(pts) {
-                out[0] += wi * pt[0];
-                out[1] += wi * pt[1];
-                out[2] += wi * pt[2];
-            }
-            out
-        };
-        let (a, a1, a2) = (weigh(&n3, p), weigh(&n2[..3], q), weigh(&n1[..2], r));
-        let Some(wt) = &self.weights else {
+        let Some(weights) = &self.weights else {
             return Eval {
                 p: a,
                 d1: a1,
@@ -209,21 +213,15 @@ impl Curve {
             };
         };
         // P&T eq. 4.8: C = A/W, C' = (A' − W'C)/W, C'' = (A'' − 2W'C' − W''C)/W.
-        let (Some(w), Some(w1), Some(w2)) = (
-            wt.w.get(span - DEGREE..=span),
-            wt.d1.get(span - DEGREE..span),
-            wt.d2.get(span - DEGREE..span - 1),
-        ) else {
+        let Some([[w], [w1], [w2]]) = weights.at(span, &basis) else {
             return zero;
         };
-        let dot_n = |b: &[f64], v: &[f64]| -> f64 { b.iter().zip(v).map(|(x, y)| x * y).sum() };
-        let (ww, ww1, ww2) = (dot_n(&n3, w), dot_n(&n2[..3], w1), dot_n(&n1[..2], w2));
-        if ww.abs() < 1e-300 {
+        if w.abs() < 1e-300 {
             return zero;
         }
-        let c: [f64; 3] = std::array::from_fn(|k| a[k] / ww);
-        let c1: [f64; 3] = std::array::from_fn(|k| (a1[k] - ww1 * c[k]) / ww);
-        let c2: [f64; 3] = std::array::from_fn(|k| (a2[k] - 2.0 * ww1 * c1[k] - ww2 * c[k]) / ww);
+        let c: [f64; 3] = std::array::from_fn(|k| a[k] / w);
+        let c1: [f64; 3] = std::array::from_fn(|k| (a1[k] - w1 * c[k]) / w);
+        let c2: [f64; 3] = std::array::from_fn(|k| (a2[k] - 2.0 * w1 * c1[k] - w2 * c[k]) / w);
         Eval {
             p: c,
             d1: c1,
@@ -522,7 +520,7 @@ mod tests {
             ctrl,
             vec![1.0, w, w, 1.0],
         );
-        assert!(c.weights().is_some());
+        assert!(c.is_rational());
         for i in 0..=100 {
             let u = i as f64 / 100.0;
             let e = c.eval(u);

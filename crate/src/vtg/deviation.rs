@@ -259,15 +259,10 @@ pub fn file_deviation(original: &PrintPath, output: &PrintPath, step: f64) -> f6
 /// Points along an arc move (`G2`/`G3`) from its start to its end, the chords between them
 /// within `step / 10` of the arc; `None` for any other move.
 pub fn arc_points(m: &PathMove, step: f64) -> Option<Vec<[f64; 3]>> {
-    let crate::machine::MoveKind::Arc(a) = &m.kind else {
-        return None;
-    };
+    let a = m.kind.arc()?;
     let (i, j, k) = a.plane.axes();
     let rise = m.to[k] - m.from[k];
-    // A chord spanning δ is r (1 − cos(δ/2)) from its arc.
-    let sagitta = (0.1 * step).max(1e-9);
-    let span = 2.0 * crate::math::acos((1.0 - sagitta / a.radius.max(sagitta)).max(-1.0));
-    let n = (a.sweep.abs() / span.max(1e-6)).ceil().clamp(1.0, 1e5) as usize;
+    let n = a.chords_within(0.1 * step);
     Some(
         (0..=n)
             .map(|s| {

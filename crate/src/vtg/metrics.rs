@@ -16,7 +16,8 @@
 
 use serde::Serialize;
 
-use crate::machine::{Arc, MoveKind};
+use super::bspline::norm;
+use crate::machine::Arc;
 use crate::math;
 use crate::math::Bound;
 
@@ -214,19 +215,6 @@ pub fn fast_acos(x: f64) -> f64 {
     }
 }
 
-/// The arc a move runs along, if it is one.
-#[inline]
-pub fn arc_of(kind: &MoveKind) -> Option<&Arc> {
-    match kind {
-        MoveKind::Arc(a) => Some(a),
-        _ => None,
-    }
-}
-
-fn norm(a: &[f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
-}
-
 fn same_point(a: &[f64; 3], b: &[f64]) -> bool {
     (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9 && (a[2] - b[2]).abs() < 1e-9
 }
@@ -273,14 +261,14 @@ pub fn from_path(
         );
         let extruding = m.is_extruding();
         let feature = u32::from(m.feature);
-        file.push(&m.from, &m.to, arc_of(&m.kind), extruding, feature, infill);
+        file.push(&m.from, &m.to, m.kind.arc(), extruding, feature, infill);
         let li = m.layer as usize;
         if m.layer != crate::path::NO_LAYER && li < path.layers.len() {
             while layers.len() <= li {
                 layers.push(MetricsAccumulator::new(critical_angle_deg));
             }
             if let Some(l) = layers.get_mut(li) {
-                l.push(&m.from, &m.to, arc_of(&m.kind), extruding, feature, infill);
+                l.push(&m.from, &m.to, m.kind.arc(), extruding, feature, infill);
             }
         }
     }
@@ -329,10 +317,10 @@ impl crate::path::MoveSink for MetricsSink {
         );
         let (extruding, feature) = (m.is_extruding(), u32::from(m.feature));
         self.file
-            .push(&m.from, &m.to, arc_of(&m.kind), extruding, feature, infill);
+            .push(&m.from, &m.to, m.kind.arc(), extruding, feature, infill);
         for (marker, layer) in [(true, layers.0), (false, layers.1)] {
             if let Some(l) = self.layer(marker, layer) {
-                l.push(&m.from, &m.to, arc_of(&m.kind), extruding, feature, infill);
+                l.push(&m.from, &m.to, m.kind.arc(), extruding, feature, infill);
             }
         }
     }

@@ -399,10 +399,7 @@ fn motion_of(m: &PathMove) -> Motion {
     Motion {
         line: m.line,
         delta: [0, 1, 2, 3].map(|k| m.to[k] - m.from[k]),
-        arc: match m.kind {
-            MoveKind::Arc(a) => Some(a),
-            _ => None,
-        },
+        arc: m.kind.arc().copied(),
         feed_mm_s: m.feed_mm_s,
         rotary_time_s: 0.0,
     }
@@ -429,14 +426,7 @@ impl Machine<'_> {
     /// changes at the path's two junctions with the rest of the file is counted too (a short
     /// last step meeting the next move at an angle slows a Klipper machine down there).
     fn cost(&self, start: [f64; 3], points: &[[f64; 3]], e: &[f64], feed: &[f64]) -> (f64, f64) {
-        let lines: Vec<Piece> = (1..=points.len().min(feed.len()))
-            .map(|end| Piece {
-                end,
-                arc: None,
-                feed: feed[end - 1],
-            })
-            .collect();
-        self.cost_pieces(start, points, e, &lines)
+        self.cost_pieces(start, points, e, &arcs::lines(feed))
     }
 
     /// [`Machine::cost`] of the path written as `pieces` (lines and arcs) through `points`.
@@ -542,10 +532,8 @@ fn rewrite_path(
     };
     let smoothed = smooth_path(&path, settings)?;
     let (original_s, original_j) = machine.cost(pts[0], &pts[1..], &e[1..], &feed);
-    let added = |w: &Written| {
-        let (s, j) = machine.cost(pts[0], &w.points, &w.e, &w.feed_mm_s);
-        [s - original_s, j - original_j]
-    };
+    let cost = |w: &Written| machine.cost(pts[0], &w.points, &w.e, &w.feed_mm_s);
+    let added_by = |(s, j): (f64, f64)| [s - original_s, j - original_j];
     let dearer = |a: &[f64; 2]| a[0] > original_s * 1e-9 || a[1] > original_j * 1e-9;
     // The eq. 29 speeds as they are, then raised step by step, then no caps at all, each
     // first as fast as the firmware will go elsewhere, then no faster than the original: the
@@ -557,25 +545,29 @@ fn rewrite_path(
     } else {
         &[None]
     };
-    let mut cheapest: Option<(Option<f64>, Written, [f64; 2])> = None;
+    // (scale, the path as written, its time and energy)
+    let mut cheapest: Option<(Option<f64>, Written, (f64, f64))> = None;
     for (k, ceiling) in scales.iter().flat_map(|&k| [(k, false), (k, true)]) {
         let w = smoothed.written(k, ceiling, pts[0], settings);
-        let a = added(&w);
+        let total = cost(&w);
+        let a = added_by(total);
         if a.iter().any(|x| x.is_nan()) {
             continue;
         }
-        let better = cheapest
-            .as_ref()
-            .is_none_or(|c| (a[1], a[0]) < (c.2[1], c.2[0]));
+        let better = cheapest.as_ref().is_none_or(|c| {
+            let b = added_by(c.2);
+            (a[1], a[0]) < (b[1], b[0])
+        });
         let stop = !dearer(&a);
         if stop || better {
-            cheapest = Some((k, w, a));
+            cheapest = Some((k, w, total));
         }
         if stop {
             break;
         }
     }
-    let (scale, written, added) = cheapest?;
+    let (scale, written, written_cost) = cheapest?;
+    let added = added_by(written_cost);
     let mut part = Rewritten::default();
     match scale {
         None if settings.limit_feed => part.uncapped_paths += 1,
@@ -604,19 +596,12 @@ fn rewrite_path(
     let all: Vec<[f64; 3]> = std::iter::once(pts[0])
         .chain(written.points.iter().copied())
         .collect();
-    let lines = || -> Vec<Piece> {
-        (1..all.len())
-            .map(|end| Piece {
-                end,
-                arc: None,
-                feed: written.feed_mm_s[end - 1],
-            })
-            .collect()
-    };
-    let mut pieces = lines();
+    let mut pieces = arcs::lines(&written.feed_mm_s);
     let mut deviation = smoothed.deviation_mm;
     if settings.arcs {
-        if let Some((with_arcs, d)) = with_arcs(&all, &written, &pts, settings, machine) {
+        if let Some((with_arcs, d)) =
+            with_arcs(&all, &written, written_cost, &pts, settings, machine)
+        {
             out.arcs_written += with_arcs.iter().filter(|p| p.arc.is_some()).count() as u64;
             deviation = deviation.max(d);
             pieces = with_arcs;
@@ -667,10 +652,12 @@ fn rewrite_path(
 /// The written path `all` (start point first; `written` after it) with its runs on a circle as
 /// arcs, if there are any, the firmware cuts them at least as finely as δθ asks, the path with
 /// them stays within the tolerance of the original `orig` both ways (returned: the distance),
-/// and it plans no slower and costs no more motor energy than the path in lines.
+/// and it plans no slower and costs no more motor energy than the path in lines did
+/// (`lines_cost`: time s, energy J).
 fn with_arcs(
     all: &[[f64; 3]],
     written: &Written,
+    lines_cost: (f64, f64),
     orig: &[[f64; 3]],
     settings: &Settings,
     machine: &Machine<'_>,
@@ -705,7 +692,7 @@ fn with_arcs(
     if d.is_nan() || d > tol {
         return None;
     }
-    let (s_lines, j_lines) = machine.cost(all[0], &written.points, &written.e, &written.feed_mm_s);
+    let (s_lines, j_lines) = lines_cost;
     let (s, j) = machine.cost_pieces(all[0], &written.points, &written.e, &pieces);
     (s <= s_lines * (1.0 + 1e-9) && j <= j_lines * (1.0 + 1e-9)).then_some((pieces, d))
 }
