@@ -327,3 +327,51 @@ fn keeping_the_feed_rounds_corners_without_costing_time() {
         assert!(o.time_pct <= 1.0, "{name}: {}", o.time_pct);
     }
 }
+
+/// The two Klipper exceptions are a trade of time and energy for quiet, not a limit of the
+/// rewrite. Allowed the 1 % of print time the issue permits (`allow_slower_pct`), the rewrite
+/// spends it on the corners that cost least and the whole file stays within it, yet the bars
+/// still do not all hold: the corners do not reach 40 %, or they do and the energy rises. With
+/// every corner rounded they pass 40 % (still within the tolerance, filament conserved,
+/// ringing less), more than 1 % slower or dearer. Should a later rewrite meet the bars at the
+/// issue's allowance, this test fails and the exception must go.
+#[test]
+fn klipper_exceptions_are_a_trade_of_time_for_quiet() {
+    let with = |pct: f64| VtgOptions {
+        allow_slower_pct: pct,
+        ..VtgOptions::default()
+    };
+    for (name, why) in TURNING_EXCEPTIONS
+        .iter()
+        .filter(|(_, why)| why.contains("Klipper"))
+    {
+        let bytes = std::fs::read(corpus_dir().join(name)).unwrap();
+        let kept = check(&bytes, name, &VtgOptions::default());
+        let at_bar = check(&bytes, name, &with(1.0));
+        let all = check(&bytes, name, &with(100.0));
+        eprintln!("{name}\n  default {kept:?}\n  1 % {at_bar:?}\n  100 % {all:?}");
+        assert!(
+            at_bar.time_pct <= 1.0,
+            "{name}: allowance overrun {at_bar:?}"
+        );
+        assert!(
+            at_bar.turning_pct < kept.turning_pct - 5.0,
+            "{name}: {at_bar:?}"
+        );
+        assert!(
+            at_bar.mean_deviation_pct < kept.mean_deviation_pct,
+            "{name}"
+        );
+        assert!(
+            at_bar.turning_pct > -40.0 || at_bar.energy_pct >= 0.0,
+            "{name}: every bar met at the issue's allowance ({at_bar:?}); drop the exception ({why})"
+        );
+        assert!(all.kept_for_time < at_bar.kept_for_time, "{name}");
+        assert!(all.turning_pct <= -40.0, "{name}: {all:?}");
+        assert!(all.mean_deviation_pct < at_bar.mean_deviation_pct, "{name}");
+        assert!(
+            all.time_pct > 1.0 || all.energy_pct >= 0.0,
+            "{name}: {all:?}"
+        );
+    }
+}

@@ -82,6 +82,16 @@ test('vtg: wasm report and output equal the CLI (dynamics rows to 1e-9)', () => 
   assert.ok(report.table1.n_turning.after < report.table1.n_turning.before);
 });
 
+test('vtg allow_slower_pct: wasm equals the CLI, and an out-of-range value is an Error', () => {
+  const out = path.join(tmp, 'vtg-slower.gcode');
+  const fromCli = runCli(['vtg', DEMO, '-o', out, '--allow-slower', '1', '--no-dynamics', '--json']);
+  const { report, output } = reportOf(qp.vtg(fs.readFileSync(DEMO), { allow_slower_pct: 1, dynamics: false }));
+  assert.deepEqual(report, fromCli);
+  assert.ok(Buffer.from(output).equals(fs.readFileSync(out)), 'rewritten file differs from the CLI output');
+  assert.ok(report.after.time_s <= report.before.time_s * 1.01, 'the allowance holds on the whole file');
+  assert.throws(() => qp.vtg(fs.readFileSync(DEMO), { allow_slower_pct: 150 }), (e) => e instanceof Error && /allow_slower_pct/.test(e.message));
+});
+
 test('infill: wasm report and output equal the CLI (angles 0/45/90, two patterns)', () => {
   const out = path.join(tmp, 'infill.gcode');
   const fromCli = runCli(['infill', DEMO, '-o', out, '--angles', '0,45,90', '--patterns', 'rectilinear,grid', '--json']);

@@ -115,7 +115,7 @@ test('TypeScript: declarations compile (tsc --strict) and match real CLI output'
     "  const spectrum: Float64Array = vr.psd.power;",
     "  const sr = smooth(bytes, { cone_deg: 60, window: { millimetres: 5 } });",
     "  const smoothed: Uint8Array = sr.output;",
-    "  const vr2 = vtg(bytes, { tolerance_mm: 0.05, limit_feed: false, dynamics: false });",
+    "  const vr2 = vtg(bytes, { tolerance_mm: 0.05, limit_feed: false, dynamics: false, allow_slower_pct: 0.5 });",
     "  const turning: number = vr2.table1.n_turning.change_pct + (vr2.table2.deviation?.mean_mm.after ?? 0) + vr2.output.length;",
     "  const ir = infill(bytes, { angles_deg: [0, 90], patterns: ['rectilinear', 'hilbert'], objective: 'time' });",
     "  const best: string = ir.best.pattern + ir.candidates[0].total_j + ir.output.length;",

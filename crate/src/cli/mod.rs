@@ -235,7 +235,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 eprintln!("warning: {}:{}: {}", file.display(), w.line, w.message);
             }
             output::write_atomically(&file, &output, force, |out| {
-                gcode::write_with_edits(&input, &[], out)
+                gcode::write_with_edits(&input, &[] as &[gcode::Edit], out)
             })
         }
         Cmd::Calibrate { file, json, opts } => {

@@ -32,6 +32,12 @@ pub struct Args {
     /// firmware with arcs enabled (Marlin's ARC_SUPPORT, Klipper's [gcode_arcs]).
     #[arg(long)]
     pub arcs: bool,
+    /// Print time the rewrite may add to round corners that cost time, percent of the
+    /// original's (by default the print gets no slower and uses no more energy). For Klipper
+    /// machines with a high square-corner velocity, when quiet matters more than time; 100
+    /// rounds every corner the tolerance allows.
+    #[arg(long, value_name = "PCT", default_value_t = 0.0)]
+    pub allow_slower: f64,
     /// Overwrite the input file if OUT names it.
     #[arg(long)]
     pub force: bool,
@@ -52,6 +58,7 @@ pub fn run(args: Args) -> Result<(), String> {
         limit_feed: !args.keep_feed,
         dynamics: !args.no_dynamics,
         arcs: args.arcs,
+        allow_slower_pct: args.allow_slower,
         ..VtgOptions::default()
     };
     let mut bar = output::ProgressBar::for_input(input.len());

@@ -21,18 +21,17 @@ pub struct Edit {
 
 /// Writes `input` with `edits` applied. Edits must be sorted by line and name each line at
 /// most once; edits naming lines past the end are ignored.
-pub fn write_with_edits<W: Write + ?Sized>(
+pub fn write_with_edits<'a, W: Write + ?Sized>(
     input: &[u8],
-    edits: &[Edit],
+    edits: impl IntoIterator<Item = &'a Edit>,
     out: &mut W,
 ) -> io::Result<()> {
-    debug_assert!(
-        edits.windows(2).all(|w| w[0].line < w[1].line),
-        "edits must be sorted and unique"
-    );
     let mut copied_from = 0usize;
     let mut lines = Lines::new(input);
+    let mut previous = 0u32;
     for edit in edits {
+        debug_assert!(edit.line > previous, "edits must be sorted and unique");
+        previous = edit.line;
         // Find the edited line, copying everything before it in one write.
         let Some(line) = lines.by_ref().find(|l| l.number == edit.line) else {
             break;
@@ -58,7 +57,7 @@ pub fn write_with_edits<W: Write + ?Sized>(
 }
 
 /// [`write_with_edits`] into a new buffer.
-pub fn apply_edits(input: &[u8], edits: &[Edit]) -> Vec<u8> {
+pub fn apply_edits<'a>(input: &[u8], edits: impl IntoIterator<Item = &'a Edit>) -> Vec<u8> {
     let mut out = Vec::with_capacity(input.len());
     // Writing into a Vec cannot fail.
     let _ = write_with_edits(input, edits, &mut out);
@@ -72,7 +71,7 @@ mod tests {
     #[test]
     fn no_edits_is_identity() {
         let input = b"G1 X1\r\n;c\nG1 X2";
-        assert_eq!(apply_edits(input, &[]), input);
+        assert_eq!(apply_edits(input, &[] as &[Edit]), input);
     }
 
     #[test]

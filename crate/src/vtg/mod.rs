@@ -19,6 +19,7 @@ pub mod arcs;
 pub mod blend;
 pub mod block;
 pub mod bspline;
+pub mod budget;
 pub mod deviation;
 pub mod fit;
 pub mod hairpin;
@@ -73,6 +74,14 @@ pub struct VtgOptions {
     /// line count (default false: the firmware must have arcs enabled, Marlin's `ARC_SUPPORT`
     /// or Klipper's `[gcode_arcs]`).
     pub arcs: bool,
+    /// Print time the rewrite may add to round corners that cost time, percent of the
+    /// original's (default 0: the print gets no slower and uses no more energy, the corners
+    /// that would cost being paid only out of what the other rewrites save). On a machine
+    /// whose firmware takes sharp corners faster than any fillet within the tolerance
+    /// (Klipper with a square-corner velocity of 50–100 mm/s) rounding costs time, and motor
+    /// and standby energy with it; where quiet matters more, this buys the corners that remove
+    /// the most sharp turns for their time first. 100 rounds every corner the tolerance allows.
+    pub allow_slower_pct: f64,
 }
 
 impl Default for VtgOptions {
@@ -87,6 +96,7 @@ impl Default for VtgOptions {
             limit_feed: true,
             dynamics: true,
             arcs: false,
+            allow_slower_pct: 0.0,
         }
     }
 }
@@ -112,6 +122,9 @@ impl VtgOptions {
         }
         if !pos(self.nozzle_diameter_mm) || self.nozzle_diameter_mm > 10.0 {
             return bad("nozzle_diameter_mm must be a number in (0, 10]");
+        }
+        if !(0.0..=100.0).contains(&self.allow_slower_pct) {
+            return bad("allow_slower_pct must be a number in [0, 100]");
         }
         Ok(())
     }
@@ -149,11 +162,11 @@ pub fn vtg_with_progress(
     // One rewrite with the eq. 29 speeds starting at `scale`, analysed and reported.
     let attempt = |scale: f64, before: Report, progress: Progress<'_>| {
         let mut step = |f: f64| progress(0.8 * f);
-        let rewritten =
-            rewrite::rewrite(input, &path, &sources, options, &limits, scale, &mut step)?;
+        let offers = rewrite::offers(input, &path, &sources, options, &limits, scale, &mut step)?;
         if !progress(0.8) {
             return Err(cancelled());
         }
+        let rewritten = within_allowed_time(input, &offers, options, &before)?;
         // The output's metrics streamed, not from a kept move list: rounding corners can
         // multiply the moves tenfold.
         let (after, after_metrics) = crate::parallel::join(
@@ -189,6 +202,43 @@ pub fn vtg_with_progress(
     progress(1.0);
     Ok(report)
 }
+
+/// The rewrite written from `offers` with the time `allow_slower_pct` allows, measured on the
+/// whole file. The choice counts the time each path adds as planned with its neighbours only;
+/// across the file the firmware's look-ahead adds a little more (3–9 % of the allowance on the
+/// Creality benchies), so where the whole file comes out slower than allowed the allowance is
+/// cut by the excess and the choice made again (at most [`TIME_ROUNDS`] times, then without
+/// any allowance).
+fn within_allowed_time(
+    input: &[u8],
+    offers: &rewrite::Offers,
+    options: &VtgOptions,
+    before: &Report,
+) -> Result<rewrite::Rewritten, Error> {
+    let allowed = options.allow_slower_pct / 100.0 * before.time_s;
+    let mut allowed_s = allowed;
+    for _ in 0..TIME_ROUNDS {
+        let rewritten = offers.write(input, allowed_s);
+        if allowed <= 0.0 {
+            return Ok(rewritten);
+        }
+        let added =
+            crate::analyze::analyze(&rewritten.output, &options.analyze)?.time_s - before.time_s;
+        if added <= allowed {
+            return Ok(rewritten);
+        }
+        allowed_s -= TIME_MARGIN * (added - allowed);
+        if allowed_s <= 0.0 {
+            break;
+        }
+    }
+    Ok(offers.write(input, 0.0))
+}
+
+/// Choices made against the whole file's time before giving up the allowance.
+const TIME_ROUNDS: usize = 4;
+/// Each round cuts the allowance by this many times the excess measured.
+const TIME_MARGIN: f64 = 1.2;
 
 /// Scales of the eq. 29 speeds tried, in turn, when the rewrite at 1 leaves the machine
 /// ringing more than the original did.
@@ -256,4 +306,47 @@ fn with_simulated_deviation(
         }
     }
     Ok(best)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn out_of_range_options_are_refused_by_name() {
+        let demo = include_bytes!("../../../www/demo/demo.gcode");
+        let cases = [
+            VtgOptions {
+                tolerance_mm: 0.0,
+                ..VtgOptions::default()
+            },
+            VtgOptions {
+                critical_angle_deg: 180.0,
+                ..VtgOptions::default()
+            },
+            VtgOptions {
+                allow_slower_pct: -1.0,
+                ..VtgOptions::default()
+            },
+            VtgOptions {
+                allow_slower_pct: f64::NAN,
+                ..VtgOptions::default()
+            },
+            VtgOptions {
+                allow_slower_pct: 100.5,
+                ..VtgOptions::default()
+            },
+        ];
+        for (options, name) in cases.iter().zip([
+            "tolerance_mm",
+            "critical_angle_deg",
+            "allow_slower_pct",
+            "allow_slower_pct",
+            "allow_slower_pct",
+        ]) {
+            let e = vtg(demo, options).expect_err(name);
+            assert!(matches!(e.kind, ErrorKind::InvalidOption { .. }), "{e}");
+            assert!(e.to_string().contains(name), "{e}");
+        }
+    }
 }

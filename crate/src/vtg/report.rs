@@ -109,7 +109,8 @@ pub struct PathCounts {
     pub uncapped: u64,
     /// Rewritten paths that plan slower, or cost more motor energy, than the original even
     /// without caps, paid for out of half of what the other rewrites saved (a firmware that
-    /// takes sharp corners faster than any fillet within the tolerance allows).
+    /// takes sharp corners faster than any fillet within the tolerance allows). With
+    /// `allow_slower_pct`, also those bought with the time it allows.
     pub paid_from_savings: u64,
     /// Paths like those that the savings could not pay for, kept as they were.
     pub kept_for_time: u64,

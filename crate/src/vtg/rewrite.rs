@@ -14,6 +14,7 @@
 use super::arcs::{self, Piece};
 use super::block::{self, Frame};
 use super::bspline::{dot, norm, sub};
+use super::budget::{self, Budget, Offer, Outcome};
 use super::deviation::both_ways;
 use super::kinematics::KinematicLimits;
 use super::resample::WalkStats;
@@ -52,7 +53,8 @@ pub struct Rewritten {
     /// them slower than the original.
     pub uncapped_paths: u64,
     /// Rewritten paths that plan slower or cost more motor energy than the original, paid for
-    /// out of what the other rewrites saved (see [`SPEND_SHARE`]).
+    /// out of what the other rewrites saved or with the time the options allow (see
+    /// [`super::budget`]).
     pub paid_paths: u64,
     /// Paths kept as they were because even rounded without caps they plan slower or cost more
     /// motor energy, and the savings elsewhere could not pay for them.
@@ -115,7 +117,17 @@ pub fn first_mode_hz(path: &PrintPath) -> f64 {
     }
 }
 
-/// Rewrites every eligible path of `input`.
+/// Every path's ways of being written, before the file-level choice ([`budget`]).
+#[derive(Debug, Default)]
+pub struct Offers {
+    offers: Vec<Offer>,
+    /// Time (s) and motor energy (J) the free rewrites save.
+    saved: [f64; 2],
+    candidate_paths: u64,
+    feed_cap_scale: f64,
+}
+
+/// Rewrites every eligible path of `input`, with the time the options allow.
 pub fn rewrite(
     input: &[u8],
     path: &PrintPath,
@@ -125,16 +137,30 @@ pub fn rewrite(
     feed_cap_scale: f64,
     progress: crate::analyze::Progress<'_>,
 ) -> Result<Rewritten, Error> {
-    let mut out = Rewritten {
+    let offers = offers(input, path, all, options, limits, feed_cap_scale, progress)?;
+    Ok(offers.write(input, options.allow_slower_pct / 100.0 * path.time_s))
+}
+
+/// Rewrites every eligible path of `input` in every way worth offering: the free rewrite, and
+/// the dearer ones (see [`budget`]).
+pub fn offers(
+    input: &[u8],
+    path: &PrintPath,
+    all: &Sources,
+    options: &VtgOptions,
+    limits: &KinematicLimits,
+    feed_cap_scale: f64,
+    progress: crate::analyze::Progress<'_>,
+) -> Result<Offers, Error> {
+    let mut out = Offers {
         feed_cap_scale,
-        ..Rewritten::default()
+        ..Offers::default()
     };
     let moves = &path.moves;
     let sources = &all.moves[..];
     let aligned =
         sources.len() == moves.len() && sources.iter().zip(moves).all(|(s, m)| s.line == m.line);
     if !aligned {
-        out.output = input.to_vec();
         return Ok(out);
     }
     let settings = Settings {
@@ -157,6 +183,7 @@ pub fn rewrite(
             .then(|| xy_jerk(&path.print_limits)),
         feed_cap_scale,
         arcs: options.arcs,
+        round_all: false,
     };
     let energy = Accumulator::new(
         &options.analyze.energy.clone().unwrap_or_default(),
@@ -180,14 +207,18 @@ pub fn rewrite(
         i = j;
     }
     out.candidate_paths = candidates.len() as u64;
-    let mut edits: Vec<Edit> = Vec::new();
-    let mut dearer: Vec<Outcome> = Vec::new();
+    let round_all = Settings {
+        round_all: true,
+        ..settings
+    };
+    let buy_time = options.allow_slower_pct > 0.0;
+    let mut offers: Vec<Offer> = Vec::with_capacity(candidates.len());
     let mut saved = [0.0f64; 2];
     for (b, batch) in candidates.chunks(BATCH_PATHS).enumerate() {
         if !progress((b * BATCH_PATHS) as f64 / candidates.len().max(1) as f64) {
             return Err(Error::new(0, 0, ErrorKind::Cancelled));
         }
-        // One result per path, added up here in file order: sums are then the same to the
+        // One offer per path, added up here in file order: sums are then the same to the
         // last bit as a sequential run's (the wasm build's, which the CLI's JSON must equal).
         let parts = crate::parallel::map_chunks(batch, |chunk| {
             chunk
@@ -202,97 +233,70 @@ pub fn rewrite(
                             moves.get(j).map(motion_of),
                         ],
                     };
-                    rewrite_path(input, &moves[i..j], &sources[i..j], &settings, &machine)
+                    let write = |s: &Settings| {
+                        rewrite_path(input, &moves[i..j], &sources[i..j], s, &machine)
+                    };
+                    let mut offer = Offer::default();
+                    let kept = write(&settings).map_or(0, |o| {
+                        let n = o.corners_removed;
+                        offer.push(o);
+                        n
+                    });
+                    // With time to spend, the variant that rounds the corners the firmware
+                    // takes faster sharp, too.
+                    if buy_time {
+                        if let Some(o) = write(&round_all).filter(|o| o.corners_removed > kept) {
+                            offer.push(o);
+                        }
+                    }
+                    offer
                 })
                 .collect()
         });
-        for outcome in parts.into_iter().flatten() {
-            if outcome.dearer {
-                dearer.push(outcome);
-            } else {
-                saved[0] -= outcome.added[0];
-                saved[1] -= outcome.added[1];
-                edits.extend(outcome.edits);
-                out.add(&outcome.part);
+        for offer in parts {
+            if let Some(free) = &offer.free {
+                saved[0] -= free.added[0];
+                saved[1] -= free.added[1];
             }
+            offers.push(offer);
         }
     }
-    pay_from_savings(&mut dearer, saved);
-    let mut paid_any = false;
-    for outcome in dearer {
-        if outcome.paid {
-            out.add(&outcome.part);
-            out.paid_paths += 1;
-            edits.extend(outcome.edits);
-            paid_any = true;
-        } else {
-            out.kept_for_time += 1;
-        }
-    }
-    if paid_any {
-        // Paid rewrites come after the others: back into line order.
-        edits.sort_unstable_by_key(|e| e.line);
-    }
-    out.output = apply_edits(input, &edits);
+    out.offers = offers;
+    out.saved = saved;
     Ok(out)
 }
 
-/// Share of what the rewrites that cost nothing saved (time and motor energy, each) that may be
-/// spent on rewrites that cost something.
-///
-/// On a firmware that takes sharp corners faster than a fillet within the tolerance allows
-/// (Klipper with a high square-corner velocity, a junction-deviation planner with a large
-/// deviation), rounding a corner costs a little time; elsewhere in the same file rounding
-/// saves time, because a fillet lets the machine carry more speed through the corner than
-/// the firmware's own rule for the sharp one. Half of those savings may buy the dearer
-/// rewrites that remove the most sharp corners for what they cost, so the file as a whole
-/// still prints faster and on less energy than the original, by at least half of what the
-/// cheap rewrites saved.
-pub const SPEND_SHARE: f64 = 0.5;
-
-/// One path's rewrite, before the file-level choice.
-struct Outcome {
-    /// The edits that write it.
-    edits: Vec<Edit>,
-    /// Its counts.
-    part: Rewritten,
-    /// Time (s) and motor energy (J) the rewrite adds to the path's own (negative: saves).
-    added: [f64; 2],
-    /// Whether it costs more time or energy than the original.
-    dearer: bool,
-    /// Sharp corners it removes.
-    corners_removed: u64,
-    /// Whether it is written (a dearer rewrite only if [`pay_from_savings`] chose it).
-    paid: bool,
-}
-
-/// Chooses the dearer rewrites to pay for out of `saved` (time s, energy J, by the rewrites
-/// that cost nothing): [`SPEND_SHARE`] of each, spent on the rewrites with the most sharp
-/// corners removed for their cost first (a knapsack's greedy order; a rewrite that does not
-/// fit is skipped and cheaper ones after it still tried). Ties go to file order, so the choice
-/// is the same on any number of threads.
-fn pay_from_savings(dearer: &mut [Outcome], saved: [f64; 2]) {
-    let budget = saved.map(|x| SPEND_SHARE * x.max(0.0));
-    if budget.iter().any(|&b| b <= 0.0) {
-        return;
-    }
-    // The cost of a rewrite as shares of the two budgets (what it saves in one counts for it).
-    let cost = |o: &Outcome| o.added[0] / budget[0] + o.added[1] / budget[1];
-    let mut order: Vec<usize> = (0..dearer.len())
-        .filter(|&k| dearer[k].corners_removed > 0 && cost(&dearer[k]).is_finite())
-        .collect();
-    order.sort_by(|&a, &b| {
-        let key = |k: usize| cost(&dearer[k]) / dearer[k].corners_removed as f64;
-        key(a).total_cmp(&key(b)).then(a.cmp(&b))
-    });
-    let mut left = budget;
-    for k in order {
-        let o = &mut dearer[k];
-        if o.added[0] <= left[0] && o.added[1] <= left[1] {
-            left[0] -= o.added[0];
-            left[1] -= o.added[1];
-            o.paid = true;
+impl Offers {
+    /// The file with the free rewrites and the dearer ones bought with half of what the free
+    /// ones saved plus `allowed_s` of time ([`budget::choose`]).
+    pub fn write(&self, input: &[u8], allowed_s: f64) -> Rewritten {
+        let mut out = Rewritten {
+            candidate_paths: self.candidate_paths,
+            feed_cap_scale: self.feed_cap_scale,
+            ..Rewritten::default()
+        };
+        let choice = budget::choose(&self.offers, Budget::new(self.saved, allowed_s));
+        let mut edits: Vec<&Edit> = Vec::new();
+        for (offer, chosen) in self.offers.iter().zip(choice) {
+            let written = match chosen {
+                Some(k) => {
+                    out.paid_paths += 1;
+                    offer.dearer.get(k)
+                }
+                None => {
+                    if offer.free.is_none() && !offer.dearer.is_empty() {
+                        out.kept_for_time += 1;
+                    }
+                    offer.free.as_ref()
+                }
+            };
+            if let Some(o) = written {
+                out.add(&o.part);
+                edits.extend(&o.edits);
+            }
         }
+        out.output = apply_edits(input, edits);
+        out
     }
 }
 
@@ -480,7 +484,7 @@ impl Machine<'_> {
 /// sets the speed). If every variant is still dearer (a machine whose planner takes sharp
 /// corners faster than a fillet within the tolerance allows, such as Klipper with a high
 /// square-corner velocity, gains nothing in time from rounding), the cheapest in energy is
-/// returned marked dearer, for [`pay_from_savings`] to take or leave.
+/// returned marked dearer, for [`budget::choose`] to take or leave.
 fn rewrite_path(
     input: &[u8],
     run: &[PathMove],
@@ -645,7 +649,6 @@ fn rewrite_path(
         added,
         dearer,
         corners_removed: removed as u64,
-        paid: !dearer,
     })
 }
 
@@ -713,50 +716,6 @@ fn sharp_turns<'a>(pts: impl IntoIterator<Item = &'a [f64; 3]>, cos_critical: f6
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-
-    fn outcome(added_s: f64, added_j: f64, corners: u64) -> Outcome {
-        Outcome {
-            edits: Vec::new(),
-            part: Rewritten::default(),
-            added: [added_s, added_j],
-            dearer: true,
-            corners_removed: corners,
-            paid: false,
-        }
-    }
-
-    #[test]
-    fn dearer_rewrites_are_paid_from_half_the_savings_best_value_first() {
-        // Saved 10 s and 100 J: 5 s and 50 J may be spent.
-        let mut d = vec![
-            outcome(4.0, 10.0, 1),  // 0.8 + 0.2 = 1.0 per corner
-            outcome(2.0, 10.0, 4),  // 0.6 / 4 = 0.15 per corner: third
-            outcome(2.0, 45.0, 10), // 1.3 / 10 = 0.13 per corner: second
-            outcome(0.5, 0.0, 0),   // removes nothing: never paid
-            outcome(1.0, -20.0, 2), // saves energy: -0.2 / 2 = -0.1 per corner, first
-        ];
-        pay_from_savings(&mut d, [10.0, 100.0]);
-        let paid: Vec<bool> = d.iter().map(|o| o.paid).collect();
-        // Order: #4 (1 s, -20 J; left 4 s, 70 J), #2 (2 s, 45 J; left 2 s, 25 J), #1 (2 s,
-        // 10 J; left 0 s, 15 J), #0 does not fit.
-        assert_eq!(paid, [false, true, true, false, true]);
-        let spent = d
-            .iter()
-            .filter(|o| o.paid)
-            .fold([0.0, 0.0], |a, o| [a[0] + o.added[0], a[1] + o.added[1]]);
-        assert!(spent[0] <= 5.0 && spent[1] <= 50.0, "{spent:?}");
-    }
-
-    #[test]
-    fn nothing_is_paid_without_savings_in_both_time_and_energy() {
-        for saved in [[0.0, 100.0], [10.0, 0.0], [-1.0, 100.0]] {
-            let mut d = vec![outcome(0.001, 0.001, 5)];
-            pay_from_savings(&mut d, saved);
-            assert!(!d[0].paid, "{saved:?}");
-        }
-    }
-
     /// Filament (relative E) pushed before each `;WIDTH:` line, in order, and the total.
     fn filament_at_notes(g: &str) -> (Vec<(String, f64)>, f64) {
         let mut e = 0.0;

@@ -72,6 +72,9 @@ pub struct Settings {
     pub feed_cap_scale: f64,
     /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`super::arcs`]).
     pub arcs: bool,
+    /// Round corners even where the fillet is slower than the firmware's sharp corner (the
+    /// dearer variant of a path that [`super::VtgOptions::allow_slower_pct`] may buy).
+    pub round_all: bool,
 }
 
 /// A rewritten path: the new geometry, and what the feed of each new segment is made of.
@@ -332,7 +335,7 @@ fn roundable(b: &blend::Blend, s: &Settings) -> bool {
 /// fillet would only slow the machine down: such a corner is kept. (A classic-jerk planner
 /// has no such rule: the feed written on the fillet is never below the original's speed.)
 fn pays(b: &blend::Blend, before: Option<&Profile>, s: &Settings) -> bool {
-    let Some(p) = before.filter(|_| s.classic_jerk_mm_s.is_none()) else {
+    let Some(p) = before.filter(|_| s.classic_jerk_mm_s.is_none() && !s.round_all) else {
         return true;
     };
     let a = p.acceleration.min(s.max_normal_accel_mm_s2);
@@ -638,6 +641,7 @@ mod tests {
             classic_jerk_mm_s: None,
             feed_cap_scale: 1.0,
             arcs: false,
+            round_all: false,
         }
     }
 

@@ -398,6 +398,8 @@ export interface VtgOptions {
   dynamics?: boolean;
   /** Write runs of new points on a circle as G2/G3 arcs (default false: the firmware must have arcs enabled). */
   arcs?: boolean;
+  /** Print time the rewrite may add to round corners that cost time, % of the original's (default 0: no slower, no dearer; 100 rounds every corner the tolerance allows). */
+  allow_slower_pct?: number;
 }
 /** before, after and the relative change in percent. */
 export interface Comparison { before: number; after: number; change_pct: number }

@@ -1,0 +1,277 @@
+//! The file-level choice of which rewrites to write when some of them cost time or energy.
+//!
+//! Each path is rewritten on its own and planned on the firmware's own model before and after
+//! (see [`super::rewrite`]). Most rewrites cost nothing; on a firmware that takes sharp corners
+//! faster than a fillet within the tolerance allows (Klipper with a high square-corner
+//! velocity, a junction-deviation planner with a large deviation), rounding a corner costs a
+//! little time and energy. Those rewrites are bought out of a budget: [`SPEND_SHARE`] of what
+//! the free rewrites saved, plus whatever time the user allows
+//! ([`super::VtgOptions::allow_slower_pct`]), the rewrites that remove the most sharp corners
+//! for their cost first: a multiple-choice knapsack, solved greedily on each path's convex
+//! hull of cost against corners removed (a path may offer a free rewrite that keeps its dear
+//! corners sharp and a dearer one that rounds them too; buying the dearer one is then an
+//! increment over the free one).
+
+use super::rewrite::Rewritten;
+use crate::gcode::Edit;
+
+/// Share of what the rewrites that cost nothing saved (time and motor energy, each) that may be
+/// spent on rewrites that cost something, so the file as a whole still prints faster and on
+/// less energy than the original, by at least half of what the free rewrites saved.
+pub const SPEND_SHARE: f64 = 0.5;
+
+/// One way of writing a path.
+#[derive(Debug)]
+pub struct Outcome {
+    /// The edits that write it.
+    pub edits: Vec<Edit>,
+    /// Its counts.
+    pub part: Rewritten,
+    /// Time (s) and motor energy (J) it adds to the path's own (negative: saves).
+    pub added: [f64; 2],
+    /// Whether it costs more time or energy than the original.
+    pub dearer: bool,
+    /// Sharp corners it removes.
+    pub corners_removed: u64,
+}
+
+/// The ways one path can be written.
+#[derive(Debug, Default)]
+pub struct Offer {
+    /// One that costs nothing: written unless a dearer one is bought in its place.
+    pub free: Option<Outcome>,
+    /// Ones that cost time or energy; at most one is bought.
+    pub dearer: Vec<Outcome>,
+}
+
+impl Offer {
+    /// Files `outcome` as free or dearer.
+    pub fn push(&mut self, outcome: Outcome) {
+        if outcome.dearer {
+            self.dearer.push(outcome);
+        } else if self
+            .free
+            .as_ref()
+            .is_none_or(|f| outcome.corners_removed > f.corners_removed)
+        {
+            self.free = Some(outcome);
+        }
+    }
+}
+
+/// What may be spent: time s, motor energy J.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Budget(pub [f64; 2]);
+
+impl Budget {
+    /// [`SPEND_SHARE`] of `saved` (time s, energy J, by the free rewrites), plus `allowed_s` of
+    /// time. With time allowed, energy is not limited: the user has chosen to spend time on
+    /// quiet, and energy follows time (the electronics, fans and motors run as long as the
+    /// print does). Without it, both must have been saved for anything to be spent.
+    pub fn new(saved: [f64; 2], allowed_s: f64) -> Self {
+        let share = saved.map(|x| SPEND_SHARE * x.max(0.0));
+        if allowed_s > 0.0 {
+            Self([share[0] + allowed_s, f64::INFINITY])
+        } else if share.iter().any(|&b| b <= 0.0) {
+            Self([0.0, 0.0])
+        } else {
+            Self(share)
+        }
+    }
+
+    /// The cost of adding `added` as shares of the two budgets (what it saves in one counts
+    /// for it).
+    fn cost(&self, added: &[f64; 2]) -> f64 {
+        let share = |k: usize| {
+            if self.0[k].is_infinite() {
+                0.0
+            } else {
+                added[k] / self.0[k]
+            }
+        };
+        share(0) + share(1)
+    }
+}
+
+/// One step up a path's hull: from what it had to `to`, adding `added` and removing `corners`
+/// more sharp corners.
+struct Step {
+    path: usize,
+    to: usize,
+    added: [f64; 2],
+    corners: u64,
+    per_corner: f64,
+}
+
+/// Chooses, for each offer, the dearer outcome to buy (`None`: the free one, or nothing): the
+/// steps that remove the most sharp corners for their cost first, while they fit the budget
+/// (a step that does not fit ends its path's climb; other paths' cheaper steps are still
+/// tried). Ties go to file order, so the choice is the same on any number of threads.
+pub fn choose(offers: &[Offer], budget: Budget) -> Vec<Option<usize>> {
+    let mut choice = vec![None; offers.len()];
+    if budget.0.iter().any(|&b| b.is_nan() || b <= 0.0) {
+        return choice;
+    }
+    let mut steps: Vec<Step> = Vec::new();
+    for (path, offer) in offers.iter().enumerate() {
+        let (mut added, mut corners) = offer
+            .free
+            .as_ref()
+            .map_or(([0.0, 0.0], 0), |f| (f.added, f.corners_removed));
+        // The lower convex hull of cost against corners, from what the path has for free.
+        loop {
+            let best = offer
+                .dearer
+                .iter()
+                .enumerate()
+                .filter(|(_, o)| o.corners_removed > corners)
+                .map(|(k, o)| {
+                    let d = [o.added[0] - added[0], o.added[1] - added[1]];
+                    let n = o.corners_removed - corners;
+                    (k, d, n, budget.cost(&d) / n as f64)
+                })
+                .filter(|s| s.3.is_finite())
+                .min_by(|a, b| a.3.total_cmp(&b.3));
+            let Some((to, d, n, per_corner)) = best else {
+                break;
+            };
+            steps.push(Step {
+                path,
+                to,
+                added: d,
+                corners: n,
+                per_corner,
+            });
+            added = offer.dearer[to].added;
+            corners += n;
+        }
+    }
+    // Along one path the steps' cost per corner rises (a convex hull), so in this order each
+    // path's steps come in their own order.
+    steps.sort_by(|a, b| {
+        a.per_corner
+            .total_cmp(&b.per_corner)
+            .then(a.path.cmp(&b.path))
+            .then(a.corners.cmp(&b.corners))
+    });
+    let mut left = budget.0;
+    let mut stopped = vec![false; offers.len()];
+    for s in steps {
+        if stopped[s.path] {
+            continue;
+        }
+        if s.added[0] <= left[0] && s.added[1] <= left[1] {
+            left[0] -= s.added[0];
+            left[1] -= s.added[1];
+            choice[s.path] = Some(s.to);
+        } else {
+            stopped[s.path] = true;
+        }
+    }
+    choice
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn outcome(added_s: f64, added_j: f64, corners: u64) -> Outcome {
+        Outcome {
+            edits: Vec::new(),
+            part: Rewritten::default(),
+            added: [added_s, added_j],
+            dearer: added_s > 0.0 || added_j > 0.0,
+            corners_removed: corners,
+        }
+    }
+
+    fn offer(o: Outcome) -> Offer {
+        let mut offer = Offer::default();
+        offer.push(o);
+        offer
+    }
+
+    #[test]
+    fn dearer_rewrites_are_paid_from_half_the_savings_best_value_first() {
+        // Saved 10 s and 100 J: 5 s and 50 J may be spent.
+        let budget = Budget::new([10.0, 100.0], 0.0);
+        assert_eq!(budget, Budget([5.0, 50.0]));
+        let offers = [
+            offer(outcome(4.0, 10.0, 1)),  // 0.8 + 0.2 = 1.0 per corner
+            offer(outcome(2.0, 10.0, 4)),  // 0.6 / 4 = 0.15 per corner: third
+            offer(outcome(2.0, 45.0, 10)), // 1.3 / 10 = 0.13 per corner: second
+            offer(outcome(0.5, 0.0, 0)),   // removes nothing: never paid
+            offer(outcome(1.0, -20.0, 2)), // saves energy: -0.2 / 2 = -0.1 per corner, first
+        ];
+        let chosen = choose(&offers, budget);
+        // Order: #4 (1 s, -20 J; left 4 s, 70 J), #2 (2 s, 45 J; left 2 s, 25 J), #1 (2 s,
+        // 10 J; left 0 s, 15 J), #0 does not fit.
+        assert_eq!(chosen, [None, Some(0), Some(0), None, Some(0)]);
+        let spent = offers
+            .iter()
+            .zip(&chosen)
+            .filter_map(|(o, c)| c.map(|k| o.dearer[k].added))
+            .fold([0.0, 0.0], |a, d| [a[0] + d[0], a[1] + d[1]]);
+        assert!(spent[0] <= 5.0 && spent[1] <= 50.0, "{spent:?}");
+    }
+
+    #[test]
+    fn nothing_is_paid_without_savings_in_both_time_and_energy() {
+        for saved in [[0.0, 100.0], [10.0, 0.0], [-1.0, 100.0]] {
+            let chosen = choose(&[offer(outcome(0.001, 0.001, 5))], Budget::new(saved, 0.0));
+            assert_eq!(chosen, [None], "{saved:?}");
+        }
+    }
+
+    #[test]
+    fn allowed_time_buys_corners_whatever_the_energy() {
+        // No savings at all, 3 s allowed: energy is not limited.
+        let budget = Budget::new([0.0, 0.0], 3.0);
+        assert_eq!(budget.0[0], 3.0);
+        let offers = [
+            offer(outcome(2.0, 1e6, 10)), // 0.2 s per corner: first
+            offer(outcome(2.0, 0.0, 4)),  // 0.5 s per corner: does not fit after the first
+            offer(outcome(1.0, 5.0, 3)),  // 0.33 s per corner: second
+        ];
+        assert_eq!(choose(&offers, budget), [Some(0), None, Some(0)]);
+    }
+
+    #[test]
+    fn a_dearer_variant_is_bought_as_a_step_over_the_free_one() {
+        // A path that rounds 3 corners for free, or 8 for 2 s; another that rounds 5 for 3 s.
+        let mut two_ways = offer(outcome(-1.0, -1.0, 3));
+        two_ways.push(outcome(1.0, 0.5, 8));
+        assert_eq!(two_ways.dearer.len(), 1);
+        let offers = [two_ways, offer(outcome(3.0, 1.0, 5))];
+        // The step over the free rewrite: 2 s for 5 more corners (0.4 s each), before the
+        // other path's 0.6 s each; 2.5 s allowed buys only the first.
+        assert_eq!(
+            choose(&offers, Budget::new([0.0, 0.0], 2.5)),
+            [Some(0), None]
+        );
+        assert_eq!(
+            choose(&offers, Budget::new([0.0, 0.0], 5.0)),
+            [Some(0), Some(0)]
+        );
+        // Nothing allowed: the free rewrite stays.
+        assert_eq!(choose(&offers, Budget::new([0.0, 0.0], 0.0)), [None, None]);
+    }
+
+    #[test]
+    fn a_path_climbs_its_hull_in_order() {
+        // 2 corners for 1 s, 6 for 2 s, 7 for 5 s: the hull is 0 → 6 (1/3 s per corner) → 7
+        // (3 s): the 2-corner variant is never the best step.
+        let mut o = Offer::default();
+        for v in [
+            outcome(1.0, 0.0, 2),
+            outcome(2.0, 0.0, 6),
+            outcome(5.0, 0.0, 7),
+        ] {
+            o.push(v);
+        }
+        let offers = [o];
+        assert_eq!(choose(&offers, Budget::new([0.0, 0.0], 2.0)), [Some(1)]);
+        assert_eq!(choose(&offers, Budget::new([0.0, 0.0], 4.9)), [Some(1)]);
+        assert_eq!(choose(&offers, Budget::new([0.0, 0.0], 5.0)), [Some(2)]);
+    }
+}
