@@ -127,22 +127,8 @@ pub struct Offers {
     feed_cap_scale: f64,
 }
 
-/// Rewrites every eligible path of `input`, with the time the options allow.
-pub fn rewrite(
-    input: &[u8],
-    path: &PrintPath,
-    all: &Sources,
-    options: &VtgOptions,
-    limits: &KinematicLimits,
-    feed_cap_scale: f64,
-    progress: crate::analyze::Progress<'_>,
-) -> Result<Rewritten, Error> {
-    let offers = offers(input, path, all, options, limits, feed_cap_scale, progress)?;
-    Ok(offers.write(input, options.allow_slower_pct / 100.0 * path.time_s))
-}
-
 /// Rewrites every eligible path of `input` in every way worth offering: the free rewrite, and
-/// the dearer ones (see [`budget`]).
+/// the dearer ones (see [`budget`]); [`Offers::write`] then writes the file with the choice.
 pub fn offers(
     input: &[u8],
     path: &PrintPath,
