@@ -166,20 +166,26 @@ pub fn vtg_with_progress(
         if !progress(0.8) {
             return Err(cancelled());
         }
-        let rewritten = within_allowed_time(input, &offers, options, &before)?;
+        let (rewritten, measured) = within_allowed_time(input, &offers, options, &before)?;
         // The output's metrics streamed, not from a kept move list: rounding corners can
         // multiply the moves tenfold.
-        let (after, after_metrics) = crate::parallel::join(
-            || crate::analyze::analyze(&rewritten.output, &options.analyze),
-            || {
-                metrics::from_input(
-                    &rewritten.output,
-                    &options.analyze,
-                    options.critical_angle_deg,
-                )
-            },
-        );
-        let (after, after_metrics) = (after?, after_metrics?);
+        let metrics = || {
+            metrics::from_input(
+                &rewritten.output,
+                &options.analyze,
+                options.critical_angle_deg,
+            )
+        };
+        let (after, after_metrics) = match measured {
+            Some(after) => (after, metrics()?),
+            None => {
+                let (after, after_metrics) = crate::parallel::join(
+                    || crate::analyze::analyze(&rewritten.output, &options.analyze),
+                    metrics,
+                );
+                (after?, after_metrics?)
+            }
+        };
         Ok(report::build(
             options,
             &limits,
@@ -204,7 +210,7 @@ pub fn vtg_with_progress(
 }
 
 /// The rewrite written from `offers` with the time `allow_slower_pct` allows, measured on the
-/// whole file. The choice counts the time each path adds as planned with its neighbours only;
+/// whole file, and the analysis it was measured with (`None`: no time allowed, not analysed). The choice counts the time each path adds as planned with its neighbours only;
 /// across the file the firmware's look-ahead adds a little more (3–9 % of the allowance on the
 /// Creality benchies), so where the whole file comes out slower than allowed the allowance is
 /// cut by the excess and the choice made again (at most [`TIME_ROUNDS`] times, then without
@@ -214,25 +220,22 @@ fn within_allowed_time(
     offers: &rewrite::Offers,
     options: &VtgOptions,
     before: &Report,
-) -> Result<rewrite::Rewritten, Error> {
+) -> Result<(rewrite::Rewritten, Option<Report>), Error> {
     let allowed = options.allow_slower_pct / 100.0 * before.time_s;
     let mut allowed_s = allowed;
     for _ in 0..TIME_ROUNDS {
-        let rewritten = offers.write(input, allowed_s);
-        if allowed <= 0.0 {
-            return Ok(rewritten);
-        }
-        let added =
-            crate::analyze::analyze(&rewritten.output, &options.analyze)?.time_s - before.time_s;
-        if added <= allowed {
-            return Ok(rewritten);
-        }
-        allowed_s -= TIME_MARGIN * (added - allowed);
         if allowed_s <= 0.0 {
             break;
         }
+        let rewritten = offers.write(input, allowed_s);
+        let after = crate::analyze::analyze(&rewritten.output, &options.analyze)?;
+        let added = after.time_s - before.time_s;
+        if added <= allowed {
+            return Ok((rewritten, Some(after)));
+        }
+        allowed_s -= TIME_MARGIN * (added - allowed);
     }
-    Ok(offers.write(input, 0.0))
+    Ok((offers.write(input, 0.0), None))
 }
 
 /// Choices made against the whole file's time before giving up the allowance.
@@ -315,35 +318,45 @@ mod tests {
     #[test]
     fn out_of_range_options_are_refused_by_name() {
         let demo = include_bytes!("../../../www/demo/demo.gcode");
+        let d = VtgOptions::default;
         let cases = [
-            VtgOptions {
-                tolerance_mm: 0.0,
-                ..VtgOptions::default()
-            },
-            VtgOptions {
-                critical_angle_deg: 180.0,
-                ..VtgOptions::default()
-            },
-            VtgOptions {
-                allow_slower_pct: -1.0,
-                ..VtgOptions::default()
-            },
-            VtgOptions {
-                allow_slower_pct: f64::NAN,
-                ..VtgOptions::default()
-            },
-            VtgOptions {
-                allow_slower_pct: 100.5,
-                ..VtgOptions::default()
-            },
+            (
+                "tolerance_mm",
+                VtgOptions {
+                    tolerance_mm: 0.0,
+                    ..d()
+                },
+            ),
+            (
+                "critical_angle_deg",
+                VtgOptions {
+                    critical_angle_deg: 180.0,
+                    ..d()
+                },
+            ),
+            (
+                "allow_slower_pct",
+                VtgOptions {
+                    allow_slower_pct: -1.0,
+                    ..d()
+                },
+            ),
+            (
+                "allow_slower_pct",
+                VtgOptions {
+                    allow_slower_pct: f64::NAN,
+                    ..d()
+                },
+            ),
+            (
+                "allow_slower_pct",
+                VtgOptions {
+                    allow_slower_pct: 100.5,
+                    ..d()
+                },
+            ),
         ];
-        for (options, name) in cases.iter().zip([
-            "tolerance_mm",
-            "critical_angle_deg",
-            "allow_slower_pct",
-            "allow_slower_pct",
-            "allow_slower_pct",
-        ]) {
+        for (name, options) in &cases {
             let e = vtg(demo, options).expect_err(name);
             assert!(matches!(e.kind, ErrorKind::InvalidOption { .. }), "{e}");
             assert!(e.to_string().contains(name), "{e}");

@@ -222,19 +222,16 @@ pub fn offers(
                     let write = |s: &Settings| {
                         rewrite_path(input, &moves[i..j], &sources[i..j], s, &machine)
                     };
-                    let mut offer = Offer::default();
-                    let kept = write(&settings).map_or(0, |o| {
-                        let n = o.corners_removed;
-                        offer.push(o);
-                        n
-                    });
+                    let base = write(&settings);
+                    let kept = base.as_ref().map_or(0, |o| o.corners_removed);
                     // With time to spend, the variant that rounds the corners the firmware
                     // takes faster sharp, too.
-                    if buy_time {
-                        if let Some(o) = write(&round_all).filter(|o| o.corners_removed > kept) {
-                            offer.push(o);
-                        }
-                    }
+                    let more = buy_time
+                        .then(|| write(&round_all))
+                        .flatten()
+                        .filter(|o| o.corners_removed > kept);
+                    let mut offer = Offer::default();
+                    base.into_iter().chain(more).for_each(|o| offer.push(o));
                     offer
                 })
                 .collect()

@@ -427,7 +427,7 @@ export interface VtgReport {
     raised_caps: number;
     /** Paths written without eq. 29 feed caps (even raised, they would have made them slower). */
     uncapped: number;
-    /** Paths slower or dearer when rounded, even without caps, paid for out of half of what the other rewrites saved. */
+    /** Paths slower or dearer when rounded, even without caps, paid for out of half of what the other rewrites saved, or with the time `allow_slower_pct` allows. */
     paid_from_savings: number;
     /** Paths kept as they were: slower or dearer when rounded, and not paid for. */
     kept_for_time: number;
