@@ -113,14 +113,7 @@ fn options(tolerance_mm: f64, limit_feed: bool) -> VtgOptions {
 
 /// Files whose sharp corners cannot fall by 40 %, and why. For them the corners must still
 /// fall, and where the reason is the firmware's cornering, paths must have been kept for it.
-const TURNING_EXCEPTIONS: [(&str, &str); 3] = [
-    (
-        "prusaslicer-2.5.0_vase_marlin-legacy_absE.gcode",
-        "most sharp turns left are thin walls filled by a variable-width line that turns back \
-         on itself in 0.07 mm steps, and 45° + 135° infill hairpins with staggered line ends \
-         (the arc across one needs 0.13 mm): neither can be rounded within 0.1 mm in steps of \
-         at least Marlin's 0.06 mm minimum segment, each turning under δθ",
-    ),
+const TURNING_EXCEPTIONS: [(&str, &str); 2] = [
     (
         "crealityprint-4.3.4_k1_benchy_m83_arcs.gcode",
         "Klipper at a square-corner velocity of 50-100 mm/s takes sharp corners faster than \
@@ -228,9 +221,9 @@ fn corpus_second_half_meets_the_criteria() {
     check_all(&corpus_files(1));
 }
 
-/// The triangle's 75° infill corners, rounded at eq. 29's speeds, leave the machine ringing a
-/// little more than the sharp ones did; the dynamics model sees it, and `vtg` rewrites the file
-/// again from faster speeds, which ring less, and keeps that.
+/// The triangle's infill tips, turned round keyhole loops, leave the machine ringing more than
+/// the sharp ones did; the dynamics model sees it, and `vtg` rewrites the file again from
+/// faster speeds, then without the loops, and keeps the first that rings less.
 #[test]
 fn the_dynamics_model_closes_the_loop() {
     let bytes = std::fs::read(fixtures_dir().join("gcode/prusaslicer-2.5.0_thesis_triangle.gcode"))
@@ -244,6 +237,7 @@ fn the_dynamics_model_closes_the_loop() {
     )
     .unwrap();
     assert_eq!(open.paths.feed_cap_scale, 1.0);
+    assert!(open.paths.keyholes > 0);
     let model = quietpath::dynamics::VibrationOptions::default();
     let mean = |b: &[u8]| {
         quietpath::dynamics::vibration(b, &model)
@@ -254,13 +248,16 @@ fn the_dynamics_model_closes_the_loop() {
     let (before, open_loop) = (mean(&bytes), mean(&open.output));
     assert!(open_loop > before, "{open_loop} vs {before}");
     let closed = vtg(&bytes, &VtgOptions::default()).unwrap();
+    // No scale of the speeds quietens the keyhole loops at the infill tips enough: they go.
     assert!(closed.paths.feed_cap_scale > 1.0);
+    assert_eq!(closed.paths.keyholes, 0);
     let d = closed.table2.deviation.as_ref().unwrap();
     assert_eq!(d.mean_mm.before, before);
     assert_eq!(d.mean_mm.after, mean(&closed.output));
     assert!(d.mean_mm.after < before);
-    // Same geometry; still faster and cheaper.
-    assert_eq!(closed.table1.n_turning, open.table1.n_turning);
+    // Without the loops more tips stay sharp, but still past the bar; faster and cheaper.
+    assert!(closed.table1.n_turning.after > open.table1.n_turning.after);
+    assert!(closed.table1.n_turning.change_pct <= -40.0);
     assert!(closed.table2.time_s.change_pct < 0.0);
     assert!(closed.table2.energy_j.change_pct < 0.0);
 }
@@ -304,6 +301,35 @@ fn arcs_cut_lines_and_keep_every_criterion() {
         assert!(o.energy_pct < 0.0 && o.time_pct <= 1.0, "{name}: {o:?}");
         assert!(o.mean_deviation_pct < 0.0, "{name}: {o:?}");
     }
+}
+
+/// The vase's thin walls end in wedge tips that turn back by 135–150° in 0.07 mm steps, too
+/// tight to fillet in Marlin-sized steps: turned round keyhole loops instead, they are what
+/// takes the file past 40 %. Without the loops (the scales the dynamics model tries last) the
+/// corners fall by only about a quarter.
+#[test]
+fn keyholes_turn_the_thin_wall_tips() {
+    let bytes =
+        std::fs::read(fixtures_dir().join("gcode/prusaslicer-2.5.0_vase_marlin-legacy_absE.gcode"))
+            .unwrap();
+    let report = vtg(&bytes, &VtgOptions::default()).unwrap();
+    assert!(report.paths.keyholes > 100, "{}", report.paths.keyholes);
+    let o = check(&bytes, "vase", &VtgOptions::default());
+    assert!(o.turning_pct <= -40.0, "{o:?}");
+    assert!(o.max_deviation_mm <= 0.1, "{o:?}");
+    assert!(o.filament_pct.abs() <= 0.5, "{o:?}");
+    // The sharp turns over 120° that are left: the loops took most of them.
+    let sharp_tips = |b: &[u8]| {
+        quietpath::vtg::metrics::from_input(b, &Default::default(), 120.0)
+            .unwrap()
+            .0
+            .n_turning
+    };
+    let (before, after) = (sharp_tips(&bytes), sharp_tips(&report.output));
+    assert!(
+        (after as f64) < 0.6 * before as f64,
+        "turns over 120°: {before} -> {after}"
+    );
 }
 
 #[test]

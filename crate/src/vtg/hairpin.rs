@@ -34,8 +34,11 @@ const COARSE_STEPS: i32 = 16;
 /// The arc a hairpin is rounded to.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Hairpin {
-    /// Index of the first of the two corners (the second is the next point).
+    /// Index of the first of the corners it replaces.
     pub at: usize,
+    /// How many corners it replaces: 2 for a hairpin (the second is the next point), 1 for a
+    /// [`super::keyhole`].
+    pub corners: usize,
     /// Radius, mm.
     pub radius_mm: f64,
     /// Points of the arc, from where it leaves the first long leg to where it meets the second.
@@ -49,13 +52,13 @@ pub struct Hairpin {
 
 /// `v / |v|`, or `None` for a tiny vector. (Divides: `orient::vec3::normalize` multiplies by
 /// the reciprocal, which rounds differently and would move the arcs in the last bit.)
-fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
+pub(super) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
     let l = norm(&v);
     (l > 1e-12).then(|| [v[0] / l, v[1] / l, v[2] / l])
 }
 
 /// The Z component of `a × b` (the turn's sense, seen from above).
-fn cross_z(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+pub(super) fn cross_z(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     cross(a, b)[2]
 }
 
@@ -165,6 +168,7 @@ pub fn find(
         let step = tolerance_mm / 10.0;
         (both_ways(&new, &original, step, tolerance_mm) <= tolerance_mm).then_some(Hairpin {
             at: i,
+            corners: 2,
             radius_mm: r,
             arc,
             before_mm: before,
@@ -204,9 +208,10 @@ pub struct Substituted {
 }
 
 /// `pts` (filament `e`, feeds `feed`, profiles `planned`) with each of `pins` (sorted, apart)
-/// in place of its two corners. Each arc point stands for the original point at the same
-/// fraction of the stretch the arc replaces, so the filament pushed up to it is read off the
-/// original and the path's total is unchanged.
+/// in place of its corners and of the stretch around them it replaces. Each new point stands
+/// for the original point at the same fraction of length along the stretch, so the filament
+/// pushed up to it is read off the original (spread by length over the new stretch) and the
+/// path's total is unchanged.
 pub fn substitute(
     pts: &[[f64; 3]],
     e: &[f64],
@@ -228,34 +233,67 @@ pub fn substitute(
     };
     let mut out = Substituted::default();
     let mut at = Vec::with_capacity(pts.len()); // original arc length of each new point
+    let mut pin_of = Vec::with_capacity(pts.len()); // the pin each new point is on, if any
     let mut next = 0usize;
-    for pin in pins {
-        for k in next..pin.at.min(pts.len()) {
+    for (index, pin) in pins.iter().enumerate() {
+        let last_corner = (pin.at + pin.corners.max(1) - 1).min(pts.len().saturating_sub(1));
+        let u0 = arc_len[pin.at] - pin.before_mm.max(0.0);
+        let u1 = arc_len[last_corner] + pin.after_mm.max(0.0);
+        // The original points it replaces: its corners and any strictly inside the stretch.
+        let mut first = pin.at;
+        while first > next && arc_len[first - 1] > u0 {
+            first -= 1;
+        }
+        let mut last = last_corner;
+        while last + 2 < pts.len() && arc_len[last + 1] < u1 {
+            last += 1;
+        }
+        for k in next..first.min(pts.len()) {
             out.pts.push(pts[k]);
             out.e.push(e[k]);
             at.push(arc_len[k]);
+            pin_of.push(None);
         }
-        let u0 = arc_len[pin.at] - pin.before_mm.max(0.0);
-        let u1 = arc_len[pin.at + 1] + pin.after_mm.max(0.0);
-        let n = (pin.arc.len() - 1).max(1) as f64;
-        for (j, p) in pin.arc.iter().enumerate() {
-            let u = u0 + (u1 - u0) * j as f64 / n;
+        // Each new point stands for the original point at the same fraction of length.
+        let new_len = arc_lengths(&pin.arc);
+        let total = new_len.last().copied().unwrap_or(0.0);
+        for (p, l) in pin.arc.iter().zip(&new_len) {
+            let f = if total > 0.0 { l / total } else { 0.0 };
+            let u = u0 + (u1 - u0) * f;
             out.pts.push(*p);
             out.e.push(e_at(u));
             at.push(u);
+            pin_of.push(Some(index));
         }
-        next = pin.at + 2;
+        next = last + 1;
     }
     for k in next..pts.len() {
         out.pts.push(pts[k]);
         out.e.push(e[k]);
         at.push(arc_len[k]);
+        pin_of.push(None);
     }
-    for w in at.windows(2) {
-        let k = segment(0.5 * (w[0] + w[1]));
+    // The original's planned speed at original arc length `u`.
+    let speed_at = |u: f64| {
+        let k = segment(u);
+        planned.get(k).map(|p| p.speed_at(u - arc_len[k]))
+    };
+    for j in 0..at.len().saturating_sub(1) {
+        let k = segment(0.5 * (at[j] + at[j + 1]));
         out.feed.push(feed[k]);
-        if let Some(p) = planned.get(k) {
-            out.planned.push(*p);
+        let Some(p) = planned.get(k) else { continue };
+        // A side of an arc moves at the speed the original had where it stands for, the
+        // lower of its two ends' (the original segment's own profile would be read at
+        // distances along the new path, which do not match it).
+        let on_arc = pin_of[j].is_some() && pin_of[j] == pin_of[j + 1];
+        match (on_arc, speed_at(at[j]), speed_at(at[j + 1])) {
+            (true, Some(v0), Some(v1)) => {
+                let v = v0.min(v1);
+                let len = norm(&sub(&out.pts[j + 1], &out.pts[j]));
+                out.planned
+                    .push(crate::plan::Profile::new(len, v, v, v, p.acceleration));
+            }
+            _ => out.planned.push(*p),
         }
     }
     if out.planned.len() != out.feed.len() {

@@ -122,6 +122,10 @@ pub struct PathCounts {
     pub feed_cap_scale: f64,
     /// Arcs (`G2`/`G3`) written (with the `arcs` option), each in place of several steps.
     pub arcs_written: u64,
+    /// Single corners too tight to fillet that were turned round a keyhole loop instead
+    /// ([`crate::vtg::keyhole`]); 0 where the dynamics model found the loops left the machine
+    /// ringing more than the original (see [`crate::vtg::VtgOptions::dynamics`]).
+    pub keyholes: u64,
 }
 
 /// Per-layer toolpath metrics before and after.
@@ -230,6 +234,7 @@ pub(crate) fn build(
             },
             feed_cap_scale: rewritten.feed_cap_scale,
             arcs_written: rewritten.arcs_written,
+            keyholes: rewritten.keyholes,
         },
         table1,
         table2,

@@ -65,6 +65,8 @@ pub struct Rewritten {
     pub feed_cap_scale: f64,
     /// Arcs (`G2`/`G3`) written.
     pub arcs_written: u64,
+    /// Corners turned round keyhole loops.
+    pub keyholes: u64,
 }
 
 /// The eq. 30 limits for a file: `v_max` from the machine's X/Y feed limits (`M203`), `A_n` the
@@ -124,7 +126,26 @@ pub struct Offers {
     /// Time (s) and motor energy (J) the free rewrites save.
     saved: [f64; 2],
     candidate_paths: u64,
-    feed_cap_scale: f64,
+    variant: Variant,
+}
+
+/// What a whole-file rewrite is tried with; [`super::vtg`] tries others where the dynamics
+/// model finds the first one ringing more than the original.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Variant {
+    /// The first scale of the eq. 29 speeds ([`Settings::feed_cap_scale`]).
+    pub feed_cap_scale: f64,
+    /// Turn corners too tight to fillet round keyhole loops ([`Settings::keyholes`]).
+    pub keyholes: bool,
+}
+
+impl Default for Variant {
+    fn default() -> Self {
+        Variant {
+            feed_cap_scale: 1.0,
+            keyholes: true,
+        }
+    }
 }
 
 /// Rewrites every eligible path of `input` in every way worth offering: the free rewrite, and
@@ -135,11 +156,11 @@ pub fn offers(
     all: &Sources,
     options: &VtgOptions,
     limits: &KinematicLimits,
-    feed_cap_scale: f64,
+    variant: Variant,
     progress: crate::analyze::Progress<'_>,
 ) -> Result<Offers, Error> {
     let mut out = Offers {
-        feed_cap_scale,
+        variant,
         ..Offers::default()
     };
     let moves = &path.moves;
@@ -167,9 +188,10 @@ pub fn offers(
         },
         classic_jerk_mm_s: (path.junction_model == JunctionModel::ClassicJerk)
             .then(|| xy_jerk(&path.print_limits)),
-        feed_cap_scale,
+        feed_cap_scale: variant.feed_cap_scale,
         arcs: options.arcs,
         round_all: false,
+        keyholes: variant.keyholes,
     };
     let energy = Accumulator::new(
         &options.analyze.energy.clone().unwrap_or_default(),
@@ -255,7 +277,7 @@ impl Offers {
     pub fn write(&self, input: &[u8], allowed_s: f64) -> Rewritten {
         let mut out = Rewritten {
             candidate_paths: self.candidate_paths,
-            feed_cap_scale: self.feed_cap_scale,
+            feed_cap_scale: self.variant.feed_cap_scale,
             ..Rewritten::default()
         };
         let choice = budget::choose(&self.offers, Budget::new(self.saved, allowed_s));
@@ -302,6 +324,7 @@ impl Rewritten {
         self.walk.steps += part.walk.steps;
         self.walk.fluctuation_sum += part.walk.fluctuation_sum;
         self.arcs_written += part.arcs_written;
+        self.keyholes += part.keyholes;
     }
 }
 
@@ -611,6 +634,7 @@ fn rewrite_path(
     out.written_moves += pieces.len() as u64;
     out.lowered_segments += written.lowered;
     out.above_k_cr_segments += smoothed.above_k_cr;
+    out.keyholes += smoothed.keyholes;
     out.max_deviation_mm = out.max_deviation_mm.max(deviation);
     out.walk.steps += smoothed.stats.steps;
     out.walk.fluctuation_sum += smoothed.stats.fluctuation_sum;

@@ -12,6 +12,7 @@ use super::bspline::{arc_lengths, dot, lerp, norm, segment_at, sub};
 use super::deviation::both_ways;
 use super::fit::fit;
 use super::hairpin;
+use super::keyhole;
 use super::kinematics::KinematicLimits;
 use super::resample::{walk, Walk, WalkStats};
 use crate::plan::Profile;
@@ -41,6 +42,9 @@ pub const MARLIN_MIN_STEP_MM: f64 = 0.06;
 const STRAIGHT_SPACING_MM: f64 = 3.0;
 /// Largest turn of one interpolation step, as a share of the critical angle.
 pub(crate) const STEP_TURN_SHARE: f64 = 0.9;
+/// Largest counter-turn where a keyhole leaves or rejoins the path, as a share of the critical
+/// angle (below the walk's share: the leg itself may bend a little there).
+const KINK_SHARE: f64 = 0.8;
 
 /// Settings for [`smooth_path`].
 #[derive(Debug, Clone, Copy)]
@@ -75,6 +79,8 @@ pub struct Settings {
     /// Round corners even where the fillet is slower than the firmware's sharp corner (the
     /// dearer variant of a path that [`super::VtgOptions::allow_slower_pct`] may buy).
     pub round_all: bool,
+    /// Turn single corners too tight to fillet round a [`keyhole`] loop where one fits.
+    pub keyholes: bool,
 }
 
 /// A rewritten path: the new geometry, and what the feed of each new segment is made of.
@@ -92,6 +98,8 @@ pub struct Smoothed {
     pub deviation_mm: f64,
     /// Walk statistics (eq. 28).
     pub stats: WalkStats,
+    /// Corners turned round a keyhole loop.
+    pub keyholes: u64,
 }
 
 /// The speed terms of one new segment.
@@ -234,6 +242,8 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
     let mut sharp = vec![false; n];
     let mut alone = vec![true; n];
     let mut degenerate = vec![false; n];
+    // Too tight to round within the tolerance (rather than not worth it).
+    let mut tight = vec![false; n];
     for i in 1..n - 1 {
         let a = sub(&pts[i], &pts[i - 1]);
         let b = sub(&pts[i + 1], &pts[i]);
@@ -247,7 +257,8 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
             continue;
         }
         sharp[i] = true;
-        alone[i] = roundable(&blends[i], s) && pays(&blends[i], path.planned.get(i - 1), s);
+        tight[i] = !roundable(&blends[i], s);
+        alone[i] = !tight[i] && pays(blends[i].max_curvature, path.planned.get(i - 1), s);
     }
     // Two sharp corners across a short leg, at least one of them too tight alone: a hairpin,
     // rounded as one turn if it can be.
@@ -266,6 +277,23 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
         }
         i += 1;
     }
+    // Single corners too tight to round: a keyhole loop, where one fits between the neighbours
+    // and the machine runs round it at least as fast as through the corner.
+    let arc = if s.keyholes {
+        arc_lengths(pts)
+    } else {
+        Vec::new()
+    };
+    let loop_pays = |i: usize| pays(1.0 / min_hairpin_radius(s), path.planned.get(i - 1), s);
+    for i in 1..n - 1 {
+        if s.keyholes && tight[i] && !pinned[i] && loop_pays(i) {
+            if let Some(k) = find_keyhole(pts, &arc, i, &sharp, &pinned, &degenerate, s) {
+                pinned[i] = true;
+                pins.push(k);
+            }
+        }
+    }
+    pins.sort_by_key(|p| p.at);
     let mut cuts = vec![0usize];
     for i in 1..n - 1 {
         if degenerate[i] || (sharp[i] && !alone[i] && !pinned[i]) {
@@ -273,7 +301,31 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
             sharp[i] = false;
         }
     }
+    // A keyhole is fitted on its own, between the original points either side of the stretch
+    // it replaces (on its straight legs): the rest of a long side need not be fitted again.
+    let span = |p: &hairpin::Hairpin| {
+        let last = (p.at + p.corners.max(1) - 1).min(n - 1);
+        (
+            arc[p.at] - p.before_mm.max(0.0),
+            arc[last] + p.after_mm.max(0.0),
+        )
+    };
+    let spans: Vec<(f64, f64)> = pins.iter().map(span).collect();
+    let free = |j: usize| {
+        j > 0
+            && j + 1 < n
+            && !sharp[j]
+            && !pinned[j]
+            && spans.iter().all(|&(u0, u1)| arc[j] <= u0 || arc[j] >= u1)
+    };
+    for (k, &(u0, u1)) in pins.iter().zip(&spans).filter(|(p, _)| p.corners == 1) {
+        let before = (0..k.at).rev().find(|&j| arc[j] <= u0);
+        let after = (k.at + 1..n).find(|&j| arc[j] >= u1);
+        cuts.extend(before.into_iter().chain(after).filter(|&j| free(j)));
+    }
     cuts.push(pts.len() - 1);
+    cuts.sort_unstable();
+    cuts.dedup();
     let mut out = Smoothed::default();
     let mut changed = false;
     for w in cuts.windows(2) {
@@ -288,7 +340,19 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
                 ..p.clone()
             })
             .collect();
-        match smooth_piece(&piece, s, has_sharp, &here) {
+        let keyholes = here.iter().filter(|p| p.corners == 1).count() as u64;
+        let mut done =
+            smooth_piece(&piece, s, has_sharp, &here).map(|p| Smoothed { keyholes, ..p });
+        if done.is_none() && keyholes > 0 {
+            // A loop the fit or the walk could not keep within the tolerance: the piece
+            // again without keyholes, its tight corners kept sharp.
+            let plain = Settings {
+                keyholes: false,
+                ..*s
+            };
+            done = smooth_path(&piece, &plain);
+        }
+        match done {
             Some(p) => {
                 changed = true;
                 out.points.extend(p.points);
@@ -298,6 +362,7 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
                 out.deviation_mm = out.deviation_mm.max(p.deviation_mm);
                 out.stats.steps += p.stats.steps;
                 out.stats.fluctuation_sum += p.stats.fluctuation_sum;
+                out.keyholes += p.keyholes;
             }
             None => {
                 out.points.extend(piece.pts.iter().skip(1).copied());
@@ -325,7 +390,8 @@ fn roundable(b: &blend::Blend, s: &Settings) -> bool {
     b.extent_mm > 0.0 && b.max_curvature * s.min_step_mm <= STEP_TURN_SHARE * s.critical_rad
 }
 
-/// Whether rounding a corner leaves the machine at least as fast through it, given how the
+/// Whether rounding a corner on a curve of the largest curvature `curvature` (a fillet's, or a
+/// keyhole's loop) leaves the machine at least as fast through it, given how the
 /// firmware ran the original move `before` that ends at the corner (unknown: assume it does).
 ///
 /// A junction-deviation or Klipper planner takes a sharp corner as if it were an arc (Klipper's
@@ -334,12 +400,12 @@ fn roundable(b: &blend::Blend, s: &Settings) -> bool {
 /// set 50–100 mm/s) that virtual arc is larger than any fillet the tolerance allows, and the
 /// fillet would only slow the machine down: such a corner is kept. (A classic-jerk planner
 /// has no such rule: the feed written on the fillet is never below the original's speed.)
-fn pays(b: &blend::Blend, before: Option<&Profile>, s: &Settings) -> bool {
+fn pays(curvature: f64, before: Option<&Profile>, s: &Settings) -> bool {
     let Some(p) = before.filter(|_| s.classic_jerk_mm_s.is_none() && !s.round_all) else {
         return true;
     };
     let a = p.acceleration.min(s.max_normal_accel_mm_s2);
-    let on_fillet = (a / b.max_curvature).sqrt();
+    let on_fillet = (a / curvature).sqrt();
     on_fillet >= p.exit
 }
 
@@ -392,9 +458,55 @@ fn find_hairpin(
         let shared = far_end != 0 && far_end + 1 != n;
         Some(blend::LEG_SHARE * l * if shared { 0.5 } else { 1.0 })
     };
-    let min_radius = 1.05 * s.min_step_mm / (STEP_TURN_SHARE * s.critical_rad);
+    let min_radius = min_hairpin_radius(s);
     let rooms = [room(i.checked_sub(1)?, i - 1)?, room(i + 1, i + 2)?];
     hairpin::find(pts, i, blend_tol, min_radius, rooms)
+}
+
+/// [`keyhole::find`] at corner `i` of `pts` (arc lengths `arc`) within the blend share of the
+/// tolerance, on a loop of the hairpins' smallest radius, with counter-turns of at most
+/// `KINK_SHARE` of the critical angle. The loop may reach along the path up to
+/// [`blend::LEG_SHARE`] of the way to the path's ends and half the way to the nearest corner
+/// that is sharp, already replaced or degenerate (which the piece may be cut at).
+fn find_keyhole(
+    pts: &[[f64; 3]],
+    arc: &[f64],
+    i: usize,
+    sharp: &[bool],
+    pinned: &[bool],
+    degenerate: &[bool],
+    s: &Settings,
+) -> Option<hairpin::Hairpin> {
+    let n = pts.len();
+    let stop = |k: usize| k == 0 || k + 1 == n || sharp[k] || pinned[k] || degenerate[k];
+    let share = |k: usize| {
+        if k == 0 || k + 1 == n {
+            blend::LEG_SHARE
+        } else {
+            0.5
+        }
+    };
+    let back = (0..i).rev().find(|&k| stop(k))?;
+    let on = (i + 1..n).find(|&k| stop(k))?;
+    let room = [
+        share(back) * (arc[i] - arc[back]),
+        share(on) * (arc[on] - arc[i]),
+    ];
+    keyhole::find(
+        pts,
+        arc,
+        i,
+        BLEND_SHARE * s.tolerance_mm,
+        min_hairpin_radius(s),
+        KINK_SHARE * s.critical_rad,
+        room,
+    )
+}
+
+/// The smallest radius of a loop the walk can follow in steps of at least the minimum step,
+/// each turning by less than its share of the critical angle, with 5 % to spare.
+fn min_hairpin_radius(s: &Settings) -> f64 {
+    1.05 * s.min_step_mm / (STEP_TURN_SHARE * s.critical_rad)
 }
 
 /// [`attempt`] on `path` with its hairpins `pins` replaced by their arcs, checked against the
@@ -411,7 +523,10 @@ fn with_hairpins(
     let pins = if again {
         found = pins
             .iter()
-            .map(|p| find_hairpin(pts, p.at, blend_tol, s))
+            .map(|p| match p.corners {
+                2 => find_hairpin(pts, p.at, blend_tol, s),
+                _ => Some(p.clone()),
+            })
             .collect::<Option<_>>()?;
         &found
     } else {
@@ -642,6 +757,7 @@ mod tests {
             feed_cap_scale: 1.0,
             arcs: false,
             round_all: false,
+            keyholes: true,
         }
     }
 
@@ -685,6 +801,60 @@ mod tests {
             })
             .count();
         assert!(sharp < 4, "{sharp}");
+    }
+
+    /// The tip of a thin wedge (136°, legs of 0.07 mm steps), too tight to fillet in Marlin's
+    /// 0.06 mm steps: with keyholes it is turned round a loop, every turn of the new path is
+    /// under the critical angle, and it stays within the tolerance with the filament kept;
+    /// without, the tip is kept sharp.
+    #[test]
+    fn a_wedge_tip_is_turned_round_a_keyhole() {
+        let half = 22f64.to_radians();
+        let leg = |k: usize, side: f64| {
+            let d = 0.07 * k as f64;
+            [10.0 + d * half.cos(), 10.0 + side * d * half.sin(), 0.2]
+        };
+        let mut pts: Vec<[f64; 3]> = (1..=20).rev().map(|k| leg(k, 1.0)).collect();
+        pts.push(leg(0, 1.0));
+        pts.extend((1..=20).map(|k| leg(k, -1.0)));
+        let e: Vec<f64> = (0..pts.len()).map(|k| 0.002 * k as f64).collect();
+        let feed = vec![30.0; pts.len() - 1];
+        let path = Path {
+            pts: &pts,
+            e: &e,
+            feed: &feed,
+            planned: &[],
+        };
+        let s = Settings {
+            min_step_mm: MARLIN_MIN_STEP_MM,
+            ..settings()
+        };
+        let turns_over = |points: &[[f64; 3]], deg: f64| {
+            let mut all = vec![pts[0]];
+            all.extend_from_slice(points);
+            all.windows(3)
+                .filter(|w| {
+                    let (a, b) = (sub(&w[1], &w[0]), sub(&w[2], &w[1]));
+                    dot(&a, &b) / (norm(&a) * norm(&b)) < deg.to_radians().cos()
+                })
+                .count()
+        };
+        let r = smooth_path(&path, &s).expect("keyhole");
+        assert_eq!(r.keyholes, 1);
+        assert_eq!(turns_over(&r.points, 30.0), 0);
+        let mut all = vec![pts[0]];
+        all.extend_from_slice(&r.points);
+        let d = both_ways(&all, &pts, 1e-3, 0.0);
+        assert!(d <= 0.1, "{d}");
+        assert!((r.e.last().unwrap() - e.last().unwrap()).abs() < 1e-12);
+        assert!(r.e.windows(2).all(|w| w[1] >= w[0]));
+        assert_eq!(r.points.last(), pts.last());
+        let plain = Settings {
+            keyholes: false,
+            ..s
+        };
+        let kept = smooth_path(&path, &plain).map_or(pts[1..].to_vec(), |r| r.points);
+        assert_eq!(turns_over(&kept, 30.0), 1);
     }
 
     #[test]

@@ -436,6 +436,8 @@ export interface VtgReport {
     feed_cap_scale: number;
     /** Arcs (G2/G3) written in place of runs of steps on a circle (option `arcs`). */
     arcs_written: number;
+    /** Single corners too tight to fillet (wedge tips) turned round a small keyhole loop instead; 0 where the dynamics model found the loops ringing more than the original. */
+    keyholes: number;
   };
   /** The VTG paper's Table 1. */
   table1: {
