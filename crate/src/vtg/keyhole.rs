@@ -12,7 +12,8 @@
 //! below the critical angle, and the machine no longer stops at the tip.
 //!
 //! Of the circles on the bisector, the one whose keyhole strays least from the original, both
-//! ways, is taken; the departure points are the nearest to the tip whose counter-turn stays
+//! ways (ranked by the distances of the two polylines' points, then measured in full), is
+//! taken; the departure points are the nearest to the tip whose counter-turn stays
 //! within its limit. The loop is longer than the stretch it replaces; the stretch's filament is
 //! spread over it by length (see [`super::hairpin::substitute`]), so the tip gets the material
 //! it had, in the same place.
@@ -156,7 +157,10 @@ pub fn find(
             (angle(&dir, &unit(line)?) <= max_kink_rad).then_some((d, p, t))
         })
     };
-    let candidate = |c: f64| -> Option<(f64, Hairpin)> {
+    // A keyhole round the circle centred `c` from the corner, the original stretch it
+    // replaces, and how far their points are from each other's polyline (a lower bound of the
+    // deviation, close to it, and cheap: what the candidates are ranked by).
+    let candidate = |c: f64| -> Option<(f64, Hairpin, Vec<[f64; 3]>)> {
         let centre = [v[0] + inward[0] * c, v[1] + inward[1] * c, z];
         // The corner must be within reach of the loop, and the loop's far side of the corner.
         if (norm(&sub(&v, &centre)) - radius_mm).abs() > tolerance_mm {
@@ -187,16 +191,12 @@ pub fn find(
         }
         loop_pts.push(db);
         let original = path.between(ui - before, ui + after)?;
-        if point_polyline(&v, &loop_pts) > tolerance_mm
-            || point_polyline(&loop_pts[1 + segments / 2], &original) > tolerance_mm
-        {
-            return None;
-        }
-        // An upper bound (certified segments count at what their ends show), which is what
-        // the candidates are ranked by.
-        let deviation = both_ways(&loop_pts, &original, tolerance_mm / 10.0, tolerance_mm);
-        (deviation <= tolerance_mm).then_some((
-            deviation,
+        let near = |a: &[[f64; 3]], b: &[[f64; 3]]| {
+            a.iter().map(|p| point_polyline(p, b)).fold(0.0, f64::max)
+        };
+        let apart = near(&loop_pts, &original).max(near(&original, &loop_pts));
+        (apart <= tolerance_mm).then_some((
+            apart,
             Hairpin {
                 at: i,
                 corners: 1,
@@ -205,6 +205,7 @@ pub fn find(
                 before_mm: before,
                 after_mm: after,
             },
+            original,
         ))
     };
     // The corner is within the tolerance of the circle only for centres `c` from the corner
@@ -218,10 +219,17 @@ pub fn find(
     if lo > hi {
         return None;
     }
-    (0..=CENTRES)
+    let mut found: Vec<_> = (0..=CENTRES)
         .filter_map(|k| candidate(lo + (hi - lo) * k as f64 / CENTRES as f64))
-        .min_by(|x, y| x.0.total_cmp(&y.0))
-        .map(|(_, h)| h)
+        .collect();
+    found.sort_by(|x, y| x.0.total_cmp(&y.0));
+    // The closest that the full measurement, both ways, keeps within the tolerance.
+    found
+        .into_iter()
+        .find(|(_, h, original)| {
+            both_ways(&h.arc, original, tolerance_mm / 10.0, tolerance_mm) <= tolerance_mm
+        })
+        .map(|(_, h, _)| h)
 }
 
 #[cfg(test)]
