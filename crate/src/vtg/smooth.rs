@@ -279,11 +279,7 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
     }
     // Single corners too tight to round: a keyhole loop, where one fits between the neighbours
     // and the machine runs round it at least as fast as through the corner.
-    let arc = if s.keyholes {
-        arc_lengths(pts)
-    } else {
-        Vec::new()
-    };
+    let arc = arc_lengths(pts);
     let loop_pays = |i: usize| pays(1.0 / min_hairpin_radius(s), path.planned.get(i - 1), s);
     for i in 1..n - 1 {
         if s.keyholes && tight[i] && !pinned[i] && loop_pays(i) {
@@ -855,6 +851,48 @@ mod tests {
         };
         let kept = smooth_path(&path, &plain).map_or(pts[1..].to_vec(), |r| r.points);
         assert_eq!(turns_over(&kept, 30.0), 1);
+    }
+
+    /// Infill turning back at the wall (a hairpin) is rounded with keyholes on or off: the
+    /// variant without them (the closed loop's last resort) handles hairpins the same way.
+    #[test]
+    fn hairpins_are_rounded_with_or_without_keyholes() {
+        // Lines 0.28 mm apart joined square to them: each 90° corner has too little of the
+        // connector to be filleted alone in Marlin's steps.
+        let pts = [
+            [10.0, 0.0, 0.2],
+            [0.0, 0.0, 0.2],
+            [0.0, 0.28, 0.2],
+            [10.0, 0.28, 0.2],
+        ];
+        let e = [0.0, 0.4, 0.4112, 0.8112];
+        let feed = [40.0; 3];
+        let path = Path {
+            pts: &pts,
+            e: &e,
+            feed: &feed,
+            planned: &[],
+        };
+        let on = Settings {
+            min_step_mm: MARLIN_MIN_STEP_MM,
+            ..settings()
+        };
+        let off = Settings {
+            keyholes: false,
+            ..on
+        };
+        let a = smooth_path(&path, &on).expect("rounded");
+        let b = smooth_path(&path, &off).expect("rounded");
+        assert_eq!(a.points, b.points);
+        assert_eq!((a.keyholes, b.keyholes), (0, 0));
+        assert!(a.deviation_mm <= 0.1);
+        // Round as one turn: no step of it turns by the critical angle.
+        let mut all = vec![pts[0]];
+        all.extend_from_slice(&a.points);
+        assert!(all.windows(3).all(|w| {
+            let (u, v) = (sub(&w[1], &w[0]), sub(&w[2], &w[1]));
+            dot(&u, &v) / (norm(&u) * norm(&v)) >= 30f64.to_radians().cos()
+        }));
     }
 
     #[test]
