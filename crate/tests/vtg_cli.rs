@@ -7,10 +7,10 @@ use std::process::Command;
 #[test]
 fn vtg_writes_the_file_and_reports_json() {
     let input = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/fixtures/gcode/prusaslicer-2.5.0_cube_marlin2_defaults.gcode");
+        .join("../tests/fixtures/gcode/prusaslicer-2.5.0_thesis_square.gcode");
     let dir = std::env::temp_dir().join(format!("quietpath-vtg-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
-    let out_path = dir.join("cube.vtg.gcode");
+    let out_path = dir.join("square.vtg.gcode");
     let out = Command::new(env!("CARGO_BIN_EXE_quietpath"))
         .arg("vtg")
         .arg(&input)
@@ -46,7 +46,12 @@ fn vtg_writes_the_file_and_reports_json() {
     let written = std::fs::read(&out_path).expect("output");
     assert!(!written.is_empty());
 
-    // --no-dynamics skips the simulation: same file, deviation rows null.
+    // The dynamics model found the first rewrite ringing less than the original, so it was
+    // kept as it is: scale 1, keyhole loops and all.
+    assert_eq!(json["paths"]["feed_cap_scale"], 1.0);
+    assert!(json["paths"]["keyholes"].as_u64().expect("keyholes") > 0);
+    // --no-dynamics skips the simulation (and the closed loop): the same file, deviation rows
+    // null.
     let fast = Command::new(env!("CARGO_BIN_EXE_quietpath"))
         .arg("vtg")
         .arg(&input)
