@@ -59,16 +59,17 @@ impl Measured<'_> {
         Some((lerp(p, q, t), unit(sub(q, p))?))
     }
 
+    /// The points strictly between arc lengths `u0 < u1`.
+    fn inside(&self, u0: f64, u1: f64) -> &[[f64; 3]] {
+        let lo = self.arc.partition_point(|&a| a <= u0);
+        let hi = self.arc.partition_point(|&a| a < u1).max(lo);
+        self.pts.get(lo..hi).unwrap_or(&[])
+    }
+
     /// The polyline between arc lengths `u0 < u1`, ends included.
     fn between(&self, u0: f64, u1: f64) -> Option<Vec<[f64; 3]>> {
         let mut out = vec![self.at(u0)?.0];
-        out.extend(
-            self.pts
-                .iter()
-                .zip(self.arc)
-                .filter(|(_, &a)| a > u0 && a < u1)
-                .map(|(p, _)| *p),
-        );
+        out.extend_from_slice(self.inside(u0, u1));
         out.push(self.at(u1)?.0);
         Some(out)
     }
@@ -126,11 +127,12 @@ pub fn find(
         return None;
     }
     let z = v[2];
-    let flat = pts
+    let (first, last) = (path.at(ui - room_a)?.0, path.at(ui + room_b)?.0);
+    let flat = path
+        .inside(ui - room_a, ui + room_b)
         .iter()
-        .zip(arc)
-        .filter(|(_, &a)| a >= ui - room_a && a <= ui + room_b)
-        .all(|(p, _)| (p[2] - z).abs() <= 1e-9);
+        .chain([&first, &last])
+        .all(|p| (p[2] - z).abs() <= 1e-9);
     if !flat {
         return None;
     }
@@ -341,6 +343,13 @@ mod tests {
     fn no_keyhole_where_the_legs_are_too_close_or_too_short() {
         // 165°: the legs are 0.06 mm apart 0.45 mm from the tip.
         let (p, i) = wedge(165.0, 1.0, 0.07);
+        let arc = arc_lengths(&p);
+        assert!(find(&p, &arc, i, 0.08, 0.134, 24f64.to_radians(), [0.9, 0.9]).is_none());
+        // 136°, but climbing (a spiral vase): the loop would leave its plane.
+        let (mut p, i) = wedge(136.0, 1.0, 0.07);
+        for (k, q) in p.iter_mut().enumerate().skip(i + 1) {
+            q[2] += 0.002 * (k - i) as f64;
+        }
         let arc = arc_lengths(&p);
         assert!(find(&p, &arc, i, 0.08, 0.134, 24f64.to_radians(), [0.9, 0.9]).is_none());
         // 136° but only 0.1 mm of leg each side.
