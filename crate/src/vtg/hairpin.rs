@@ -57,6 +57,27 @@ pub(super) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
     (l > 1e-12).then(|| [v[0] / l, v[1] / l, v[2] / l])
 }
 
+/// The `segments + 1` points of a circular arc in the plane of constant Z through `centre`,
+/// from `start` on, sweeping `sweep` rad (positive: anticlockwise seen from above): the radius
+/// vector turned step by step.
+pub(super) fn arc_polygon(
+    centre: &[f64; 3],
+    start: &[f64; 3],
+    sweep: f64,
+    segments: usize,
+) -> impl Iterator<Item = [f64; 3]> {
+    let (c, u) = (*centre, sub(start, centre));
+    (0..=segments).map(move |j| {
+        let phi = sweep * j as f64 / segments as f64;
+        let (sin, cos) = (crate::math::sin(phi), crate::math::cos(phi));
+        [
+            c[0] + u[0] * cos - u[1] * sin,
+            c[1] + u[0] * sin + u[1] * cos,
+            c[2],
+        ]
+    })
+}
+
 /// The Z component of `a × b` (the turn's sense, seen from above).
 pub(super) fn cross_z(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     cross(a, b)[2]
@@ -141,18 +162,7 @@ pub fn find(
         if before > room_a || after > room_b {
             return None;
         }
-        // The arc from ta, its radius vector turned step by step.
-        let u = sub(&ta, &centre);
-        let mut arc = Vec::with_capacity(segments + 1);
-        for j in 0..=segments {
-            let phi = side * turn * j as f64 / segments as f64;
-            let (sin, cos) = (crate::math::sin(phi), crate::math::cos(phi));
-            arc.push([
-                centre[0] + u[0] * cos - u[1] * sin,
-                centre[1] + u[0] * sin + u[1] * cos,
-                z,
-            ]);
-        }
+        let arc: Vec<[f64; 3]> = arc_polygon(&centre, &ta, side * turn, segments).collect();
         let mut new = Vec::with_capacity(arc.len() + 2);
         new.push(pa);
         new.extend_from_slice(&arc);

@@ -20,7 +20,7 @@
 
 use super::bspline::{dot, lerp, norm, segment_at, sub};
 use super::deviation::{both_ways, point_polyline};
-use super::hairpin::{cross_z, unit, Hairpin};
+use super::hairpin::{arc_polygon, cross_z, unit, Hairpin};
 
 /// Smallest turn a keyhole is tried at, rad (60°: below it a corner fillets within the
 /// tolerance, or the legs are too short for anything).
@@ -182,15 +182,7 @@ pub fn find(
         let segments = (span / POLYGON_TURN_RAD).ceil().max(1.0) as usize;
         let mut loop_pts = Vec::with_capacity(segments + 3);
         loop_pts.push(da);
-        for j in 0..=segments {
-            let phi = side * span * j as f64 / segments as f64;
-            let (sin, cos) = (crate::math::sin(phi), crate::math::cos(phi));
-            loop_pts.push([
-                centre[0] + ra[0] * cos - ra[1] * sin,
-                centre[1] + ra[0] * sin + ra[1] * cos,
-                z,
-            ]);
-        }
+        loop_pts.extend(arc_polygon(&centre, &ta, side * span, segments));
         loop_pts.push(db);
         let original = path.between(ui - before, ui + after)?;
         let near = |a: &[[f64; 3]], b: &[[f64; 3]]| {
