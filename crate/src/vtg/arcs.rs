@@ -48,8 +48,8 @@ impl ArcShape {
     /// The machine's arc from `from` to `to` on this circle (the sweep the firmware takes).
     pub fn resolve(&self, from: &[f64; 3], to: &[f64; 3]) -> Arc {
         let c = self.center;
-        let a0 = (from[1] - c[1]).atan2(from[0] - c[0]);
-        let mut a1 = (to[1] - c[1]).atan2(to[0] - c[0]);
+        let a0 = crate::math::atan2(from[1] - c[1], from[0] - c[0]);
+        let mut a1 = crate::math::atan2(to[1] - c[1], to[0] - c[0]);
         if self.ccw && a1 < a0 {
             a1 += std::f64::consts::TAU;
         }
@@ -149,7 +149,7 @@ fn arc_over(
         let (a, b) = (rel(&w[0]), rel(&w[1]));
         let cross = a[0] * b[1] - a[1] * b[0];
         let dot = a[0] * b[0] + a[1] * b[1];
-        let step = cross.atan2(dot);
+        let step = crate::math::atan2(cross, dot);
         if sign == 0.0 {
             sign = step.signum();
         }

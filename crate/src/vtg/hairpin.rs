@@ -119,7 +119,7 @@ pub fn find(
         return None;
     }
     let side = t1.signum();
-    let mut turn = (side * cross_z(&a, &b)).atan2(dot(&a, &b));
+    let mut turn = crate::math::atan2(side * cross_z(&a, &b), dot(&a, &b));
     if turn < 0.0 {
         turn += 2.0 * std::f64::consts::PI;
     }

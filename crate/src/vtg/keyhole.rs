@@ -21,6 +21,7 @@
 use super::bspline::{dot, lerp, norm, segment_at, sub};
 use super::deviation::{both_ways, point_polyline};
 use super::hairpin::{arc_polygon, cross_z, unit, Hairpin};
+use crate::orient::vec3::angle;
 
 /// Smallest turn a keyhole is tried at, rad (60°: below it a corner fillets within the
 /// tolerance, or the legs are too short for anything).
@@ -90,7 +91,7 @@ fn tangent_point(
     if dist <= r * 1.001 {
         return None;
     }
-    let phi = side * (r / dist).acos() * if leaving { -1.0 } else { 1.0 };
+    let phi = side * crate::math::acos(r / dist) * if leaving { -1.0 } else { 1.0 };
     let (sin, cos) = (crate::math::sin(phi), crate::math::cos(phi));
     let u = [v[0] / dist, v[1] / dist];
     Some([
@@ -98,11 +99,6 @@ fn tangent_point(
         centre[1] + r * (u[0] * sin + u[1] * cos),
         centre[2],
     ])
-}
-
-/// The angle between unit vectors `a` and `b`, rad.
-fn angle(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    cross_z(a, b).abs().atan2(dot(a, b))
 }
 
 /// The keyhole at corner `i` of `pts` (arc lengths `arc`): a loop of radius `radius_mm` that
@@ -139,7 +135,7 @@ pub fn find(
     // The legs' directions, read over the probe length.
     let a = unit(sub(&v, &path.at(ui - room_a.min(PROBE_MM))?.0))?;
     let b = unit(sub(&path.at(ui + room_b.min(PROBE_MM))?.0, &v))?;
-    let turn = angle(&a, &b);
+    let turn = angle(a, b);
     if !(MIN_TURN_RAD..=MAX_TURN_RAD).contains(&turn) {
         return None;
     }
@@ -156,7 +152,7 @@ pub fn find(
             let (p, dir) = path.at(ui + sign * d)?;
             let t = tangent_point(&p, centre, radius_mm, side, sign > 0.0)?;
             let line = if sign < 0.0 { sub(&t, &p) } else { sub(&p, &t) };
-            (angle(&dir, &unit(line)?) <= max_kink_rad).then_some((d, p, t))
+            (angle(dir, unit(line)?) <= max_kink_rad).then_some((d, p, t))
         })
     };
     // A keyhole round the circle centred `c` from the corner, the original stretch it
@@ -172,7 +168,7 @@ pub fn find(
         let (after, db, tb) = depart(&centre, 1.0, room_b)?;
         // Round the circle from `ta` to `tb` the way the corner turns.
         let (ra, rb) = (sub(&ta, &centre), sub(&tb, &centre));
-        let mut span = side * cross_z(&ra, &rb).atan2(dot(&ra, &rb));
+        let mut span = side * crate::math::atan2(cross_z(&ra, &rb), dot(&ra, &rb));
         if span < 0.0 {
             span += 2.0 * std::f64::consts::PI;
         }
@@ -251,8 +247,8 @@ mod tests {
 
     fn turn_at(p: &[[f64; 3]], k: usize) -> f64 {
         angle(
-            &unit(sub(&p[k], &p[k - 1])).unwrap(),
-            &unit(sub(&p[k + 1], &p[k])).unwrap(),
+            unit(sub(&p[k], &p[k - 1])).unwrap(),
+            unit(sub(&p[k + 1], &p[k])).unwrap(),
         )
     }
 
