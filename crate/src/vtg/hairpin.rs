@@ -50,6 +50,22 @@ pub struct Hairpin {
     pub after_mm: f64,
 }
 
+impl Hairpin {
+    /// Index of the last corner it replaces, within a polyline of `points` points.
+    fn last_corner(&self, points: usize) -> usize {
+        (self.at + self.corners.max(1) - 1).min(points.saturating_sub(1))
+    }
+
+    /// The stretch of the original it replaces, as arc lengths `(u0, u1)` along it (`arc`:
+    /// the original's arc length at each point).
+    pub fn span(&self, arc: &[f64]) -> (f64, f64) {
+        (
+            arc[self.at] - self.before_mm.max(0.0),
+            arc[self.last_corner(arc.len())] + self.after_mm.max(0.0),
+        )
+    }
+}
+
 /// `v / |v|`, or `None` for a tiny vector. (Divides: `orient::vec3::normalize` multiplies by
 /// the reciprocal, which rounds differently and would move the arcs in the last bit.)
 pub(super) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
@@ -246,15 +262,13 @@ pub fn substitute(
     let mut pin_of = Vec::with_capacity(pts.len()); // the pin each new point is on, if any
     let mut next = 0usize;
     for (index, pin) in pins.iter().enumerate() {
-        let last_corner = (pin.at + pin.corners.max(1) - 1).min(pts.len().saturating_sub(1));
-        let u0 = arc_len[pin.at] - pin.before_mm.max(0.0);
-        let u1 = arc_len[last_corner] + pin.after_mm.max(0.0);
+        let (u0, u1) = pin.span(&arc_len);
         // The original points it replaces: its corners and any strictly inside the stretch.
         let mut first = pin.at;
         while first > next && arc_len[first - 1] > u0 {
             first -= 1;
         }
-        let mut last = last_corner;
+        let mut last = pin.last_corner(pts.len());
         while last + 2 < pts.len() && arc_len[last + 1] < u1 {
             last += 1;
         }

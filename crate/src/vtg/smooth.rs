@@ -299,14 +299,7 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
     }
     // A keyhole is fitted on its own, between the original points either side of the stretch
     // it replaces (on its straight legs): the rest of a long side need not be fitted again.
-    let span = |p: &hairpin::Hairpin| {
-        let last = (p.at + p.corners.max(1) - 1).min(n - 1);
-        (
-            arc[p.at] - p.before_mm.max(0.0),
-            arc[last] + p.after_mm.max(0.0),
-        )
-    };
-    let spans: Vec<(f64, f64)> = pins.iter().map(span).collect();
+    let spans: Vec<(f64, f64)> = pins.iter().map(|p| p.span(&arc)).collect();
     let free = |j: usize| {
         j > 0
             && j + 1 < n
