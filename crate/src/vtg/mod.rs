@@ -212,8 +212,9 @@ pub fn vtg_with_progress(
 }
 
 /// The rewrite written from `offers` with the time `allow_slower_pct` allows, measured on the
-/// whole file, and the analysis it was measured with (`None`: no time allowed, not analysed). The choice counts the time each path adds as planned with its neighbours only;
-/// across the file the firmware's look-ahead adds a little more (3–9 % of the allowance on the
+/// whole file, and the analysis it was measured with (`None`: no time allowed, not analysed).
+/// The choice counts the time each path adds as planned with its neighbours only; across the
+/// file the firmware's look-ahead adds a little more (3–9 % of the allowance on the
 /// Creality benchies), so where the whole file comes out slower than allowed the allowance is
 /// cut by the excess and the choice made again (at most [`TIME_ROUNDS`] times, then without
 /// any allowance).
@@ -280,8 +281,10 @@ fn quieter_variants() -> impl Iterator<Item = rewrite::Variant> {
 /// longer stops at the tip of a wedge, but it swings round a loop of a tenth of a millimetre
 /// or so in radius, and on a few files (the thesis triangle's, oval's and teardrop's infill
 /// tips) that rings more than the stop did. If no scale brings the mean below the original's
-/// with them, the scales are tried again without keyholes. `None` rows when the model cannot run (a print too long to
-/// simulate, for instance): the rest of the report stands without them.
+/// with them, the scales are tried again without keyholes.
+///
+/// `None` rows when the model cannot run (a print too long to simulate, for instance): the
+/// rest of the report stands without them.
 fn with_simulated_deviation(
     input: &[u8],
     first: VtgReport,
