@@ -21,6 +21,7 @@ pub mod block;
 pub mod bspline;
 pub mod budget;
 pub mod deviation;
+pub mod feed;
 pub mod fit;
 pub mod hairpin;
 pub mod keyhole;

@@ -8,8 +8,9 @@
 //! path that cannot be rounded within the tolerance is kept as it was.
 
 use super::blend;
-use super::bspline::{arc_lengths, dot, lerp, norm, segment_at, sub};
+use super::bspline::{arc_lengths, dot, norm, segment_at, sub};
 use super::deviation::both_ways;
+use super::feed::StepSpeed;
 use super::fit::fit;
 use super::hairpin;
 use super::keyhole;
@@ -100,80 +101,6 @@ pub struct Smoothed {
     pub stats: WalkStats,
     /// Corners turned round a keyhole loop.
     pub keyholes: u64,
-}
-
-/// The speed terms of one new segment.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StepSpeed {
-    /// The original's programmed feed there, mm/s.
-    pub programmed: f64,
-    /// The speed eq. 29 allows for the segment's curvature, mm/s (infinite below `K_cr`).
-    pub limit: f64,
-    /// The original's planned speed over the stretch the segment replaces, mm/s: the feed is
-    /// never lowered below it.
-    pub floor: f64,
-    /// The original's highest planned speed over that stretch, mm/s (infinite when unknown).
-    pub ceiling: f64,
-    /// The acceleration the firmware used there, mm/s² (0: unknown).
-    pub accel: f64,
-}
-
-/// A rewritten path as it is written: points, filament and feed of each segment.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Written {
-    /// Points after the start point.
-    pub points: Vec<[f64; 3]>,
-    /// Filament pushed from the path start to each point, mm.
-    pub e: Vec<f64>,
-    /// Feed of the segment ending at each point, mm/s.
-    pub feed_mm_s: Vec<f64>,
-    /// Segments written with a lowered feed.
-    pub lowered: u64,
-}
-
-impl Smoothed {
-    /// The path as written with the eq. 29 speeds scaled by `scale` (`None`: no caps, the
-    /// firmware's own cornering sets the speed), from `start` on; with `ceiling`, no faster
-    /// than the original went over the same stretch either (rounded corners let the machine
-    /// carry more speed into each leg, so it peaks higher on it: faster, but dearer in motor
-    /// energy). On a classic-jerk firmware rising feeds are ramped: such a planner counts a
-    /// rise of the feed from one block to the next as jerk against the new block's full speed,
-    /// so the segment where it rises is cut into pieces that each rise by a share of the jerk.
-    pub fn written(
-        &self,
-        scale: Option<f64>,
-        ceiling: bool,
-        start: [f64; 3],
-        s: &Settings,
-    ) -> Written {
-        let mut out = Written {
-            points: self.points.clone(),
-            e: self.e.clone(),
-            feed_mm_s: Vec::with_capacity(self.steps.len()),
-            lowered: 0,
-        };
-        for st in &self.steps {
-            let mut cap = f64::INFINITY;
-            if let Some(k) = scale {
-                cap = (st.limit * k).max(st.floor);
-            }
-            if ceiling {
-                cap = cap.min(st.ceiling);
-            }
-            let v = if cap < st.programmed * 0.99 {
-                out.lowered += 1;
-                cap.max(1.0)
-            } else {
-                st.programmed
-            };
-            out.feed_mm_s.push(v);
-        }
-        if let (Some(jerk), Some(first)) = (s.classic_jerk_mm_s, self.steps.first()) {
-            let accel: Vec<f64> = self.steps.iter().map(|st| st.accel).collect();
-            ramp_up(&mut out, start, first.programmed, jerk, &accel);
-        }
-        out
-    }
 }
 
 /// A path to rewrite: its points, and what the original asks of each stretch.
@@ -651,77 +578,6 @@ fn attempt(
     Some(out)
 }
 
-/// Share of the jerk limit a ramp's feed may rise by from one piece to the next (the rest is
-/// left for the change of direction at the same junction).
-const RAMP_JERK_SHARE: f64 = 0.7;
-/// Shortest ramp piece, mm.
-const MIN_RAMP_PIECE_MM: f64 = 0.02;
-
-/// Splits segments where the written feed rises by more than a classic-jerk planner takes
-/// without slowing down.
-///
-/// Such a planner (Marlin's and Prusa firmware's classic jerk, and the slicers' estimators
-/// that copy it) compares the *nominal* speeds of the two blocks at a junction: where the
-/// feed falls, the previous block's speed is scaled down to the junction speed first, but
-/// where it rises, the new block's full feed counts against the old one's, and a rise from
-/// 30 to 80 mm/s against a 7 mm/s jerk limit brings the junction down to 4 mm/s. Lowering the
-/// feed on a curve (eq. 29) would cost a near-stop wherever the feed rises again. So a segment
-/// whose feed rises by more than the limit is cut into collinear pieces whose feeds rise by
-/// `RAMP_JERK_SHARE` of it at a time, each as long as the machine needs to accelerate through
-/// it at `accel[i]` (segment `i`'s acceleration): the speed profile is the one it would have
-/// had anyway, and no junction is penalised. The pieces lie on the segment and share its
-/// filament by length.
-fn ramp_up(out: &mut Written, start: [f64; 3], start_feed: f64, jerk: f64, accel: &[f64]) {
-    let rise = RAMP_JERK_SHARE * jerk;
-    if rise <= 0.0
-        || accel.len() != out.points.len()
-        || out.feed_mm_s.windows(2).all(|w| w[1] <= w[0] + jerk)
-    {
-        return;
-    }
-    let n = out.points.len();
-    let mut points = Vec::with_capacity(n + 16);
-    let mut e = Vec::with_capacity(n + 16);
-    let mut feeds = Vec::with_capacity(n + 16);
-    let (mut from, mut e_from, mut now) = (start, 0.0, start_feed);
-    // `e` of the first point is the filament up to it from the piece's start.
-    let segments = out.points.iter().zip(&out.e).zip(&out.feed_mm_s).zip(accel);
-    for (i, (((&to, &e_to), &target), &a)) in segments.enumerate() {
-        let len = norm(&sub(&to, &from));
-        let mut done = 0.0;
-        if i > 0 && target > now + jerk && len > 0.0 && a > 0.0 {
-            loop {
-                let next = (now + rise).min(target);
-                let piece = ((next * next - now * now) / (2.0 * a)).max(MIN_RAMP_PIECE_MM);
-                if next >= target || done + piece >= len - MIN_RAMP_PIECE_MM {
-                    break;
-                }
-                done += piece;
-                let t = done / len;
-                points.push(lerp(&from, &to, t));
-                e.push(e_from + (e_to - e_from) * t);
-                feeds.push(next);
-                now = next;
-            }
-        }
-        // The rest of the segment: at its own feed if the ramp got there, else still ramping.
-        let last = if target > now + jerk && i > 0 {
-            (now + rise).min(target)
-        } else {
-            target
-        };
-        points.push(to);
-        e.push(e_to);
-        feeds.push(last);
-        now = last;
-        from = to;
-        e_from = e_to;
-    }
-    out.points = points;
-    out.e = e;
-    out.feed_mm_s = feeds;
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -886,50 +742,6 @@ mod tests {
             let (u, v) = (sub(&w[1], &w[0]), sub(&w[2], &w[1]));
             dot(&u, &v) / (norm(&u) * norm(&v)) >= 30f64.to_radians().cos()
         }));
-    }
-
-    #[test]
-    fn ramp_rises_within_the_jerk_and_keeps_geometry_and_filament() {
-        // A slow 1 mm stretch, then 20 mm at 60 mm/s: the rise from 10 to 60 mm/s is split
-        // into pieces rising by 0.7 · 8 mm/s, each as long as 1000 mm/s² needs.
-        let mut out = Written {
-            points: vec![[1.0, 0.0, 0.2], [21.0, 0.0, 0.2]],
-            e: vec![0.05, 1.05],
-            feed_mm_s: vec![10.0, 60.0],
-            lowered: 0,
-        };
-        ramp_up(&mut out, [0.0, 0.0, 0.2], 10.0, 8.0, &[1000.0; 2]);
-        let n = out.points.len();
-        assert!(n > 8, "{n}");
-        assert_eq!(out.e.len(), n);
-        assert_eq!(out.feed_mm_s.len(), n);
-        // The original points stay, with their filament; the new ones lie on the segment.
-        assert_eq!(out.points[0], [1.0, 0.0, 0.2]);
-        assert_eq!(out.points[n - 1], [21.0, 0.0, 0.2]);
-        assert_eq!((out.e[0], out.e[n - 1]), (0.05, 1.05));
-        let mut prev = 10.0;
-        for (i, (p, e)) in out.points.iter().zip(&out.e).enumerate() {
-            assert!(p[1] == 0.0 && p[2] == 0.2 && p[0] >= 1.0 && p[0] <= 21.0);
-            // Filament in proportion to the distance along the segment.
-            assert!((e - (0.05 + (p[0] - 1.0) * 0.05)).abs() < 1e-12, "{i}: {e}");
-            let f = out.feed_mm_s[i];
-            assert!(f <= prev + 0.7 * 8.0 + 1e-9, "{i}: {prev} -> {f}");
-            prev = f;
-        }
-        assert_eq!(out.feed_mm_s[n - 1], 60.0);
-        // Each piece is as long as accelerating from its predecessor's feed to its own takes.
-        let piece = |i: usize| out.points[i][0] - out.points[i - 1][0];
-        let (f0, f1) = (out.feed_mm_s[1], out.feed_mm_s[2]);
-        assert!((piece(2) - (f1 * f1 - f0 * f0) / 2000.0).abs() < 1e-9);
-        // Falling feeds need nothing.
-        let mut down = Written {
-            points: vec![[1.0, 0.0, 0.2], [2.0, 0.0, 0.2]],
-            e: vec![0.05, 0.1],
-            feed_mm_s: vec![60.0, 10.0],
-            lowered: 0,
-        };
-        ramp_up(&mut down, [0.0, 0.0, 0.2], 60.0, 8.0, &[1000.0; 2]);
-        assert_eq!(down.points.len(), 2);
     }
 
     /// On a classic-jerk machine the rewritten corners are no slower than the sharp ones and
