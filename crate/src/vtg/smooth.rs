@@ -1,6 +1,7 @@
 //! One extrusion path through the VTG pipeline: blend its corners, fit (within tolerance), walk
 //! the curve with Algorithm 1, spread the path's filament over the new points, cap the feed
 //! where the curvature is above `K_cr`, and check the result against the original polyline.
+//! The feed each new segment is then written with is [`super::feed`]'s business.
 //!
 //! The tolerance is shared: the corner blends ([`super::blend`]) may use `BLEND_SHARE` of it,
 //! the fit's residuals `FIT_SHARE` and the chords of the walk `CHORD_SHARE`. If the measured
