@@ -353,9 +353,19 @@ impl Planner {
             MoveClass::Travel => l.travel_acceleration.value,
             MoveClass::Retract => l.retract_acceleration.value,
         };
-        for (d, max) in delta.iter().zip(&l.max_acceleration) {
+        // Klipper has no X/Y (or extruder) limit of its own on a move that prints or travels:
+        // `M204` and `SET_VELOCITY_LIMIT ACCEL` set the toolhead's `max_accel`, the limit along
+        // the move, whatever the profile's per-axis values; only Z (`max_z_accel`) and
+        // extrude-only moves (`max_extrude_only_accel`) are limited on their own axis.
+        let axis_limited = |axis: usize| match (self.model, class) {
+            (JunctionModel::Klipper, MoveClass::Retract) => axis >= 2,
+            (JunctionModel::Klipper, _) => axis == 2,
+            _ => true,
+        };
+        for (axis, (d, max)) in delta.iter().zip(&l.max_acceleration).enumerate() {
             let (d, max) = (d.abs(), max.value);
-            if d > 1e-12 && max > 0.0 && acceleration * d * inv_distance > max {
+            if axis_limited(axis) && d > 1e-12 && max > 0.0 && acceleration * d * inv_distance > max
+            {
                 acceleration = max * distance / d;
             }
         }
@@ -559,6 +569,45 @@ mod tests {
         }
         planner.flush(&mut |p| out.push(*p));
         out
+    }
+
+    /// Moves planned on the `voron-klipper` profile (per-axis limits 3000 mm/s² for X and Y,
+    /// 350 for Z) after `M204 S20000`, with `model`: the accelerations used.
+    fn accelerations_after_m204(model: JunctionModel) -> Vec<f64> {
+        let limits = MachineProfile::preset("voron-klipper")
+            .expect("preset")
+            .limits;
+        let mut planner = Planner::new(limits, model);
+        let (mut machine, mut w, mut out) = (Machine::default(), Warnings::default(), Vec::new());
+        let src = "M204 S20000\nG1 X100 Y50 F12000\nG1 Z10 F600\n";
+        for (i, l) in src.lines().enumerate() {
+            let line = parse_line(l.as_bytes()).expect(l);
+            planner
+                .limits_mut()
+                .apply_command(&line, FeedUnits::PerMinute);
+            if let Some(Event::Move(m)) = machine.apply(i as u32 + 1, &line, &mut w) {
+                planner.push(&Motion::from(&m), 0, &mut |p| out.push(*p));
+            }
+        }
+        planner.flush(&mut |p| out.push(*p));
+        out.iter().map(|p| p.profile.acceleration).collect()
+    }
+
+    #[test]
+    fn klipper_accelerates_as_m204_says_whatever_the_per_axis_limits() {
+        // Klipper: M204 sets the toolhead's max_accel; X and Y have no limit of their own, Z
+        // keeps max_z_accel (350 mm/s² along Z: 350 along a pure Z move).
+        let a = accelerations_after_m204(JunctionModel::Klipper);
+        assert_eq!(a.len(), 2);
+        assert!((a[0] - 20_000.0).abs() < 1e-6, "{a:?}");
+        assert!((a[1] - 350.0).abs() < 1e-6, "{a:?}");
+        // Marlin 2 caps each axis by M201 (here the profile's 3000 mm/s²): the X component of
+        // the move, 100/111.8 of it, reaches 3000 first.
+        let m = accelerations_after_m204(JunctionModel::JunctionDeviation);
+        assert!(
+            (m[0] - 3000.0 * 50f64.hypot(100.0) / 100.0).abs() < 1e-6,
+            "{m:?}"
+        );
     }
 
     #[test]
