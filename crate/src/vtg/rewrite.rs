@@ -709,7 +709,10 @@ fn with_arcs(
 }
 
 /// Turns above the critical angle (cosine `cos_critical`) along the polyline through `pts`.
-fn sharp_turns<'a>(pts: impl IntoIterator<Item = &'a [f64; 3]>, cos_critical: f64) -> usize {
+pub(super) fn sharp_turns<'a>(
+    pts: impl IntoIterator<Item = &'a [f64; 3]>,
+    cos_critical: f64,
+) -> usize {
     let mut pts = pts.into_iter();
     let (Some(mut p0), Some(mut p1)) = (pts.next(), pts.next()) else {
         return 0;

@@ -583,6 +583,12 @@ fn attempt(
 mod tests {
     use super::*;
 
+    /// Turns over the critical angle of `settings()` (30°) along `start` then `points`.
+    fn sharp_turns_from(start: [f64; 3], points: &[[f64; 3]]) -> usize {
+        let cos = settings().critical_rad.cos();
+        crate::vtg::rewrite::sharp_turns(std::iter::once(&start).chain(points), cos)
+    }
+
     fn settings() -> Settings {
         Settings {
             tolerance_mm: 0.1,
@@ -637,15 +643,7 @@ mod tests {
         assert_eq!(r.points.last(), pts.last());
         // The square's three roundable corners are rounded: fewer sharp turns than before
         // (the first corner, 0.06 mm from the start, is kept).
-        let mut all = vec![pts[0]];
-        all.extend(r.points.iter().copied());
-        let sharp = all
-            .windows(3)
-            .filter(|w| {
-                let (a, b) = (sub(&w[1], &w[0]), sub(&w[2], &w[1]));
-                dot(&a, &b) / (norm(&a) * norm(&b)) < 30f64.to_radians().cos()
-            })
-            .count();
+        let sharp = sharp_turns_from(pts[0], &r.points);
         assert!(sharp < 4, "{sharp}");
     }
 
@@ -675,19 +673,9 @@ mod tests {
             min_step_mm: MARLIN_MIN_STEP_MM,
             ..settings()
         };
-        let turns_over = |points: &[[f64; 3]], deg: f64| {
-            let mut all = vec![pts[0]];
-            all.extend_from_slice(points);
-            all.windows(3)
-                .filter(|w| {
-                    let (a, b) = (sub(&w[1], &w[0]), sub(&w[2], &w[1]));
-                    dot(&a, &b) / (norm(&a) * norm(&b)) < deg.to_radians().cos()
-                })
-                .count()
-        };
         let r = smooth_path(&path, &s).expect("keyhole");
         assert_eq!(r.keyholes, 1);
-        assert_eq!(turns_over(&r.points, 30.0), 0);
+        assert_eq!(sharp_turns_from(pts[0], &r.points), 0);
         let mut all = vec![pts[0]];
         all.extend_from_slice(&r.points);
         let d = both_ways(&all, &pts, 1e-3, 0.0);
@@ -700,7 +688,7 @@ mod tests {
             ..s
         };
         let kept = smooth_path(&path, &plain).map_or(pts[1..].to_vec(), |r| r.points);
-        assert_eq!(turns_over(&kept, 30.0), 1);
+        assert_eq!(sharp_turns_from(pts[0], &kept), 1);
     }
 
     /// Infill turning back at the wall (a hairpin) is rounded with keyholes on or off: the
@@ -736,13 +724,9 @@ mod tests {
         assert_eq!(a.points, b.points);
         assert_eq!((a.keyholes, b.keyholes), (0, 0));
         assert!(a.deviation_mm <= 0.1);
-        // Round as one turn: no step of it turns by the critical angle.
-        let mut all = vec![pts[0]];
-        all.extend_from_slice(&a.points);
-        assert!(all.windows(3).all(|w| {
-            let (u, v) = (sub(&w[1], &w[0]), sub(&w[2], &w[1]));
-            dot(&u, &v) / (norm(&u) * norm(&v)) >= 30f64.to_radians().cos()
-        }));
+        // Round as one turn: no step of it turns by the critical angle, and none is empty.
+        assert_eq!(sharp_turns_from(pts[0], &a.points), 0);
+        assert!(a.points.windows(2).all(|w| w[0] != w[1]) && a.points[0] != pts[0]);
     }
 
     /// On a classic-jerk machine the rewritten corners are no slower than the sharp ones and
