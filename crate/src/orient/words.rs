@@ -7,7 +7,8 @@ fn is_number_byte(b: u8) -> bool {
 }
 
 /// `text` with the value of each word in `values` (upper-case letter, new number text)
-/// replaced where the word is present and appended after the last word where it is not.
+/// replaced where the word is present (with or without a number) and appended after the last
+/// word where it is not.
 /// Comments and every other word stay as written; a `*nn` checksum is recomputed.
 pub fn rewrite_line(text: &[u8], values: &[(u8, String)]) -> Vec<u8> {
     let comment_at = text
@@ -42,7 +43,12 @@ pub fn rewrite_line(text: &[u8], values: &[(u8, String)]) -> Vec<u8> {
             while j < code.len() && code.get(j).copied().is_some_and(is_number_byte) {
                 j += 1;
             }
-            if j > start && !done.get(k).copied().unwrap_or(true) {
+            if j == start {
+                // A word without a number (`Z` in `G1 X5 Z E2`): it is replaced too, keeping
+                // the blank after it, or the line would carry the letter twice.
+                j = i + 1;
+            }
+            if !done.get(k).copied().unwrap_or(true) {
                 out.push(b);
                 if let Some((_, v)) = values.get(k) {
                     out.extend_from_slice(v.as_bytes());
@@ -102,6 +108,14 @@ mod tests {
             out,
             b"G1 X1.000 Y-6.227 Z38.479 B2.000 C-3.500 E1.290 A0.5 ; keep".to_vec()
         );
+    }
+
+    #[test]
+    fn a_word_without_a_number_is_replaced_not_repeated() {
+        let out = rewrite_line(b"G1 X-25 Z E12", &vals(&[(b'X', "1"), (b'Z', "0.3")]));
+        assert_eq!(out, b"G1 X1 Z0.3 E12".to_vec());
+        let out = rewrite_line(b"G1 X-25 Z", &vals(&[(b'Z', "0.3")]));
+        assert_eq!(out, b"G1 X-25 Z0.3".to_vec());
     }
 
     #[test]
