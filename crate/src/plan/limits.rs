@@ -233,7 +233,12 @@ impl Limits {
                     }
                 }
             }
-        } else if let Some(i) = key.strip_prefix("machine_max_feedrate_").and_then(axis) {
+        } else if let Some(i) = key
+            .strip_prefix("machine_max_feedrate_")
+            // OrcaSlicer, Bambu Studio and Creality Print 5 name the same limit `machine_max_speed_`.
+            .or_else(|| key.strip_prefix("machine_max_speed_"))
+            .and_then(axis)
+        {
             set(&mut self.max_feedrate[i], v, src);
         } else if let Some(i) = key.strip_prefix("machine_max_jerk_").and_then(axis) {
             set(&mut self.max_jerk[i], v, src);
@@ -244,5 +249,35 @@ impl Limits {
         } else if key == "machine_max_junction_deviation" {
             set(&mut self.junction_deviation, v, src);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::profiles::Profile;
+
+    fn voron() -> Limits {
+        Profile::preset("voron-klipper").expect("preset").limits
+    }
+
+    #[test]
+    fn prusa_and_orca_name_the_maximum_speeds_differently_and_both_are_read() {
+        let mut prusa = voron();
+        prusa.apply_setting("machine_max_feedrate_x", "500,200");
+        let mut orca = voron();
+        orca.apply_setting("machine_max_speed_x", "500,200");
+        orca.apply_setting("machine_max_speed_e", " 50,25");
+        for limits in [&prusa, &orca] {
+            assert_eq!(limits.max_feedrate[0].value, 500.0, "normal-mode column");
+            assert_eq!(limits.max_feedrate[0].source, LimitSource::SlicerSettings);
+        }
+        assert_eq!(orca.max_feedrate[3].value, 50.0);
+        assert_ne!(prusa.max_feedrate[0].value, voron().max_feedrate[0].value);
+        // Keys that only look alike change nothing.
+        let mut other = voron();
+        other.apply_setting("machine_max_speed_w", "1");
+        other.apply_setting("travel_speed", "1");
+        assert_eq!(other, voron());
     }
 }
