@@ -123,8 +123,15 @@ pub fn junction_deviation(prev: &Segment, curr: &Segment, limits: &Limits) -> f6
     v_sqr.sqrt().at_most(curr.cruise).at_most(prev.cruise)
 }
 
+/// Klipper's extruder `instantaneous_corner_velocity` (its default), mm/s: the largest step
+/// in filament speed a junction may ask of the extruder.
+pub const KLIPPER_INSTANT_CORNER_V: f64 = 1.0;
+
 /// Klipper's junction speed: the square-corner velocity as an equivalent junction deviation
-/// (`scv² (√2 − 1) / accel`), plus the centripetal limit of both moves.
+/// (`scv² (√2 − 1) / accel`), the centripetal limit of both moves, and the extruder's limit:
+/// where the filament per millimetre changes by Δr (a travel straight into a print, a change
+/// of line width), the junction is held to `instantaneous_corner_velocity / |Δr|`, so the
+/// filament speed steps by at most that much.
 pub fn klipper(prev: &Segment, curr: &Segment, limits: &Limits) -> f64 {
     if is_e_only(prev) || is_e_only(curr) {
         return 0.0;
@@ -132,6 +139,18 @@ pub fn klipper(prev: &Segment, curr: &Segment, limits: &Limits) -> f64 {
     let scv = limits.square_corner_velocity.value;
     let mut max_v2 = curr.cruise * curr.cruise;
     max_v2 = max_v2.at_most(prev.cruise * prev.cruise);
+    let e_ratio = |s: &Segment| {
+        if s.cruise > 0.0 {
+            s.axis_feedrate[3] / s.cruise
+        } else {
+            0.0
+        }
+    };
+    let step = (e_ratio(curr) - e_ratio(prev)).abs();
+    if step > 0.0 {
+        let v = KLIPPER_INSTANT_CORNER_V / step;
+        max_v2 = max_v2.at_most(v * v);
+    }
     let cos = cos_theta(prev, curr);
     let sin_d2 = (0.5 * (1.0 - cos)).at_least(0.0).sqrt();
     let cos_d2 = (0.5 * (1.0 + cos)).at_least(0.0).sqrt();
@@ -227,6 +246,21 @@ mod tests {
             let v = klipper(&a, &b, &l);
             assert!((v - 5.0).abs() < 1e-9, "{accel}: {v}");
         }
+    }
+
+    #[test]
+    fn klipper_holds_a_change_of_flow_to_the_extruder_corner_velocity() {
+        // Straight on from a travel into a print of 0.04 mm of filament per mm: only the
+        // extruder limits the junction, to 1 mm/s / 0.04 = 25 mm/s.
+        let l = limits();
+        let travel = seg([1.0, 0.0], 200.0, 3000.0, 50.0);
+        let mut print = seg([1.0, 0.0], 200.0, 3000.0, 50.0);
+        print.axis_feedrate[3] = 0.04 * 200.0;
+        let v = klipper(&travel, &print, &l);
+        assert!((v - 25.0).abs() < 1e-9, "{v}");
+        // The same flow on both sides: no limit from the extruder.
+        let v = klipper(&print, &print, &l);
+        assert!((v - 200.0).abs() < 1e-9, "{v}");
     }
 
     #[test]
