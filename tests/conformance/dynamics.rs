@@ -85,9 +85,14 @@ fn square(fillet_mm: f64, points: usize) -> Vec<u8> {
     }
     let mut g =
         String::from("G21\nG90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2 F600\nG1 X80 Y80 F6000\n");
+    // Filament in proportion to length, as a slicer writes it: the same flow everywhere, so
+    // only the geometry differs (Klipper also slows a junction where the flow steps).
+    let mut at = (80.0, 80.0);
     for _ in 0..20 {
-        for (x, y) in &pts {
-            g.push_str(&format!("G1 X{x:.4} Y{y:.4} E0.05 F3000\n"));
+        for &(x, y) in &pts {
+            let e = 0.04 * (x - at.0).hypot(y - at.1);
+            g.push_str(&format!("G1 X{x:.4} Y{y:.4} E{e:.5} F3000\n"));
+            at = (x, y);
         }
     }
     g.into_bytes()

@@ -46,6 +46,11 @@ pub struct Limit {
 }
 
 impl Limit {
+    /// A profile value of 0, "not set".
+    pub const fn unset() -> Self {
+        Self::profile(0.0)
+    }
+
     /// A profile value.
     pub const fn profile(value: f64) -> Self {
         Self {
@@ -74,8 +79,16 @@ pub struct Limits {
     pub junction_deviation: Limit,
     /// Klipper square-corner velocity, mm/s.
     pub square_corner_velocity: Limit,
-    /// Klipper `minimum_cruise_ratio` (older `max_accel_to_decel` is converted to it).
+    /// Klipper `minimum_cruise_ratio`: a chain of moves is smoothed as if it sped up and
+    /// braked at accel (1 − ratio). Used when `accel_to_decel` is 0.
     pub minimum_cruise_ratio: Limit,
+    /// Older Klipper's `max_accel_to_decel`, mm/s², the smoothed rate itself (at most the
+    /// acceleration in force); 0 when the cruise ratio applies instead. Creality's Klipper
+    /// (K1 series) and the slicers written for it set it apart from the acceleration, before
+    /// it (`SET_VELOCITY_LIMIT ACCEL_TO_DECEL=18000` then `M204 S20000`): as a ratio of the
+    /// acceleration then in force it would mean something else.
+    #[serde(default = "Limit::unset")]
+    pub accel_to_decel: Limit,
     /// Minimum feed rate of printing moves, mm/s (`M205 S`).
     pub min_feedrate: Limit,
     /// Minimum feed rate of travel moves, mm/s (`M205 T`).
@@ -186,19 +199,12 @@ impl Limits {
                     num("SQUARE_CORNER_VELOCITY"),
                     src,
                 );
-                set(
-                    &mut self.minimum_cruise_ratio,
-                    num("MINIMUM_CRUISE_RATIO"),
-                    src,
-                );
-                if let Some(a2d) = num("ACCEL_TO_DECEL") {
-                    // Older Klipper: max_accel_to_decel; the cruise ratio it implies.
-                    let accel = self.acceleration.value.max(1e-9);
-                    set(
-                        &mut self.minimum_cruise_ratio,
-                        Some((1.0 - a2d / accel).clamp(0.0, 0.99)),
-                        src,
-                    );
+                // Whichever of the two a file sets last is the one in force.
+                if let Some(ratio) = num("MINIMUM_CRUISE_RATIO") {
+                    set(&mut self.minimum_cruise_ratio, Some(ratio), src);
+                    set(&mut self.accel_to_decel, Some(0.0), src);
+                } else {
+                    set(&mut self.accel_to_decel, num("ACCEL_TO_DECEL"), src);
                 }
                 return true;
             }
@@ -259,6 +265,24 @@ mod tests {
 
     fn voron() -> Limits {
         Profile::preset("voron-klipper").expect("preset").limits
+    }
+
+    #[test]
+    fn accel_to_decel_is_a_rate_of_its_own_until_a_cruise_ratio_replaces_it() {
+        // Creality Print for the K1: the rate first, then the acceleration it belongs to.
+        let mut l = voron();
+        for src in ["SET_VELOCITY_LIMIT ACCEL_TO_DECEL=18000", "M204 S20000"] {
+            let line = crate::gcode::parse_line(src.as_bytes()).expect(src);
+            assert!(l.apply_command(&line, FeedUnits::PerMinute), "{src}");
+        }
+        assert_eq!(l.accel_to_decel.value, 18000.0);
+        assert_eq!(l.accel_to_decel.source, LimitSource::Command);
+        assert_eq!(l.acceleration.value, 20000.0);
+        let line =
+            crate::gcode::parse_line(b"SET_VELOCITY_LIMIT MINIMUM_CRUISE_RATIO=0.3").expect("line");
+        l.apply_command(&line, FeedUnits::PerMinute);
+        assert_eq!(l.accel_to_decel.value, 0.0);
+        assert_eq!(l.minimum_cruise_ratio.value, 0.3);
     }
 
     #[test]

@@ -9,8 +9,14 @@
 //! window of [`REFRESH_THRESHOLD`] and all but the last [`KEEP_BLOCKS`] are final and handed to
 //! the caller's sink, as PrusaSlicer's time estimator does.
 //!
-//! Arcs are split into straight segments of `arc_segment_mm` (a machine setting), as firmware
-//! splits them.
+//! Klipper adds one step of its own (`toolhead.py`): a chain of moves that speeds up and slows
+//! down again peaks no higher than if the whole chain accelerated and braked at
+//! `accel_to_decel` (the minimum cruise ratio), so the window's cruise speeds and junctions are
+//! capped by each chain's peak before the trapezoids are built.
+//!
+//! Arcs are split into straight segments as the firmware splits them: Marlin 2 by chord
+//! deviation and segment rate up to `arc_segment_mm`, Klipper into pieces of `arc_segment_mm`
+//! (its `[gcode_arcs] resolution`).
 
 pub mod junction;
 pub mod limits;
@@ -146,6 +152,28 @@ pub fn arc_segments(radius: f64, planar_length: f64, feed_mm_s: f64, max_segment
     }
 }
 
+/// Number of straight segments the firmware of a junction model cuts an arc into: Klipper's
+/// `[gcode_arcs]` makes pieces of `resolution` (the machine's `arc_segment_mm`, 1 mm unless
+/// set), `floor(length / resolution)` of them; Marlin 2 as in [`arc_segments`].
+pub fn firmware_arc_segments(
+    model: JunctionModel,
+    radius: f64,
+    planar_length: f64,
+    feed_mm_s: f64,
+    max_segment_mm: f64,
+) -> usize {
+    if model == JunctionModel::Klipper {
+        let n = (planar_length / max_segment_mm.at_least(1e-3)).floor();
+        if n.is_finite() {
+            (n as usize).clamp(1, MAX_ARC_SEGMENTS)
+        } else {
+            MAX_ARC_SEGMENTS
+        }
+    } else {
+        arc_segments(radius, planar_length, feed_mm_s, max_segment_mm)
+    }
+}
+
 #[derive(Debug, Clone)]
 struct Block {
     line: u32,
@@ -160,8 +188,12 @@ struct Block {
     max_entry: f64,
     /// Speed the block may end at if nothing follows it.
     safe: f64,
-    /// Highest cruise speed Klipper's minimum cruise ratio allows, as an accel-to-decel rate.
-    accel_to_decel: f64,
+    /// Klipper: how much the squared speed may change over the block at the "smoothed"
+    /// acceleration `accel_to_decel` = accel (1 − minimum_cruise_ratio), mm²/s² (0 otherwise).
+    smooth_delta_v2: f64,
+    /// Klipper: the highest squared junction speed a chain of blocks smoothed that way can
+    /// reach at the block's start, mm²/s².
+    max_smoothed_v2: f64,
     nominal_length: bool,
     recalculate: bool,
     /// The entry speed is the exit speed of an already finalised block and may not change.
@@ -169,21 +201,9 @@ struct Block {
 }
 
 impl Block {
-    /// The block's speed profile for its current entry and exit speeds. Only finalised blocks
-    /// need it, so the look-ahead passes work on speeds alone.
-    fn profile(&self) -> Profile {
-        let mut cruise = self.cruise;
-        if self.accel_to_decel > 0.0 && self.accel_to_decel < self.acceleration {
-            // Klipper: the peak of a move is limited as if it accelerated and decelerated at
-            // `accel_to_decel` = accel (1 - minimum_cruise_ratio), so short zig-zags do not
-            // reach full speed only to brake at once.
-            let v2 = 0.5 * (self.entry * self.entry + self.exit * self.exit)
-                + self.distance * self.accel_to_decel;
-            cruise = cruise
-                .at_most(v2.sqrt())
-                .at_least(self.entry)
-                .at_least(self.exit);
-        }
+    /// The block's speed profile between the given junction speeds, cruising at most at
+    /// `cruise`. Only finalised blocks need it, so the look-ahead passes work on speeds alone.
+    fn profile(&self, entry: f64, cruise: f64, exit: f64) -> Profile {
         // Marlin's safe-speed rule can put a junction above this block's nominal speed (a slow
         // extrusion followed by a travel): the firmware runs the block at its nominal rate and
         // the next one starts faster (the stepper's braking phase, clamped to the final rate,
@@ -192,9 +212,9 @@ impl Block {
         // 1.4 mm/s perimeter at the travel's 8 mm/s.
         Profile::new(
             self.distance,
-            self.entry,
+            entry,
             cruise,
-            self.exit.at_most(cruise),
+            exit.at_most(cruise),
             self.acceleration,
         )
     }
@@ -208,6 +228,8 @@ pub struct Planner {
     blocks: Vec<Block>,
     /// Profiles of the blocks being finalised (kept to reuse its allocation).
     profiles: Vec<Profile>,
+    /// Klipper's cruise speed² of each block in the window (reused likewise).
+    cruise_v2: Vec<f64>,
     prev: Option<Segment>,
     elapsed_s: f64,
     finalized: u64,
@@ -221,6 +243,7 @@ impl Planner {
             model,
             blocks: Vec::with_capacity(REFRESH_THRESHOLD + 1),
             profiles: Vec::with_capacity(REFRESH_THRESHOLD + 1),
+            cruise_v2: Vec::with_capacity(REFRESH_THRESHOLD + 1),
             prev: None,
             elapsed_s: 0.0,
             finalized: 0,
@@ -262,7 +285,8 @@ impl Planner {
         match m.arc {
             Some(arc) => {
                 let (p0, p1, h) = arc.plane.axes();
-                let n = arc_segments(
+                let n = firmware_arc_segments(
+                    self.model,
                     arc.radius,
                     arc.planar_length(),
                     m.feed_mm_s,
@@ -400,11 +424,25 @@ impl Planner {
             (Some(prev), JunctionModel::Klipper) => junction::klipper(prev, &curr, l),
         };
         let v_allowable = trapezoid::max_allowable_speed(-acceleration, safe, distance);
-        let accel_to_decel = match self.model {
+        let (smooth_delta_v2, max_smoothed_v2) = match self.model {
             JunctionModel::Klipper => {
-                acceleration * (1.0 - l.minimum_cruise_ratio.value.clamp(0.0, 0.99))
+                let accel_to_decel = if l.accel_to_decel.value > 0.0 {
+                    l.accel_to_decel.value.at_most(acceleration)
+                } else {
+                    acceleration * (1.0 - l.minimum_cruise_ratio.value.clamp(0.0, 0.99))
+                };
+                // Klipper's `max_smoothed_v2`: the junction limit, and no more than the chain
+                // of blocks before could reach accelerating at their smoothed rate.
+                let reach = match (&self.prev, self.blocks.last()) {
+                    (Some(_), Some(p)) => p.max_smoothed_v2 + p.smooth_delta_v2,
+                    _ => 0.0,
+                };
+                (
+                    2.0 * distance * accel_to_decel,
+                    (vmax_junction * vmax_junction).at_most(reach),
+                )
             }
-            _ => 0.0,
+            _ => (0.0, 0.0),
         };
         let block = Block {
             line,
@@ -418,7 +456,8 @@ impl Planner {
             exit: safe,
             max_entry: vmax_junction,
             safe,
-            accel_to_decel,
+            smooth_delta_v2,
+            max_smoothed_v2,
             nominal_length: cruise <= v_allowable,
             recalculate: true,
             entry_fixed: false,
@@ -514,8 +553,15 @@ impl Planner {
         // The profiles first, in a loop of their own: they are independent of each other, and
         // their divisions overlap there instead of waiting, block by block, between sink calls.
         self.profiles.clear();
-        self.profiles
-            .extend(self.blocks[..finalize].iter().map(Block::profile));
+        if self.model == JunctionModel::Klipper {
+            self.klipper_profiles(finalize);
+        } else {
+            self.profiles.extend(
+                self.blocks[..finalize]
+                    .iter()
+                    .map(|b| b.profile(b.entry, b.cruise, b.exit)),
+            );
+        }
         for (b, &profile) in self.blocks.drain(..finalize).zip(&self.profiles) {
             let pm = PlannedMove {
                 line: b.line,
@@ -542,6 +588,100 @@ impl Planner {
     }
 }
 
+impl Planner {
+    /// Klipper's look-ahead (`toolhead.py`, `LookAheadQueue.flush`) on top of the junction
+    /// speeds of the passes above: a chain of blocks that speeds up and slows down again peaks
+    /// no higher than if the whole chain accelerated and braked at `accel_to_decel` =
+    /// accel (1 − minimum_cruise_ratio), so short zig-zags and finely cut curves do not reach
+    /// full speed only to brake at once. Each block's cruise is capped by its chain's peak
+    /// (and a braking block by the speeds it brakes through), and each junction by the
+    /// cruise of both blocks. Profiles of the first `finalize` blocks go to `self.profiles`.
+    fn klipper_profiles(&mut self, finalize: usize) {
+        let blocks = &mut self.blocks[..];
+        let caps = &mut self.cruise_v2;
+        klipper_cruise_v2(blocks, caps);
+        let cap = |i: usize| caps.get(i).copied().unwrap_or(f64::INFINITY).sqrt();
+        // Speed at the start of block i: its junction, within the cruise of both blocks (the
+        // first block keeps an entry the machine is already committed to).
+        let junction = |blocks: &[Block], i: usize| match (i.checked_sub(1), blocks.get(i)) {
+            (_, None) => 0.0,
+            (None, Some(b)) if b.entry_fixed => b.entry,
+            (None, Some(b)) => b.entry.at_most(cap(0)),
+            (Some(p), Some(b)) => b.entry.at_most(cap(p)).at_most(cap(i)),
+        };
+        let n = blocks.len();
+        for i in 0..finalize {
+            let entry = junction(blocks, i);
+            let exit = if i + 1 < n {
+                junction(blocks, i + 1)
+            } else {
+                blocks[i].exit.at_most(cap(i))
+            };
+            let cruise = cap(i)
+                .at_most(blocks[i].cruise)
+                .at_least(entry)
+                .at_least(exit);
+            self.profiles.push(blocks[i].profile(entry, cruise, exit));
+        }
+        // The first block left in the queue starts where the last finalised one ended.
+        if finalize > 0 && finalize < n {
+            let entry = junction(blocks, finalize);
+            blocks[finalize].entry = entry;
+        }
+    }
+}
+
+/// Klipper's cruise speed² of every block in the window (`LookAheadQueue.flush`), from the
+/// junction speeds of the look-ahead passes: scanning back from the end, a block that can
+/// speed up at the smoothed rate sets the peak of its chain, `(smoothed start² + smoothed
+/// reach²) / 2`; the braking blocks after it are held to that peak and to the entry speeds
+/// they brake through. Blocks still braking at the window's start (their peak is in an
+/// earlier window) only brake.
+fn klipper_cruise_v2(blocks: &[Block], out: &mut Vec<f64>) {
+    out.clear();
+    out.resize(blocks.len(), f64::INFINITY);
+    let Some(last) = blocks.last() else {
+        return;
+    };
+    let sq = |v: f64| v * v;
+    let mut next_smoothed_v2 = sq(last.exit);
+    let mut peak_v2 = 0.0f64;
+    // Braking blocks waiting for their chain's peak: i + 1 ..= end.
+    let mut delayed_end: Option<usize> = None;
+    let hold = |out: &mut Vec<f64>, from: usize, to: usize, mut cruise_v2: f64| {
+        for k in from..=to {
+            if let (Some(o), Some(b)) = (out.get_mut(k), blocks.get(k)) {
+                cruise_v2 = cruise_v2.at_most(sq(b.entry));
+                *o = cruise_v2;
+            }
+        }
+    };
+    for (i, b) in blocks.iter().enumerate().rev() {
+        let reach_smoothed_v2 = next_smoothed_v2 + b.smooth_delta_v2;
+        let smoothed_v2 = b.max_smoothed_v2.at_most(reach_smoothed_v2);
+        if smoothed_v2 < reach_smoothed_v2 {
+            if smoothed_v2 + b.smooth_delta_v2 > next_smoothed_v2 || delayed_end.is_some() {
+                peak_v2 = sq(b.cruise).at_most((smoothed_v2 + reach_smoothed_v2) * 0.5);
+                if let Some(end) = delayed_end.take() {
+                    hold(out, i + 1, end, peak_v2);
+                }
+            }
+            let reach_v2 = sq(b.exit) + 2.0 * b.distance * b.acceleration;
+            if let Some(o) = out.get_mut(i) {
+                *o = ((sq(b.entry) + reach_v2) * 0.5)
+                    .at_most(sq(b.cruise))
+                    .at_most(peak_v2);
+            }
+        } else {
+            delayed_end.get_or_insert(i);
+        }
+        next_smoothed_v2 = smoothed_v2;
+    }
+    if let Some(end) = delayed_end {
+        hold(out, 0, end, f64::INFINITY);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -549,13 +689,22 @@ mod tests {
     use crate::gcode::parse_line;
     use crate::machine::{Event, Machine};
 
-    fn plan(src: &str, model: JunctionModel) -> Vec<PlannedMove> {
+    /// Test limits: 1000 mm/s and 1000 mm/s² on every move, jerk 10 mm/s.
+    fn test_limits() -> Limits {
         let mut limits = MachineProfile::preset("prusa-mk3s").expect("preset").limits;
         limits.max_feedrate = [Limit::profile(1000.0); 4];
         limits.max_acceleration = [Limit::profile(100_000.0); 4];
         limits.acceleration = Limit::profile(1000.0);
         limits.travel_acceleration = Limit::profile(1000.0);
         limits.max_jerk = [Limit::profile(10.0); 4];
+        limits
+    }
+
+    fn plan(src: &str, model: JunctionModel) -> Vec<PlannedMove> {
+        plan_on(test_limits(), src, model)
+    }
+
+    fn plan_on(limits: Limits, src: &str, model: JunctionModel) -> Vec<PlannedMove> {
         let mut planner = Planner::new(limits, model);
         let mut machine = Machine::default();
         let mut w = Warnings::default();
@@ -591,6 +740,57 @@ mod tests {
         }
         planner.flush(&mut |p| out.push(*p));
         out.iter().map(|p| p.profile.acceleration).collect()
+    }
+
+    #[test]
+    fn klipper_smooths_a_chain_of_moves_as_one_move() {
+        // Klipper's minimum cruise ratio 0.5 (accel_to_decel = 500 mm/s² at 1000): a 20 mm
+        // move from rest to rest peaks at v² = 20 mm × 500 mm/s² (100 mm/s): 5 mm speeding up,
+        // 10 mm at 100 mm/s, 5 mm braking, 0.3 s. Cut into collinear pieces it is the same
+        // chain and takes the same time; the pieces' own speeds used to peak at 141 mm/s.
+        let limits = |ratio: f64| Limits {
+            minimum_cruise_ratio: Limit::profile(ratio),
+            ..test_limits()
+        };
+        let time_at = |ratio: f64, src: &str| -> f64 {
+            plan_on(limits(ratio), src, JunctionModel::Klipper)
+                .iter()
+                .map(|p| p.profile.duration())
+                .sum()
+        };
+        let time = |src: &str| time_at(0.5, src);
+        let whole = time("G1 X20 F60000");
+        let pieces = time("G1 X10 F60000\nG1 X20");
+        let quarters = time("G1 X5 F60000\nG1 X10\nG1 X15\nG1 X20");
+        for t in [whole, pieces, quarters] {
+            assert!((t - 0.3).abs() < 1e-3, "{whole} {pieces} {quarters}");
+        }
+        // Older Klipper's absolute max_accel_to_decel of 500 mm/s² is the same chain.
+        let rate = Limits {
+            accel_to_decel: Limit::profile(500.0),
+            ..limits(0.0)
+        };
+        let t: f64 = plan_on(rate, "G1 X10 F60000\nG1 X20", JunctionModel::Klipper)
+            .iter()
+            .map(|p| p.profile.duration())
+            .sum();
+        assert!((t - 0.3).abs() < 1e-3, "{t}");
+        // Without either it is a triangle: 2 √(20 mm / 1000 mm/s²) = 0.283 s.
+        let t = time_at(0.0, "G1 X10 F60000\nG1 X20");
+        assert!((t - 2.0 * (0.02f64).sqrt()).abs() < 1e-3, "{t}");
+        // Speeds stay continuous from piece to piece.
+        let p = plan_on(
+            limits(0.5),
+            "G1 X5 F60000\nG1 X10\nG1 X15\nG1 X20",
+            JunctionModel::Klipper,
+        );
+        for w in p.windows(2) {
+            assert!(
+                (w[0].profile.exit - w[1].profile.entry).abs() < 1e-9,
+                "{p:?}"
+            );
+        }
+        assert!(p.iter().all(|m| m.profile.peak <= 100.0 + 1e-3), "{p:?}");
     }
 
     #[test]

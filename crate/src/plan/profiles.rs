@@ -38,6 +38,7 @@ fn limits(
         junction_deviation: Limit::profile(jd),
         square_corner_velocity: Limit::profile(scv),
         minimum_cruise_ratio: Limit::profile(cruise_ratio),
+        accel_to_decel: Limit::unset(),
         min_feedrate: Limit::profile(0.0),
         min_travel_feedrate: Limit::profile(0.0),
         arc_segment_mm: Limit::profile(1.0),

@@ -675,15 +675,11 @@ fn with_arcs(
 ) -> Option<(Vec<Piece>, f64)> {
     let limits = machine.limits?;
     let max_segment = limits.arc_segment_mm.value;
-    let klipper = machine.model == JunctionModel::Klipper;
-    // Klipper's [gcode_arcs] cuts an arc into pieces of `resolution` (1 mm unless set), Marlin 2
-    // by chord deviation and segment rate.
+    let model = machine.model;
+    // As the planner times them: Klipper's [gcode_arcs] cuts an arc into pieces of
+    // `resolution`, Marlin 2 by chord deviation and segment rate.
     let segments = move |r: f64, len: f64, feed: f64| {
-        if klipper {
-            (len / max_segment.max(1e-3)).floor().max(1.0) as usize
-        } else {
-            crate::plan::arc_segments(r, len, feed, max_segment)
-        }
+        crate::plan::firmware_arc_segments(model, r, len, feed, max_segment)
     };
     let firmware = arcs::Firmware {
         segments: &segments,

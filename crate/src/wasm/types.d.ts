@@ -16,6 +16,8 @@ export interface Limits {
   junction_deviation: Limit;
   square_corner_velocity: Limit;
   minimum_cruise_ratio: Limit;
+  /** Older Klipper's max_accel_to_decel, mm/s²; 0 when minimum_cruise_ratio applies. */
+  accel_to_decel: Limit;
   min_feedrate: Limit;
   min_travel_feedrate: Limit;
   arc_segment_mm: Limit;
