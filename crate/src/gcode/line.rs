@@ -278,7 +278,7 @@ fn trim(mut s: &[u8]) -> &[u8] {
 /// extrusion word, so that one is read as an exponent; in all-lower-case lines (`g1x10e-2`) `e`
 /// is the extrusion word again.
 #[inline]
-fn scan_number(s: &[u8], upper_letter: bool) -> usize {
+pub(crate) fn scan_number(s: &[u8], upper_letter: bool) -> usize {
     let mut i = 0;
     if matches!(s.first(), Some(b'+' | b'-')) {
         i = 1;

@@ -2,10 +2,6 @@
 
 pub use crate::gcode::number::{fixed as format_value, rounded};
 
-fn is_number_byte(b: u8) -> bool {
-    b.is_ascii_digit() || b == b'.' || b == b'-' || b == b'+'
-}
-
 /// `text` with the value of each word in `values` (upper-case letter, new number text)
 /// replaced where the word is present (with or without a number) and appended after the last
 /// word where it is not.
@@ -40,9 +36,12 @@ pub fn rewrite_line(text: &[u8], values: &[(u8, String)]) -> Vec<u8> {
                 j += 1;
             }
             let start = j;
-            while j < code.len() && code.get(j).copied().is_some_and(is_number_byte) {
-                j += 1;
-            }
+            // The number exactly as the parser reads it (`Y-0e+40` is one number after an
+            // upper-case letter), so no part of it is left behind the new value.
+            j += crate::gcode::line::scan_number(
+                code.get(start..).unwrap_or_default(),
+                b.is_ascii_uppercase(),
+            );
             if j == start {
                 // A word without a number (`Z` in `G1 X5 Z E2`): it is replaced too, keeping
                 // the blank after it, or the line would carry the letter twice.
@@ -116,6 +115,15 @@ mod tests {
         assert_eq!(out, b"G1 X1 Z0.3 E12".to_vec());
         let out = rewrite_line(b"G1 X-25 Z", &vals(&[(b'Z', "0.3")]));
         assert_eq!(out, b"G1 X-25 Z0.3".to_vec());
+    }
+
+    #[test]
+    fn a_number_with_an_exponent_is_replaced_whole() {
+        let out = rewrite_line(b"G1 X1 Y-0e+40 E2", &vals(&[(b'Y', "0.182")]));
+        assert_eq!(out, b"G1 X1 Y0.182 E2".to_vec());
+        // Upper-case E is never an exponent: the extrusion word stays.
+        let out = rewrite_line(b"G1X10E-2", &vals(&[(b'X', "5")]));
+        assert_eq!(out, b"G1X5E-2".to_vec());
     }
 
     #[test]
