@@ -588,3 +588,20 @@ fn widely_spaced_points_warn_about_the_gap_limit() {
     assert_eq!(r.runs, 1);
     assert!(r.warnings.is_empty());
 }
+
+#[test]
+fn rotary_words_written_under_g91_are_not_offsets() {
+    // B reaches 49.0994° by two relative moves; the absolute line after G90 that the smoother
+    // rewrites must say B49.099, not the 6.099 a G92-like offset learnt from the relative word
+    // (B6.0994 there is a distance) would give: 43° off the original orientation.
+    let input = b"G91\nG1 B43\nG1 B6.0994\nG90\nG1 X128\nG1 X129 E1\n";
+    let r = orient::smooth(input, &SmoothOptions::default()).expect("smooths");
+    let out = String::from_utf8(r.output).expect("text");
+    let last = out.lines().last().expect("a line");
+    assert!(last.contains("B49.099"), "{out}");
+    assert!(
+        r.max_angle_to_original_deg < 0.01,
+        "{}",
+        r.max_angle_to_original_deg
+    );
+}

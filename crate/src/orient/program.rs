@@ -220,8 +220,12 @@ pub(super) fn differs(fmt: &WordFormat<'_>, old_to: &Pos, new: &Pose) -> [bool; 
 pub(super) struct Offsets([f64; 6]);
 
 impl Offsets {
-    /// Learns the offsets from a move and its line.
+    /// Learns the offsets from a move and its line. Only a line in absolute positioning
+    /// writes positions; under `G91` its words are distances and say nothing of the offset.
     pub fn learn(&mut self, m: &PathMove, line: &MotionLine) {
+        if line.relative {
+            return;
+        }
         for (k, (_, ax)) in AXIS_INDEX.iter().enumerate() {
             if let (Some(w), Some(o)) = (line.words.get(k).copied().flatten(), self.0.get_mut(k)) {
                 let d = w - m.to[*ax];
