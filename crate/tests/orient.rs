@@ -605,3 +605,36 @@ fn rotary_words_written_under_g91_are_not_offsets() {
         r.max_angle_to_original_deg
     );
 }
+
+#[test]
+fn a_g92_shift_carries_into_the_words_written_after_it() {
+    // The table is tilted to B30, then G92 names that B0: every B the smoother writes after
+    // it is relative to the new zero (about B0, the same 30° of tilt), not about B30, which
+    // would tilt the table to 60°.
+    // The lines after it turn C to and fro without a B word, so the smoother rewrites them
+    // with all their words.
+    let mut input = String::from("G90\nM83\nG1 B30\nG92 B0\n");
+    for i in 1..=16 {
+        input.push_str(&format!(
+            "G1 X{i} C{} E0.1\n",
+            if i % 2 == 0 { 8 } else { 0 }
+        ));
+    }
+    let r = orient::smooth(input.as_bytes(), &SmoothOptions::default()).expect("smooths");
+    let out = String::from_utf8(r.output).expect("text");
+    let written: Vec<&str> = out
+        .lines()
+        .skip(4)
+        .flat_map(|l| l.split_whitespace())
+        .filter(|w| w.starts_with('B'))
+        .collect();
+    assert!(!written.is_empty(), "{out}");
+    // Smoothing the tool vector moves the tilt by hundredths of a degree, never by 30°.
+    let b = |w: &str| w[1..].parse::<f64>().expect("number");
+    assert!(written.iter().all(|w| b(w).abs() < 0.5), "{out}");
+    assert!(
+        r.max_angle_to_original_deg < 5.0,
+        "{}",
+        r.max_angle_to_original_deg
+    );
+}

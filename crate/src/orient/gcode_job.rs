@@ -24,7 +24,7 @@ pub(super) fn run(
     let moves = &read.moves;
     let mut warnings = read.warnings.clone();
     summary::tick(progress, 0.3)?;
-    let lines = program::motion_lines(input, options.analyze.strict)?;
+    let (lines, position_sets) = program::motion_lines(input, options.analyze.strict)?;
     let line_of = program::line_of_moves(moves, &lines);
     let runs = program::runs(kin, moves, &line_of, options.max_gap_mm);
     let [r0, r1] = kin.model.rotary_axes();
@@ -101,7 +101,12 @@ pub(super) fn run(
         crate::machine::axis::Y,
         crate::machine::axis::Z,
     ];
+    let mut sets = position_sets.iter().peekable();
     for (mi, m) in moves.iter().enumerate() {
+        // G92 / G28 lines before this move: the machine has not moved since.
+        while let Some(set) = sets.next_if(|s| s.number < m.line) {
+            offsets.set(set, &m.from);
+        }
         let Some(line) = line_of.get(mi).copied().flatten() else {
             continue;
         };

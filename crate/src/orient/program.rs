@@ -38,9 +38,26 @@ pub(super) struct MotionLine {
     pub words: [Option<f64>; 6],
 }
 
-/// Every `G0`/`G1` line of the input, in order.
-pub(super) fn motion_lines(input: &[u8], strict: bool) -> Result<Vec<MotionLine>, Error> {
+/// A line that sets the logical position without moving: `G92` (the values it sets; bare,
+/// every axis to 0) or `G28` (the homed axes, where word and position are both 0 after it).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct PositionSet {
+    /// 1-based line number.
+    pub number: u32,
+    /// For X, Y, Z, A, B, C (in [`AXIS_INDEX`] order): `G92`'s new value of the word, or
+    /// `None` for an axis the line leaves alone.
+    pub words: [Option<f64>; 6],
+    /// `G28`: the offset of every named axis becomes 0, wherever the machine is.
+    pub homing: bool,
+}
+
+/// Every `G0`/`G1` line of the input, in order, and every `G92` / `G28`.
+pub(super) fn motion_lines(
+    input: &[u8],
+    strict: bool,
+) -> Result<(Vec<MotionLine>, Vec<PositionSet>), Error> {
     let mut out = Vec::new();
+    let mut sets = Vec::new();
     let mut relative = false;
     let mut warnings = Warnings::default();
     let strictness = if strict {
@@ -54,7 +71,31 @@ pub(super) fn motion_lines(input: &[u8], strict: bool) -> Result<Vec<MotionLine>
             return Ok(());
         };
         let Code { letter, number, .. } = code;
-        if letter == b'G' && number == 90 {
+        if letter == b'G' && number == 92 {
+            // As the machine model reads it: a bare G92 zeroes every axis.
+            let bare = !crate::machine::AXIS_LETTERS
+                .iter()
+                .any(|l| line.params.has(*l));
+            sets.push(PositionSet {
+                number: raw.number,
+                words: AXIS_INDEX.map(|(l, _)| if bare { Some(0.0) } else { line.params.get(l) }),
+                homing: false,
+            });
+        } else if letter == b'G' && number == 28 {
+            // The named axes of X, Y, Z (all three if none).
+            let any = AXIS_INDEX[..3].iter().any(|(l, _)| line.params.has(*l));
+            let mut words = [None; 6];
+            for (w, (l, _)) in words.iter_mut().zip(&AXIS_INDEX[..3]) {
+                if !any || line.params.has(*l) {
+                    *w = Some(0.0);
+                }
+            }
+            sets.push(PositionSet {
+                number: raw.number,
+                words,
+                homing: true,
+            });
+        } else if letter == b'G' && number == 90 {
             relative = false;
         } else if letter == b'G' && number == 91 {
             relative = true;
@@ -68,7 +109,7 @@ pub(super) fn motion_lines(input: &[u8], strict: bool) -> Result<Vec<MotionLine>
         }
         Ok(())
     })?;
-    Ok(out)
+    Ok((out, sets))
 }
 
 /// One run: indexes of its moves in the path.
@@ -229,6 +270,23 @@ impl Offsets {
         for (k, (_, ax)) in AXIS_INDEX.iter().enumerate() {
             if let (Some(w), Some(o)) = (line.words.get(k).copied().flatten(), self.0.get_mut(k)) {
                 let d = w - m.to[*ax];
+                if d.is_finite() {
+                    *o = d;
+                }
+            }
+        }
+    }
+
+    /// Applies a `G92` or `G28` with the machine at `position` (where the move after it
+    /// starts).
+    pub fn set(&mut self, set: &PositionSet, position: &Pos) {
+        for (k, (_, ax)) in AXIS_INDEX.iter().enumerate() {
+            if let (Some(w), Some(o)) = (set.words.get(k).copied().flatten(), self.0.get_mut(k)) {
+                let d = if set.homing {
+                    0.0
+                } else {
+                    w - position.get(*ax).copied().unwrap_or(0.0)
+                };
                 if d.is_finite() {
                     *o = d;
                 }
