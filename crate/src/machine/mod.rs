@@ -303,6 +303,11 @@ impl Machine {
         &self.logical
     }
 
+    /// Whether relative positioning (`G91`) is in force.
+    pub fn relative_positioning(&self) -> bool {
+        self.relative_axes
+    }
+
     /// Extrusion mode in force for E words.
     pub fn extrusion_mode(&self) -> ExtrusionMode {
         if self.relative_axes {

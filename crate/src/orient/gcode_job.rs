@@ -3,7 +3,7 @@
 use super::core::{self, RunSettings};
 use super::kinematics::Pose;
 use super::metrics::Sample;
-use super::program::{self, Offsets};
+use super::program;
 use super::summary::{self, Counts};
 use super::vec3;
 use super::words;
@@ -24,7 +24,7 @@ pub(super) fn run(
     let moves = &read.moves;
     let mut warnings = read.warnings.clone();
     summary::tick(progress, 0.3)?;
-    let (lines, position_sets) = program::motion_lines(input, options.analyze.strict)?;
+    let lines = program::motion_lines(input, options.analyze.strict)?;
     let line_of = program::line_of_moves(moves, &lines);
     let runs = program::runs(kin, moves, &line_of, options.max_gap_mm);
     let [r0, r1] = kin.model.rotary_axes();
@@ -89,7 +89,6 @@ pub(super) fn run(
             }
         }
     }
-    let mut offsets = Offsets::default();
     let mut edits: Vec<Edit> = Vec::new();
     let mut after_est: Vec<Vec<Sample>> = before.clone();
     // Axes whose modal value in the output differs from the input's (X, Y, Z, rotary ×2): a
@@ -101,16 +100,11 @@ pub(super) fn run(
         crate::machine::axis::Y,
         crate::machine::axis::Z,
     ];
-    let mut sets = position_sets.iter().peekable();
     for (mi, m) in moves.iter().enumerate() {
-        // G92 / G28 lines before this move: the machine has not moved since.
-        while let Some(set) = sets.next_if(|s| s.number < m.line) {
-            offsets.set(set, &m.from);
-        }
         let Some(line) = line_of.get(mi).copied().flatten() else {
             continue;
         };
-        offsets.learn(m, line);
+        let offsets = line.offsets;
         let omits = program::omitted(line, kin);
         let force = omits.iter().zip(&dirty).any(|(o, d)| *o && *d);
         let slot_here = slot.get(mi).copied().flatten();

@@ -8,7 +8,7 @@
 
 use crate::error::{Error, Warnings};
 use crate::gcode::{self, Code, Edit};
-use crate::machine::{axis, MoveKind, Pos};
+use crate::machine::{axis, Machine, MoveKind, Pos};
 use crate::path::PathMove;
 
 use super::kinematics::{Kinematics, Pose};
@@ -36,29 +36,19 @@ pub(super) struct MotionLine {
     pub relative: bool,
     /// Values written for X, Y, Z, A, B, C (in [`AXIS_INDEX`] order).
     pub words: [Option<f64>; 6],
+    /// The `G92` / `G28` shifts in force at the line.
+    pub offsets: Offsets,
 }
 
-/// A line that sets the logical position without moving: `G92` (the values it sets; bare,
-/// every axis to 0) or `G28` (the homed axes, where word and position are both 0 after it).
-#[derive(Debug, Clone, Copy)]
-pub(super) struct PositionSet {
-    /// 1-based line number.
-    pub number: u32,
-    /// For X, Y, Z, A, B, C (in [`AXIS_INDEX`] order): `G92`'s new value of the word, or
-    /// `None` for an axis the line leaves alone.
-    pub words: [Option<f64>; 6],
-    /// `G28`: the offset of every named axis becomes 0, wherever the machine is.
-    pub homing: bool,
-}
-
-/// Every `G0`/`G1` line of the input, in order, and every `G92` / `G28`.
-pub(super) fn motion_lines(
-    input: &[u8],
-    strict: bool,
-) -> Result<(Vec<MotionLine>, Vec<PositionSet>), Error> {
+/// Every `G0`/`G1` line of the input, in order.
+pub(super) fn motion_lines(input: &[u8], strict: bool) -> Result<Vec<MotionLine>, Error> {
     let mut out = Vec::new();
-    let mut sets = Vec::new();
-    let mut relative = false;
+    // The machine model tracks the logical position beside the machine's (G92, G28) and the
+    // positioning mode (G90, G91): the offsets and the mode are its own, not a second reading
+    // of those commands.
+    let mut machine = Machine::default();
+    // The path extraction has already reported what the machine model warns of.
+    let mut machine_warnings = Warnings::default();
     let mut warnings = Warnings::default();
     let strictness = if strict {
         gcode::Strictness::Strict
@@ -67,49 +57,23 @@ pub(super) fn motion_lines(
     };
     gcode::for_each_line(input, strictness, &mut warnings, |raw, line, _| {
         let Some(line) = line else { return Ok(()) };
+        machine.apply(raw.number, line, &mut machine_warnings);
         let Some(code) = line.code() else {
             return Ok(());
         };
         let Code { letter, number, .. } = code;
-        if letter == b'G' && number == 92 {
-            // As the machine model reads it: a bare G92 zeroes every axis.
-            let bare = !crate::machine::AXIS_LETTERS
-                .iter()
-                .any(|l| line.params.has(*l));
-            sets.push(PositionSet {
-                number: raw.number,
-                words: AXIS_INDEX.map(|(l, _)| if bare { Some(0.0) } else { line.params.get(l) }),
-                homing: false,
-            });
-        } else if letter == b'G' && number == 28 {
-            // The named axes of X, Y, Z (all three if none).
-            let any = AXIS_INDEX[..3].iter().any(|(l, _)| line.params.has(*l));
-            let mut words = [None; 6];
-            for (w, (l, _)) in words.iter_mut().zip(&AXIS_INDEX[..3]) {
-                if !any || line.params.has(*l) {
-                    *w = Some(0.0);
-                }
-            }
-            sets.push(PositionSet {
-                number: raw.number,
-                words,
-                homing: true,
-            });
-        } else if letter == b'G' && number == 90 {
-            relative = false;
-        } else if letter == b'G' && number == 91 {
-            relative = true;
-        } else if letter == b'G' && (number == 0 || number == 1) {
+        if letter == b'G' && (number == 0 || number == 1) {
             out.push(MotionLine {
                 number: raw.number,
                 range: raw.offset..raw.offset + raw.text.len(),
-                relative,
+                relative: machine.relative_positioning(),
                 words: AXIS_INDEX.map(|(l, _)| line.params.get(l)),
+                offsets: Offsets::of_machine(&machine),
             });
         }
         Ok(())
     })?;
-    Ok((out, sets))
+    Ok(out)
 }
 
 /// One run: indexes of its moves in the path.
@@ -255,43 +219,24 @@ pub(super) fn differs(fmt: &WordFormat<'_>, old_to: &Pos, new: &Pose) -> [bool; 
     })
 }
 
-/// Offsets between written words and machine positions (G92 shifts), tracked along the file:
+/// Offsets between written words and machine positions (G92 shifts, undone by G28):
 /// `word = position + offset`.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, Clone, Copy)]
 pub(super) struct Offsets([f64; 6]);
 
 impl Offsets {
-    /// Learns the offsets from a move and its line. Only a line in absolute positioning
-    /// writes positions; under `G91` its words are distances and say nothing of the offset.
-    pub fn learn(&mut self, m: &PathMove, line: &MotionLine) {
-        if line.relative {
-            return;
-        }
-        for (k, (_, ax)) in AXIS_INDEX.iter().enumerate() {
-            if let (Some(w), Some(o)) = (line.words.get(k).copied().flatten(), self.0.get_mut(k)) {
-                let d = w - m.to[*ax];
-                if d.is_finite() {
-                    *o = d;
-                }
+    /// The machine model's logical position less its machine position, per axis.
+    fn of_machine(machine: &Machine) -> Self {
+        let (logical, physical) = (machine.logical_position(), machine.position());
+        Self(AXIS_INDEX.map(|(_, ax)| {
+            let d =
+                logical.get(ax).copied().unwrap_or(0.0) - physical.get(ax).copied().unwrap_or(0.0);
+            if d.is_finite() {
+                d
+            } else {
+                0.0
             }
-        }
-    }
-
-    /// Applies a `G92` or `G28` with the machine at `position` (where the move after it
-    /// starts).
-    pub fn set(&mut self, set: &PositionSet, position: &Pos) {
-        for (k, (_, ax)) in AXIS_INDEX.iter().enumerate() {
-            if let (Some(w), Some(o)) = (set.words.get(k).copied().flatten(), self.0.get_mut(k)) {
-                let d = if set.homing {
-                    0.0
-                } else {
-                    w - position.get(*ax).copied().unwrap_or(0.0)
-                };
-                if d.is_finite() {
-                    *o = d;
-                }
-            }
-        }
+        }))
     }
 
     /// Offset of an axis index.
