@@ -144,7 +144,12 @@ pub fn arc_segments(radius: f64, planar_length: f64, feed_mm_s: f64, max_segment
         .sqrt()
         .at_most(feed_mm_s / ARC_SEGMENTS_PER_SEC)
         .clamp(MIN_ARC_SEGMENT_MM, max);
-    let n = planar_length / seg + 0.8;
+    segment_count(planar_length / seg + 0.8)
+}
+
+/// A segment count from its real-valued estimate: at least 1, at most [`MAX_ARC_SEGMENTS`]
+/// (also for an infinite or NaN estimate).
+fn segment_count(n: f64) -> usize {
     if n.is_finite() {
         (n as usize).clamp(1, MAX_ARC_SEGMENTS)
     } else {
@@ -163,12 +168,7 @@ pub fn firmware_arc_segments(
     max_segment_mm: f64,
 ) -> usize {
     if model == JunctionModel::Klipper {
-        let n = (planar_length / max_segment_mm.at_least(1e-3)).floor();
-        if n.is_finite() {
-            (n as usize).clamp(1, MAX_ARC_SEGMENTS)
-        } else {
-            MAX_ARC_SEGMENTS
-        }
+        segment_count((planar_length / max_segment_mm.at_least(1e-3)).floor())
     } else {
         arc_segments(radius, planar_length, feed_mm_s, max_segment_mm)
     }
