@@ -25,6 +25,13 @@
 //! the tolerance allows, and a leg too short for both requests is split between them so the
 //! larger of their curvatures is least (a gentle corner beside a sharp one leaves the sharp
 //! one the room it needs).
+//!
+//! Where the path has room either side, the corner then takes the racing line (`racing`):
+//! the path eases out to the far edge of the tolerance band before the corner, turns on a
+//! circle tangent to the legs' offsets that still passes `ε` inside the vertex, and eases back,
+//! which widens the circle by `1 + sec(θ/2)` (2.4× at 90°). "Within `ε` of the vertex" above
+//! is then the whole story only for the inside line ([`Line::Inside`]), which the pipeline
+//! still uses where the wider circle cannot be walked.
 
 use super::bspline::{dot, norm, sub};
 
@@ -50,6 +57,12 @@ pub struct Blend {
     pub deviation_mm: f64,
     /// Largest curvature of the transition, 1/mm.
     pub max_curvature: f64,
+    /// How far outside the legs the fillet's tangent lines run (the racing line), mm; 0: the
+    /// fillet is tangent to the legs themselves.
+    pub offset_mm: f64,
+    /// Length of leg beyond `extent_mm` over which the path eases out to the offset and back
+    /// onto the leg, mm (0 without an offset).
+    pub ramp_mm: f64,
 }
 
 impl Blend {
@@ -58,7 +71,14 @@ impl Blend {
         turn_rad: 0.0,
         deviation_mm: 0.0,
         max_curvature: 0.0,
+        offset_mm: 0.0,
+        ramp_mm: 0.0,
     };
+
+    /// Length of each leg the blend takes: the fillet's extent and the ramp beyond it.
+    fn reach(&self) -> f64 {
+        self.extent_mm + self.ramp_mm
+    }
 }
 
 /// The shape constants of a fillet turning by `turn` (rad) for `L = 1`: the distance from the
@@ -103,7 +123,7 @@ fn fillet_point(v: &[f64; 3], a: &[f64; 3], b: &[f64; 3], turn: f64, l: f64, t: 
 /// curvature down to `enough_curvature` (1/mm; the curvature at which the machine's limits no
 /// longer slow it, `K_cr`): a gentle turn could be spread over metres within the tolerance, and
 /// would take the leg a sharp neighbour needs.
-pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64) -> Vec<Blend> {
+pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64, line: Line) -> Vec<Blend> {
     let n = pts.len();
     let mut out = vec![Blend::NONE; n];
     if n < 3 {
@@ -113,6 +133,8 @@ pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64) -> Vec<B
     // What each corner asks for.
     let mut want = vec![0.0f64; n];
     let mut shapes = vec![(0.0, 0.0); n];
+    // Vertices a ramp out to a racing line may run through: the path is straight there.
+    let mut through = vec![false; n];
     for i in 1..n - 1 {
         let (la, lb) = (lens[i - 1], lens[i]);
         if la <= 0.0 || lb <= 0.0 {
@@ -121,6 +143,7 @@ pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64) -> Vec<B
         let a = sub(&pts[i], &pts[i - 1]);
         let b = sub(&pts[i + 1], &pts[i]);
         let turn = crate::math::acos((dot(&a, &b) / (la * lb)).clamp(-1.0, 1.0));
+        through[i] = turn <= STRAIGHT_RAD;
         if turn <= STRAIGHT_RAD || turn > MAX_TURN_RAD {
             continue;
         }
@@ -164,7 +187,108 @@ pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64) -> Vec<B
         out[i].deviation_mm = c * l;
         out[i].max_curvature = k / l;
     }
+    if line == Line::Inside {
+        return out;
+    }
+    // Then, corner by corner, the racing line where the path has room for it: up to the
+    // nearest vertex either way that is not straight (less what its own blend takes), or the
+    // path's end.
+    let mut along = Vec::with_capacity(n);
+    along.push(0.0);
+    for l in &lens {
+        along.push(along.last().copied().unwrap_or(0.0) + l);
+    }
+    for i in 1..n - 1 {
+        if out[i].extent_mm <= 0.0 || out[i].max_curvature <= enough_curvature {
+            continue;
+        }
+        let room = |other: usize| {
+            let used = if other == 0 || other == n - 1 {
+                0.0
+            } else {
+                out[other].reach()
+            };
+            LEG_SHARE * (along[i] - along[other]).abs() - used
+        };
+        let back = (0..i).rev().find(|&k| !through[k]).unwrap_or(0);
+        let on = (i + 1..n).find(|&k| !through[k]).unwrap_or(n - 1);
+        let room = room(back).min(room(on));
+        if let Some(r) = racing(out[i], tolerance_mm, enough_curvature, room) {
+            out[i] = r;
+        }
+    }
     out
+}
+
+/// Which side of the vertex a blend may use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Line {
+    /// Fillets tangent to the legs: the path stays on or inside the corner.
+    Inside,
+    /// The racing line where there is room for it, else the inside fillet.
+    Racing,
+}
+
+/// Shares of the tolerance tried as the racing line's offset, largest first.
+const OFFSET_SHARES: [f64; 3] = [1.0, 0.5, 0.25];
+/// Peak curvature of a ramp out to the racing line, as a share of the fillet's: low, since
+/// the ramp lies where the machine is still faster than on the fillet.
+const RAMP_CURVATURE_SHARE: f64 = 0.15;
+/// Peak of `|o''|` of the quintic ease `o(x) = 1 − (10x³ − 15x⁴ + 6x⁵)` on `0..1` (at
+/// `x = 1/2 ± √3/6`): `10/√3`.
+const EASE_PEAK: f64 = 5.773_502_691_896_258;
+
+/// The quintic ease from 1 (at `x ≤ 0`) to 0 (at `x ≥ 1`), flat and straight at both ends.
+fn ease(x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    1.0 - x * x * x * (10.0 + x * (6.0 * x - 15.0))
+}
+
+/// The racing-line version of `inside` (a fillet tangent to the legs within `tolerance_mm` of
+/// the vertex) that fits in `room` of each leg, if one rounds the corner wider.
+///
+/// A fillet tangent to the legs has to pass within the tolerance of the vertex from the inside
+/// only, which caps its radius at `ε / (sec(θ/2) − 1)`. The tolerance is a band on both sides
+/// of the path, though: if the path eases out by `s` before the corner, runs round a fillet
+/// tangent to the legs' offsets, and eases back after it (out, in, out, as a driver takes a
+/// bend), the fillet's innermost point may still pass `ε` inside the vertex, and its radius is
+/// `(ε + s sec(θ/2)) / (sec(θ/2) − 1)`: with `s = ε`, `1 + sec(θ/2)` times the inside fillet's
+/// (2.4× at 90°, 3.6× at 135°). The machine's speed through it, `√(a r)`, rises by the root of
+/// that, which on firmware that takes sharp corners fast (Klipper's square-corner velocity)
+/// makes rounding a corner cost no time where the inside fillet did. No radius beyond the
+/// `enough_curvature` one is asked for. The ramps are quintic eases whose peak curvature is
+/// [`RAMP_CURVATURE_SHARE`] of the fillet's.
+fn racing(inside: Blend, tolerance_mm: f64, enough_curvature: f64, room: f64) -> Option<Blend> {
+    let half = 0.5 * inside.turn_rad;
+    let sec = 1.0 / crate::math::cos(half);
+    let tan = crate::math::tan(half);
+    if !(sec > 1.0 && tan.is_finite()) {
+        return None;
+    }
+    let cap = if enough_curvature > 0.0 {
+        1.0 / enough_curvature
+    } else {
+        f64::INFINITY
+    };
+    let inside_radius = 1.0 / inside.max_curvature;
+    OFFSET_SHARES.iter().find_map(|&share| {
+        let radius = ((tolerance_mm + share * tolerance_mm * sec) / (sec - 1.0)).min(cap);
+        let offset = ((sec - 1.0) * radius - tolerance_mm) / sec;
+        let offset = offset.clamp(0.0, tolerance_mm);
+        if radius <= inside_radius || offset <= 0.0 {
+            return None;
+        }
+        let extent = (radius - offset) * tan;
+        let ramp = (EASE_PEAK * offset * radius / RAMP_CURVATURE_SHARE).sqrt();
+        (extent > 0.0 && extent + ramp <= room).then_some(Blend {
+            extent_mm: extent,
+            turn_rad: inside.turn_rad,
+            deviation_mm: ((sec - 1.0) * radius - offset * sec).max(offset),
+            max_curvature: 1.0 / radius,
+            offset_mm: offset,
+            ramp_mm: ramp,
+        })
+    })
 }
 
 /// Points of the blended path for the fit, with parameters: the arc length of the original
@@ -179,7 +303,6 @@ pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64
     if n == 0 || blends.len() != n {
         return (data, par);
     }
-    let mut s = 0.0; // arc length of the original at pts[i]
     let push = |p: [f64; 3], u: f64, data: &mut Vec<[f64; 3]>, par: &mut Vec<f64>| {
         if par.last().is_none_or(|&last| u > last + 1e-9) {
             data.push(p);
@@ -187,6 +310,30 @@ pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64
         }
     };
     push(pts[0], 0.0, &mut data, &mut par);
+    // The ramps out to the racing lines: each runs from its blend's end along the straight
+    // stretch, possibly past straight vertices, so each leg looks for the blend before it and
+    // the one after it.
+    let racer = |j: usize| -> Option<Racer> {
+        let bl = blends.get(j)?;
+        let o = (bl.offset_mm > 0.0 && bl.ramp_mm > 0.0)
+            .then(|| Outward::at(pts, j))
+            .flatten()?;
+        Some(Racer { blend: *bl, o })
+    };
+    let along = super::bspline::arc_lengths(pts);
+    let mut next_blend = vec![n; n];
+    for i in (1..n - 1).rev() {
+        next_blend[i] = if blends[i].extent_mm > 0.0 {
+            i
+        } else if blends[i].turn_rad == 0.0 {
+            next_blend[i + 1]
+        } else {
+            n
+        };
+    }
+    let mut arc = 0.0; // arc length of the original at pts[i]
+    let mut last: Option<(usize, f64)> = None; // the blend before this leg, and its arc length
+    let mut ts = Vec::new();
     for i in 0..n - 1 {
         let (a, b) = (pts[i], pts[i + 1]);
         let len = norm(&sub(&b, &a));
@@ -199,13 +346,53 @@ pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64
         } else {
             [0.0; 3]
         };
-        let at = |t: f64| [a[0] + dir[0] * t, a[1] + dir[1] * t, a[2] + dir[2] * t];
+        if i > 0 {
+            if blends[i].extent_mm > 0.0 {
+                last = Some((i, arc));
+            } else if blends[i].turn_rad != 0.0 || len <= 0.0 {
+                last = None;
+            }
+        }
+        // The ramps reaching into this leg: the one after the blend before it, the one before
+        // the blend after it (arc lengths of their far ends at full offset, signs of travel).
+        let before = last.and_then(|(j, at)| {
+            racer(j).map(|r| (r.o.after, at + r.blend.extent_mm, 1.0, r.blend))
+        });
+        let j = next_blend.get(i + 1).copied().unwrap_or(n);
+        let after = if j < n {
+            let at = along.get(j).copied().unwrap_or(arc + len);
+            racer(j).map(|r| (r.o.before, at - r.blend.extent_mm, -1.0, r.blend))
+        } else {
+            None
+        };
+        let ramps = [before, after];
+        let at = |t: f64| {
+            let mut p = [a[0] + dir[0] * t, a[1] + dir[1] * t, a[2] + dir[2] * t];
+            for &(normal, from, sign, bl) in ramps.iter().flatten() {
+                let offset = bl.offset_mm * ease(sign * (arc + t - from) / bl.ramp_mm);
+                // (`racer` only yields blends with a ramp: no division by zero here.)
+                for k in 0..3 {
+                    p[k] += normal[k] * offset;
+                }
+            }
+            p
+        };
         // The straight stretch of this leg, between the blends at its ends.
         let (t0, t1) = (blends[i].extent_mm, len - blends[i + 1].extent_mm);
         if t1 > t0 {
-            straight(t0, t1, spacing_mm, |t| {
-                push(at(t), s + t, &mut data, &mut par)
-            });
+            ts.clear();
+            straight(t0, t1, spacing_mm, |t| ts.push(t));
+            for &(_, from, sign, bl) in ramps.iter().flatten() {
+                ts.extend(
+                    (1..RAMP_SAMPLES)
+                        .map(|k| from + sign * bl.ramp_mm * k as f64 / RAMP_SAMPLES as f64 - arc)
+                        .filter(|t| (t0..=t1).contains(t)),
+                );
+            }
+            ts.sort_by(f64::total_cmp);
+            for &t in &ts {
+                push(at(t), arc + t, &mut data, &mut par);
+            }
         }
         // The blend at the far end of the leg.
         let bl = &blends[i + 1];
@@ -214,21 +401,79 @@ pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64
             let lc = norm(&sub(&c, &b));
             let out_dir = [(c[0] - b[0]) / lc, (c[1] - b[1]) / lc, (c[2] - b[2]) / lc];
             let l = bl.extent_mm;
+            // A racing line's fillet is tangent to the legs' offsets, which meet outside the
+            // vertex.
+            let (vertex, reach) = match racer(i + 1) {
+                Some(r) => {
+                    let half = 0.5 * bl.turn_rad;
+                    let away = bl.offset_mm / crate::math::cos(half);
+                    let w = r.o.bisector;
+                    (
+                        [b[0] + w[0] * away, b[1] + w[1] * away, b[2] + w[2] * away],
+                        l + bl.offset_mm * crate::math::tan(half),
+                    )
+                }
+                None => (b, l),
+            };
             for k in 0..SAMPLES {
                 let u = k as f64 / (SAMPLES - 1) as f64;
                 push(
-                    fillet_point(&b, &dir, &out_dir, bl.turn_rad, l, u),
-                    s + len - l + 2.0 * l * u,
+                    fillet_point(&vertex, &dir, &out_dir, bl.turn_rad, reach, u),
+                    arc + len - l + 2.0 * l * u,
                     &mut data,
                     &mut par,
                 );
             }
         } else {
-            push(b, s + len, &mut data, &mut par);
+            push(b, arc + len, &mut data, &mut par);
         }
-        s += len;
+        arc += len;
     }
     (data, par)
+}
+
+/// A blend on a racing line, with its outward directions.
+#[derive(Clone, Copy)]
+struct Racer {
+    blend: Blend,
+    o: Outward,
+}
+
+/// Samples across each ramp out to a racing line (its ends excluded).
+const RAMP_SAMPLES: usize = 8;
+
+/// The outward directions at a corner: away from the centre of its turn.
+#[derive(Clone, Copy)]
+struct Outward {
+    /// Along the bisector of the two legs.
+    bisector: [f64; 3],
+    /// Square to the leg into the corner.
+    before: [f64; 3],
+    /// Square to the leg out of it.
+    after: [f64; 3],
+}
+
+impl Outward {
+    /// At vertex `i` of `pts` (neither end), if it turns.
+    fn at(pts: &[[f64; 3]], i: usize) -> Option<Outward> {
+        let unit = super::hairpin::unit;
+        let a = unit(sub(pts.get(i)?, pts.get(i.checked_sub(1)?)?))?;
+        let b = unit(sub(pts.get(i + 1)?, pts.get(i)?))?;
+        let w = unit(sub(&a, &b))?;
+        let square = |d: &[f64; 3]| {
+            let along = dot(&w, d);
+            unit([
+                w[0] - d[0] * along,
+                w[1] - d[1] * along,
+                w[2] - d[2] * along,
+            ])
+        };
+        Some(Outward {
+            bisector: w,
+            before: square(&a)?,
+            after: square(&b)?,
+        })
+    }
 }
 
 /// Points of a straight stretch `t0..t1` (both ends included): dense at the ends, gaps growing
@@ -290,7 +535,7 @@ mod tests {
         ];
         // Within 0.1 mm a right angle asks for 0.1 / (√2 − 1) = 0.241 mm of each leg; two of
         // them share the 0.4 mm leg: 0.9 · 0.2 each.
-        let b = plan(&pts, 0.1, 0.0);
+        let b = plan(&pts, 0.1, 0.0, Line::Inside);
         assert_eq!(b[0].extent_mm, 0.0);
         for bl in &b[1..3] {
             assert!((bl.extent_mm - 0.18).abs() < 1e-12, "{}", bl.extent_mm);
@@ -298,7 +543,7 @@ mod tests {
         }
         // With room, the blend uses the whole tolerance.
         let wide = [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0]];
-        let b = plan(&wide, 0.05, 0.0);
+        let b = plan(&wide, 0.05, 0.0, Line::Inside);
         assert!((b[1].deviation_mm - 0.05).abs() < 1e-12);
         // The samples stay within the tolerance of the polyline and run forward.
         let (data, par) = samples(&wide, &b, 2.0);
@@ -309,6 +554,90 @@ mod tests {
         }
         assert_eq!(data.first(), wide.first());
         assert_eq!(data.last(), wide.last());
+    }
+
+    #[test]
+    fn the_racing_line_rounds_a_right_angle_wider_within_the_tolerance() {
+        // Legs of 10 mm, 0.08 mm: the inside fillet's radius is ε / (√2 − 1); eased out by ε,
+        // the racing line's is ε (1 + √2) / (√2 − 1), 2.414 times larger, and still passes ε
+        // inside the vertex.
+        let eps = 0.08;
+        let pts = [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0]];
+        let inside = plan(&pts, eps, 0.0, Line::Inside)[1];
+        let racing = plan(&pts, eps, 0.0, Line::Racing)[1];
+        let r2 = std::f64::consts::SQRT_2;
+        assert!((1.0 / inside.max_curvature - eps / (r2 - 1.0)).abs() < 1e-12);
+        let radius = eps * (1.0 + r2) / (r2 - 1.0);
+        assert!(
+            (1.0 / racing.max_curvature - radius).abs() < 1e-12,
+            "{racing:?}"
+        );
+        assert!((racing.offset_mm - eps).abs() < 1e-12);
+        assert!((racing.extent_mm - (radius - eps)).abs() < 1e-12);
+        assert!((racing.deviation_mm - eps).abs() < 1e-12);
+        // The ramp's peak curvature is its share of the fillet's.
+        let ramp_peak = EASE_PEAK * eps / (racing.ramp_mm * racing.ramp_mm);
+        assert!((ramp_peak * radius - RAMP_CURVATURE_SHARE).abs() < 1e-12);
+        // The samples: within ε of the corner both ways, outside the first leg by ε where the
+        // fillet starts, on the leg again beyond the ramp, and ε inside the vertex at the
+        // fillet's middle.
+        let blends = [Blend::NONE, racing, Blend::NONE];
+        let (data, par) = samples(&pts, &blends, 2.0);
+        assert!(par.windows(2).all(|w| w[1] > w[0]));
+        let d = super::super::deviation::both_ways(&data, &pts, 1e-3, 0.0);
+        assert!((d - eps).abs() <= 0.5e-3 + 1e-9, "{d}");
+        let near = |x: f64| {
+            data.iter()
+                .zip(&par)
+                .min_by(|a, b| (a.1 - x).abs().total_cmp(&(b.1 - x).abs()))
+                .map(|(p, &u)| (*p, u))
+                .expect("samples")
+        };
+        let (p, u) = near(10.0 - racing.extent_mm);
+        assert!((u - (10.0 - racing.extent_mm)).abs() < 1e-9);
+        assert!((p[1] + eps).abs() < 1e-9, "{p:?}");
+        let beyond = 10.0 - racing.reach() - 0.01;
+        assert!(data
+            .iter()
+            .zip(&par)
+            .filter(|(_, &u)| u <= beyond)
+            .all(|(p, _)| p[1] == 0.0));
+        let (mid, _) = near(10.0);
+        assert!((norm(&sub(&mid, &pts[1])) - eps).abs() < 1e-9, "{mid:?}");
+        assert!(mid[0] < 10.0 && mid[1] > 0.0);
+    }
+
+    #[test]
+    fn the_racing_line_needs_room_and_a_ramp_may_run_through_straight_vertices() {
+        let eps = 0.08;
+        // A leg of 1 mm leaves no room for the full ramp: a smaller offset, or none.
+        let short = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 10.0, 0.0]];
+        let b = plan(&short, eps, 0.0, Line::Racing)[1];
+        assert!(b.reach() <= LEG_SHARE * 1.0 + 1e-12, "{b:?}");
+        assert!(b.offset_mm < eps);
+        // The same corner with its first leg cut by straight vertices has the room of the
+        // whole leg, and samples that stay within ε.
+        let mut cut: Vec<[f64; 3]> = (0..=10).map(|k| [k as f64, 0.0, 0.0]).collect();
+        cut.push([10.0, 10.0, 0.0]);
+        let blends = plan(&cut, eps, 0.0, Line::Racing);
+        let whole = plan(
+            &[[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0]],
+            eps,
+            0.0,
+            Line::Racing,
+        )[1];
+        assert_eq!(blends[10], whole);
+        assert!(blends[..10].iter().all(|b| b.extent_mm == 0.0));
+        let (data, par) = samples(&cut, &blends, 2.0);
+        assert!(par.windows(2).all(|w| w[1] > w[0]));
+        let d = super::super::deviation::both_ways(&data, &cut, 1e-3, 0.0);
+        assert!((d - eps).abs() <= 0.5e-3 + 1e-9, "{d}");
+        // Ramp samples were placed on the legs it crosses.
+        let on_ramp = data
+            .iter()
+            .filter(|p| p[1] < -1e-6 && p[1] > -eps + 1e-6)
+            .count();
+        assert!(on_ramp >= RAMP_SAMPLES - 1, "{on_ramp}");
     }
 
     #[test]
@@ -324,7 +653,7 @@ mod tests {
             [116.313, 116.462, 0.0],
         ];
         let tol = 0.072;
-        let b = plan(&pts, tol, 0.05);
+        let b = plan(&pts, tol, 0.05, Line::Inside);
         let sharp = &b[3];
         assert!(sharp.turn_rad.to_degrees() > 110.0);
         let (c, _) = shape(sharp.turn_rad);

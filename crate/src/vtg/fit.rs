@@ -300,7 +300,7 @@ mod tests {
     }
 
     fn blended(pts: &[[f64; 3]], tol: f64) -> (Vec<[f64; 3]>, Vec<f64>) {
-        let b = crate::vtg::blend::plan(pts, tol, 0.0);
+        let b = crate::vtg::blend::plan(pts, tol, 0.0, crate::vtg::blend::Line::Racing);
         crate::vtg::blend::samples(pts, &b, 2.0)
     }
 

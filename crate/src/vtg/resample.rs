@@ -382,7 +382,11 @@ mod tests {
     #[test]
     fn walks_a_corner_in_gentle_equal_steps() {
         let pts = [[0.0, 0.0, 0.2], [10.0, 0.0, 0.2], [10.0, 10.0, 0.2]];
-        let (d, u) = blend::samples(&pts, &blend::plan(&pts, 0.05, 0.0), 2.0);
+        let (d, u) = blend::samples(
+            &pts,
+            &blend::plan(&pts, 0.05, 0.0, blend::Line::Racing),
+            2.0,
+        );
         let f = fit(&d, &u, 0.02).unwrap();
         let w = Walk {
             chord_tol_mm: 0.01,
@@ -428,7 +432,7 @@ mod tests {
                     }
                 }
                 prop_assume!(pts.len() >= 3);
-                let (d, u) = blend::samples(&pts, &blend::plan(&pts, 0.06, 0.0), 3.0);
+                let (d, u) = blend::samples(&pts, &blend::plan(&pts, 0.06, 0.0, blend::Line::Racing), 3.0);
                 let Some(f) = fit(&d, &u, 0.02) else { return Ok(()) };
                 let w = Walk {
                     chord_tol_mm: 0.03,

@@ -193,6 +193,7 @@ pub fn offers(
         arcs: options.arcs,
         round_all: false,
         keyholes: variant.keyholes,
+        line: super::blend::Line::Racing,
     };
     let energy = Accumulator::new(
         &options.analyze.energy.clone().unwrap_or_default(),

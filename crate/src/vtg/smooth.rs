@@ -83,6 +83,8 @@ pub struct Settings {
     pub round_all: bool,
     /// Turn single corners too tight to fillet round a [`keyhole`] loop where one fits.
     pub keyholes: bool,
+    /// Which side of its corners a path may be rounded on ([`blend::Line`]).
+    pub line: blend::Line,
 }
 
 /// A rewritten path: the new geometry, and what the feed of each new segment is made of.
@@ -154,17 +156,57 @@ impl<'a> Path<'a> {
 /// own with its ends pinned (rounding such a corner would only trade one sharp turn for
 /// several). Pieces without a sharp corner, and pieces that cannot be fitted within the
 /// tolerance, keep their original points.
+///
+/// On the racing line, corners too tight for an inside fillet may be rounded by the wider
+/// racing-line one, which the fit and walk do not always manage to follow in steps under δθ
+/// (it then stays sharp): where that happened, the path is also rounded on the inside line
+/// (with its hairpins and keyholes) and the one left with fewer sharp turns is kept.
 pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
-    let pts = path.pts;
-    if pts.len() < 3 || !path.consistent() {
-        return None;
+    let (result, rescued) = smooth_on(path, s);
+    if !rescued {
+        return result;
     }
     let cos_critical = crate::math::cos(s.critical_rad);
-    let blends = blend::plan(
-        pts,
-        BLEND_SHARE * s.tolerance_mm,
-        s.limits.critical_curvature(),
-    );
+    let left = |r: &Option<Smoothed>| {
+        r.as_ref().map_or(usize::MAX, |r| {
+            super::rewrite::sharp_turns(path.pts.iter().take(1).chain(&r.points), cos_critical)
+        })
+    };
+    let left_wide = left(&result);
+    if left_wide == 0 {
+        return result;
+    }
+    let inside_line = Settings {
+        line: blend::Line::Inside,
+        ..*s
+    };
+    let (inside, _) = smooth_on(path, &inside_line);
+    if left(&inside) < left_wide {
+        inside
+    } else {
+        result
+    }
+}
+
+/// [`smooth_path`] on the line `s` asks for; and whether the racing line made a corner
+/// roundable that the inside fillet could not round.
+fn smooth_on(path: &Path<'_>, s: &Settings) -> (Option<Smoothed>, bool) {
+    let pts = path.pts;
+    if pts.len() < 3 || !path.consistent() {
+        return (None, false);
+    }
+    let cos_critical = crate::math::cos(s.critical_rad);
+    let plan = |line| {
+        blend::plan(
+            pts,
+            BLEND_SHARE * s.tolerance_mm,
+            s.limits.critical_curvature(),
+            line,
+        )
+    };
+    let blends = plan(s.line);
+    let inside = (s.line != blend::Line::Inside).then(|| plan(blend::Line::Inside));
+    let mut rescued = false;
     let n = pts.len();
     // Each corner: sharp, and whether it can be rounded on its own.
     let mut sharp = vec![false; n];
@@ -186,6 +228,7 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
         }
         sharp[i] = true;
         tight[i] = !roundable(&blends[i], s);
+        rescued |= !tight[i] && inside.as_ref().is_some_and(|b| !roundable(&b[i], s));
         alone[i] = !tight[i] && pays(blends[i].max_curvature, path.planned.get(i - 1), s);
     }
     // Two sharp corners across a short leg, at least one of them too tight alone: a hairpin,
@@ -247,7 +290,9 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
     let mut changed = false;
     for w in cuts.windows(2) {
         let (a, b) = (w[0], w[1]);
-        let piece = path.piece(a, b)?;
+        let Some(piece) = path.piece(a, b) else {
+            return (None, rescued);
+        };
         let has_sharp = sharp.get(a + 1..b).is_some_and(|v| v.iter().any(|&x| x));
         let here: Vec<hairpin::Hairpin> = pins
             .iter()
@@ -298,7 +343,7 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
             }
         }
     }
-    changed.then_some(out)
+    (changed.then_some(out), rescued)
 }
 
 /// Whether a corner's blend can be walked in steps of at least the minimum step, each turning
@@ -478,7 +523,7 @@ fn attempt(
     let budget = tol - 0.001;
     let k_cr = s.limits.critical_curvature();
     let arc = arc_lengths(pts);
-    let blends = blend::plan(pts, blend_tol, k_cr);
+    let blends = blend::plan(pts, blend_tol, k_cr, s.line);
     let (data, params) = blend::samples(pts, &blends, STRAIGHT_SPACING_MM);
     let f = fit(&data, &params, FIT_SHARE * tol)?;
     let w = Walk {
@@ -610,6 +655,7 @@ mod tests {
             arcs: false,
             round_all: false,
             keyholes: true,
+            line: blend::Line::Racing,
         }
     }
 
