@@ -659,6 +659,46 @@ mod tests {
         }
     }
 
+    /// A right angle between long legs is walked on the racing line: out past the first leg,
+    /// round a circle about 2.4 times the inside fillet's, and back, within the tolerance.
+    #[test]
+    fn a_right_angle_is_walked_on_the_racing_line() {
+        let pts = [[0.0, 0.0, 0.2], [10.0, 0.0, 0.2], [10.0, 10.0, 0.2]];
+        let e = [0.0, 0.4, 0.8];
+        let feed = [50.0, 50.0];
+        let path = Path {
+            pts: &pts,
+            e: &e,
+            feed: &feed,
+            planned: &[],
+        };
+        // The tightest circle through three consecutive points, and how far the path strays
+        // outside the first leg.
+        let shape = |line| {
+            let s = Settings { line, ..settings() };
+            let r = smooth_path(&path, &s).expect("rounded");
+            let mut all = vec![pts[0]];
+            all.extend_from_slice(&r.points);
+            assert!(both_ways(&all, &pts, 1e-3, 0.0) <= 0.1);
+            assert_eq!(sharp_turns_from(pts[0], &r.points), 0);
+            let tightest = all
+                .windows(3)
+                .map(|w| {
+                    let (a, b, c) = (sub(&w[1], &w[0]), sub(&w[2], &w[1]), sub(&w[2], &w[0]));
+                    let cross = a[0] * b[1] - a[1] * b[0];
+                    norm(&a) * norm(&b) * norm(&c) / (2.0 * cross.abs())
+                })
+                .fold(f64::INFINITY, f64::min);
+            let outside = all.iter().map(|p| -p[1]).fold(0.0, f64::max);
+            (tightest, outside)
+        };
+        let (inside_r, inside_out) = shape(blend::Line::Inside);
+        let (racing_r, racing_out) = shape(blend::Line::Racing);
+        assert!(inside_out < 0.02, "{inside_out}");
+        assert!(racing_out > 0.06, "{racing_out}");
+        assert!(racing_r > 2.0 * inside_r, "{racing_r} vs {inside_r}");
+    }
+
     #[test]
     fn square_loop_is_rounded() {
         let pts = [
