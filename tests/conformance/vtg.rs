@@ -269,6 +269,37 @@ fn the_dynamics_model_closes_the_loop() {
     assert!(closed.table2.energy_j.change_pct < 0.0);
 }
 
+/// `inside_corners` keeps every corner on the inside line: on the thesis triangle, whose infill
+/// tips then take keyhole loops that ring more than the stops they replace (so the closed loop
+/// drops them) where the racing line rounds them quietly, fewer sharp corners go; both stay
+/// within the tolerance.
+#[test]
+fn inside_corners_round_fewer_than_the_racing_line() {
+    let bytes = std::fs::read(fixtures_dir().join("gcode/prusaslicer-2.5.0_thesis_triangle.gcode"))
+        .unwrap();
+    let run = |inside_corners| {
+        vtg(
+            &bytes,
+            &VtgOptions {
+                inside_corners,
+                ..VtgOptions::default()
+            },
+        )
+        .unwrap()
+    };
+    let (racing, inside) = (run(false), run(true));
+    for r in [&racing, &inside] {
+        assert!(r.max_deviation_mm <= 0.1, "{}", r.max_deviation_mm);
+        assert!(r.table1.n_turning.change_pct < 0.0);
+    }
+    assert!(
+        racing.table1.n_turning.after * 2.0 < inside.table1.n_turning.after,
+        "{} vs {}",
+        racing.table1.n_turning.after,
+        inside.table1.n_turning.after
+    );
+}
+
 /// With `arcs`, runs on a circle are written as `G2`/`G3` where the firmware would cut them at
 /// least as finely as the walk did and they cost nothing: fewer lines, every criterion still
 /// met (the deviation is measured on the arcs themselves).

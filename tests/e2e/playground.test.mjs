@@ -572,12 +572,14 @@ test('the job UI with every capability: tables, charts, downloads, before/after 
   // VTG: before/after table, paper tables, download, viewer side by side.
   await id('opt-vtg-tolerance').fill('0.05');
   await id('opt-vtg-arcs').check();
+  await id('opt-vtg-inside-corners').check();
   await id('opt-vtg-allow-slower').fill('0.5');
   await id('run-vtg').click();
   await idle();
   const vtgJson = JSON.parse(await id('report-json').textContent());
   assert.equal(vtgJson.tolerance_mm, 0.05);
   assert.equal(vtgJson.options_seen.arcs, true, 'the arcs box reaches the job');
+  assert.equal(vtgJson.options_seen.inside_corners, true, 'the inside-corners box reaches the job');
   assert.equal(vtgJson.options_seen.allow_slower_pct, 0.5, 'the allow-slower field reaches the job');
   assert.ok(!('output' in vtgJson));
   const rows = await id('compare-table').locator('tbody tr').allTextContents();
@@ -594,6 +596,7 @@ test('the job UI with every capability: tables, charts, downloads, before/after 
   await tab.waitForFunction(() => /after/.test(document.querySelector('[data-testid="layer-info"]').textContent));
   assert.match(tab.url(), /vtg\.tolerance_mm=0\.05/);
   assert.match(tab.url(), /vtg\.arcs=1/);
+  assert.match(tab.url(), /vtg\.inside_corners=1/);
   assert.match(tab.url(), /vtg\.allow_slower_pct=0\.5/);
   assert.match(tab.url(), /view=side/);
 

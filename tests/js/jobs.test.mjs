@@ -92,6 +92,17 @@ test('vtg allow_slower_pct: wasm equals the CLI, and an out-of-range value is an
   assert.throws(() => qp.vtg(fs.readFileSync(DEMO), { allow_slower_pct: 150 }), (e) => e instanceof Error && /allow_slower_pct/.test(e.message));
 });
 
+test('vtg inside_corners: wasm equals the CLI, and the output differs from the racing line', () => {
+  const out = path.join(tmp, 'vtg-inside.gcode');
+  const fromCli = runCli(['vtg', DEMO, '-o', out, '--inside-corners', '--no-dynamics', '--json']);
+  const { report, output } = reportOf(qp.vtg(fs.readFileSync(DEMO), { inside_corners: true, dynamics: false }));
+  assert.deepEqual(report, fromCli);
+  assert.ok(Buffer.from(output).equals(fs.readFileSync(out)), 'rewritten file differs from the CLI output');
+  const racing = reportOf(qp.vtg(fs.readFileSync(DEMO), { dynamics: false }));
+  assert.ok(!Buffer.from(racing.output).equals(Buffer.from(output)), 'inside corners changed nothing');
+  assert.ok(report.max_deviation_mm <= report.tolerance_mm);
+});
+
 test('infill: wasm report and output equal the CLI (angles 0/45/90, two patterns)', () => {
   const out = path.join(tmp, 'infill.gcode');
   const fromCli = runCli(['infill', DEMO, '-o', out, '--angles', '0,45,90', '--patterns', 'rectilinear,grid', '--json']);

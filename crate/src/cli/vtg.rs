@@ -38,6 +38,10 @@ pub struct Args {
     /// rounds every corner the tolerance allows.
     #[arg(long, value_name = "PCT", default_value_t = 0.0)]
     pub allow_slower: f64,
+    /// Round corners only on the inside (fillets tangent to the legs) instead of on the racing
+    /// line, which eases out by up to the tolerance before a corner for a wider circle.
+    #[arg(long)]
+    pub inside_corners: bool,
     /// Overwrite the input file if OUT names it.
     #[arg(long)]
     pub force: bool,
@@ -59,6 +63,7 @@ pub fn run(args: Args) -> Result<(), String> {
         dynamics: !args.no_dynamics,
         arcs: args.arcs,
         allow_slower_pct: args.allow_slower,
+        inside_corners: args.inside_corners,
         ..VtgOptions::default()
     };
     let mut bar = output::ProgressBar::for_input(input.len());

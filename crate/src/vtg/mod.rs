@@ -84,6 +84,13 @@ pub struct VtgOptions {
     /// and standby energy with it; where quiet matters more, this buys the corners that remove
     /// the most sharp turns for their time first. 100 rounds every corner the tolerance allows.
     pub allow_slower_pct: f64,
+    /// Round corners only on the inside, with fillets tangent to the legs (default false: where
+    /// the path has room, a corner takes the racing line, easing out by up to the tolerance
+    /// before it and back after it, round a circle 2.4 times wider at 90°; see
+    /// `blend::racing`). The racing line moves a wall's edge outward by up to the tolerance
+    /// near a corner, as the inside fillet moves it inward at the corner; this keeps every
+    /// new point on or inside the corner's legs.
+    pub inside_corners: bool,
 }
 
 impl Default for VtgOptions {
@@ -99,6 +106,7 @@ impl Default for VtgOptions {
             dynamics: true,
             arcs: false,
             allow_slower_pct: 0.0,
+            inside_corners: false,
         }
     }
 }
@@ -270,8 +278,9 @@ fn quieter_variants() -> impl Iterator<Item = rewrite::Variant> {
 /// Eq. 29's speeds (`J_n = A_n f₁`) are meant to keep a rounded corner from exciting the frame
 /// more than the sharp one did, and on nearly every file they do. They are a rule of thumb,
 /// though: the ringing a corner leaves depends on how its timing falls against the modes,
-/// which no bound on `a_n` and `j_n` sees. On the thesis triangle, whose 75° infill corners the
-/// firmware takes at 14 mm/s, fillets at eq. 29's 20 mm/s raised the mean deviation by 1.2 %,
+/// which no bound on `a_n` and `j_n` sees. On the thesis triangle (with inside fillets, before
+/// corners took the racing line), whose 75° infill corners the firmware takes at 14 mm/s,
+/// fillets at eq. 29's 20 mm/s raised the mean deviation by 1.2 %,
 /// while at 1.5× (30 mm/s) it fell by 1.1 % (and at 0.5× it rose by 4 %: not monotonic). So
 /// when the simulated mean deviation does not fall, the file is rewritten again with the speeds
 /// starting at each of [`QUIETER_SCALES`] in turn, and the rewrite with the lowest simulated
@@ -280,8 +289,8 @@ fn quieter_variants() -> impl Iterator<Item = rewrite::Variant> {
 ///
 /// Keyhole loops ([`keyhole`]) are the other thing the model can object to: the machine no
 /// longer stops at the tip of a wedge, but it swings round a loop of a tenth of a millimetre
-/// or so in radius, and on a few files (the thesis triangle's, oval's and teardrop's infill
-/// tips) that rings more than the stop did. If no scale brings the mean below the original's
+/// or so in radius, and on some files (the thesis triangle's, oval's and teardrop's infill
+/// tips, before the racing line) that rang more than the stop did. If no scale brings the mean below the original's
 /// with them, the scales are tried again without keyholes.
 ///
 /// `None` rows when the model cannot run (a print too long to simulate, for instance): the

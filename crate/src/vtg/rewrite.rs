@@ -193,7 +193,11 @@ pub fn offers(
         arcs: options.arcs,
         round_all: false,
         keyholes: variant.keyholes,
-        line: super::blend::Line::Racing,
+        line: if options.inside_corners {
+            super::blend::Line::Inside
+        } else {
+            super::blend::Line::Racing
+        },
     };
     let energy = Accumulator::new(
         &options.analyze.energy.clone().unwrap_or_default(),

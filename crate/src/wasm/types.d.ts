@@ -402,6 +402,8 @@ export interface VtgOptions {
   arcs?: boolean;
   /** Print time the rewrite may add to round corners that cost time, % of the original's (default 0: no slower, no dearer; 100 rounds every corner the tolerance allows). */
   allow_slower_pct?: number;
+  /** Round corners only on the inside, with fillets tangent to the legs (default false: the racing line, easing out by up to the tolerance before a corner for a circle 2.4× wider at 90°). */
+  inside_corners?: boolean;
 }
 /** before, after and the relative change in percent. */
 export interface Comparison { before: number; after: number; change_pct: number }
