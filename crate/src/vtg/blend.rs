@@ -193,11 +193,7 @@ pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64, line: Li
     // Then, corner by corner, the racing line where the path has room for it: up to the
     // nearest vertex either way that is not straight (less what its own blend takes), or the
     // path's end.
-    let mut along = Vec::with_capacity(n);
-    along.push(0.0);
-    for l in &lens {
-        along.push(along.last().copied().unwrap_or(0.0) + l);
-    }
+    let along = super::bspline::arc_lengths(pts);
     for i in 1..n - 1 {
         if out[i].extent_mm <= 0.0 || out[i].max_curvature <= enough_curvature {
             continue;
@@ -311,31 +307,39 @@ pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64
     };
     push(pts[0], 0.0, &mut data, &mut par);
     // The ramps out to the racing lines: each runs from its blend's end along the straight
-    // stretch, possibly past straight vertices, so each leg looks for the blend before it and
-    // the one after it.
-    let racer = |j: usize| -> Option<Racer> {
-        let bl = blends.get(j)?;
-        let o = (bl.offset_mm > 0.0 && bl.ramp_mm > 0.0)
-            .then(|| Outward::at(pts, j))
-            .flatten()?;
-        Some(Racer { blend: *bl, o })
-    };
+    // stretch, possibly past straight vertices (no turn, so no blend), so each leg looks for
+    // the nearest blend either way through those.
+    let racers: Vec<Option<Racer>> = blends
+        .iter()
+        .enumerate()
+        .map(|(j, bl)| {
+            let o = (bl.offset_mm > 0.0 && bl.ramp_mm > 0.0)
+                .then(|| Outward::at(pts, j))
+                .flatten()?;
+            Some(Racer { blend: *bl, o })
+        })
+        .collect();
     let along = super::bspline::arc_lengths(pts);
-    let mut next_blend = vec![n; n];
-    for i in (1..n - 1).rev() {
-        next_blend[i] = if blends[i].extent_mm > 0.0 {
-            i
-        } else if blends[i].turn_rad == 0.0 {
-            next_blend[i + 1]
+    // The blend at vertex `i` itself, or `None` past a turn without one (a path end included).
+    let here = |i: usize| {
+        if i == 0 || i + 1 == n || blends[i].turn_rad != 0.0 {
+            Some((blends[i].extent_mm > 0.0).then_some(i))
         } else {
-            n
-        };
+            None
+        }
+    };
+    let mut prev_blend = vec![None; n];
+    let mut next_blend = vec![None; n];
+    for i in 0..n {
+        prev_blend[i] = here(i).unwrap_or_else(|| prev_blend[i - 1]);
     }
-    let mut arc = 0.0; // arc length of the original at pts[i]
-    let mut last: Option<(usize, f64)> = None; // the blend before this leg, and its arc length
+    for i in (0..n).rev() {
+        next_blend[i] = here(i).unwrap_or_else(|| next_blend[i + 1]);
+    }
     let mut ts = Vec::new();
     for i in 0..n - 1 {
         let (a, b) = (pts[i], pts[i + 1]);
+        let arc = along[i]; // arc length of the original at pts[i]
         let len = norm(&sub(&b, &a));
         let dir = if len > 0.0 {
             [
@@ -346,31 +350,19 @@ pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64
         } else {
             [0.0; 3]
         };
-        if i > 0 {
-            if blends[i].extent_mm > 0.0 {
-                last = Some((i, arc));
-            } else if blends[i].turn_rad != 0.0 || len <= 0.0 {
-                last = None;
-            }
-        }
         // The ramps reaching into this leg: the one after the blend before it, the one before
         // the blend after it (arc lengths of their far ends at full offset, signs of travel).
-        let before = last.and_then(|(j, at)| {
-            racer(j).map(|r| (r.o.after, at + r.blend.extent_mm, 1.0, r.blend))
-        });
-        let j = next_blend.get(i + 1).copied().unwrap_or(n);
-        let after = if j < n {
-            let at = along.get(j).copied().unwrap_or(arc + len);
-            racer(j).map(|r| (r.o.before, at - r.blend.extent_mm, -1.0, r.blend))
-        } else {
-            None
-        };
+        let racer = |j: Option<usize>| j.and_then(|j| racers[j].map(|r| (along[j], r)));
+        let before =
+            racer(prev_blend[i]).map(|(at, r)| (r.o.after, at + r.blend.extent_mm, 1.0, r.blend));
+        let after = racer(next_blend[i + 1])
+            .map(|(at, r)| (r.o.before, at - r.blend.extent_mm, -1.0, r.blend));
         let ramps = [before, after];
         let at = |t: f64| {
             let mut p = [a[0] + dir[0] * t, a[1] + dir[1] * t, a[2] + dir[2] * t];
             for &(normal, from, sign, bl) in ramps.iter().flatten() {
                 let offset = bl.offset_mm * ease(sign * (arc + t - from) / bl.ramp_mm);
-                // (`racer` only yields blends with a ramp: no division by zero here.)
+                // (`racers` holds only blends with a ramp: no division by zero here.)
                 for k in 0..3 {
                     p[k] += normal[k] * offset;
                 }
@@ -403,7 +395,7 @@ pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64
             let l = bl.extent_mm;
             // A racing line's fillet is tangent to the legs' offsets, which meet outside the
             // vertex.
-            let (vertex, reach) = match racer(i + 1) {
+            let (vertex, reach) = match racers[i + 1] {
                 Some(r) => {
                     let half = 0.5 * bl.turn_rad;
                     let away = bl.offset_mm / crate::math::cos(half);
@@ -427,7 +419,6 @@ pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64
         } else {
             push(b, arc + len, &mut data, &mut par);
         }
-        arc += len;
     }
     (data, par)
 }
