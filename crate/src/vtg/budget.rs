@@ -9,8 +9,9 @@
 //! ([`super::VtgOptions::allow_slower_pct`]), the rewrites that remove the most sharp corners
 //! for their cost first: a multiple-choice knapsack, solved greedily on each path's convex
 //! hull of cost against corners removed (a path may offer a free rewrite that keeps its dear
-//! corners sharp and a dearer one that rounds them too; buying the dearer one is then an
-//! increment over the free one).
+//! corners sharp and dearer ones that round some or all of them too,
+//! [`super::rewrite::DEARER_SPEED_SHARES`]; buying a dearer one is then an increment over
+//! the free one).
 
 use super::rewrite::Rewritten;
 use crate::gcode::Edit;

@@ -78,9 +78,11 @@ pub struct Settings {
     pub feed_cap_scale: f64,
     /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`super::arcs`]).
     pub arcs: bool,
-    /// Round corners even where the fillet is slower than the firmware's sharp corner (the
-    /// dearer variant of a path that [`super::VtgOptions::allow_slower_pct`] may buy).
-    pub round_all: bool,
+    /// The slowest a rounded corner may be run, as a share of the firmware's speed through the
+    /// sharp one: 1 rounds only the corners the machine runs round at least as fast (the free
+    /// rewrite); below 1, the dearer variants of a path that
+    /// [`super::VtgOptions::allow_slower_pct`] may buy (0 rounds every corner it can).
+    pub min_speed_share: f64,
     /// Turn single corners too tight to fillet round a [`keyhole`] loop where one fits.
     pub keyholes: bool,
     /// Which side of its corners a path may be rounded on ([`blend::Line`]).
@@ -360,15 +362,17 @@ fn roundable(b: &blend::Blend, s: &Settings) -> bool {
 /// of radius `jd sin(θ/2) / (1 − sin(θ/2))`, `jd = scv² (√2 − 1) / a`), and holds a real curve
 /// of radius `r` to `√(a r)`. Where the square-corner velocity is high (Creality's K1 profiles
 /// set 50–100 mm/s) that virtual arc is larger than any fillet the tolerance allows, and the
-/// fillet would only slow the machine down: such a corner is kept. (A classic-jerk planner
-/// has no such rule: the feed written on the fillet is never below the original's speed.)
+/// fillet would only slow the machine down: such a corner is kept, unless the settings let a
+/// rounded corner run slower ([`Settings::min_speed_share`] of the sharp one's speed: the
+/// dearer variants time may be spent on). (A classic-jerk planner has no such rule: the feed
+/// written on the fillet is never below the original's speed.)
 fn pays(curvature: f64, before: Option<&Profile>, s: &Settings) -> bool {
-    let Some(p) = before.filter(|_| s.classic_jerk_mm_s.is_none() && !s.round_all) else {
+    let Some(p) = before.filter(|_| s.classic_jerk_mm_s.is_none()) else {
         return true;
     };
     let a = p.acceleration.min(s.max_normal_accel_mm_s2);
     let on_fillet = (a / curvature).sqrt();
-    on_fillet >= p.exit
+    on_fillet >= s.min_speed_share * p.exit
 }
 
 /// One piece between kept corners, with its hairpins (`at` counted in the piece) as found with
@@ -653,10 +657,42 @@ mod tests {
             classic_jerk_mm_s: None,
             feed_cap_scale: 1.0,
             arcs: false,
-            round_all: false,
+            min_speed_share: 1.0,
             keyholes: true,
             line: blend::Line::Racing,
         }
+    }
+
+    /// A corner pays when the machine runs round the fillet at least as fast as it left the
+    /// sharp corner, or at least the settings' share of that speed.
+    #[test]
+    fn a_dearer_variant_rounds_corners_down_to_its_share_of_the_sharp_speed() {
+        let before = Profile {
+            entry: 100.0,
+            peak: 100.0,
+            exit: 50.0,
+            acceleration: 5000.0,
+            ..Profile::default()
+        };
+        // √(1000 mm/s² × 1.6 mm) = 40 mm/s on the fillet: 80 % of the 50 mm/s corner
+        // (the settings' 1000 mm/s² X/Y limit is below the 5000 the move used).
+        let curvature = 1.0 / 1.6;
+        let with = |min_speed_share| Settings {
+            min_speed_share,
+            ..settings()
+        };
+        assert!(!pays(curvature, Some(&before), &with(1.0)));
+        assert!(pays(curvature, Some(&before), &with(0.79)));
+        assert!(!pays(curvature, Some(&before), &with(0.81)));
+        assert!(pays(curvature, Some(&before), &with(0.0)));
+        // Where the sharp corner's speed is not known, rounding is assumed to pay.
+        assert!(pays(curvature, None, &with(1.0)));
+        // A classic-jerk planner has no virtual arc to compete with.
+        let classic = Settings {
+            classic_jerk_mm_s: Some(8.0),
+            ..with(1.0)
+        };
+        assert!(pays(curvature, Some(&before), &classic));
     }
 
     /// A right angle between long legs is walked on the racing line: out past the first leg,
