@@ -280,18 +280,18 @@ fn quieter_variants() -> impl Iterator<Item = rewrite::Variant> {
 /// though: the ringing a corner leaves depends on how its timing falls against the modes,
 /// which no bound on `a_n` and `j_n` sees. On the thesis triangle (with inside fillets, before
 /// corners took the racing line), whose 75° infill corners the firmware takes at 14 mm/s,
-/// fillets at eq. 29's 20 mm/s raised the mean deviation by 1.2 %,
-/// while at 1.5× (30 mm/s) it fell by 1.1 % (and at 0.5× it rose by 4 %: not monotonic). So
-/// when the simulated mean deviation does not fall, the file is rewritten again with the speeds
-/// starting at each of [`QUIETER_SCALES`] in turn, and the rewrite with the lowest simulated
-/// mean deviation is kept: every variant still passes the no-dearer check path by path, so
-/// time and energy fall as before.
+/// fillets at eq. 29's 20 mm/s raised the mean deviation by 1.2 %, while at 1.5× (30 mm/s) it
+/// fell by 1.1 % (and at 0.5× it rose by 4 %: not monotonic). So when the simulated mean
+/// deviation does not fall, the file is rewritten again with the speeds starting at each of
+/// [`QUIETER_SCALES`] in turn, and the rewrite with the lowest simulated mean deviation is
+/// kept: every variant still passes the no-dearer check path by path, so time and energy fall
+/// as before.
 ///
 /// Keyhole loops ([`keyhole`]) are the other thing the model can object to: the machine no
 /// longer stops at the tip of a wedge, but it swings round a loop of a tenth of a millimetre
 /// or so in radius, and on some files (the thesis triangle's, oval's and teardrop's infill
-/// tips, before the racing line) that rang more than the stop did. If no scale brings the mean below the original's
-/// with them, the scales are tried again without keyholes.
+/// tips, before the racing line) that rang more than the stop did. If no scale brings the
+/// mean below the original's with them, the scales are tried again without keyholes.
 ///
 /// `None` rows when the model cannot run (a print too long to simulate, for instance): the
 /// rest of the report stands without them.
