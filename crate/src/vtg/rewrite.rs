@@ -236,7 +236,8 @@ pub fn offers(
         min_speed_share,
         ..settings
     });
-    let buy_time = options.allow_slower_pct > 0.0;
+    // Dearer variants only where they can differ from the free rewrite.
+    let buy_time = options.allow_slower_pct > 0.0 && settings.speed_share_matters();
     let mut offers: Vec<Offer> = Vec::with_capacity(candidates.len());
     let mut saved = [0.0f64; 2];
     for (b, batch) in candidates.chunks(BATCH_PATHS).enumerate() {

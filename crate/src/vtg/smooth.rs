@@ -367,12 +367,21 @@ fn roundable(b: &blend::Blend, s: &Settings) -> bool {
 /// dearer variants time may be spent on). (A classic-jerk planner has no such rule: the feed
 /// written on the fillet is never below the original's speed.)
 fn pays(curvature: f64, before: Option<&Profile>, s: &Settings) -> bool {
-    let Some(p) = before.filter(|_| s.classic_jerk_mm_s.is_none()) else {
+    let Some(p) = before.filter(|_| s.speed_share_matters()) else {
         return true;
     };
     let a = p.acceleration.min(s.max_normal_accel_mm_s2);
     let on_fillet = (a / curvature).sqrt();
     on_fillet >= s.min_speed_share * p.exit
+}
+
+impl Settings {
+    /// Whether [`Settings::min_speed_share`] can change which corners are rounded: only where
+    /// the firmware takes a sharp corner as a virtual arc that a fillet must keep up with (see
+    /// `pays`); a classic-jerk planner's corners all pay already.
+    pub fn speed_share_matters(&self) -> bool {
+        self.classic_jerk_mm_s.is_none()
+    }
 }
 
 /// One piece between kept corners, with its hairpins (`at` counted in the piece) as found with
