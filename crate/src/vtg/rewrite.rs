@@ -126,9 +126,10 @@ pub fn first_mode_hz(path: &PrintPath) -> f64 {
 /// corner. A path's corners differ in what rounding them costs (on the K1C benchy a wall's
 /// short chamfers cost little, its right angles at 50 mm/s square-corner velocity much more),
 /// and one all-or-nothing variant makes the budget pay for a path's dear corners to buy its
-/// cheap ones. Measured on the K1C benchy at `--allow-slower 1`: sharp corners −32.1 % with
-/// the all-corners variant alone, −33.9 % with this rung added, −34.0 % with four rungs (0.9,
-/// 0.7, 0.5, 0) at 1.6 times the run time of two.
+/// cheap ones. Measured on the K1C benchy at `--allow-slower 1` (blends at 0.8 of the
+/// tolerance, before `BLEND_SHARE` rose to 0.9): sharp corners −32.1 % with the all-corners
+/// variant alone, −33.9 % with this rung added, −34.0 % with four rungs (0.9, 0.7, 0.5, 0) at
+/// 1.6 times the run time of two.
 pub const DEARER_SPEED_SHARES: [f64; 2] = [0.8, 0.0];
 
 /// Every path's ways of being written, before the file-level choice ([`budget`]).
