@@ -79,7 +79,7 @@ pub struct Piece {
 }
 
 /// The circle through three points in the XY plane: centre and radius.
-fn circle_through(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Option<([f64; 2], f64)> {
+pub(super) fn circle_through(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Option<([f64; 2], f64)> {
     let (bx, by) = (b[0] - a[0], b[1] - a[1]);
     let (cx, cy) = (c[0] - a[0], c[1] - a[1]);
     let d = 2.0 * (bx * cy - by * cx);

@@ -268,7 +268,9 @@ pub fn offers(
                     // With time to spend, the variants that round the corners the firmware
                     // takes faster sharp, too: first those it takes nearly as fast round.
                     let mut offer = Offer::default();
-                    base.into_iter().for_each(|o| offer.push(o));
+                    if let Some(o) = base {
+                        offer.push(o);
+                    }
                     if buy_time {
                         dearer
                             .iter()

@@ -739,11 +739,8 @@ mod tests {
             assert_eq!(sharp_turns_from(pts[0], &r.points), 0);
             let tightest = all
                 .windows(3)
-                .map(|w| {
-                    let (a, b, c) = (sub(&w[1], &w[0]), sub(&w[2], &w[1]), sub(&w[2], &w[0]));
-                    let cross = a[0] * b[1] - a[1] * b[0];
-                    norm(&a) * norm(&b) * norm(&c) / (2.0 * cross.abs())
-                })
+                .filter_map(|w| super::super::arcs::circle_through(&w[0], &w[1], &w[2]))
+                .map(|(_, r)| r)
                 .fold(f64::INFINITY, f64::min);
             let outside = all.iter().map(|p| -p[1]).fold(0.0, f64::max);
             (tightest, outside)
