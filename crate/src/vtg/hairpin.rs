@@ -231,6 +231,8 @@ pub struct Substituted {
     pub feed: Vec<f64>,
     /// Planned profile of each segment (empty if the original had none).
     pub planned: Vec<crate::plan::Profile>,
+    /// Index of each pin's first point (its arc then runs on for `arc.len()` points).
+    pub starts: Vec<usize>,
 }
 
 /// `pts` (filament `e`, feeds `feed`, profiles `planned`) with each of `pins` (sorted, apart)
@@ -279,6 +281,7 @@ pub fn substitute(
             pin_of.push(None);
         }
         // Each new point stands for the original point at the same fraction of length.
+        out.starts.push(out.pts.len());
         let new_len = arc_lengths(&pin.arc);
         let total = new_len.last().copied().unwrap_or(0.0);
         for (p, l) in pin.arc.iter().zip(&new_len) {

@@ -20,6 +20,7 @@ pub mod blend;
 pub mod block;
 pub mod bspline;
 pub mod budget;
+pub mod corner;
 pub mod deviation;
 pub mod feed;
 pub mod fit;

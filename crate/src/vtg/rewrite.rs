@@ -205,6 +205,9 @@ pub fn offers(
         arcs: options.arcs,
         min_speed_share: 1.0,
         keyholes: variant.keyholes,
+        klipper_scv_mm_s: (path.junction_model == JunctionModel::Klipper)
+            .then_some(path.print_limits.square_corner_velocity.value)
+            .filter(|v| v.is_finite() && *v > 0.0),
         line: if options.inside_corners {
             super::blend::Line::Inside
         } else {
@@ -448,6 +451,10 @@ impl Machine<'_> {
             }
             if s.classic_jerk_mm_s.is_some() {
                 s.classic_jerk_mm_s = Some(xy_jerk(l));
+            }
+            if s.klipper_scv_mm_s.is_some() {
+                let scv = l.square_corner_velocity.value;
+                s.klipper_scv_mm_s = (scv.is_finite() && scv > 0.0).then_some(scv);
             }
         }
         s

@@ -11,6 +11,7 @@
 
 use super::blend;
 use super::bspline::{arc_lengths, dot, norm, segment_at, sub};
+use super::corner;
 use super::deviation::both_ways;
 use super::feed::StepSpeed;
 use super::fit::fit;
@@ -98,6 +99,9 @@ pub struct Settings {
     pub keyholes: bool,
     /// Which side of its corners a path may be rounded on ([`blend::Line`]).
     pub line: blend::Line,
+    /// Klipper's square-corner velocity, mm/s, on a Klipper machine (`None` elsewhere): its
+    /// sharp corners are then turned as polygons placed for its look-ahead ([`corner`]).
+    pub klipper_scv_mm_s: Option<f64>,
 }
 
 /// A rewritten path: the new geometry, and what the feed of each new segment is made of.
@@ -175,7 +179,47 @@ impl<'a> Path<'a> {
 /// (it then stays sharp): where that happened, the path is also rounded on the inside line
 /// (with its hairpins and keyholes) and the one left with fewer sharp turns is kept.
 pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
-    let (result, rescued) = smooth_on(path, s);
+    let corners = polygon_corners(path, s);
+    if corners.is_empty() {
+        return smooth_cut(path, s, &[]);
+    }
+    let pins: Vec<hairpin::Hairpin> = corners.iter().map(|c| c.pin.clone()).collect();
+    let mut sub = hairpin::substitute(path.pts, path.e, path.feed, path.planned, &pins);
+    // A polygon's sides are run as the firmware will: no ceiling below the legs' own peak
+    // (the substitute's profiles are the original's speeds near the corner).
+    for (&start, pin) in sub.starts.iter().zip(&pins) {
+        let sides = pin.arc.len() - 1;
+        for j in 0..sides {
+            let leg = if 2 * j < sides { pin.at - 1 } else { pin.at };
+            if let (Some(slot), Some(p)) = (sub.planned.get_mut(start + j), path.planned.get(leg)) {
+                *slot = *p;
+            }
+        }
+    }
+    // The polygons are written as they are: the path is cut at their two ends.
+    let cuts: Vec<usize> = sub
+        .starts
+        .iter()
+        .zip(&pins)
+        .flat_map(|(&k, p)| [k, k + p.arc.len() - 1])
+        .collect();
+    let replaced = Path {
+        pts: &sub.pts,
+        e: &sub.e,
+        feed: &sub.feed,
+        planned: &sub.planned,
+    };
+    let mut out = smooth_cut(&replaced, s, &cuts)?;
+    for c in &corners {
+        out.deviation_mm = out.deviation_mm.max(c.deviation_mm);
+    }
+    Some(out)
+}
+
+/// [`smooth_path`] without polygon corners, the path also cut at the points `forced` (whose
+/// pieces are kept as they are unless they have a sharp corner).
+fn smooth_cut(path: &Path<'_>, s: &Settings, forced: &[usize]) -> Option<Smoothed> {
+    let (result, rescued) = smooth_on(path, s, forced);
     if !rescued {
         return result;
     }
@@ -193,7 +237,7 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
         line: blend::Line::Inside,
         ..*s
     };
-    let (inside, _) = smooth_on(path, &inside_line);
+    let (inside, _) = smooth_on(path, &inside_line, forced);
     if left(&inside) < left_wide {
         inside
     } else {
@@ -203,7 +247,7 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
 
 /// [`smooth_path`] on the line `s` asks for; and whether the racing line made a corner
 /// roundable that the inside fillet could not round.
-fn smooth_on(path: &Path<'_>, s: &Settings) -> (Option<Smoothed>, bool) {
+fn smooth_on(path: &Path<'_>, s: &Settings, forced: &[usize]) -> (Option<Smoothed>, bool) {
     let pts = path.pts;
     if pts.len() < 3 || !path.consistent() {
         return (None, false);
@@ -296,11 +340,12 @@ fn smooth_on(path: &Path<'_>, s: &Settings) -> (Option<Smoothed>, bool) {
         let after = (k.at + 1..n).find(|&j| arc[j] >= u1);
         cuts.extend(before.into_iter().chain(after).filter(|&j| free(j)));
     }
+    cuts.extend(forced.iter().filter(|&&j| j < n));
     cuts.push(pts.len() - 1);
     cuts.sort_unstable();
     cuts.dedup();
     let mut out = Smoothed::default();
-    let mut changed = false;
+    let mut changed = !forced.is_empty();
     for w in cuts.windows(2) {
         let (a, b) = (w[0], w[1]);
         let Some(piece) = path.piece(a, b) else {
@@ -325,7 +370,7 @@ fn smooth_on(path: &Path<'_>, s: &Settings) -> (Option<Smoothed>, bool) {
                 keyholes: false,
                 ..*s
             };
-            done = smooth_path(&piece, &plain);
+            done = smooth_cut(&piece, &plain, &[]);
         }
         match done {
             Some(p) => {
@@ -357,6 +402,74 @@ fn smooth_on(path: &Path<'_>, s: &Settings) -> (Option<Smoothed>, bool) {
         }
     }
     (changed.then_some(out), rescued)
+}
+
+/// The sharp corners of `path` to turn as polygons placed for Klipper's look-ahead
+/// ([`corner`]): on a Klipper machine, where the original's planned speeds are known, a polygon
+/// fits within the tolerance and the legs' room (all of the leg where it ends the path, half
+/// where it is shared, less a shortest step), and the firmware runs it no slower than
+/// [`Settings::min_speed_share`] of its speed through the sharp corner.
+fn polygon_corners(path: &Path<'_>, s: &Settings) -> Vec<corner::Corner> {
+    let mut out = Vec::new();
+    let Some(scv) = s.klipper_scv_mm_s else {
+        return out;
+    };
+    let pts = path.pts;
+    let n = pts.len();
+    if n < 3 || path.planned.is_empty() || !path.consistent() {
+        return out;
+    }
+    let cos_critical = crate::math::cos(s.critical_rad);
+    // Corners a fillet already rounds at no loss of speed keep the fillet: the fitted curve
+    // rings less than a polygon of the largest turns.
+    let blends = blend::plan(
+        pts,
+        BLEND_SHARE * s.tolerance_mm,
+        s.limits.critical_curvature(),
+        s.line,
+    );
+    let room = |from: usize, to: usize, end: bool| {
+        let l = norm(&sub(&pts[to], &pts[from]));
+        (if end { blend::LEG_SHARE } else { 0.5 } * l - s.min_step_mm).max(0.0)
+    };
+    for i in 1..n - 1 {
+        let u = sub(&pts[i], &pts[i - 1]);
+        let w = sub(&pts[i + 1], &pts[i]);
+        let (lu, lw) = (norm(&u), norm(&w));
+        if !(lu > 0.0 && lw > 0.0) || dot(&u, &w) / (lu * lw) >= cos_critical {
+            continue;
+        }
+        let (before, after) = (&path.planned[i - 1], &path.planned[i]);
+        let free = Settings {
+            min_speed_share: 1.0,
+            ..*s
+        };
+        if roundable(&blends[i], s) && pays(blends[i].max_curvature, Some(before), &free) {
+            continue;
+        }
+        let accel = before.acceleration.min(after.acceleration);
+        if accel.is_nan() || accel <= 0.0 {
+            continue;
+        }
+        let bounds = corner::Bounds {
+            tolerance_mm: s.tolerance_mm - 0.001,
+            max_turn_rad: STEP_TURN_SHARE * s.critical_rad,
+            min_step_mm: s.min_step_mm,
+            room_mm: [room(i - 1, i, i == 1), room(i, i + 1, i + 2 == n)],
+        };
+        let fw = corner::Firmware {
+            accel_mm_s2: accel,
+            junction_deviation_mm: crate::plan::junction::klipper_junction_deviation(scv, accel),
+            feed_mm_s: [path.feed[i - 1], path.feed[i]],
+            ends_mm_s: [before.entry, after.exit],
+        };
+        if let Some(c) = corner::find(pts, i, &bounds, &fw)
+            .filter(|c| c.slowest_mm_s >= s.min_speed_share * c.sharp_mm_s)
+        {
+            out.push(c);
+        }
+    }
+    out
 }
 
 /// Whether a corner's blend can be walked in steps of at least the minimum step, each turning
@@ -680,6 +793,7 @@ mod tests {
             min_speed_share: 1.0,
             keyholes: true,
             line: blend::Line::Racing,
+            klipper_scv_mm_s: None,
         }
     }
 
@@ -866,6 +980,42 @@ mod tests {
         // Round as one turn: no step of it turns by the critical angle, and none is empty.
         assert_eq!(sharp_turns_from(pts[0], &a.points), 0);
         assert!(a.points.windows(2).all(|w| w[0] != w[1]) && a.points[0] != pts[0]);
+    }
+
+    /// On a Klipper machine whose square-corner velocity takes sharp corners fast (the K1's
+    /// 50 mm/s at 5000 mm/s²), every corner of a square costs time to round; the polygons placed
+    /// for its look-ahead cost about 3.5 ms a corner through the real planner, where a fillet
+    /// fitted and walked cost 5.6 ms and a circle on the racing line 4.5 ms. Bought with the
+    /// time allowed, all 40 corners go.
+    #[test]
+    fn klipper_square_corners_are_bought_as_polygons() {
+        let mut src = String::from(
+            "SET_VELOCITY_LIMIT ACCEL=5000 ACCEL_TO_DECEL=2500 SQUARE_CORNER_VELOCITY=50\nM83\n",
+        );
+        src.push_str("G1 X60 Y50 F30000\nG1 Z0.2\nG1 F12000\n");
+        for _ in 0..10 {
+            for (x, y) in [(70.0, 50.0), (70.0, 70.0), (50.0, 70.0), (50.0, 50.0)] {
+                let e = if x == 70.0 && y == 50.0 { 0.3 } else { 0.6 };
+                src.push_str(&format!("G1 X{x} Y{y} E{e}\n"));
+            }
+        }
+        src.push_str("G1 X60 Y50 E0.3\n");
+        let options = crate::vtg::VtgOptions {
+            dynamics: false,
+            allow_slower_pct: 10.0,
+            ..Default::default()
+        };
+        let r = crate::vtg::vtg(src.as_bytes(), &options).expect("vtg");
+        assert_eq!(r.table1.n_turning.before, 40.0);
+        assert_eq!(r.table1.n_turning.after, 0.0, "{:?}", r.table1.n_turning);
+        assert!(r.max_deviation_mm <= 0.1, "{}", r.max_deviation_mm);
+        let t = &r.table2.time_s;
+        let per_corner_ms = (t.after - t.before) / 40.0 * 1e3;
+        eprintln!("{per_corner_ms} ms a corner");
+        assert!(
+            per_corner_ms > 0.0 && per_corner_ms < 4.0,
+            "{per_corner_ms}"
+        );
     }
 
     /// On a classic-jerk machine the rewritten corners are no slower than the sharp ones and
