@@ -66,8 +66,6 @@ pub struct Corner {
     pub slowest_mm_s: f64,
     /// Slowest speed through the sharp corner, mm/s (the same model).
     pub sharp_mm_s: f64,
-    /// Time through the legs and the polygon, s.
-    pub time_s: f64,
     /// Time through the legs and the sharp corner, s.
     pub sharp_time_s: f64,
 }
@@ -161,7 +159,6 @@ pub fn find(pts: &[[f64; 3]], i: usize, bounds: &Bounds, fw: &Firmware) -> Optio
         deviation_mm: deviation,
         slowest_mm_s: timing.slowest_mm_s,
         sharp_mm_s: sharp.slowest_mm_s,
-        time_s: timing.time_s,
         sharp_time_s: sharp.time_s,
     })
 }
@@ -215,20 +212,21 @@ impl Shape {
                 [q[0] + u[0] * l, q[1] + u[1] * l]
             })
         };
-        let placed =
-            |y: f64| -> Vec<[f64; 2]> { unit_half.iter().map(|p| [p[0], p[1] + y]).collect() };
+        let placed = |y: f64| unit_half.iter().map(move |p| [p[0], p[1] + y]);
         // Largest distance from the corner both ways (the half is the mirror of the other).
+        let leg = [c, s];
         let spread = |y: f64| -> f64 {
-            let pts = placed(y);
-            let Some(end) = pts.last().and_then(|&q| ramp_end(q)) else {
+            let Some(q) = placed(y).next_back() else {
                 return f64::INFINITY;
             };
-            let leg = [c, s];
-            let out = pts.iter().map(|p| to_legs(p, leg)).fold(0.0, f64::max);
-            let mut to_corner = point_segment_2d([0.0, 0.0], *pts.last().unwrap_or(&end), end);
-            for w in pts.windows(2) {
-                to_corner = to_corner.min(point_segment_2d([0.0, 0.0], w[0], w[1]));
-            }
+            let Some(end) = ramp_end(q) else {
+                return f64::INFINITY;
+            };
+            let out = placed(y).map(|p| to_legs(&p, leg)).fold(0.0, f64::max);
+            let sides = placed(y).zip(placed(y).skip(1));
+            let to_corner = sides
+                .map(|(a, b)| point_segment_2d([0.0, 0.0], a, b))
+                .fold(point_segment_2d([0.0, 0.0], q, end), f64::min);
             out.max(to_corner)
         };
         // Feasible while the ramp can reach the leg: the apex below `y_max`.
@@ -261,8 +259,8 @@ impl Shape {
             return None;
         }
         let d = budget / unit_spread;
-        let mut half: Vec<[f64; 2]> = placed(y).iter().map(|p| [p[0] * d, p[1] * d]).collect();
-        let q_end = ramp_end(placed(y).last().copied()?)?;
+        let mut half: Vec<[f64; 2]> = placed(y).map(|p| [p[0] * d, p[1] * d]).collect();
+        let q_end = ramp_end(placed(y).next_back()?)?;
         half.push([q_end[0] * d, q_end[1] * d]);
         Some(Shape {
             theta,

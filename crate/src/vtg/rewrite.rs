@@ -386,7 +386,7 @@ fn has_sharp_corner(run: &[PathMove], cos_critical: f64) -> bool {
 
 /// Whether the turn from direction `a` to direction `b` (neither normalised) is above the
 /// critical angle (cosine `cos_critical`); a zero-length side turns nothing.
-fn is_sharp(a: &[f64; 3], b: &[f64; 3], cos_critical: f64) -> bool {
+pub(super) fn is_sharp(a: &[f64; 3], b: &[f64; 3], cos_critical: f64) -> bool {
     let (la, lb) = (norm(a), norm(b));
     la > 0.0 && lb > 0.0 && dot(a, b) / (la * lb) < cos_critical
 }

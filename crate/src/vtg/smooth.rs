@@ -432,18 +432,16 @@ fn polygon_corners(path: &Path<'_>, s: &Settings) -> Vec<corner::Corner> {
         let l = norm(&sub(&pts[to], &pts[from]));
         (if end { blend::LEG_SHARE } else { 0.5 } * l - s.min_step_mm).max(0.0)
     };
+    let free = Settings {
+        min_speed_share: 1.0,
+        ..*s
+    };
     for i in 1..n - 1 {
-        let u = sub(&pts[i], &pts[i - 1]);
-        let w = sub(&pts[i + 1], &pts[i]);
-        let (lu, lw) = (norm(&u), norm(&w));
-        if !(lu > 0.0 && lw > 0.0) || dot(&u, &w) / (lu * lw) >= cos_critical {
+        let (u, w) = (sub(&pts[i], &pts[i - 1]), sub(&pts[i + 1], &pts[i]));
+        if !super::rewrite::is_sharp(&u, &w, cos_critical) {
             continue;
         }
         let (before, after) = (&path.planned[i - 1], &path.planned[i]);
-        let free = Settings {
-            min_speed_share: 1.0,
-            ..*s
-        };
         if roundable(&blends[i], s) && pays(blends[i].max_curvature, Some(before), &free) {
             continue;
         }
