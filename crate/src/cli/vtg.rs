@@ -33,10 +33,10 @@ pub struct Args {
     #[arg(long)]
     pub arcs: bool,
     /// Print time the rewrite may add to round corners that cost time, percent of the
-    /// original's (by default the print gets no slower and uses no more energy). For Klipper
-    /// machines with a high square-corner velocity, when quiet matters more than time; 100
-    /// rounds every corner the tolerance allows.
-    #[arg(long, value_name = "PCT", default_value_t = 0.0)]
+    /// original's. Only Klipper machines with a high square-corner velocity spend it: they take
+    /// sharp corners faster than rounded ones. 0: the print gets no slower and uses no more
+    /// energy; 100 rounds every corner the tolerance allows.
+    #[arg(long, value_name = "PCT", default_value_t = quietpath::vtg::DEFAULT_ALLOW_SLOWER_PCT)]
     pub allow_slower: f64,
     /// Round corners only on the inside (fillets tangent to the legs) instead of on the racing
     /// line, which eases out by up to the tolerance before a corner for a wider circle.

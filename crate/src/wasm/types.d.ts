@@ -400,7 +400,7 @@ export interface VtgOptions {
   dynamics?: boolean;
   /** Write runs of new points on a circle as G2/G3 arcs (default false: the firmware must have arcs enabled). */
   arcs?: boolean;
-  /** Print time the rewrite may add to round corners that cost time, % of the original's (default 0: no slower, no dearer; 100 rounds every corner the tolerance allows). */
+  /** Print time the rewrite may add to round corners that cost time, % of the original's (default 1, the bar; only machines that take sharp corners faster than round ones, such as Klipper at a high square-corner velocity, spend it; 0: no slower, no dearer; 100 rounds every corner the tolerance allows). */
   allow_slower_pct?: number;
   /** Round corners only on the inside, with fillets tangent to the legs (default false: the racing line, easing out by up to the tolerance before a corner for a circle 2.4× wider at 90°). */
   inside_corners?: boolean;
