@@ -206,8 +206,8 @@ pub fn offers(
         min_speed_share: 1.0,
         keyholes: variant.keyholes,
         klipper_scv_mm_s: (path.junction_model == JunctionModel::Klipper)
-            .then_some(path.print_limits.square_corner_velocity.value)
-            .filter(|v| v.is_finite() && *v > 0.0),
+            .then(|| square_corner_velocity(&path.print_limits))
+            .flatten(),
         line: if options.inside_corners {
             super::blend::Line::Inside
         } else {
@@ -298,6 +298,12 @@ pub fn offers(
 }
 
 impl Offers {
+    /// Whether any path offers a rewrite that costs time or energy: otherwise what the budget
+    /// allows changes nothing.
+    pub fn has_dearer(&self) -> bool {
+        self.offers.iter().any(|o| !o.dearer.is_empty())
+    }
+
     /// The file with the free rewrites and the dearer ones bought with half of what the free
     /// ones saved plus `allowed_s` of time, energy weighed at the print's `mean_power_w` where
     /// time is allowed ([`budget::choose`]).
@@ -403,6 +409,12 @@ fn xy_acceleration(limits: &Limits) -> Option<f64> {
     (m.is_finite() && m > 0.0).then_some(m)
 }
 
+/// Klipper's square-corner velocity in `limits`, mm/s, if it is a usable number.
+fn square_corner_velocity(limits: &Limits) -> Option<f64> {
+    let v = limits.square_corner_velocity.value;
+    (v.is_finite() && v > 0.0).then_some(v)
+}
+
 /// The X/Y jerk of a classic-jerk planner (`M205 X Y`, the lower of the two axes), mm/s.
 fn xy_jerk(limits: &Limits) -> f64 {
     limits.max_jerk[0].value.min(limits.max_jerk[1].value)
@@ -457,8 +469,7 @@ impl Machine<'_> {
                 s.classic_jerk_mm_s = Some(xy_jerk(l));
             }
             if s.klipper_scv_mm_s.is_some() {
-                let scv = l.square_corner_velocity.value;
-                s.klipper_scv_mm_s = (scv.is_finite() && scv > 0.0).then_some(scv);
+                s.klipper_scv_mm_s = square_corner_velocity(l);
             }
         }
         s
@@ -594,7 +605,8 @@ fn rewrite_path(
     };
     // (scale, the path as written, its time and energy)
     let mut cheapest: Option<(Option<f64>, Written, (f64, f64))> = None;
-    let mut fastest: Option<(Option<f64>, Written, (f64, f64))> = None;
+    // (scale, ceiling, its time and energy): written again at the end if it is another way.
+    let mut fastest: Option<(Option<f64>, bool, (f64, f64))> = None;
     for (k, ceiling) in scales.iter().flat_map(|&k| [(k, false), (k, true)]) {
         let w = smoothed.written(k, ceiling, pts[0], settings);
         let total = cost(&w);
@@ -617,14 +629,17 @@ fn rewrite_path(
             (a[0], a[1]) < (b[0], b[1])
         });
         if quicker {
-            fastest = Some((k, w.clone(), total));
+            fastest = Some((k, ceiling, total));
         }
         if better {
             cheapest = Some((k, w, total));
         }
     }
     let (scale, written, written_cost) = cheapest?;
+    let cos_critical = crate::math::cos(settings.critical_rad);
     let draft = Draft {
+        sharp_before: sharp_turns(&pts, cos_critical),
+        cos_critical,
         input,
         run,
         src,
@@ -636,7 +651,8 @@ fn rewrite_path(
     };
     let added = added_by(written_cost);
     let mut out = vec![draft.outcome(scale, &written, written_cost, added, dearer(&added))?];
-    if let Some((k, w, total)) = fastest.filter(|f| f.2 .0 < written_cost.0) {
+    if let Some((k, ceiling, total)) = fastest.filter(|f| f.2 .0 < written_cost.0) {
+        let w = smoothed.written(k, ceiling, pts[0], settings);
         out.extend(draft.outcome(k, &w, total, added_by(total), true));
     }
     Some(out)
@@ -651,6 +667,9 @@ struct Draft<'a> {
     pts: &'a [[f64; 3]],
     /// Filament from the path start at each vertex, in E words.
     e: &'a [f64],
+    /// Turns above the critical angle (cosine `cos_critical`) of the original.
+    sharp_before: usize,
+    cos_critical: f64,
     smoothed: &'a Smoothed,
     settings: &'a Settings,
     machine: &'a Machine<'a>,
@@ -673,6 +692,8 @@ impl Draft<'_> {
             src,
             pts,
             e,
+            sharp_before,
+            cos_critical,
             smoothed,
             settings,
             machine,
@@ -687,8 +708,7 @@ impl Draft<'_> {
             Some(k) if k > base => part.raised_caps_paths += 1,
             _ => {}
         }
-        let cos_critical = crate::math::cos(settings.critical_rad);
-        let removed = sharp_turns(pts, cos_critical).saturating_sub(sharp_turns(
+        let removed = sharp_before.saturating_sub(sharp_turns(
             std::iter::once(&pts[0]).chain(&written.points),
             cos_critical,
         ));
