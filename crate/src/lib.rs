@@ -41,6 +41,7 @@ pub mod orient;
 pub mod parallel;
 pub mod path;
 pub mod plan;
+pub mod read;
 pub mod vtg;
 
 #[cfg(target_arch = "wasm32")]

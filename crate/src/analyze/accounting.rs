@@ -7,7 +7,6 @@
 
 use std::collections::{HashMap, VecDeque};
 
-use super::layers::LayerTracker;
 use super::report::{Bounds, FanEvent, FeatureSummary, TemperatureEvent};
 use crate::energy::Accumulator;
 use crate::energy::Material;
@@ -15,6 +14,7 @@ use crate::gcode::{feature_kind, FeatureKind};
 use crate::machine::{Heater, Move};
 use crate::math::Bound;
 use crate::plan::{Limits, Motion, PlannedMove, Planner};
+use crate::read::{LayerTracker, NO_LAYER};
 use crate::vtg::metrics::{MetricsAccumulator, DEFAULT_CRITICAL_ANGLE_DEG};
 
 /// Feature slot of travel moves.
@@ -59,7 +59,6 @@ pub struct Accounts {
     /// The feature extruding moves belong to, as slot and whether it is infill.
     current_feature: Option<(u32, bool)>,
     pub travel: FeatureSummary,
-    pub layers: LayerTracker,
     /// Material named in the file's comments, if any.
     pub material: Option<Material>,
     /// Toolpath metrics of the VTG paper (eq. 24–26, 31).
@@ -77,7 +76,6 @@ impl Accounts {
             feature_names: HashMap::new(),
             current_feature: None,
             travel: summary("travel", None),
-            layers: LayerTracker::new(),
             material: None,
             toolpath: MetricsAccumulator::new(DEFAULT_CRITICAL_ANGLE_DEG),
             moves_read: 0,
@@ -119,8 +117,8 @@ impl Accounts {
         self.features.len() - 1
     }
 
-    /// A move was read; returns the message that times it.
-    pub fn read_move(&mut self, m: &Move) -> TimeMsg {
+    /// A move was read, in `layers` (by marker, by count); returns the message that times it.
+    pub fn read_move(&mut self, m: &Move, layers: (u32, u32)) -> TimeMsg {
         let extruding = m.is_extruding();
         account_move(m, extruding, &mut self.totals, &mut self.bounded);
         let (slot, infill) = if extruding {
@@ -137,9 +135,7 @@ impl Accounts {
         s.moves += 1;
         s.distance_mm += m.length_mm;
         s.filament_mm += m.extrusion();
-        self.layers.motion(m);
         self.moves_read += 1;
-        let layers = self.layers.current();
         let motion = Motion::from(m);
         if motion.arc.is_none() && motion.rotary_time_s == 0.0 {
             TimeMsg::Move {
@@ -158,13 +154,10 @@ impl Accounts {
         }
     }
 
-    /// A dwell, charged to the current layer.
-    pub fn dwell(&mut self, secs: f64) -> TimeMsg {
+    /// A dwell, charged to the layer it is in.
+    pub fn dwell(&mut self, secs: f64, layers: (u32, u32)) -> TimeMsg {
         self.totals.dwell_s += secs.at_least(0.0);
-        TimeMsg::Dwell {
-            secs,
-            layers: self.layers.current(),
-        }
+        TimeMsg::Dwell { secs, layers }
     }
 
     /// A heater target, to be timed.
@@ -189,7 +182,7 @@ impl Accounts {
     }
 
     /// Adds the timing side's per-feature and per-layer times and energies.
-    pub fn merge(&mut self, timing: &TimeBook) {
+    pub fn merge(&mut self, timing: &TimeBook, layers: &mut LayerTracker) {
         for (i, (t, e)) in timing.feature_time.iter().enumerate() {
             if let Some(f) = self.features.get_mut(i) {
                 f.time_s += t;
@@ -199,12 +192,10 @@ impl Accounts {
         self.travel.time_s += timing.travel_time.0;
         self.travel.energy_j += timing.travel_time.1;
         for (i, (t, e)) in timing.layer_time[0].iter().enumerate() {
-            self.layers
-                .add_time_energy((i as u32, super::layers::NO_LAYER), *t, *e);
+            layers.add_time_energy((i as u32, NO_LAYER), *t, *e);
         }
         for (i, (t, e)) in timing.layer_time[1].iter().enumerate() {
-            self.layers
-                .add_time_energy((super::layers::NO_LAYER, i as u32), *t, *e);
+            layers.add_time_energy((NO_LAYER, i as u32), *t, *e);
         }
     }
 
@@ -276,7 +267,7 @@ pub struct TimeBook {
 }
 
 fn add(v: &mut Vec<(f64, f64)>, i: u32, t: f64, e: f64) {
-    if i == super::layers::NO_LAYER || i == TRAVEL {
+    if i == NO_LAYER || i == TRAVEL {
         return;
     }
     let i = i as usize;

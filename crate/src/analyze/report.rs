@@ -4,8 +4,9 @@
 use serde::Serialize;
 
 use crate::error::Warning;
-use crate::gcode::{FeatureKind, LayerMarkerKind};
+use crate::gcode::FeatureKind;
 use crate::machine::{ExtrusionMode, Heater, ModeSource};
+pub use crate::read::{LayerSource, LayerSummary};
 
 /// Everything `analyze` says about a file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -108,16 +109,6 @@ pub struct ExtrusionInfo {
     pub density_g_cm3: f64,
 }
 
-/// How the layer count was obtained.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case", tag = "method", content = "marker")]
-pub enum LayerSource {
-    /// From the slicer's own layer-change comments.
-    Markers(LayerMarkerKind),
-    /// From changes of Z while extruding (no markers in the file).
-    ZChanges,
-}
-
 /// Axis-aligned bounding box.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Bounds {
@@ -145,29 +136,6 @@ pub struct FeatureSummary {
     pub time_s: f64,
     /// Energy of its moves, J: their `E_servo` plus the share of `E_aux` of their time (see
     /// [`crate::energy`]).
-    pub energy_j: f64,
-}
-
-/// Totals for one layer.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct LayerSummary {
-    /// 0-based layer index.
-    pub index: u64,
-    /// Z of the layer, mm (the marker's, else the first extrusion's).
-    pub z: Option<f64>,
-    /// 1-based line where the layer starts.
-    pub line: u32,
-    /// Moves in the layer.
-    pub moves: u64,
-    /// Path length while extruding, mm.
-    pub extrude_distance_mm: f64,
-    /// Path length of travel, mm.
-    pub travel_distance_mm: f64,
-    /// Net filament, mm.
-    pub filament_mm: f64,
-    /// Time, s.
-    pub time_s: f64,
-    /// Energy, J: `E_servo` of its moves and dwells plus the share of `E_aux` of its time.
     pub energy_j: f64,
 }
 

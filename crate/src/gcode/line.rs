@@ -25,6 +25,12 @@ impl Code {
     pub fn is(&self, letter: u8, number: u16) -> bool {
         self.letter == letter && self.number == number && self.sub.is_none()
     }
+
+    /// Whether this is a motion command: `G0`, `G1`, `G2` or `G3`, with no sub-code.
+    #[inline]
+    pub fn is_motion(&self) -> bool {
+        self.letter == b'G' && self.number <= 3 && self.sub.is_none()
+    }
 }
 
 /// Numeric words of a line, indexed by letter. Fixed size: parsing a line never allocates.

@@ -1,16 +1,16 @@
 //! The file as a program for the planner: every move and every event that times or flushes
 //! the queue, in file order, plus the sparse-infill blocks that a candidate may replace.
 //!
-//! The pass mirrors [`crate::analyze::analyze`] line for line (same setup, same machine, same
+//! It is a fold over the same [`Reader`] as [`crate::analyze::analyze`] (same setup, machine,
 //! limit commands, dwells, heater waits and event stamping), so that replaying the program
 //! through a fresh [`crate::plan::Planner`] gives the same numbers as `analyze` of the file,
 //! and replaying it with some blocks replaced gives the numbers of the rewritten file.
 
-use crate::analyze::{layers::LayerTracker, prepare, AnalyzeOptions, LayerSource, Setup};
 use crate::error::Error;
-use crate::gcode::{self, classify_comment, feature_kind, Command, FeatureKind, Marker};
+use crate::gcode::{feature_kind, Command, FeatureKind, Line};
 use crate::machine::{axis, Event, Heater, Machine, Move, MoveKind};
 use crate::plan::{JunctionModel, Limits, MachineProfile};
+use crate::read::{AnalyzeOptions, At, Fold, LayerSource, Reader};
 
 /// One thing the timing side sees.
 #[derive(Debug, Clone)]
@@ -85,143 +85,165 @@ pub(crate) struct Program {
     pub bed: Option<[f64; 4]>,
 }
 
-/// Reads `input` into a [`Program`].
-pub(crate) fn read(input: &[u8], options: &AnalyzeOptions) -> Result<Program, Error> {
-    let setup = prepare(input, options)?;
-    let mut machine = setup.machine();
-    let Setup {
-        strictness,
-        mut warnings,
-        profile,
-        model,
-        limits,
-        units,
-        ..
-    } = setup;
-    let mut limits_now = limits.clone();
-    let mut tracker = LayerTracker::new();
-    let mut moves: Vec<Mv> = Vec::new();
-    let mut pairs: Vec<(u32, u32)> = Vec::new();
-    let mut ops: Vec<Op> = Vec::new();
-    let mut names: Vec<String> = Vec::new();
-    let mut kind: Option<FeatureKind> = None;
-    let mut relative_xy = false;
-    let mut relative_now = false;
-    let mut bed = None;
-    // Block candidates: (first move, first line, machine before), open while sparse moves come.
-    let mut raw_blocks: Vec<RawBlock> = Vec::new();
-    let mut open: Option<(usize, u32, Box<Machine>)> = None;
-    let mut retracted = false;
-    let mut retract_marks: Vec<bool> = Vec::new();
+/// The fold of [`read`]: moves, ops and the sparse-infill blocks as they open and close.
+#[derive(Default)]
+struct Reading {
+    moves: Vec<Mv>,
+    pairs: Vec<(u32, u32)>,
+    ops: Vec<Op>,
+    names: Vec<String>,
+    kind: Option<FeatureKind>,
+    relative_xy: bool,
+    bed: Option<[f64; 4]>,
+    raw_blocks: Vec<RawBlock>,
+    /// The block being read: first move, first line, the machine before it.
+    open: Option<(usize, u32, Box<Machine>)>,
+    retracted: bool,
+    retract_marks: Vec<bool>,
+    /// The machine before the line being read.
+    before: Option<Machine>,
+}
 
-    gcode::for_each_line(input, strictness, &mut warnings, |raw, line, warnings| {
-        let Some(line) = line else { return Ok(()) };
-        if let Some(comment) = line.comment {
-            match classify_comment(comment) {
-                Some(Marker::Layer { kind: k, z }) => {
-                    tracker.marker(k, z, raw.number);
-                    close(&mut open, &moves, &machine, &mut raw_blocks);
-                }
-                Some(Marker::Feature(name)) => {
-                    kind = Some(feature_kind(name));
-                    if names.len() < 4096 && !names.iter().any(|n| n == name) {
-                        names.push(name.to_string());
-                    }
-                    close(&mut open, &moves, &machine, &mut raw_blocks);
-                }
-                None => {
-                    if bed.is_none() {
-                        bed = parse_bed(comment);
-                    }
-                }
-            }
+impl Reading {
+    fn close(&mut self, after: &Machine) {
+        close(&mut self.open, &self.moves, after, &mut self.raw_blocks);
+    }
+
+    /// Whether the filament is retracted after `m`.
+    fn track_retraction(&mut self, m: &Move) {
+        self.retract_marks.push(self.retracted);
+        if m.is_extruding() {
+            self.retracted = false;
+        } else if m.length_mm <= 1e-9 && m.extrusion() < -1e-9 {
+            self.retracted = true;
+        } else if m.length_mm <= 1e-9 && m.extrusion() > 1e-9 {
+            self.retracted = false;
         }
+    }
+
+    fn moved(&mut self, line: &Line<'_>, m: &Move, at: At<'_>) {
+        self.pairs.push(at.layers);
+        let relative = at.machine.relative_positioning();
+        let sparse = self.kind == Some(FeatureKind::SparseInfill)
+            && !relative
+            && (m.to[axis::Z] - m.from[axis::Z]).abs() < 1e-9
+            && !matches!(m.kind, MoveKind::Home);
+        let before = self.before.take().unwrap_or_else(|| at.machine.clone());
+        if !sparse {
+            self.close(&before);
+        } else if self.open.is_none() {
+            self.open = Some((self.moves.len(), at.line, Box::new(before)));
+        }
+        if relative && m.length_mm > 0.0 {
+            self.relative_xy = true;
+        }
+        self.track_retraction(m);
+        self.ops.push(Op::Move(self.moves.len()));
+        self.moves.push(Mv {
+            m: *m,
+            names: [line.params.has(b'X'), line.params.has(b'Y')],
+            kind: self.kind,
+            layer: u32::MAX,
+        });
+    }
+}
+
+impl Fold for Reading {
+    fn layer_marker(&mut self, machine: &Machine) {
+        self.close(machine);
+    }
+
+    fn feature(&mut self, name: &str, machine: &Machine) {
+        self.kind = Some(feature_kind(name));
+        if self.names.len() < 4096 && !self.names.iter().any(|n| n == name) {
+            self.names.push(name.to_string());
+        }
+        self.close(machine);
+    }
+
+    fn comment(&mut self, comment: &[u8]) {
+        if self.bed.is_none() {
+            self.bed = parse_bed(comment);
+        }
+    }
+
+    fn limits(&mut self, limits: &Limits, machine: &Machine) {
+        self.close(machine);
+        self.ops.push(Op::Limits(Box::new(limits.clone())));
+    }
+
+    fn command(&mut self, line: &Line<'_>, machine: &Machine) {
         let code = line.code();
-        if let Some(c) = code {
-            if c.letter == b'G' && c.number == 91 {
-                relative_now = true;
-            } else if c.letter == b'G' && c.number == 90 {
-                relative_now = false;
-            }
-        }
-        let is_motion_code =
-            matches!(code, Some(c) if c.letter == b'G' && c.number <= 3 && c.sub.is_none());
         let harmless = matches!(line.command, Command::None)
-            || is_motion_code
-            || matches!(code, Some(c) if c.letter == b'M' && c.number == 73);
+            || code.is_some_and(|c| c.is_motion() || c.is(b'M', 73));
         if !harmless {
-            close(&mut open, &moves, &machine, &mut raw_blocks);
+            self.close(machine);
         }
-        if limits_now.apply_command(line, units) {
-            ops.push(Op::Limits(Box::new(limits_now.clone())));
-            return Ok(());
-        }
-        let before = machine.clone();
-        match machine.apply(raw.number, line, warnings) {
-            Some(Event::Move(m)) => {
-                tracker.motion(&m);
-                pairs.push(tracker.current());
-                let sparse = kind == Some(FeatureKind::SparseInfill)
-                    && !relative_now
-                    && (m.to[axis::Z] - m.from[axis::Z]).abs() < 1e-9
-                    && !matches!(m.kind, MoveKind::Home);
-                if !sparse {
-                    close(&mut open, &moves, &before, &mut raw_blocks);
-                } else if open.is_none() {
-                    open = Some((moves.len(), raw.number, Box::new(before)));
-                }
-                if relative_now && m.length_mm > 0.0 {
-                    relative_xy = true;
-                }
-                retract_marks.push(retracted);
-                if m.is_extruding() {
-                    retracted = false;
-                } else if m.length_mm <= 1e-9 && m.extrusion() < -1e-9 {
-                    retracted = true;
-                } else if m.length_mm <= 1e-9 && m.extrusion() > 1e-9 {
-                    retracted = false;
-                }
-                ops.push(Op::Move(moves.len()));
-                moves.push(Mv {
-                    m,
-                    names: [line.params.has(b'X'), line.params.has(b'Y')],
-                    kind,
-                    layer: u32::MAX,
-                });
-            }
-            Some(Event::Dwell(secs)) => ops.push(Op::Dwell(secs)),
-            Some(Event::Temperature {
+        self.before = Some(machine.clone());
+    }
+
+    fn event(&mut self, line: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
+        match *event {
+            Event::Move(ref m) => self.moved(line, m, at),
+            Event::Dwell(secs) => self.ops.push(Op::Dwell(secs)),
+            Event::Temperature {
                 heater,
                 target_c,
                 wait,
-            }) => {
-                ops.push(Op::Temperature {
-                    line: raw.number,
+            } => {
+                self.ops.push(Op::Temperature {
+                    line: at.line,
                     heater,
                     target_c,
                     wait,
                 });
                 if wait {
-                    ops.push(Op::Flush);
+                    self.ops.push(Op::Flush);
                 }
             }
-            Some(Event::Fan { index, speed }) => ops.push(Op::Fan {
-                line: raw.number,
+            Event::Fan { index, speed } => self.ops.push(Op::Fan {
+                line: at.line,
                 index,
                 speed,
             }),
-            None => {}
         }
         Ok(())
-    })?;
-    close(&mut open, &moves, &machine, &mut raw_blocks);
-    retract_marks.push(retracted);
+    }
+}
 
-    let (summaries, source) = tracker.finish();
+/// Reads `input` into a [`Program`].
+pub(crate) fn read(input: &[u8], options: &AnalyzeOptions) -> Result<Program, Error> {
+    let mut reader = Reader::new(input, options)?;
+    let mut r = Reading::default();
+    reader.read(input, &mut r)?;
+    r.close(&reader.machine);
+    r.retract_marks.push(r.retracted);
+    let Reader { setup, layers, .. } = reader;
+    let (summaries, source) = layers.finish();
     let by_marker = matches!(source, LayerSource::Markers(_));
-    for (mv, &(a, b)) in moves.iter_mut().zip(&pairs) {
+    for (mv, &(a, b)) in r.moves.iter_mut().zip(&r.pairs) {
         mv.layer = if by_marker { a } else { b };
     }
+    let blocks = blocks(
+        &r.moves,
+        std::mem::take(&mut r.raw_blocks),
+        &r.retract_marks,
+    );
+    Ok(Program {
+        moves: r.moves,
+        ops: r.ops,
+        blocks,
+        layer_count: summaries.len(),
+        profile: setup.profile,
+        model: setup.model,
+        limits: setup.limits,
+        relative_xy: r.relative_xy,
+        bed: r.bed,
+    })
+}
+
+/// The blocks a candidate may replace: each raw block within one layer that extrudes.
+fn blocks(moves: &[Mv], raw_blocks: Vec<RawBlock>, retract_marks: &[bool]) -> Vec<Block> {
     let mut blocks = Vec::new();
     for (first, end, first_line, last_line, machine, end_logical, end_physical, end_feed) in
         raw_blocks
@@ -260,17 +282,7 @@ pub(crate) fn read(input: &[u8], options: &AnalyzeOptions) -> Result<Program, Er
                 .is_some_and(|m| !m.m.is_extruding() && !matches!(m.m.kind, MoveKind::Arc(_))),
         });
     }
-    Ok(Program {
-        moves,
-        ops,
-        blocks,
-        layer_count: summaries.len(),
-        profile,
-        model,
-        limits,
-        relative_xy,
-        bed,
-    })
+    blocks
 }
 
 type RawBlock = (

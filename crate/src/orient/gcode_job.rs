@@ -24,7 +24,7 @@ pub(super) fn run(
     let moves = &read.moves;
     let mut warnings = read.warnings.clone();
     summary::tick(progress, 0.3)?;
-    let lines = program::motion_lines(input, options.analyze.strict)?;
+    let lines = program::motion_lines(input, &options.analyze)?;
     let line_of = program::line_of_moves(moves, &lines);
     let runs = program::runs(kin, moves, &line_of, options.max_gap_mm);
     let [r0, r1] = kin.model.rotary_axes();

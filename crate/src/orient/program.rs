@@ -6,10 +6,11 @@
 //! Travel moves, arcs, moves in relative positioning (`G91`) and every other line stay
 //! byte-identical. A run starts at the end of the move before it, which is not changed.
 
-use crate::error::{Error, Warnings};
-use crate::gcode::{self, Code, Edit};
+use crate::error::Error;
+use crate::gcode::{Edit, Line, RawLine};
 use crate::machine::{axis, Machine, MoveKind, Pos};
 use crate::path::PathMove;
+use crate::read::{AnalyzeOptions, Flow, Fold, Reader};
 
 use super::kinematics::{Kinematics, Pose};
 use super::metrics::Sample;
@@ -40,40 +41,47 @@ pub(super) struct MotionLine {
     pub offsets: Offsets,
 }
 
-/// Every `G0`/`G1` line of the input, in order.
-pub(super) fn motion_lines(input: &[u8], strict: bool) -> Result<Vec<MotionLine>, Error> {
-    let mut out = Vec::new();
-    // The machine model tracks the logical position beside the machine's (G92, G28) and the
-    // positioning mode (G90, G91): the offsets and the mode are its own, not a second reading
-    // of those commands.
-    let mut machine = Machine::default();
-    // The path extraction has already reported what the machine model warns of.
-    let mut machine_warnings = Warnings::default();
-    let mut warnings = Warnings::default();
-    let strictness = if strict {
-        gcode::Strictness::Strict
-    } else {
-        gcode::Strictness::Lenient
-    };
-    gcode::for_each_line(input, strictness, &mut warnings, |raw, line, _| {
-        let Some(line) = line else { return Ok(()) };
-        machine.apply(raw.number, line, &mut machine_warnings);
-        let Some(code) = line.code() else {
-            return Ok(());
-        };
-        let Code { letter, number, .. } = code;
-        if letter == b'G' && (number == 0 || number == 1) {
-            out.push(MotionLine {
-                number: raw.number,
-                range: raw.offset..raw.offset + raw.text.len(),
+/// The fold of [`motion_lines`]. The machine model tracks the logical position beside the
+/// machine's (G92, G28) and the positioning mode (G90, G91): the offsets and the mode are its
+/// own, not a second reading of those commands.
+#[derive(Default)]
+struct Lines {
+    out: Vec<MotionLine>,
+    /// Number and byte range of the line being read.
+    current: (u32, std::ops::Range<usize>),
+}
+
+impl Fold for Lines {
+    fn line(&mut self, raw: &RawLine<'_>, _: Option<&Line<'_>>) -> Result<Flow, Error> {
+        self.current = (raw.number, raw.offset..raw.offset + raw.text.len());
+        Ok(Flow::Read)
+    }
+
+    /// A `G0`/`G1` line changes neither the offsets nor the positioning mode, so the machine
+    /// before it tells both.
+    fn command(&mut self, line: &Line<'_>, machine: &Machine) {
+        if line.code().is_some_and(|c| c.is(b'G', 0) || c.is(b'G', 1)) {
+            let (number, range) = self.current.clone();
+            self.out.push(MotionLine {
+                number,
+                range,
                 relative: machine.relative_positioning(),
                 words: AXIS_INDEX.map(|(l, _)| line.params.get(l)),
-                offsets: Offsets::of_machine(&machine),
+                offsets: Offsets::of_machine(machine),
             });
         }
-        Ok(())
-    })?;
-    Ok(out)
+    }
+}
+
+/// Every `G0`/`G1` line of the input, in order. (The path extraction has already reported
+/// what the reader warns of.)
+pub(super) fn motion_lines(
+    input: &[u8],
+    options: &AnalyzeOptions,
+) -> Result<Vec<MotionLine>, Error> {
+    let mut lines = Lines::default();
+    Reader::new(input, options)?.read(input, &mut lines)?;
+    Ok(lines.out)
 }
 
 /// One run: indexes of its moves in the path.

@@ -21,16 +21,17 @@ pub use geometry::{LayerGeometry, SegmentKind, ARC_CHORD_DEG};
 
 use serde::Serialize;
 
-use crate::analyze::{layers::LayerTracker, prepare, AnalyzeOptions, LayerSource, Setup};
 use crate::error::{Error, Warning};
-use crate::gcode::{self, classify_comment, feature_kind, FeatureKind, Marker};
-use crate::machine::{Event, ExtrusionMode, MoveKind, Pos};
+use crate::gcode::{feature_kind, FeatureKind, Line};
+use crate::machine::{Event, ExtrusionMode, Machine, MoveKind, Pos};
 use crate::plan::{JunctionModel, Limits, MachineProfile, Motion, PlannedMove, Planner, Profile};
+use crate::read::{AnalyzeOptions, LayerSource};
+use crate::read::{At, Fold, Reader};
 
 /// Feature index of moves before the file names any feature.
 pub const NO_FEATURE: u16 = u16::MAX;
 /// Layer index of moves before the first layer.
-pub const NO_LAYER: u32 = crate::analyze::layers::NO_LAYER;
+pub const NO_LAYER: u32 = crate::read::NO_LAYER;
 
 /// When and how fast the machine runs one move (from the motion planner).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -186,6 +187,71 @@ impl Walked {
     }
 }
 
+/// The fold of [`walk`]: names features, numbers moves, plans them when asked.
+struct Walk<'s, S> {
+    sink: &'s mut S,
+    planner: Option<Planner>,
+    features: Vec<PathFeature>,
+    current_feature: u16,
+    count: usize,
+}
+
+impl<S: MoveSink> Fold for Walk<'_, S> {
+    fn feature(&mut self, name: &str, _: &Machine) {
+        let features = &mut self.features;
+        self.current_feature = match features.iter().position(|f| f.name == name) {
+            Some(i) => i as u16,
+            None if features.len() < NO_FEATURE as usize => {
+                features.push(PathFeature {
+                    name: name.to_string(),
+                    kind: feature_kind(name),
+                });
+                (features.len() - 1) as u16
+            }
+            None => NO_FEATURE,
+        };
+    }
+
+    fn limits(&mut self, limits: &Limits, _: &Machine) {
+        if let Some(planner) = &mut self.planner {
+            *planner.limits_mut() = limits.clone();
+        }
+    }
+
+    fn event(&mut self, _: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
+        let sink = &mut *self.sink;
+        match (event, &mut self.planner) {
+            (Event::Move(m), planner) => {
+                let index = self.count;
+                self.count += 1;
+                let moved = PathMove {
+                    line: m.line,
+                    kind: m.kind,
+                    from: m.from,
+                    to: m.to,
+                    feed_mm_s: m.feed_mm_s,
+                    length_mm: m.length_mm,
+                    feature: self.current_feature,
+                    layer: NO_LAYER,
+                    timing: None,
+                };
+                sink.moved(index, moved, at.layers, &self.features);
+                if let Some(planner) = planner {
+                    planner.push(&Motion::from(m), index as u64, &mut |pm| sink.timed(pm));
+                }
+            }
+            (&Event::Dwell(secs), Some(planner)) => {
+                planner.dwell(secs, &mut |pm| sink.timed(pm));
+            }
+            (Event::Temperature { wait: true, .. }, Some(planner)) => {
+                planner.flush(&mut |pm| sink.timed(pm));
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
 /// Reads every move of `input` the way [`crate::analyze::analyze`] does and hands each to
 /// `sink`, keeping nothing itself: memory stays bounded whatever the file's size (what a sink
 /// keeps is its own business). With `plan`, the planner's timing follows through
@@ -196,89 +262,30 @@ pub fn walk(
     plan: bool,
     sink: &mut impl MoveSink,
 ) -> Result<Walked, Error> {
-    let setup = prepare(input, options)?;
-    let mut machine = setup.machine();
-    let Setup {
-        strictness,
-        mode,
-        mut warnings,
-        profile,
-        model,
-        limits,
-        units,
+    let mut reader = Reader::new(input, options)?;
+    let mut fold = Walk {
+        sink,
+        planner: plan.then(|| Planner::new(reader.setup.limits.clone(), reader.setup.model)),
+        features: Vec::new(),
+        current_feature: NO_FEATURE,
+        count: 0,
+    };
+    reader.read(input, &mut fold)?;
+    let Walk {
+        sink,
+        planner,
+        features,
+        count,
         ..
-    } = setup;
-    let mut planner = Planner::new(limits.clone(), model);
-    let mut limits_now = limits;
-    let mut print_limits = None;
-    let mut tracker = LayerTracker::new();
-    let mut count = 0usize;
-    let mut features: Vec<PathFeature> = Vec::new();
-    let mut current_feature = NO_FEATURE;
-
-    gcode::for_each_line(input, strictness, &mut warnings, |raw, line, warnings| {
-        let Some(line) = line else { return Ok(()) };
-        if let Some(comment) = line.comment {
-            match classify_comment(comment) {
-                Some(Marker::Layer { kind, z }) => tracker.marker(kind, z, raw.number),
-                Some(Marker::Feature(name)) => {
-                    current_feature = match features.iter().position(|f| f.name == name) {
-                        Some(i) => i as u16,
-                        None if features.len() < NO_FEATURE as usize => {
-                            features.push(PathFeature {
-                                name: name.to_string(),
-                                kind: feature_kind(name),
-                            });
-                            (features.len() - 1) as u16
-                        }
-                        None => NO_FEATURE,
-                    };
-                }
-                None => {}
-            }
-        }
-        if limits_now.apply_command(line, units) {
-            if plan {
-                *planner.limits_mut() = limits_now.clone();
-            }
-            return Ok(());
-        }
-        match machine.apply(raw.number, line, warnings) {
-            Some(Event::Move(m)) => {
-                if print_limits.is_none() && m.is_extruding() {
-                    print_limits = Some(limits_now.clone());
-                }
-                tracker.motion(&m);
-                let index = count;
-                count += 1;
-                let moved = PathMove {
-                    line: m.line,
-                    kind: m.kind,
-                    from: m.from,
-                    to: m.to,
-                    feed_mm_s: m.feed_mm_s,
-                    length_mm: m.length_mm,
-                    feature: current_feature,
-                    layer: NO_LAYER,
-                    timing: None,
-                };
-                sink.moved(index, moved, tracker.current(), &features);
-                if plan {
-                    planner.push(&Motion::from(&m), index as u64, &mut |pm| sink.timed(pm));
-                }
-            }
-            Some(Event::Dwell(secs)) if plan => planner.dwell(secs, &mut |pm| sink.timed(pm)),
-            Some(Event::Temperature { wait: true, .. }) if plan => {
-                planner.flush(&mut |pm| sink.timed(pm));
-            }
-            _ => {}
-        }
-        Ok(())
-    })?;
-    if plan {
+    } = fold;
+    let mut time_s = 0.0;
+    if let Some(mut planner) = planner {
         planner.flush(&mut |pm| sink.timed(pm));
+        time_s = planner.elapsed_s();
     }
-    let (summaries, layer_source) = tracker.finish();
+    let print_limits = reader.limits_in_force().clone();
+    let Reader { setup, layers, .. } = reader;
+    let (summaries, layer_source) = layers.finish();
     let layers = summaries
         .iter()
         .map(|s| PathLayer {
@@ -288,16 +295,16 @@ pub fn walk(
             end: 0,
         })
         .collect();
-    let (warnings, _) = warnings.into_parts();
+    let (warnings, _) = setup.warnings.into_parts();
     Ok(Walked {
         layers,
         layer_source,
         features,
-        profile,
-        junction_model: model,
-        print_limits: print_limits.unwrap_or(limits_now),
-        extrusion_mode: mode,
-        time_s: planner.elapsed_s(),
+        profile: setup.profile,
+        junction_model: setup.model,
+        print_limits,
+        extrusion_mode: setup.mode,
+        time_s,
         warnings,
         moves: count,
     })

@@ -2,14 +2,14 @@
 //! whether the line can be replaced safely, the extrusion mode its `E` word is read in, its
 //! `E` word and the modal feed rate word after it.
 //!
-//! A second pass reads the file exactly as `path::extract` does (same setup, limit commands
-//! skipped the same way), so its moves line up one for one with the path's.
+//! A second fold over the [`Reader`], as `path::extract` is, so its moves line up one for one
+//! with the path's.
 
-use crate::analyze::{prepare, AnalyzeOptions};
 use crate::error::Error;
-use crate::gcode::{self, Command, Line};
-use crate::machine::{axis, Event, ExtrusionMode};
+use crate::gcode::{Command, Line, RawLine};
+use crate::machine::{axis, Event, ExtrusionMode, Machine};
 use crate::plan::Limits;
+use crate::read::{AnalyzeOptions, At, Flow, Fold, Reader};
 
 /// A move's source line as the rewriter sees it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -79,82 +79,99 @@ impl Sources {
     }
 }
 
+/// The fold of [`move_sources`].
+struct Read {
+    sources: Sources,
+    /// Annotation lines since the last other line.
+    notes: Notes,
+    /// The annotations before the line being read.
+    line_notes: Notes,
+    /// The modal `F` word.
+    f_modal: Option<f64>,
+    /// What the line's move needs of the state before it: mode, logical E, modal `F`.
+    before: (ExtrusionMode, f64, Option<f64>),
+}
+
+impl Fold for Read {
+    fn line(&mut self, raw: &RawLine<'_>, line: Option<&Line<'_>>) -> Result<Flow, Error> {
+        let Some(line) = line else {
+            self.notes = Notes::default();
+            return Ok(Flow::Read);
+        };
+        if !is_annotation(line) {
+            self.line_notes = std::mem::take(&mut self.notes);
+            return Ok(Flow::Read);
+        }
+        let end = raw.offset + raw.text.len();
+        self.notes = if self.notes.lines > 0 {
+            Notes {
+                lines: self.notes.lines + 1,
+                to: end,
+                ..self.notes
+            }
+        } else {
+            Notes {
+                lines: 1,
+                from: raw.offset,
+                to: end,
+            }
+        };
+        Ok(Flow::Skip)
+    }
+
+    fn limits(&mut self, limits: &Limits, _: &Machine) {
+        let changes = &mut self.sources.limits;
+        let k = self.sources.moves.len();
+        // Several commands in a row before the next move: keep the last.
+        if changes.last().is_some_and(|(from, _)| *from == k) {
+            changes.pop();
+        }
+        changes.push((k, limits.clone()));
+    }
+
+    fn command(&mut self, line: &Line<'_>, machine: &Machine) {
+        let e_before = machine.logical_position()[axis::E];
+        self.before = (machine.extrusion_mode(), e_before, self.f_modal);
+        if line.code().is_some_and(|c| c.is_motion()) {
+            if let Some(f) = line.params.get(b'F') {
+                self.f_modal = Some(f);
+            }
+        }
+    }
+
+    fn event(&mut self, line: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
+        if let Event::Move(m) = event {
+            let (mode, e_before, f_before) = self.before;
+            self.sources.moves.push(MoveSource {
+                line: at.line,
+                plain: is_plain(line, &m.to),
+                mode,
+                e_word: line.params.get(b'E').unwrap_or(0.0),
+                e_before,
+                f_before,
+                f_after: self.f_modal,
+                notes: self.line_notes,
+            });
+        }
+        Ok(())
+    }
+}
+
 /// Reads the source of every move and the limits along the file.
 pub fn move_sources(input: &[u8], options: &AnalyzeOptions) -> Result<Sources, Error> {
-    let setup = prepare(input, options)?;
-    let mut machine = setup.machine();
-    let mut warnings = setup.warnings;
-    let mut limits = setup.limits;
-    let mut f_modal: Option<f64> = None;
-    let mut out = Vec::new();
-    let mut changes = vec![(0usize, limits.clone())];
-    let mut notes = Notes::default();
-    gcode::for_each_line(
-        input,
-        setup.strictness,
-        &mut warnings,
-        |raw, line, warnings| {
-            let Some(line) = line else {
-                notes = Notes::default();
-                return Ok(());
-            };
-            if is_annotation(line) {
-                let end = raw.offset + raw.text.len();
-                notes = if notes.lines > 0 {
-                    Notes {
-                        lines: notes.lines + 1,
-                        to: end,
-                        ..notes
-                    }
-                } else {
-                    Notes {
-                        lines: 1,
-                        from: raw.offset,
-                        to: end,
-                    }
-                };
-                return Ok(());
-            }
-            let notes = std::mem::take(&mut notes);
-            if limits.apply_command(line, setup.units) {
-                // Several commands in a row before the next move: keep the last.
-                if changes.last().is_some_and(|(k, _)| *k == out.len()) {
-                    changes.pop();
-                }
-                changes.push((out.len(), limits.clone()));
-                return Ok(());
-            }
-            let mode = machine.extrusion_mode();
-            let e_before = machine.logical_position()[axis::E];
-            let f_before = f_modal;
-            let is_motion = line
-                .code()
-                .is_some_and(|c| c.letter == b'G' && c.number <= 3 && c.sub.is_none());
-            if is_motion {
-                if let Some(f) = line.params.get(b'F') {
-                    f_modal = Some(f);
-                }
-            }
-            if let Some(Event::Move(m)) = machine.apply(raw.number, line, warnings) {
-                let plain = is_plain(line, &m.to);
-                out.push(MoveSource {
-                    line: raw.number,
-                    plain,
-                    mode,
-                    e_word: line.params.get(b'E').unwrap_or(0.0),
-                    e_before,
-                    f_before,
-                    f_after: f_modal,
-                    notes,
-                });
-            }
-            Ok(())
+    let mut reader = Reader::new(input, options)?;
+    let mut fold = Read {
+        sources: Sources {
+            moves: Vec::new(),
+            limits: vec![(0, reader.limits.clone())],
         },
-    )?;
-    Ok(Sources {
-        moves: out,
-        limits: changes,
-    })
+        notes: Notes::default(),
+        line_notes: Notes::default(),
+        f_modal: None,
+        before: (ExtrusionMode::Absolute, 0.0, None),
+    };
+    reader.read(input, &mut fold)?;
+    Ok(fold.sources)
 }
 
 fn is_plain(line: &Line<'_>, to: &crate::machine::Pos) -> bool {

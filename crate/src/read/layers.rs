@@ -8,10 +8,44 @@
 //! direction has turned through a full 360°. A helix is then as many layers as it has turns,
 //! not one layer per point.
 
-use super::report::{LayerSource, LayerSummary};
+use serde::Serialize;
+
 use crate::gcode::LayerMarkerKind;
 use crate::machine::{axis, Move};
 use std::f64::consts::TAU;
+
+/// How the layer count was obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "method", content = "marker")]
+pub enum LayerSource {
+    /// From the slicer's own layer-change comments.
+    Markers(LayerMarkerKind),
+    /// From changes of Z while extruding (no markers in the file).
+    ZChanges,
+}
+
+/// Totals for one layer.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LayerSummary {
+    /// 0-based layer index.
+    pub index: u64,
+    /// Z of the layer, mm (the marker's, else the first extrusion's).
+    pub z: Option<f64>,
+    /// 1-based line where the layer starts.
+    pub line: u32,
+    /// Moves in the layer.
+    pub moves: u64,
+    /// Path length while extruding, mm.
+    pub extrude_distance_mm: f64,
+    /// Path length of travel, mm.
+    pub travel_distance_mm: f64,
+    /// Net filament, mm.
+    pub filament_mm: f64,
+    /// Time, s.
+    pub time_s: f64,
+    /// Energy, J: `E_servo` of its moves and dwells plus the share of `E_aux` of its time.
+    pub energy_j: f64,
+}
 
 /// Layer index meaning "before the first layer".
 pub const NO_LAYER: u32 = u32::MAX;

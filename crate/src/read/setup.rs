@@ -1,0 +1,199 @@
+//! What every pass over a file needs before its first line: validated options, the extrusion
+//! mode, the head/tail prescan, the machine profile, junction model and starting limits.
+
+use serde::Deserialize;
+
+use super::prescan;
+use crate::energy::EnergyOptions;
+use crate::error::{Error, ErrorKind, Warnings};
+use crate::gcode::{self, Strictness};
+use crate::machine::{self, ExtrusionMode, Machine, MachineConfig};
+use crate::plan::{FeedUnits, JunctionModel, Limit, LimitSource, MachineProfile};
+
+/// Options of `analyze`, and of how every other job reads its input. Every field is optional
+/// in JSON.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize, serde::Serialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AnalyzeOptions {
+    /// Stop at the first malformed line instead of warning.
+    pub strict: bool,
+    /// Filament diameter, mm (default: from the file, else 1.75).
+    pub filament_diameter_mm: Option<f64>,
+    /// Filament density, g/cm³ (default: from the file, else 1.24, PLA).
+    pub density_g_cm3: Option<f64>,
+    /// Force the starting extrusion mode instead of inferring it.
+    pub extrusion_mode: Option<ExtrusionModeOption>,
+    /// Built-in machine preset (see `plan::profiles::PRESETS`); default: chosen from the file's
+    /// flavour.
+    pub machine: Option<String>,
+    /// A whole machine profile (wins over `machine`).
+    pub machine_profile: Option<MachineProfile>,
+    /// Junction model; default: the profile's, or Klipper's for files that drive Klipper.
+    pub junction_model: Option<JunctionModel>,
+    /// Length of the segments arcs are split into, mm (default: the profile's, 1 mm).
+    pub arc_segment_mm: Option<f64>,
+    /// Energy model settings (coefficients, material, powers, emission factors); default:
+    /// [`EnergyOptions::default`].
+    pub energy: Option<EnergyOptions>,
+}
+
+/// Starting extrusion mode, as an option.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ExtrusionModeOption {
+    /// `M82`.
+    Absolute,
+    /// `M83`.
+    Relative,
+}
+
+/// The machine, junction model and limits a file is planned with, and why.
+fn choose_machine(
+    options: &AnalyzeOptions,
+    pre: &prescan::Prescan,
+) -> Result<(MachineProfile, JunctionModel, String), Error> {
+    let klipper = pre.klipper_commands
+        || pre
+            .flavor
+            .as_deref()
+            .is_some_and(|f| f.contains("klipper") || f.contains("creality os"));
+    let invalid = |reason| Error::new(0, 0, ErrorKind::InvalidOption { reason });
+    let (profile, why) = if let Some(p) = &options.machine_profile {
+        (
+            p.clone(),
+            format!("profile '{}' given in the options", p.name),
+        )
+    } else if let Some(name) = &options.machine {
+        let p = MachineProfile::preset(name)
+            .ok_or_else(|| invalid("unknown machine preset (see plan::profiles::PRESETS)"))?;
+        (p, format!("preset '{name}' given in the options"))
+    } else if klipper {
+        (
+            MachineProfile::preset("voron-klipper").ok_or_else(|| invalid("preset missing"))?,
+            "the file drives Klipper".to_string(),
+        )
+    } else {
+        (
+            MachineProfile::preset("prusa-mk3s").ok_or_else(|| invalid("preset missing"))?,
+            "default for Marlin-style files (classic jerk, as slicer estimators assume)"
+                .to_string(),
+        )
+    };
+    let (model, why) = match options.junction_model {
+        Some(m) => (m, format!("{why}; junction model given in the options")),
+        None if klipper => (JunctionModel::Klipper, why),
+        None => (profile.junction, why),
+    };
+    Ok((profile, model, why))
+}
+
+/// What every pass over a file needs before its first line: validated options, the extrusion
+/// mode, the head/tail prescan, the machine profile, junction model and starting limits.
+/// Held by the [`Reader`](super::Reader), so every pass reads a file the same way.
+#[derive(Debug)]
+pub(crate) struct Setup {
+    pub strictness: Strictness,
+    pub mode: ExtrusionMode,
+    pub source: machine::ModeSource,
+    pub warnings: Warnings,
+    pub pre: prescan::Prescan,
+    pub profile: MachineProfile,
+    pub model: JunctionModel,
+    pub model_reason: String,
+    pub limits: crate::plan::Limits,
+    pub units: FeedUnits,
+}
+
+impl Setup {
+    /// The machine a pass starts with: the file's extrusion mode, everything else at its
+    /// power-on state.
+    pub fn machine(&self) -> Machine {
+        Machine::new(MachineConfig {
+            extrusion: self.mode,
+            ..MachineConfig::default()
+        })
+    }
+}
+
+/// Builds the [`Setup`] of a pass over `input`.
+pub(crate) fn prepare(input: &[u8], options: &AnalyzeOptions) -> Result<Setup, Error> {
+    validate_options(options)?;
+    let strictness = if options.strict {
+        Strictness::Strict
+    } else {
+        Strictness::Lenient
+    };
+    gcode::check_encoding(input)?;
+    let inference = machine::infer_extrusion_mode(input);
+    let (mode, source) = match options.extrusion_mode {
+        Some(ExtrusionModeOption::Absolute) => {
+            (ExtrusionMode::Absolute, machine::ModeSource::Explicit)
+        }
+        Some(ExtrusionModeOption::Relative) => {
+            (ExtrusionMode::Relative, machine::ModeSource::Explicit)
+        }
+        None => (inference.mode, inference.source),
+    };
+    let mut warnings = Warnings::default();
+    if source == machine::ModeSource::Inferred {
+        warnings.push(
+            0,
+            format!(
+                "the file never sets M82/M83 before extruding; read as {} extrusion ({} of {} E values increase)",
+                if mode == ExtrusionMode::Absolute { "absolute" } else { "relative" },
+                inference.increasing,
+                inference.samples
+            ),
+        );
+    }
+
+    let pre = prescan::prescan(input);
+    let (profile, model, model_reason) = choose_machine(options, &pre)?;
+    let mut limits = profile.limits.clone();
+    for (key, value) in &pre.limit_settings {
+        limits.apply_setting(key, value);
+    }
+    if let Some(seg) = options.arc_segment_mm {
+        limits.arc_segment_mm = Limit {
+            value: seg,
+            source: LimitSource::Option,
+        };
+    }
+    let units = if pre.flavor.as_deref() == Some("reprapfirmware") {
+        FeedUnits::PerMinute
+    } else {
+        FeedUnits::PerSecond
+    };
+    Ok(Setup {
+        strictness,
+        mode,
+        source,
+        warnings,
+        pre,
+        profile,
+        model,
+        model_reason,
+        limits,
+        units,
+    })
+}
+
+fn validate_options(o: &AnalyzeOptions) -> Result<(), Error> {
+    let positive = |v: Option<f64>| v.is_none_or(|x| x.is_finite() && x > 0.0);
+    if let Some(reason) = o.energy.as_ref().and_then(|e| e.validate().err()) {
+        return Err(Error::new(0, 0, ErrorKind::InvalidOption { reason }));
+    }
+    if !positive(o.filament_diameter_mm)
+        || !positive(o.density_g_cm3)
+        || !positive(o.arc_segment_mm)
+    {
+        return Err(Error::new(
+            0,
+            0,
+            ErrorKind::InvalidOption {
+                reason: "filament_diameter_mm, density_g_cm3 and arc_segment_mm must be positive numbers",
+            },
+        ));
+    }
+    Ok(())
+}
