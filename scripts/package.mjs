@@ -63,7 +63,7 @@ const manifest = {
 fs.writeFileSync(path.join(pkg, 'package.json'), JSON.stringify(manifest, null, 2) + '\n');
 fs.writeFileSync(
   path.join(pkg, 'README.md'),
-  `# quietpath ${version}\n\nWebAssembly build of [quietpath](${manifest.repository.url}): see the repository README for the API.\n\n` +
+  `# quietpath ${version}\n\nWebAssembly build of [quietpath](${manifest.repository.url}): the API is documented in the repository's docs/js-api.md.\n\n` +
     "```js\nimport { analyze } from 'quietpath';          // Node or a bundler\nimport init, { analyze } from 'quietpath/web'; // plain browser ES modules: await init() first\n```\n",
 );
 console.log(`pkg/package.json: quietpath ${version} (${targets.join(', ')})`);

@@ -2,7 +2,7 @@
 # Installs what building and testing quietpath needs, and nothing that is already there.
 #   scripts/setup.sh wasm     Rust wasm32 target, wasm-pack, wasm-bindgen-cli (matching Cargo.lock), npm devDependencies
 #   scripts/setup.sh test     the above, plus Debian's chromium for the browser tests
-# Known traps (see README): Debian's binaryen/wasm-opt 108 silently breaks current wasm-bindgen output,
+# Known traps (see docs/development.md): Debian's binaryen/wasm-opt 108 silently breaks current wasm-bindgen output,
 # so the npm `binaryen` package's wasm-opt is put first on PATH by the Makefile; browser downloads by test
 # tools fail here, so tests drive Debian's /usr/bin/chromium through playwright-core.
 set -euo pipefail

@@ -1,4 +1,4 @@
-//! The `quietpath` command-line tool (native builds only).
+//! The `quietpath` command-line tool (native builds only; needs the `cli` feature, on by default).
 
 #[cfg(not(target_arch = "wasm32"))]
 mod cli;
