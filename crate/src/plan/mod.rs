@@ -57,6 +57,7 @@ pub struct Motion {
 }
 
 impl From<&Move> for Motion {
+    #[inline]
     fn from(m: &Move) -> Self {
         let delta = [
             m.to[axis::X] - m.from[axis::X],
