@@ -4,6 +4,7 @@
 mod bench;
 mod calibrate;
 mod infill;
+mod klipper;
 mod output;
 mod smooth;
 mod table;
@@ -19,7 +20,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use quietpath::analyze::{analyze_with_progress, AnalyzeOptions, ExtrusionModeOption};
 use quietpath::error::Warnings;
 use quietpath::gcode::{self, Strictness};
-use quietpath::plan::{JunctionModel, MachineProfile};
+use quietpath::plan::{JunctionModel, KlipperVersion, MachineProfile};
 
 /// Quieter, cheaper 3D-printer toolpaths.
 #[derive(Debug, Parser)]
@@ -123,6 +124,20 @@ struct AnalyzeArgs {
     /// material, powers, emission factors; every field optional).
     #[arg(long, value_name = "FILE")]
     energy: Option<PathBuf>,
+    /// The printer's Klipper config (printer.cfg, includes followed): the file runs on Klipper
+    /// with its [printer], [extruder], [gcode_arcs] and [firmware_retraction] settings.
+    #[arg(long, value_name = "FILE")]
+    klipper_config: Option<PathBuf>,
+    /// How that Klipper reads max_accel_to_decel: legacy (v0.12, Creality's K1 family) or
+    /// current (Klipper since 2025-08, minimum_cruise_ratio only) [default: current].
+    #[arg(long, value_enum)]
+    klipper_version: Option<KlipperVersionArg>,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum KlipperVersionArg {
+    Legacy,
+    Current,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -159,7 +174,16 @@ impl AnalyzeArgs {
             }
             None => None,
         };
+        let klipper_config = match &self.klipper_config {
+            Some(path) => Some(klipper::read_config(path)?),
+            None => None,
+        };
         Ok(AnalyzeOptions {
+            klipper_config,
+            klipper_version: self.klipper_version.map(|v| match v {
+                KlipperVersionArg::Legacy => KlipperVersion::Legacy,
+                KlipperVersionArg::Current => KlipperVersion::Current,
+            }),
             energy,
             machine: self.machine.clone(),
             machine_profile,

@@ -17,6 +17,8 @@ pub enum LimitSource {
     Profile,
     /// The slicer's settings block in the file.
     SlicerSettings,
+    /// The printer's firmware configuration (Klipper's `printer.cfg`).
+    PrinterConfig,
     /// A command in the file (`M201`…, `SET_VELOCITY_LIMIT`).
     Command,
     /// An option of the analysis.

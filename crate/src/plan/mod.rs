@@ -19,6 +19,7 @@
 //! (its `[gcode_arcs] resolution`).
 
 pub mod junction;
+pub mod klipper_config;
 pub mod limits;
 pub mod profiles;
 pub mod trapezoid;
@@ -28,6 +29,7 @@ use serde::Serialize;
 use crate::machine::{axis, Move};
 use crate::math::Bound;
 use junction::Segment;
+pub use klipper_config::{KlipperConfig, KlipperConfigError, KlipperVersion};
 pub use limits::{FeedUnits, JunctionModel, Limit, LimitSource, Limits};
 pub use profiles::Profile as MachineProfile;
 pub use trapezoid::Profile;

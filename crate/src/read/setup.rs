@@ -8,6 +8,7 @@ use crate::energy::EnergyOptions;
 use crate::error::{Error, ErrorKind, Warnings};
 use crate::gcode::{self, Strictness};
 use crate::machine::{self, ExtrusionMode, Machine, MachineConfig};
+use crate::plan::klipper_config::{self, KlipperConfig, KlipperVersion};
 use crate::plan::{FeedUnits, JunctionModel, Limit, LimitSource, MachineProfile};
 
 /// Options of `analyze`, and of how every other job reads its input. Every field is optional
@@ -35,6 +36,12 @@ pub struct AnalyzeOptions {
     /// Energy model settings (coefficients, material, powers, emission factors); default:
     /// [`EnergyOptions::default`].
     pub energy: Option<EnergyOptions>,
+    /// The printer's Klipper config (`printer.cfg`): the file runs on Klipper with these
+    /// limits, over the profile's. In JSON, the config's text or its parsed form.
+    #[serde(deserialize_with = "klipper_config::text_or_parsed")]
+    pub klipper_config: Option<KlipperConfig>,
+    /// How that Klipper reads `max_accel_to_decel` (default: current Klipper).
+    pub klipper_version: Option<KlipperVersion>,
 }
 
 /// Starting extrusion mode, as an option.
@@ -52,7 +59,8 @@ fn choose_machine(
     options: &AnalyzeOptions,
     pre: &prescan::Prescan,
 ) -> Result<(MachineProfile, JunctionModel, String), Error> {
-    let klipper = pre.klipper_commands
+    let klipper = options.klipper_config.is_some()
+        || pre.klipper_commands
         || pre
             .flavor
             .as_deref()
@@ -68,9 +76,14 @@ fn choose_machine(
             .ok_or_else(|| invalid("unknown machine preset (see plan::profiles::PRESETS)"))?;
         (p, format!("preset '{name}' given in the options"))
     } else if klipper {
+        let why = if options.klipper_config.is_some() {
+            "a Klipper config given in the options"
+        } else {
+            "the file drives Klipper"
+        };
         (
             MachineProfile::preset("voron-klipper").ok_or_else(|| invalid("preset missing"))?,
-            "the file drives Klipper".to_string(),
+            why.to_string(),
         )
     } else {
         (
@@ -102,15 +115,19 @@ pub(crate) struct Setup {
     pub model_reason: String,
     pub limits: crate::plan::Limits,
     pub units: FeedUnits,
+    /// Firmware retraction length and speed the printer's config sets, if it does.
+    pub retract: (Option<f64>, Option<f64>),
 }
 
 impl Setup {
     /// The machine a pass starts with: the file's extrusion mode, everything else at its
     /// power-on state.
     pub fn machine(&self) -> Machine {
+        let default = MachineConfig::default();
         Machine::new(MachineConfig {
             extrusion: self.mode,
-            ..MachineConfig::default()
+            retract_mm: self.retract.0.unwrap_or(default.retract_mm),
+            retract_feed_mm_s: self.retract.1.unwrap_or(default.retract_feed_mm_s),
         })
     }
 }
@@ -149,10 +166,22 @@ pub(crate) fn prepare(input: &[u8], options: &AnalyzeOptions) -> Result<Setup, E
 
     let pre = prescan::prescan(input);
     let (profile, model, model_reason) = choose_machine(options, &pre)?;
-    let mut limits = profile.limits.clone();
-    for (key, value) in &pre.limit_settings {
-        limits.apply_setting(key, value);
-    }
+    let mut limits = match &options.klipper_config {
+        // Klipper takes its limits from its config alone: a slicer's machine_max_* block
+        // describes some other machine.
+        Some(config) => config.limits(&profile.limits, options.klipper_version.unwrap_or_default()),
+        None => {
+            let mut limits = profile.limits.clone();
+            for (key, value) in &pre.limit_settings {
+                limits.apply_setting(key, value);
+            }
+            limits
+        }
+    };
+    let retract = options
+        .klipper_config
+        .as_ref()
+        .map(|c| (c.retract_length, c.retract_speed));
     if let Some(seg) = options.arc_segment_mm {
         limits.arc_segment_mm = Limit {
             value: seg,
@@ -175,6 +204,7 @@ pub(crate) fn prepare(input: &[u8], options: &AnalyzeOptions) -> Result<Setup, E
         model_reason,
         limits,
         units,
+        retract: retract.unwrap_or_default(),
     })
 }
 

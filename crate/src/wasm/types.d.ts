@@ -2,7 +2,7 @@
 // CLI's --json). Checked against real CLI output by tests/js/types.test.mjs. ──
 
 /** Where a machine limit came from, in order of precedence. */
-export type LimitSource = "command" | "slicer_settings" | "profile" | "option";
+export type LimitSource = "command" | "slicer_settings" | "printer_config" | "profile" | "option";
 export interface Limit { value: number; source: LimitSource }
 export type JunctionModel = "classic_jerk" | "junction_deviation" | "klipper";
 /** Machine limits; arrays are per axis X, Y, Z, E. */
@@ -62,6 +62,10 @@ export interface AnalyzeOptions {
   junction_model?: JunctionModel | null;
   arc_segment_mm?: number | null;
   energy?: EnergyOptions | null;
+  /** The printer's Klipper config: the text of its printer.cfg (includes pasted in place). */
+  klipper_config?: string | null;
+  /** How that Klipper reads max_accel_to_decel (default "current"). */
+  klipper_version?: "legacy" | "current" | null;
 }
 export interface Warning { line: number; message: string }
 export type FeatureKind =
