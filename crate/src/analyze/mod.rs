@@ -6,6 +6,7 @@ pub(crate) mod layers;
 mod pipeline;
 pub mod prescan;
 pub mod report;
+pub mod toolpath;
 
 use serde::Deserialize;
 
@@ -14,6 +15,7 @@ use crate::error::{Error, ErrorKind, Warnings};
 use crate::gcode::{self, classify_comment, Marker, SlicerInfo, Strictness};
 use crate::machine::{self, axis, Event, ExtrusionMode, Machine, MachineConfig};
 use crate::plan::{FeedUnits, JunctionModel, Limit, LimitSource, MachineProfile, Planner};
+use crate::progress::Progress;
 use accounting::{Accounts, TimeBook, TimeMsg, Timing};
 pub use report::*;
 
@@ -57,9 +59,6 @@ pub enum ExtrusionModeOption {
     /// `M83`.
     Relative,
 }
-
-/// Progress callback: receives the fraction done (0..=1); returning `false` cancels the job.
-pub type Progress<'p> = &'p mut dyn FnMut(f64) -> bool;
 
 /// Bytes between two progress callbacks.
 const PROGRESS_STEP: usize = 1 << 20;

@@ -30,9 +30,10 @@ pub mod welch;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analyze::{AnalyzeOptions, Progress};
+use crate::analyze::AnalyzeOptions;
 use crate::error::{Error, ErrorKind};
 use crate::path::PrintPath;
+use crate::progress::Progress;
 pub use compare::{compare, VibrationComparison};
 pub use modal::Mode;
 pub use parameters::{Drive, MachineDynamics};

@@ -5,9 +5,9 @@ use super::axis::{Axis, State, TABLE, TABLE_VELOCITY};
 use super::parameters::MachineDynamics;
 use super::trajectory::{Command, Segment};
 use super::welch::Welch;
-use crate::analyze::Progress;
 use crate::error::{Error, ErrorKind};
 use crate::path::NO_LAYER;
+use crate::progress::Progress;
 
 /// Most simulation steps one run may take (about 55 hours of motion at 1 ms).
 pub const MAX_STEPS: f64 = 2e8;

@@ -12,9 +12,10 @@
 
 use super::geom::{rotate, P2};
 use super::program::{Op, Program};
-use crate::analyze::{FanEvent, Report, TemperatureEvent};
+use crate::analyze::Report;
 use crate::energy::{Accumulator, EnergyOptions, MaterialSource};
 use crate::machine::axis;
+use crate::machine::{FanEvent, TemperatureEvent};
 use crate::plan::{Motion, Planner};
 
 /// A part rotation about Z: `p' = R(p − centre) + centre + shift`, applied to moves
@@ -66,7 +67,7 @@ pub(crate) struct Costs {
     pub filament_mm: f64,
     /// VTG trajectory metrics (eq. 24–26, 31) of the new infill strokes alone: the paper's
     /// Fig. 4–5 comparison of patterns by length and turning.
-    pub infill: crate::vtg::metrics::ToolpathMetrics,
+    pub infill: crate::analyze::toolpath::ToolpathMetrics,
 }
 
 /// What replay needs from the original analysis.
@@ -196,8 +197,8 @@ pub(crate) fn replay_blocks(
     let mut next_start = 0usize;
     let mut skip_until = 0usize;
     let mut resume_from: Option<[f64; 3]> = None;
-    let mut infill_metrics = crate::vtg::metrics::MetricsAccumulator::new(
-        crate::vtg::metrics::DEFAULT_CRITICAL_ANGLE_DEG,
+    let mut infill_metrics = crate::analyze::toolpath::MetricsAccumulator::new(
+        crate::analyze::toolpath::DEFAULT_CRITICAL_ANGLE_DEG,
     );
 
     macro_rules! push {

@@ -18,10 +18,11 @@ use super::{
     link, pattern, write, Best, Candidate, InfillOptions, InfillReport, Measured, Objective,
     Pattern,
 };
-use crate::analyze::{analyze, Progress, Report};
+use crate::analyze::{analyze, Report};
 use crate::error::{Error, ErrorKind};
 use crate::gcode::FeatureKind;
 use crate::machine::axis;
+use crate::progress::Progress;
 
 /// Clearance used when the file gives no evidence of its own, mm (a 0.45 mm line with 10 %
 /// overlap).

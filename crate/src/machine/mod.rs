@@ -12,6 +12,7 @@
 
 pub mod arc;
 pub mod extrusion;
+pub mod timeline;
 
 use serde::Serialize;
 
@@ -19,6 +20,7 @@ use crate::error::Warnings;
 use crate::gcode::{Code, Command, Line};
 pub use arc::{Arc, ArcSpec, Plane};
 pub use extrusion::{infer_extrusion_mode, ExtrusionInference, ExtrusionMode, ModeSource};
+pub use timeline::{FanEvent, TemperatureEvent};
 
 /// Number of tracked axes: X, Y, Z, E, A, B, C, U, V, W.
 pub const AXES: usize = 10;

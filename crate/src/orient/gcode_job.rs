@@ -5,13 +5,13 @@ use super::kinematics::Pose;
 use super::metrics::Sample;
 use super::program;
 use super::summary::{self, Counts};
-use super::vec3;
 use super::words;
 use super::{InputFormat, SmoothOptions, SmoothReport};
-use crate::analyze::Progress;
 use crate::error::{Error, Warning};
 use crate::gcode::{self, Edit};
 use crate::path;
+use crate::progress::Progress;
+use crate::vec3;
 
 pub(super) fn run(
     input: &[u8],

@@ -4,10 +4,10 @@ use super::core::{self, RunSettings};
 use super::metrics::Sample;
 use super::points::PointVector;
 use super::summary::{self, Counts};
-use super::vec3::{self, V3};
 use super::{InputFormat, SmoothOptions, SmoothReport};
-use crate::analyze::Progress;
 use crate::error::{Error, ErrorKind};
+use crate::progress::Progress;
+use crate::vec3::{self, V3};
 
 pub(super) fn run(
     input: &[PointVector],

@@ -261,10 +261,12 @@ impl Limits {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plan::profiles::Profile;
+    use crate::plan::profiles::MachineProfile;
 
     fn voron() -> Limits {
-        Profile::preset("voron-klipper").expect("preset").limits
+        MachineProfile::preset("voron-klipper")
+            .expect("preset")
+            .limits
     }
 
     #[test]

@@ -29,7 +29,7 @@ use crate::machine::{axis, Move};
 use crate::math::Bound;
 use junction::Segment;
 pub use limits::{FeedUnits, JunctionModel, Limit, LimitSource, Limits};
-pub use profiles::Profile as MachineProfile;
+pub use profiles::MachineProfile;
 pub use trapezoid::Profile;
 
 /// Blocks kept un-finalised at the end of the window (they may still slow down for what follows).
