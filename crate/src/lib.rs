@@ -177,6 +177,8 @@
 //! - [`infill`]: infill regeneration and the energy-driven search.
 //! - [`orient`]: tool-orientation smoothing for multi-axis toolpaths.
 //! - [`math`]: portable transcendental functions (identical results native and wasm).
+//! - [`vec3`]: 3-vector helpers shared by [`vtg`] and [`orient`].
+//! - [`progress`]: the progress callback every long job takes.
 
 pub mod analyze;
 pub mod dynamics;
@@ -190,7 +192,12 @@ pub mod orient;
 pub mod parallel;
 pub mod path;
 pub mod plan;
+pub mod progress;
 pub mod read;
+pub mod vec3;
+// The rewriter keeps its points in slices and hands them to `vec3` by reference, which the
+// helpers take as well as values (`impl Borrow<V3>`).
+#[allow(clippy::needless_borrows_for_generic_args)]
 pub mod vtg;
 
 #[cfg(target_arch = "wasm32")]

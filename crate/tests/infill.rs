@@ -189,8 +189,8 @@ fn per_layer_hybrid_is_kept_only_when_it_wins() {
 /// mean turn (to the rounding of written coordinates).
 #[test]
 fn pattern_length_and_turning_match_the_written_file() {
+    use quietpath::analyze::toolpath::{MetricsAccumulator, DEFAULT_CRITICAL_ANGLE_DEG};
     use quietpath::gcode::FeatureKind;
-    use quietpath::vtg::metrics::{MetricsAccumulator, DEFAULT_CRITICAL_ANGLE_DEG};
     let input = std::fs::read(data("rect_infill_45.gcode")).unwrap();
     let mut seen = Vec::new();
     for pattern in [

@@ -4,9 +4,10 @@
 
 use proptest::prelude::*;
 use quietpath::orient::{
-    self, cone, quarter_torus, smooth_points, square_tube, vec3, FilterKind, KinematicModel,
-    Kinematics, PartOptions, PointVector, Pose, SmoothOptions, Window,
+    self, cone, quarter_torus, smooth_points, square_tube, FilterKind, KinematicModel, Kinematics,
+    PartOptions, PointVector, Pose, SmoothOptions, Window,
 };
+use quietpath::vec3;
 
 fn unit(p: &PointVector) -> [f64; 3] {
     vec3::normalize([p.i, p.j, p.k]).expect("unit vector")

@@ -1,7 +1,8 @@
 //! Conformance of `orient` on the real corpus: the 5-axis file of Zhang et al. (table-tilting B,
 //! rotary C, multi-turn C) smoothed with the defaults.
 
-use quietpath::orient::{self, vec3, Kinematics, Pose, SmoothOptions};
+use quietpath::orient::{self, Kinematics, Pose, SmoothOptions};
+use quietpath::vec3;
 use quietpath_conformance::corpus_dir;
 
 const FILE: &str = "multiaxis-xyzbc_zhang-ral2021_model1.gcode";

@@ -8,6 +8,7 @@
 use std::collections::{HashMap, VecDeque};
 
 use super::report::{Bounds, FanEvent, FeatureSummary, TemperatureEvent};
+use super::toolpath::{MetricsAccumulator, DEFAULT_CRITICAL_ANGLE_DEG};
 use crate::energy::Accumulator;
 use crate::energy::Material;
 use crate::gcode::{feature_kind, FeatureKind};
@@ -15,7 +16,6 @@ use crate::machine::{Heater, Move};
 use crate::math::Bound;
 use crate::plan::{Limits, Motion, PlannedMove, Planner};
 use crate::read::{LayerTracker, NO_LAYER};
-use crate::vtg::metrics::{MetricsAccumulator, DEFAULT_CRITICAL_ANGLE_DEG};
 
 /// Feature slot of travel moves.
 pub const TRAVEL: u32 = u32::MAX;

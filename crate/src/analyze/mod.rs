@@ -4,12 +4,14 @@
 mod accounting;
 mod pipeline;
 pub mod report;
+pub mod toolpath;
 
 use crate::energy::Accumulator;
 use crate::error::{Error, ErrorKind};
 use crate::gcode::{Line, RawLine, SlicerInfo};
 use crate::machine::{axis, Event, Machine};
 use crate::plan::{Limits, Planner};
+use crate::progress::Progress;
 pub use crate::read::{prescan, AnalyzeOptions, ExtrusionModeOption};
 use crate::read::{At, Flow, Fold, Reader};
 use accounting::{Accounts, TimeBook, TimeMsg, Timing};
@@ -19,9 +21,6 @@ pub use report::*;
 pub const DEFAULT_FILAMENT_DIAMETER_MM: f64 = 1.75;
 /// Default filament density (PLA), g/cm³.
 pub const DEFAULT_DENSITY_G_CM3: f64 = 1.24;
-
-/// Progress callback: receives the fraction done (0..=1); returning `false` cancels the job.
-pub type Progress<'p> = &'p mut dyn FnMut(f64) -> bool;
 
 /// Bytes between two progress callbacks.
 const PROGRESS_STEP: usize = 1 << 20;

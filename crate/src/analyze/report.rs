@@ -5,7 +5,7 @@ use serde::Serialize;
 
 use crate::error::Warning;
 use crate::gcode::FeatureKind;
-use crate::machine::{ExtrusionMode, Heater, ModeSource};
+use crate::machine::{ExtrusionMode, ModeSource};
 pub use crate::read::{LayerSource, LayerSummary};
 
 /// Everything `analyze` says about a file.
@@ -139,68 +139,8 @@ pub struct FeatureSummary {
     pub energy_j: f64,
 }
 
-/// A heater target set at some point of the print.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct TemperatureEvent {
-    /// 1-based line.
-    pub line: u32,
-    /// Print time at that line, s.
-    pub time_s: f64,
-    /// Which heater.
-    pub heater: Heater,
-    /// Target, °C.
-    pub target_c: f64,
-    /// Whether the printer waits for it.
-    pub wait: bool,
-}
+pub use crate::energy::Energy;
+pub use crate::machine::{FanEvent, TemperatureEvent};
 
-/// A fan speed set at some point of the print.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct FanEvent {
-    /// 1-based line.
-    pub line: u32,
-    /// Print time at that line, s.
-    pub time_s: f64,
-    /// Fan index.
-    pub index: u16,
-    /// Speed, 0..=1.
-    pub speed: f64,
-}
-
-/// Energy and carbon figures (see [`crate::energy`] for the models, their units and sources).
-///
-/// `total_j = servo_j + fuse_j + aux_j` (VTG eq. 16); `co2_g` is eq. 17.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct Energy {
-    /// X/Y stepper energy by the thesis model (eq. 28), J. Always computed.
-    pub thesis_j: f64,
-    /// Energy of the X/Y drives, `E_servo`, J (equal to `thesis_j` with the thesis model).
-    pub servo_j: f64,
-    /// Model that gave `servo_j`: `thesis` or `physical`.
-    pub servo_model: crate::energy::ServoModel,
-    /// Heat to melt the filament, `E_fuse`, J.
-    pub fuse_j: f64,
-    /// Heaters, fans and electronics over the print, `E_aux`, J.
-    pub aux_j: f64,
-    /// `E = E_servo + E_fuse + E_aux`, J.
-    pub total_j: f64,
-    /// The same in kWh.
-    pub total_kwh: f64,
-    /// Material mass the fuse and carbon figures use, g.
-    pub material_g: f64,
-    /// Carbon emission `f_e·E + f_m·m`, g CO₂.
-    pub co2_g: f64,
-    /// The thesis terms `A`, `B`, `C`, `H` and the coefficients used.
-    pub thesis: crate::energy::ThesisReport,
-    /// The physical servo model's parts, when it gave `servo_j`.
-    pub physical_servo: Option<crate::energy::ServoReport>,
-    /// How `fuse_j` was computed.
-    pub fuse: crate::energy::FuseReport,
-    /// `aux_j` by system.
-    pub aux: crate::energy::AuxReport,
-    /// `co2_g` by source and the factors used.
-    pub co2: crate::energy::Co2Report,
-}
-
-/// Toolpath metrics of the VTG paper (eq. 24–26, 31), see [`crate::vtg::metrics`].
-pub type Toolpath = crate::vtg::metrics::ToolpathMetrics;
+/// Toolpath metrics of the VTG paper (eq. 24–26, 31), see [`super::toolpath`].
+pub type Toolpath = super::toolpath::ToolpathMetrics;

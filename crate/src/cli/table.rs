@@ -18,7 +18,19 @@ fn duration(s: f64) -> String {
 /// Writes a report as aligned text.
 pub fn write_report(out: &mut impl Write, path: &Path, r: &Report) -> io::Result<()> {
     writeln!(out, "{}", path.display())?;
-    let row = |out: &mut dyn Write, k: &str, v: String| writeln!(out, "  {k:<22} {v}");
+    write_summary(out, r)?;
+    write_energy(out, r)?;
+    write_features(out, r)?;
+    write_warnings(out, r)
+}
+
+/// One `key value` row of the summary.
+fn row(out: &mut dyn Write, k: &str, v: String) -> io::Result<()> {
+    writeln!(out, "  {k:<22} {v}")
+}
+
+/// The file, time, moves, distance, filament, extrusion and bounds rows.
+fn write_summary(out: &mut dyn Write, r: &Report) -> io::Result<()> {
     row(
         out,
         "slicer",
@@ -81,6 +93,11 @@ pub fn write_report(out: &mut impl Write, path: &Path, r: &Report) -> io::Result
             ),
         )?;
     }
+    Ok(())
+}
+
+/// The energy, thesis stepper and CO₂ rows.
+fn write_energy(out: &mut dyn Write, r: &Report) -> io::Result<()> {
     let e = &r.energy;
     row(
         out,
@@ -106,7 +123,11 @@ pub fn write_report(out: &mut impl Write, path: &Path, r: &Report) -> io::Result
             e.thesis_j, e.thesis.a, e.thesis.b, e.thesis.c, e.thesis.h
         ),
     )?;
-    row(out, "CO2", format!("{:.1} g", e.co2_g))?;
+    row(out, "CO2", format!("{:.1} g", e.co2_g))
+}
+
+/// The table of features.
+fn write_features(out: &mut dyn Write, r: &Report) -> io::Result<()> {
     writeln!(
         out,
         "\n  {:<28} {:>8} {:>12} {:>12} {:>10} {:>10}",
@@ -124,6 +145,11 @@ pub fn write_report(out: &mut impl Write, path: &Path, r: &Report) -> io::Result
             f.energy_j
         )?;
     }
+    Ok(())
+}
+
+/// The first 20 warnings and how many more there are.
+fn write_warnings(out: &mut dyn Write, r: &Report) -> io::Result<()> {
     let dropped = r.warnings_dropped;
     if !r.warnings.is_empty() {
         writeln!(out, "\n  warnings ({}):", r.warnings.len() as u64 + dropped)?;

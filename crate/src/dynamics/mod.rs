@@ -30,9 +30,10 @@ pub mod welch;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analyze::{AnalyzeOptions, Progress};
+use crate::analyze::AnalyzeOptions;
 use crate::error::{Error, ErrorKind};
 use crate::path::PrintPath;
+use crate::progress::Progress;
 pub use compare::{compare, VibrationComparison};
 pub use modal::Mode;
 pub use parameters::{Drive, MachineDynamics};
@@ -261,56 +262,14 @@ pub fn vibration_of_path(
         progress,
     )?;
 
-    // Modes in the middle of the printed area.
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for s in &segs {
-        for p in [s.from, s.to] {
-            for ax in 0..2 {
-                lo[ax] = lo[ax].min(p[ax]);
-                hi[ax] = hi[ax].max(p[ax]);
-            }
-        }
-    }
-    let mid = |ax: usize| {
-        let m = 0.5 * (lo[ax] + hi[ax]);
-        if m.is_finite() {
-            m
-        } else {
-            0.0
-        }
-    };
-    let axes: Vec<AxisModes> = [("x", &machine.x), ("y", &machine.y)]
-        .into_iter()
-        .enumerate()
-        .map(|(ax, (name, drive))| AxisModes {
-            axis: name,
-            position_mm: mid(ax),
-            modes: axis::modes(drive, mid(ax) * 1e-3),
-        })
-        .collect();
+    let axes = axis_modes(&segs, &machine);
     let mut all: Vec<Mode> = axes.iter().flat_map(|a| a.modes.iter().copied()).collect();
     all.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
 
     let spectrum = welch.finish();
     let peaks = welch::peaks(&spectrum.freqs, &spectrum.power, options.peaks);
     let d = &outcome.deviation;
-    let layers = outcome
-        .layers
-        .iter()
-        .enumerate()
-        .filter(|(_, l)| l.deviation.count > 0)
-        .map(|(i, l)| LayerVibration {
-            layer: i,
-            z: path.layers.get(i).and_then(|l| l.z),
-            amplitude: l.deviation.max,
-            mean: l.deviation.mean(),
-            acceleration_rms: if l.accel_count > 0 {
-                (l.accel_sq / l.accel_count as f64).sqrt()
-            } else {
-                0.0
-            },
-        })
-        .collect();
+    let layers = layer_vibrations(&outcome, path);
     Ok(VibrationReport {
         machine: path.profile.name.clone(),
         dynamics: machine.name.clone(),
@@ -346,6 +305,57 @@ pub fn vibration_of_path(
         simulated_s: outcome.simulated_s,
         steps: outcome.steps,
     })
+}
+
+/// The modes of each axis in the middle of the printed area.
+fn axis_modes(segs: &[trajectory::Segment], machine: &MachineDynamics) -> Vec<AxisModes> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for s in segs {
+        for p in [s.from, s.to] {
+            for ax in 0..2 {
+                lo[ax] = lo[ax].min(p[ax]);
+                hi[ax] = hi[ax].max(p[ax]);
+            }
+        }
+    }
+    let mid = |ax: usize| {
+        let m = 0.5 * (lo[ax] + hi[ax]);
+        if m.is_finite() {
+            m
+        } else {
+            0.0
+        }
+    };
+    [("x", &machine.x), ("y", &machine.y)]
+        .into_iter()
+        .enumerate()
+        .map(|(ax, (name, drive))| AxisModes {
+            axis: name,
+            position_mm: mid(ax),
+            modes: axis::modes(drive, mid(ax) * 1e-3),
+        })
+        .collect()
+}
+
+/// The vibration of each layer with samples.
+fn layer_vibrations(outcome: &simulate::Outcome, path: &PrintPath) -> Vec<LayerVibration> {
+    outcome
+        .layers
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.deviation.count > 0)
+        .map(|(i, l)| LayerVibration {
+            layer: i,
+            z: path.layers.get(i).and_then(|l| l.z),
+            amplitude: l.deviation.max,
+            mean: l.deviation.mean(),
+            acceleration_rms: if l.accel_count > 0 {
+                (l.accel_sq / l.accel_count as f64).sqrt()
+            } else {
+                0.0
+            },
+        })
+        .collect()
 }
 
 #[cfg(test)]

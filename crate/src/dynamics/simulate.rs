@@ -5,9 +5,9 @@ use super::axis::{Axis, State, TABLE, TABLE_VELOCITY};
 use super::parameters::MachineDynamics;
 use super::trajectory::{Command, Segment};
 use super::welch::Welch;
-use crate::analyze::Progress;
 use crate::error::{Error, ErrorKind};
 use crate::path::NO_LAYER;
+use crate::progress::Progress;
 
 /// Most simulation steps one run may take (about 55 hours of motion at 1 ms).
 pub const MAX_STEPS: f64 = 2e8;
@@ -146,6 +146,104 @@ impl Cursor<'_> {
     }
 }
 
+impl Outcome {
+    /// Nothing simulated yet, over `layers` layers.
+    fn new(layers: usize) -> Self {
+        Outcome {
+            deviation: Stats::default(),
+            max_at: [0.0; 3],
+            printing: Stats::default(),
+            printing_max_at: [0.0; 3],
+            layers: vec![LayerSums::default(); layers],
+            steps: 0,
+            simulated_s: 0.0,
+        }
+    }
+
+    /// A deviation sample `dev` (mm) at X, Y (mm) and time `at`, in layer `layer`.
+    #[inline]
+    fn add_deviation(&mut self, dev: f64, at: [f64; 3], extruding: bool, layer: u32) {
+        if dev > self.deviation.max || self.deviation.count == 0 {
+            self.max_at = at;
+        }
+        self.deviation.add(dev);
+        if extruding {
+            if dev > self.printing.max || self.printing.count == 0 {
+                self.printing_max_at = at;
+            }
+            self.printing.add(dev);
+        }
+        if let Some(l) = self.layers.get_mut(layer as usize) {
+            l.deviation.add(dev);
+        }
+    }
+
+    /// An acceleration sample of the table (X, Y, m/s²) in layer `layer`.
+    #[inline]
+    fn add_acceleration(&mut self, acc: &[f64; 2], layer: u32) {
+        if let Some(l) = self.layers.get_mut(layer as usize) {
+            l.accel_sq += acc[0] * acc[0] + acc[1] * acc[1];
+            l.accel_count += 1;
+        }
+    }
+}
+
+/// One step of both axes from the command `prev` to `next`.
+#[inline]
+fn step_axes(
+    axes: &mut [Axis; 2],
+    x: &mut [State; 2],
+    prev: &Command,
+    next: &Command,
+    ts: f64,
+) -> Result<(), Error> {
+    for ax in 0..2 {
+        let v0 = prev.vel[ax] * 1e-3;
+        let a = (next.vel[ax] - prev.vel[ax]) * 1e-3 / ts;
+        let st = axes[ax].at(prev.pos[ax] * 1e-3).ok_or_else(model_error)?;
+        x[ax] = st.step(&x[ax], v0, a);
+    }
+    Ok(())
+}
+
+/// The table's mean acceleration (X, Y, m/s²) over the `dt` since its velocity was `last_v`,
+/// which becomes its velocity now.
+#[inline]
+fn table_acceleration(next: &Command, x: &[State; 2], last_v: &mut [f64; 2], dt: f64) -> [f64; 2] {
+    let mut acc = [0.0; 2];
+    for ax in 0..2 {
+        let v = next.vel[ax] * 1e-3 + x[ax][TABLE_VELOCITY];
+        acc[ax] = (v - last_v[ax]) / dt;
+        last_v[ax] = v;
+    }
+    acc
+}
+
+/// Steps to the end of `segs` at period `ts` and the most steps the run may take; an error if
+/// their motion would take more.
+fn step_budget(segs: &[Segment], ts: f64) -> Result<(u64, f64), Error> {
+    let end = segs.last().map_or(0.0, |s| s.end_s());
+    // Motion time bounds the work (rests are skipped once the machine is still).
+    let motion: f64 = segs.iter().map(|s| s.duration_s).sum();
+    let steps = motion / ts;
+    let budget = (STEPS_PER_MOVE * segs.len() as f64).clamp(MIN_STEP_BUDGET, MAX_STEPS);
+    if steps.is_nan() || steps > budget || !end.is_finite() || end / ts > u64::MAX as f64 / 2.0 {
+        return Err(too_long());
+    }
+    Ok(((end / ts).ceil() as u64, budget))
+}
+
+fn too_long() -> Error {
+    Error::new(
+        0,
+        0,
+        ErrorKind::InvalidOption {
+            reason: "print too long to simulate at this period (over 2e8 steps, or 2000 \
+                     steps a move); use a longer ts",
+        },
+    )
+}
+
 fn cancelled() -> Error {
     Error::new(0, 0, ErrorKind::Cancelled)
 }
@@ -172,39 +270,13 @@ pub fn run(
     progress: Progress<'_>,
 ) -> Result<Outcome, Error> {
     let ts = settings.ts;
-    let end = segs.last().map_or(0.0, |s| s.end_s());
-    // Motion time bounds the work (rests are skipped once the machine is still).
-    let motion: f64 = segs.iter().map(|s| s.duration_s).sum();
-    let too_long = || {
-        Error::new(
-            0,
-            0,
-            ErrorKind::InvalidOption {
-                reason: "print too long to simulate at this period (over 2e8 steps, or 2000 \
-                         steps a move); use a longer ts",
-            },
-        )
-    };
-    let steps = motion / ts;
-    let budget = (STEPS_PER_MOVE * segs.len() as f64).clamp(MIN_STEP_BUDGET, MAX_STEPS);
-    if steps.is_nan() || steps > budget || !end.is_finite() || end / ts > u64::MAX as f64 / 2.0 {
-        return Err(too_long());
-    }
-    let total = (end / ts).ceil() as u64;
+    let (total, budget) = step_budget(segs, ts)?;
     let mut axes = [
         Axis::new(machine.x, ts, settings.bucket_m),
         Axis::new(machine.y, ts, settings.bucket_m),
     ];
     let mut x = [State::zeros(); 2];
-    let mut out = Outcome {
-        deviation: Stats::default(),
-        max_at: [0.0; 3],
-        printing: Stats::default(),
-        printing_max_at: [0.0; 3],
-        layers: vec![LayerSums::default(); layers],
-        steps: 0,
-        simulated_s: 0.0,
-    };
+    let mut out = Outcome::new(layers);
     let mut cursor = Cursor { segs, j: 0 };
     let (mut prev, _) = cursor.at(0.0);
     // Table velocity (m/s) at the last acceleration sample, and steps since.
@@ -215,46 +287,21 @@ pub fn run(
     while k < total {
         let t1 = (k + 1) as f64 * ts;
         let (next, seg) = cursor.at(t1);
-        for ax in 0..2 {
-            let v0 = prev.vel[ax] * 1e-3;
-            let a = (next.vel[ax] - prev.vel[ax]) * 1e-3 / ts;
-            let st = axes[ax].at(prev.pos[ax] * 1e-3).ok_or_else(model_error)?;
-            x[ax] = st.step(&x[ax], v0, a);
-        }
+        step_axes(&mut axes, &mut x, &prev, &next, ts)?;
         k += 1;
         out.steps += 1;
         let layer = seg.and_then(|i| segs.get(i)).map_or(NO_LAYER, |s| s.layer);
         if seg.is_some() {
             let (dx, dy) = (x[0][TABLE], x[1][TABLE]);
             let dev = (dx * dx + dy * dy).sqrt() * 1e3;
-            if dev > out.deviation.max || out.deviation.count == 0 {
-                out.max_at = [next.pos[0], next.pos[1], t1];
-            }
-            out.deviation.add(dev);
-            if seg.and_then(|i| segs.get(i)).is_some_and(|s| s.extruding) {
-                if dev > out.printing.max || out.printing.count == 0 {
-                    out.printing_max_at = [next.pos[0], next.pos[1], t1];
-                }
-                out.printing.add(dev);
-            }
-            if let Some(l) = out.layers.get_mut(layer as usize) {
-                l.deviation.add(dev);
-            }
+            let extruding = seg.and_then(|i| segs.get(i)).is_some_and(|s| s.extruding);
+            out.add_deviation(dev, [next.pos[0], next.pos[1], t1], extruding, layer);
         }
         since += 1;
         if since >= settings.decimation {
-            let dt = since as f64 * ts;
-            let mut acc = [0.0; 2];
-            for ax in 0..2 {
-                let v = next.vel[ax] * 1e-3 + x[ax][TABLE_VELOCITY];
-                acc[ax] = (v - last_v[ax]) / dt;
-                last_v[ax] = v;
-            }
+            let acc = table_acceleration(&next, &x, &mut last_v, since as f64 * ts);
             welch.push(&acc);
-            if let Some(l) = out.layers.get_mut(layer as usize) {
-                l.accel_sq += acc[0] * acc[0] + acc[1] * acc[1];
-                l.accel_count += 1;
-            }
+            out.add_acceleration(&acc, layer);
             since = 0;
         }
         let mut jumped = false;

@@ -18,8 +18,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::analyze::{FanEvent, TemperatureEvent};
-use crate::machine::Heater;
+use crate::machine::{FanEvent, Heater, TemperatureEvent};
 
 /// Powers and heat capacities of the auxiliary systems.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

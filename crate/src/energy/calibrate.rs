@@ -306,55 +306,14 @@ pub fn parse_csv(text: &str) -> Result<CsvRows, CalibrationError> {
 
 /// Ordinary least squares of `e` on `a`, `b`, `c`, `h` without intercept.
 pub fn fit(rows: &[Observation]) -> Result<Calibration, CalibrationError> {
+    check_rows(rows)?;
     let n = rows.len();
-    if n == 0 {
-        return Err(CalibrationError::Empty);
-    }
-    if n <= P {
-        return Err(CalibrationError::TooFewRows {
-            needed: P + 1,
-            found: n,
-        });
-    }
-    for r in rows {
-        for (column, v) in [r.a, r.b, r.c, r.h, r.e].into_iter().enumerate() {
-            if !v.is_finite() || v < 0.0 {
-                return Err(CalibrationError::OutOfRange {
-                    row: r.row,
-                    column: column + 1,
-                    value: v,
-                });
-            }
-        }
-    }
     let x = DMatrix::from_fn(n, P, |i, j| {
         let r = &rows[i];
         [r.a, r.b, r.c, r.h][j]
     });
     let y = DVector::from_iterator(n, rows.iter().map(|r| r.e));
-    // Scale columns to unit norm: the rank test is then relative, and the triangular solve
-    // works on numbers of one magnitude.
-    let scale: Vec<f64> = (0..P).map(|j| x.column(j).norm()).collect();
-    if let Some(j) = scale.iter().position(|&s| s == 0.0 || !s.is_finite()) {
-        return Err(CalibrationError::RankDeficient { rank: j.min(P - 1) });
-    }
-    let mut xs = x.clone();
-    for (j, s) in scale.iter().enumerate() {
-        xs.column_mut(j).unscale_mut(*s);
-    }
-    let qr = xs.qr();
-    let r = qr.r();
-    let rank = (0..P).filter(|&j| r[(j, j)].abs() > 1e-10).count();
-    if rank < P {
-        return Err(CalibrationError::RankDeficient { rank });
-    }
-    let mut qty = y.clone();
-    qr.q_tr_mul(&mut qty);
-    let qty = qty.rows(0, P).into_owned();
-    let beta_scaled = r
-        .solve_upper_triangular(&qty)
-        .ok_or(CalibrationError::RankDeficient { rank })?;
-    let beta: Vec<f64> = (0..P).map(|j| beta_scaled[j] / scale[j]).collect();
+    let LeastSquares { beta, r_inv, scale } = solve(&x, &y)?;
 
     let predicted = &x * DVector::from_column_slice(&beta);
     let residual = &y - &predicted;
@@ -369,9 +328,6 @@ pub fn fit(rows: &[Observation]) -> Result<Calibration, CalibrationError> {
     };
     let sigma2 = ss_res / df;
     // Covariance of the coefficients: σ²·(RᵀR)⁻¹, in scaled units.
-    let r_inv = r
-        .solve_upper_triangular(&DMatrix::identity(P, P))
-        .ok_or(CalibrationError::RankDeficient { rank })?;
     let se: Vec<f64> = (0..P)
         .map(|j| (sigma2 * r_inv.row(j).norm_squared()).sqrt() / scale[j])
         .collect();
@@ -420,6 +376,74 @@ pub fn fit(rows: &[Observation]) -> Result<Calibration, CalibrationError> {
             })
             .collect(),
     })
+}
+
+/// Enough rows for the fit, every value finite and non-negative.
+fn check_rows(rows: &[Observation]) -> Result<(), CalibrationError> {
+    let n = rows.len();
+    if n == 0 {
+        return Err(CalibrationError::Empty);
+    }
+    if n <= P {
+        return Err(CalibrationError::TooFewRows {
+            needed: P + 1,
+            found: n,
+        });
+    }
+    for r in rows {
+        for (column, v) in [r.a, r.b, r.c, r.h, r.e].into_iter().enumerate() {
+            if !v.is_finite() || v < 0.0 {
+                return Err(CalibrationError::OutOfRange {
+                    row: r.row,
+                    column: column + 1,
+                    value: v,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A least-squares fit, in the units of the data.
+struct LeastSquares {
+    /// The coefficients.
+    beta: Vec<f64>,
+    /// The inverse of the `R` of the scaled columns' QR decomposition (the covariance is
+    /// `σ²·(RᵀR)⁻¹` in scaled units).
+    r_inv: DMatrix<f64>,
+    /// Norms the columns were scaled by.
+    scale: Vec<f64>,
+}
+
+/// The least-squares fit of `y` on the columns of `x`.
+fn solve(x: &DMatrix<f64>, y: &DVector<f64>) -> Result<LeastSquares, CalibrationError> {
+    // Scale columns to unit norm: the rank test is then relative, and the triangular solve
+    // works on numbers of one magnitude.
+    let scale: Vec<f64> = (0..P).map(|j| x.column(j).norm()).collect();
+    if let Some(j) = scale.iter().position(|&s| s == 0.0 || !s.is_finite()) {
+        return Err(CalibrationError::RankDeficient { rank: j.min(P - 1) });
+    }
+    let mut xs = x.clone();
+    for (j, s) in scale.iter().enumerate() {
+        xs.column_mut(j).unscale_mut(*s);
+    }
+    let qr = xs.qr();
+    let r = qr.r();
+    let rank = (0..P).filter(|&j| r[(j, j)].abs() > 1e-10).count();
+    if rank < P {
+        return Err(CalibrationError::RankDeficient { rank });
+    }
+    let mut qty = y.clone();
+    qr.q_tr_mul(&mut qty);
+    let qty = qty.rows(0, P).into_owned();
+    let beta_scaled = r
+        .solve_upper_triangular(&qty)
+        .ok_or(CalibrationError::RankDeficient { rank })?;
+    let beta: Vec<f64> = (0..P).map(|j| beta_scaled[j] / scale[j]).collect();
+    let r_inv = r
+        .solve_upper_triangular(&DMatrix::identity(P, P))
+        .ok_or(CalibrationError::RankDeficient { rank })?;
+    Ok(LeastSquares { beta, r_inv, scale })
 }
 
 /// `P(F > f)` for an F distribution with `d1` and `d2` degrees of freedom:

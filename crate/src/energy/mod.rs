@@ -33,8 +33,7 @@ pub mod thesis;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analyze::{Energy, FanEvent, TemperatureEvent};
-use crate::machine::Heater;
+use crate::machine::{FanEvent, Heater, TemperatureEvent};
 use crate::plan::PlannedMove;
 pub use auxiliary::{AuxPowers, AuxReport};
 pub use calibrate::{fit, parse_csv, Calibration, CalibrationError, CsvRows, Observation};
@@ -64,6 +63,41 @@ pub enum ServoModel {
     Thesis,
     /// The physical servo model with [`EnergyOptions::servo`].
     Physical,
+}
+
+/// Energy and carbon figures (see [`crate::energy`] for the models, their units and sources).
+///
+/// `total_j = servo_j + fuse_j + aux_j` (VTG eq. 16); `co2_g` is eq. 17.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Energy {
+    /// X/Y stepper energy by the thesis model (eq. 28), J. Always computed.
+    pub thesis_j: f64,
+    /// Energy of the X/Y drives, `E_servo`, J (equal to `thesis_j` with the thesis model).
+    pub servo_j: f64,
+    /// Model that gave `servo_j`: `thesis` or `physical`.
+    pub servo_model: ServoModel,
+    /// Heat to melt the filament, `E_fuse`, J.
+    pub fuse_j: f64,
+    /// Heaters, fans and electronics over the print, `E_aux`, J.
+    pub aux_j: f64,
+    /// `E = E_servo + E_fuse + E_aux`, J.
+    pub total_j: f64,
+    /// The same in kWh.
+    pub total_kwh: f64,
+    /// Material mass the fuse and carbon figures use, g.
+    pub material_g: f64,
+    /// Carbon emission `f_e·E + f_m·m`, g CO₂.
+    pub co2_g: f64,
+    /// The thesis terms `A`, `B`, `C`, `H` and the coefficients used.
+    pub thesis: ThesisReport,
+    /// The physical servo model's parts, when it gave `servo_j`.
+    pub physical_servo: Option<ServoReport>,
+    /// How `fuse_j` was computed.
+    pub fuse: FuseReport,
+    /// `aux_j` by system.
+    pub aux: AuxReport,
+    /// `co2_g` by source and the factors used.
+    pub co2: Co2Report,
 }
 
 /// Settings of the energy models; every field is optional in JSON.

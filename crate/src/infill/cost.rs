@@ -11,10 +11,12 @@
 //! Replaying skips the parser and the machine, so it costs a fraction of an `analyze` pass.
 
 use super::geom::{rotate, P2};
-use super::program::{Op, Program};
-use crate::analyze::{FanEvent, Report, TemperatureEvent};
+use super::program::{Mv, Op, Program};
+use crate::analyze::toolpath::ToolpathMetrics;
+use crate::analyze::Report;
 use crate::energy::{Accumulator, EnergyOptions, MaterialSource};
 use crate::machine::axis;
+use crate::machine::{FanEvent, TemperatureEvent};
 use crate::plan::{Motion, Planner};
 
 /// A part rotation about Z: `p' = R(p − centre) + centre + shift`, applied to moves
@@ -66,7 +68,7 @@ pub(crate) struct Costs {
     pub filament_mm: f64,
     /// VTG trajectory metrics (eq. 24–26, 31) of the new infill strokes alone: the paper's
     /// Fig. 4–5 comparison of patterns by length and turning.
-    pub infill: crate::vtg::metrics::ToolpathMetrics,
+    pub infill: ToolpathMetrics,
 }
 
 /// What replay needs from the original analysis.
@@ -164,158 +166,164 @@ pub(crate) fn replay_blocks(
     base: &Baseline,
     per_block: Option<&mut Vec<[f64; 2]>>,
 ) -> Costs {
-    let mut planner = Planner::new(prog.limits.clone(), prog.model);
-    let mut book = Book {
-        energy: Accumulator::new(&base.energy, &prog.profile.name),
-        temperatures: Vec::new(),
-        fans: Vec::new(),
-        pending: Default::default(),
-        owner: Vec::new(),
-        per_block,
-    };
-    if let Some(pb) = book.per_block.as_deref_mut() {
-        pb.clear();
-        pb.resize(prog.blocks.len(), [0.0; 2]);
-    }
-    if let Some(m) = base.material_from_file {
-        book.energy.set_material_from_file(m);
-    }
-    let track = book.per_block.is_some();
-    let mut seq: u64 = 0;
-    let mut length = 0.0;
+    let mut run = Replay::new(prog, base, per_block);
     let mut filament = base.filament_mm;
-    // Block starts: move index -> block index.
-    let mut starts: Vec<(usize, usize)> = prog
-        .blocks
-        .iter()
-        .enumerate()
-        .filter(|(b, _)| replace.get(*b).is_some_and(|r| r.is_some()))
-        .map(|(b, blk)| (blk.first, b))
-        .collect();
-    starts.sort_unstable();
+    let starts = replaced_starts(prog, replace);
     let mut next_start = 0usize;
     let mut skip_until = 0usize;
     let mut resume_from: Option<[f64; 3]> = None;
-    let mut infill_metrics = crate::vtg::metrics::MetricsAccumulator::new(
-        crate::vtg::metrics::DEFAULT_CRITICAL_ANGLE_DEG,
+    let mut infill_metrics = crate::analyze::toolpath::MetricsAccumulator::new(
+        crate::analyze::toolpath::DEFAULT_CRITICAL_ANGLE_DEG,
     );
-
-    macro_rules! push {
-        ($m:expr, $owner:expr) => {{
-            let m: Motion = $m;
-            length += motion_length(&m);
-            if track {
-                book.owner.push($owner);
+    for op in &prog.ops {
+        let Op::Move(i) = op else {
+            run.other(op);
+            continue;
+        };
+        let i = *i;
+        if i < skip_until {
+            continue;
+        }
+        if let Some(&(first, b)) = starts.get(next_start) {
+            if first == i {
+                next_start += 1;
+                let blk = &prog.blocks[b];
+                skip_until = blk.end;
+                let orig = prog
+                    .moves
+                    .get(blk.first..blk.end)
+                    .map_or(0.0, |ms| ms.iter().map(|m| m.m.extrusion()).sum::<f64>());
+                filament -= orig;
+                if let Some(r) = &replace[b] {
+                    // Turning and length need directions only: positions from the
+                    // block's start.
+                    let mut at = [0.0f64; 3];
+                    for m in &r.motions {
+                        filament += m.delta[3];
+                        let to = [at[0] + m.delta[0], at[1] + m.delta[1], at[2] + m.delta[2]];
+                        infill_metrics.push(&at, &to, None, m.delta[3] > 0.0, b as u32, true);
+                        at = to;
+                        run.push(*m, b as u32);
+                    }
+                    resume_from = Some(r.end);
+                }
+                continue;
             }
-            planner.push(&m, seq, &mut |pm| book.planned(pm));
-            seq += 1;
-        }};
+        }
+        let Some(mv) = prog.moves.get(i) else {
+            continue;
+        };
+        let mut m = rotated_motion(mv, i, rotation);
+        if let Some(end) = resume_from {
+            resume_from = resume(&mut m, mv, i, rotation, end);
+        }
+        run.push(m, u32::MAX);
+    }
+    run.finish(base, filament, infill_metrics.finish())
+}
+
+/// The planner and the books of one replay.
+struct Replay<'a> {
+    planner: Planner,
+    book: Book<'a>,
+    /// Motions pushed so far (the tag of the next).
+    seq: u64,
+    /// Length of the motions pushed, mm.
+    length: f64,
+    /// Whether `book.owner` is kept (for `per_block`).
+    track: bool,
+}
+
+impl<'a> Replay<'a> {
+    fn new(prog: &Program, base: &Baseline, per_block: Option<&'a mut Vec<[f64; 2]>>) -> Self {
+        let mut book = Book {
+            energy: Accumulator::new(&base.energy, &prog.profile.name),
+            temperatures: Vec::new(),
+            fans: Vec::new(),
+            pending: Default::default(),
+            owner: Vec::new(),
+            per_block,
+        };
+        if let Some(pb) = book.per_block.as_deref_mut() {
+            pb.clear();
+            pb.resize(prog.blocks.len(), [0.0; 2]);
+        }
+        if let Some(m) = base.material_from_file {
+            book.energy.set_material_from_file(m);
+        }
+        let track = book.per_block.is_some();
+        Self {
+            planner: Planner::new(prog.limits.clone(), prog.model),
+            book,
+            seq: 0,
+            length: 0.0,
+            track,
+        }
     }
 
-    for op in &prog.ops {
+    /// Plans motion `m`, owned by block `owner` (`u32::MAX`: by none).
+    fn push(&mut self, m: Motion, owner: u32) {
+        self.length += motion_length(&m);
+        if self.track {
+            self.book.owner.push(owner);
+        }
+        let book = &mut self.book;
+        self.planner.push(&m, self.seq, &mut |pm| book.planned(pm));
+        self.seq += 1;
+    }
+
+    fn flush(&mut self) {
+        let book = &mut self.book;
+        self.planner.flush(&mut |pm| book.planned(pm));
+    }
+
+    /// The costs once every operation is replayed, with `filament` mm of net filament.
+    fn finish(mut self, base: &Baseline, filament: f64, infill: ToolpathMetrics) -> Costs {
+        self.flush();
+        let time_s = self.planner.elapsed_s();
+        self.book.stamp(u64::MAX, time_s);
+        let Book {
+            energy,
+            temperatures,
+            fans,
+            ..
+        } = self.book;
+        let material_g = if base.filament_mm > 0.0 {
+            base.material_g * filament / base.filament_mm
+        } else {
+            base.material_g
+        };
+        let e = energy.finish(time_s, material_g, &temperatures, &fans);
+        Costs {
+            time_s,
+            thesis_j: e.thesis_j,
+            total_j: e.total_j,
+            length_mm: self.length,
+            filament_mm: filament,
+            infill,
+        }
+    }
+
+    /// Any operation but a move.
+    fn other(&mut self, op: &Op) {
         match op {
-            Op::Move(i) => {
-                let i = *i;
-                if i < skip_until {
-                    continue;
-                }
-                if let Some(&(first, b)) = starts.get(next_start) {
-                    if first == i {
-                        next_start += 1;
-                        let blk = &prog.blocks[b];
-                        skip_until = blk.end;
-                        let orig = prog
-                            .moves
-                            .get(blk.first..blk.end)
-                            .map_or(0.0, |ms| ms.iter().map(|m| m.m.extrusion()).sum::<f64>());
-                        filament -= orig;
-                        if let Some(r) = &replace[b] {
-                            // Turning and length need directions only: positions from the
-                            // block's start.
-                            let mut at = [0.0f64; 3];
-                            for m in &r.motions {
-                                filament += m.delta[3];
-                                let to =
-                                    [at[0] + m.delta[0], at[1] + m.delta[1], at[2] + m.delta[2]];
-                                infill_metrics.push(
-                                    &at,
-                                    &to,
-                                    None,
-                                    m.delta[3] > 0.0,
-                                    b as u32,
-                                    true,
-                                );
-                                at = to;
-                                push!(*m, b as u32);
-                            }
-                            resume_from = Some(r.end);
-                        }
-                        continue;
-                    }
-                }
-                let Some(mv) = prog.moves.get(i) else {
-                    continue;
-                };
-                let mut m = Motion::from(&mv.m);
-                if let Some(r) = rotation {
-                    let from = [mv.m.from[axis::X], mv.m.from[axis::Y]];
-                    let to = [mv.m.to[axis::X], mv.m.to[axis::Y]];
-                    // As the rewritten lines give them (0.001 mm).
-                    let f = if i > r.first && i <= r.last + 1 {
-                        r.apply_r3(from)
-                    } else {
-                        from
-                    };
-                    let t = if r.covers(i) { r.apply_r3(to) } else { to };
-                    m.delta[0] = t[0] - f[0];
-                    m.delta[1] = t[1] - f[1];
-                    if r.covers(i) {
-                        if let Some(a) = m.arc.as_mut() {
-                            a.center = r.apply(a.center);
-                            a.start_angle += crate::math::atan2(r.cs.1, r.cs.0);
-                        }
-                    }
-                }
-                // Moves after new infill start where the new infill ended: the axes a line
-                // does not name stay there (a Z lift or a retraction stays put; a rotated
-                // line names both).
-                if let Some(end) = resume_from {
-                    let rotated = rotation.is_some_and(|r| r.covers(i));
-                    let to = [mv.m.to[axis::X], mv.m.to[axis::Y]];
-                    let moves_xy = to != [mv.m.from[axis::X], mv.m.from[axis::Y]];
-                    let names = if rotated && moves_xy {
-                        [true; 2]
-                    } else {
-                        mv.names
-                    };
-                    let t = match rotation {
-                        Some(r) if rotated => r.apply_r3(to),
-                        _ => to,
-                    };
-                    let x = if names[0] { t[0] } else { end[0] };
-                    let y = if names[1] { t[1] } else { end[1] };
-                    m.delta[0] = x - end[0];
-                    m.delta[1] = y - end[1];
-                    m.delta[2] = mv.m.to[axis::Z] - end[2];
-                    resume_from = (!names[0] || !names[1]).then_some([x, y, mv.m.to[axis::Z]]);
-                }
-                push!(m, u32::MAX);
-            }
+            Op::Move(_) => {}
             Op::Dwell(secs) => {
-                planner.flush(&mut |pm| book.planned(pm));
-                book.stamp(u64::MAX, planner.elapsed_s());
-                planner.dwell(*secs, &mut |pm| book.planned(pm));
-                book.energy.dwell(*secs);
+                self.flush();
+                self.book.stamp(u64::MAX, self.planner.elapsed_s());
+                let book = &mut self.book;
+                self.planner.dwell(*secs, &mut |pm| book.planned(pm));
+                self.book.energy.dwell(*secs);
             }
-            Op::Flush => planner.flush(&mut |pm| book.planned(pm)),
-            Op::Limits(l) => *planner.limits_mut() = (**l).clone(),
+            Op::Flush => self.flush(),
+            Op::Limits(l) => *self.planner.limits_mut() = (**l).clone(),
             Op::Temperature {
                 line,
                 heater,
                 target_c,
                 wait,
-            } => book.pending.push_back((
-                seq,
+            } => self.book.pending.push_back((
+                self.seq,
                 Pending::T(TemperatureEvent {
                     line: *line,
                     time_s: 0.0,
@@ -324,8 +332,8 @@ pub(crate) fn replay_blocks(
                     wait: *wait,
                 }),
             )),
-            Op::Fan { line, index, speed } => book.pending.push_back((
-                seq,
+            Op::Fan { line, index, speed } => self.book.pending.push_back((
+                self.seq,
                 Pending::F(FanEvent {
                     line: *line,
                     time_s: 0.0,
@@ -335,27 +343,73 @@ pub(crate) fn replay_blocks(
             )),
         }
     }
-    planner.flush(&mut |pm| book.planned(pm));
-    let time_s = planner.elapsed_s();
-    book.stamp(u64::MAX, time_s);
-    let Book {
-        energy,
-        temperatures,
-        fans,
-        ..
-    } = book;
-    let material_g = if base.filament_mm > 0.0 {
-        base.material_g * filament / base.filament_mm
-    } else {
-        base.material_g
-    };
-    let e = energy.finish(time_s, material_g, &temperatures, &fans);
-    Costs {
-        time_s,
-        thesis_j: e.thesis_j,
-        total_j: e.total_j,
-        length_mm: length,
-        filament_mm: filament,
-        infill: infill_metrics.finish(),
+}
+
+/// Blocks replaced, as (first move, block index), in file order.
+fn replaced_starts(prog: &Program, replace: &[Option<Replacement>]) -> Vec<(usize, usize)> {
+    let mut starts: Vec<(usize, usize)> = prog
+        .blocks
+        .iter()
+        .enumerate()
+        .filter(|(b, _)| replace.get(*b).is_some_and(|r| r.is_some()))
+        .map(|(b, blk)| (blk.first, b))
+        .collect();
+    starts.sort_unstable();
+    starts
+}
+
+/// The motion of move `i` of the file, turned with the part when `rotation` covers it.
+fn rotated_motion(mv: &Mv, i: usize, rotation: Option<&Rotation>) -> Motion {
+    let mut m = Motion::from(&mv.m);
+    if let Some(r) = rotation {
+        let from = [mv.m.from[axis::X], mv.m.from[axis::Y]];
+        let to = [mv.m.to[axis::X], mv.m.to[axis::Y]];
+        // As the rewritten lines give them (0.001 mm).
+        let f = if i > r.first && i <= r.last + 1 {
+            r.apply_r3(from)
+        } else {
+            from
+        };
+        let t = if r.covers(i) { r.apply_r3(to) } else { to };
+        m.delta[0] = t[0] - f[0];
+        m.delta[1] = t[1] - f[1];
+        if r.covers(i) {
+            if let Some(a) = m.arc.as_mut() {
+                a.center = r.apply(a.center);
+                a.start_angle += crate::math::atan2(r.cs.1, r.cs.0);
+            }
+        }
     }
+    m
+}
+
+/// Moves after new infill start where the new infill ended (`end`): the axes a line does not
+/// name stay there (a Z lift or a retraction stays put; a rotated line names both). Sets the
+/// motion `m` of move `i` from there; the point the next move starts from when this one still
+/// leaves an axis where the infill ended.
+fn resume(
+    m: &mut Motion,
+    mv: &Mv,
+    i: usize,
+    rotation: Option<&Rotation>,
+    end: [f64; 3],
+) -> Option<[f64; 3]> {
+    let rotated = rotation.is_some_and(|r| r.covers(i));
+    let to = [mv.m.to[axis::X], mv.m.to[axis::Y]];
+    let moves_xy = to != [mv.m.from[axis::X], mv.m.from[axis::Y]];
+    let names = if rotated && moves_xy {
+        [true; 2]
+    } else {
+        mv.names
+    };
+    let t = match rotation {
+        Some(r) if rotated => r.apply_r3(to),
+        _ => to,
+    };
+    let x = if names[0] { t[0] } else { end[0] };
+    let y = if names[1] { t[1] } else { end[1] };
+    m.delta[0] = x - end[0];
+    m.delta[1] = y - end[1];
+    m.delta[2] = mv.m.to[axis::Z] - end[2];
+    (!names[0] || !names[1]).then_some([x, y, mv.m.to[axis::Z]])
 }

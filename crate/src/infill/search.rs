@@ -18,10 +18,11 @@ use super::{
     link, pattern, write, Best, Candidate, InfillOptions, InfillReport, Measured, Objective,
     Pattern,
 };
-use crate::analyze::{analyze, Progress, Report};
+use crate::analyze::{analyze, Report};
 use crate::error::{Error, ErrorKind};
 use crate::gcode::FeatureKind;
 use crate::machine::axis;
+use crate::progress::Progress;
 
 /// Clearance used when the file gives no evidence of its own, mm (a 0.45 mm line with 10 %
 /// overlap).
@@ -81,106 +82,15 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
         }
     }
     let clearance = region::clearance(&prog, &by_layer).unwrap_or(DEFAULT_CLEARANCE_MM);
-    let mut blocks_of: HashMap<usize, Vec<usize>> = HashMap::new();
-    for (b, blk) in prog.blocks.iter().enumerate() {
-        blocks_of.entry(blk.layer).or_default().push(b);
-    }
-    let mut layers: Vec<usize> = blocks_of.keys().copied().collect();
-    layers.sort_unstable();
-    let mut work = Vec::new();
-    for layer in layers {
-        let blocks = blocks_of.remove(&layer).unwrap_or_default();
-        let Some(idx) = by_layer.get(layer) else {
-            continue;
-        };
-        let moves: Vec<_> = idx
-            .iter()
-            .filter_map(|&i| prog.moves.get(i).copied())
-            .collect();
-        let Some(region) = region::extract(&moves, clearance) else {
-            continue;
-        };
-        let (e, l) = blocks
-            .iter()
-            .filter_map(|&b| prog.blocks.get(b))
-            .flat_map(|b| prog.moves.get(b.first..b.end).unwrap_or(&[]))
-            .filter(|m| m.m.is_extruding())
-            .fold((0.0, 0.0), |(e, l), m| {
-                (e + m.m.extrusion(), l + m.m.length_mm)
-            });
-        // Guard: the file's own sparse infill must lie in the region we found (at least 80 %
-        // of its length, judged by move midpoints); otherwise the walls did not describe the
-        // infill area (open or unmarked walls) and the layer is left as it is.
-        let (inside_mm, all_mm) = blocks
-            .iter()
-            .filter_map(|&b| prog.blocks.get(b))
-            .flat_map(|b| prog.moves.get(b.first..b.end).unwrap_or(&[]))
-            .filter(|m| m.m.is_extruding())
-            .fold((0.0, 0.0), |(i, a), m| {
-                let mid = [
-                    0.5 * (m.m.from[axis::X] + m.m.to[axis::X]),
-                    0.5 * (m.m.from[axis::Y] + m.m.to[axis::Y]),
-                ];
-                let inside = super::geom::inside_tol(&region.region, mid, clearance);
-                (
-                    i + if inside { m.m.length_mm } else { 0.0 },
-                    a + m.m.length_mm,
-                )
-            });
-        if inside_mm < 0.8 * all_mm {
-            continue;
-        }
-        let Some(first) = blocks.first().and_then(|&b| prog.blocks.get(b)) else {
-            continue;
-        };
-        let p = first.machine.position();
-        if l > 0.0 {
-            work.push(Work {
-                layer,
-                start: [p[axis::X], p[axis::Y]],
-                blocks,
-                region,
-                target_mm: l,
-                nominal_mm: 0.0,
-                e_per_mm: e / l,
-            });
-        }
-    }
+    let mut work = work_items(&prog, &by_layer, clearance);
     if work.is_empty() {
         return Err(invalid(
             "no layer has a sparse-infill region inside closed walls",
         ));
     }
-    let spacing = options.spacing_mm.unwrap_or_else(|| {
-        let a: f64 = work.iter().map(|w| w.region.area_mm2).sum();
-        let l: f64 = work.iter().map(|w| w.target_mm).sum();
-        let estimate = a / l;
-        let lines: Vec<Line> = work
-            .iter()
-            .flat_map(|w| w.blocks.iter().map(move |&b| (w.layer, b)))
-            .filter_map(|(layer, b)| prog.blocks.get(b).map(|blk| (layer, blk)))
-            .flat_map(|(layer, blk)| {
-                prog.moves
-                    .get(blk.first..blk.end)
-                    .unwrap_or(&[])
-                    .iter()
-                    .map(move |m| (layer, m))
-            })
-            .filter(|(_, m)| m.m.is_extruding() && m.m.length_mm > 3.0 * estimate)
-            .map(|(layer, m)| {
-                let (dx, dy) = (m.m.to[0] - m.m.from[0], m.m.to[1] - m.m.from[1]);
-                Line {
-                    layer,
-                    dir_deg: crate::math::atan2(dy, dx).to_degrees().rem_euclid(180.0),
-                    mid: [
-                        0.5 * (m.m.to[0] + m.m.from[0]),
-                        0.5 * (m.m.to[1] + m.m.from[1]),
-                    ],
-                }
-            })
-            .collect();
-        super::spacing::measured(&lines, estimate).unwrap_or(estimate)
-    });
+    let spacing = options
+        .spacing_mm
+        .unwrap_or_else(|| measured_spacing(&prog, &work));
     // Each layer's target: the length of the equivalent rectilinear lines over its area.
     for w in &mut work {
         w.nominal_mm = w.region.area_mm2 / spacing;
@@ -190,15 +100,7 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
             "could not measure a line spacing from the file's infill",
         ));
     }
-    // The print: from the first to the last move of a printed feature.
-    let printed = |i: &usize| {
-        prog.moves.get(*i).is_some_and(|m| {
-            m.layer != u32::MAX && !matches!(m.kind, None | Some(FeatureKind::Other))
-        })
-    };
-    let first = (0..prog.moves.len()).find(printed);
-    let last = (0..prog.moves.len()).rev().find(printed);
-    let zone = first.zip(last);
+    let zone = print_zone(&prog);
     let pts: Vec<P2> = zone
         .map(|(a, b)| {
             prog.moves[a..=b]
@@ -210,22 +112,7 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
         .unwrap_or_default();
     let b = bbox(&pts).unwrap_or([0.0; 4]);
     let centre = [0.5 * (b[0] + b[2]), 0.5 * (b[1] + b[3])];
-    let bed = prog.bed.unwrap_or_else(|| {
-        let all = bbox(
-            prog.moves
-                .iter()
-                .map(|m| [m.m.to[0], m.m.to[1]])
-                .collect::<Vec<_>>()
-                .iter(),
-        )
-        .unwrap_or([0.0; 4]);
-        [
-            all[0].min(0.0),
-            all[1].min(0.0),
-            all[2].max(200.0),
-            all[3].max(200.0),
-        ]
-    });
+    let bed = prog.bed.unwrap_or_else(|| bed_of_moves(&prog));
     let base = Baseline::new(&before, options.analyze.energy.clone().unwrap_or_default());
     Ok(Prepared {
         input,
@@ -240,6 +127,149 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
         centre,
         bed,
     })
+}
+
+/// The layers whose sparse infill can be regenerated, in order (`by_layer`: the moves of each
+/// layer).
+fn work_items(prog: &Program, by_layer: &[Vec<usize>], clearance: f64) -> Vec<Work> {
+    let mut blocks_of: HashMap<usize, Vec<usize>> = HashMap::new();
+    for (b, blk) in prog.blocks.iter().enumerate() {
+        blocks_of.entry(blk.layer).or_default().push(b);
+    }
+    let mut layers: Vec<usize> = blocks_of.keys().copied().collect();
+    layers.sort_unstable();
+    let mut work = Vec::new();
+    for layer in layers {
+        let blocks = blocks_of.remove(&layer).unwrap_or_default();
+        let Some(idx) = by_layer.get(layer) else {
+            continue;
+        };
+        if let Some(w) = work_item(prog, layer, blocks, idx, clearance) {
+            work.push(w);
+        }
+    }
+    work
+}
+
+/// Layer `layer` with sparse-infill blocks `blocks` and moves `idx` as a work item, if its
+/// infill region is found and holds the file's own infill.
+fn work_item(
+    prog: &Program,
+    layer: usize,
+    blocks: Vec<usize>,
+    idx: &[usize],
+    clearance: f64,
+) -> Option<Work> {
+    let moves: Vec<_> = idx
+        .iter()
+        .filter_map(|&i| prog.moves.get(i).copied())
+        .collect();
+    let region = region::extract(&moves, clearance)?;
+    let (e, l) = blocks
+        .iter()
+        .filter_map(|&b| prog.blocks.get(b))
+        .flat_map(|b| prog.moves.get(b.first..b.end).unwrap_or(&[]))
+        .filter(|m| m.m.is_extruding())
+        .fold((0.0, 0.0), |(e, l), m| {
+            (e + m.m.extrusion(), l + m.m.length_mm)
+        });
+    // Guard: the file's own sparse infill must lie in the region we found (at least 80 %
+    // of its length, judged by move midpoints); otherwise the walls did not describe the
+    // infill area (open or unmarked walls) and the layer is left as it is.
+    let (inside_mm, all_mm) = blocks
+        .iter()
+        .filter_map(|&b| prog.blocks.get(b))
+        .flat_map(|b| prog.moves.get(b.first..b.end).unwrap_or(&[]))
+        .filter(|m| m.m.is_extruding())
+        .fold((0.0, 0.0), |(i, a), m| {
+            let mid = [
+                0.5 * (m.m.from[axis::X] + m.m.to[axis::X]),
+                0.5 * (m.m.from[axis::Y] + m.m.to[axis::Y]),
+            ];
+            let inside = super::geom::inside_tol(&region.region, mid, clearance);
+            (
+                i + if inside { m.m.length_mm } else { 0.0 },
+                a + m.m.length_mm,
+            )
+        });
+    if inside_mm < 0.8 * all_mm {
+        return None;
+    }
+    let first = blocks.first().and_then(|&b| prog.blocks.get(b))?;
+    let p = first.machine.position();
+    (l > 0.0).then(|| Work {
+        layer,
+        start: [p[axis::X], p[axis::Y]],
+        blocks,
+        region,
+        target_mm: l,
+        nominal_mm: 0.0,
+        e_per_mm: e / l,
+    })
+}
+
+/// The line spacing of the file's sparse infill: the mean (area / length) refined by the
+/// spacing of its long lines ([`super::spacing::measured`]).
+fn measured_spacing(prog: &Program, work: &[Work]) -> f64 {
+    let a: f64 = work.iter().map(|w| w.region.area_mm2).sum();
+    let l: f64 = work.iter().map(|w| w.target_mm).sum();
+    let estimate = a / l;
+    let lines: Vec<Line> = work
+        .iter()
+        .flat_map(|w| w.blocks.iter().map(move |&b| (w.layer, b)))
+        .filter_map(|(layer, b)| prog.blocks.get(b).map(|blk| (layer, blk)))
+        .flat_map(|(layer, blk)| {
+            prog.moves
+                .get(blk.first..blk.end)
+                .unwrap_or(&[])
+                .iter()
+                .map(move |m| (layer, m))
+        })
+        .filter(|(_, m)| m.m.is_extruding() && m.m.length_mm > 3.0 * estimate)
+        .map(|(layer, m)| {
+            let (dx, dy) = (m.m.to[0] - m.m.from[0], m.m.to[1] - m.m.from[1]);
+            Line {
+                layer,
+                dir_deg: crate::math::atan2(dy, dx).to_degrees().rem_euclid(180.0),
+                mid: [
+                    0.5 * (m.m.to[0] + m.m.from[0]),
+                    0.5 * (m.m.to[1] + m.m.from[1]),
+                ],
+            }
+        })
+        .collect();
+    super::spacing::measured(&lines, estimate).unwrap_or(estimate)
+}
+
+/// The print: from the first to the last move of a printed feature.
+fn print_zone(prog: &Program) -> Option<(usize, usize)> {
+    let printed = |i: &usize| {
+        prog.moves.get(*i).is_some_and(|m| {
+            m.layer != u32::MAX && !matches!(m.kind, None | Some(FeatureKind::Other))
+        })
+    };
+    let first = (0..prog.moves.len()).find(printed);
+    let last = (0..prog.moves.len()).rev().find(printed);
+    first.zip(last)
+}
+
+/// A bed for a file that gives none: at least 200 × 200 mm from the origin, and wherever the
+/// moves go.
+fn bed_of_moves(prog: &Program) -> [f64; 4] {
+    let all = bbox(
+        prog.moves
+            .iter()
+            .map(|m| [m.m.to[0], m.m.to[1]])
+            .collect::<Vec<_>>()
+            .iter(),
+    )
+    .unwrap_or([0.0; 4]);
+    [
+        all[0].min(0.0),
+        all[1].min(0.0),
+        all[2].max(200.0),
+        all[3].max(200.0),
+    ]
 }
 
 impl Prepared<'_> {
@@ -403,54 +433,7 @@ pub fn infill_with_progress(
     if rotations.is_empty() {
         return Err(invalid("no rotation keeps the part on the bed"));
     }
-    let total = options.patterns.len() * options.angles_deg.len() * rotations.len();
-    let mut done = 0usize;
-    let mut candidates: Vec<Candidate> = Vec::with_capacity(total);
-    let mut best: Option<(f64, usize)> = None;
-    for &pattern in &options.patterns {
-        let mut cache: HashMap<i64, Vec<Vec<Path>>> = HashMap::new();
-        for &angle in &options.angles_deg {
-            for (rot_deg, rotation) in &rotations {
-                if !progress(done as f64 / total as f64) {
-                    return Err(Error::new(0, 0, ErrorKind::Cancelled));
-                }
-                done += 1;
-                let beta = angle - rot_deg;
-                // Concentric loops do not depend on the angle.
-                let key = if pattern == Pattern::Concentric {
-                    0
-                } else {
-                    angle_key(beta)
-                };
-                let plans = cache.entry(key).or_insert_with(|| {
-                    prep.work
-                        .iter()
-                        .map(|w| prep.plan_layer(w, pattern, beta))
-                        .collect()
-                });
-                let refs: Vec<&Vec<Path>> = plans.iter().collect();
-                let (_, motions) = prep.candidate(&refs, rotation.as_ref());
-                let c = replay(&prep.prog, &motions, rotation.as_ref(), &prep.base);
-                let s = score(options.objective, &options.weights, &c, &base_costs);
-                if best.is_none_or(|(b, _)| s < b) {
-                    best = Some((s, candidates.len()));
-                }
-                candidates.push(Candidate {
-                    pattern,
-                    angle_deg: angle,
-                    rotation_deg: *rot_deg,
-                    thesis_j: c.thesis_j,
-                    total_j: c.total_j,
-                    time_s: c.time_s,
-                    length_mm: c.length_mm,
-                    filament_mm: c.filament_mm,
-                    infill_length_mm: c.infill.l_total_mm,
-                    infill_turning_points: c.infill.n_turning,
-                    infill_mean_turn_deg: c.infill.mean_turn_deg,
-                });
-            }
-        }
-    }
+    let Searched { candidates, best } = search(&prep, options, &rotations, &base_costs, progress)?;
     let Some((best_score, bi)) = best else {
         return Err(invalid("no candidate"));
     };
@@ -491,8 +474,93 @@ pub fn infill_with_progress(
     let output = crate::gcode::apply_edits(prep.input, &edits);
     let after = analyze(&output, &options.analyze)?;
     progress(1.0);
-    let before_j = prep.before.energy.total_j;
-    let best = Best {
+    let best = best_of(&chosen, &result, prep.before.energy.total_j, layers);
+    let measured = measured(&prep);
+    Ok(InfillReport {
+        before: prep.before,
+        after,
+        best,
+        candidates,
+        measured,
+        rotations_skipped,
+        output,
+    })
+}
+
+/// Every (pattern, angle, rotation) costed.
+struct Searched {
+    candidates: Vec<Candidate>,
+    /// Score and index of the best candidate.
+    best: Option<(f64, usize)>,
+}
+
+/// Every (pattern, angle, rotation) costed, and the score and index of the best.
+fn search(
+    prep: &Prepared<'_>,
+    options: &InfillOptions,
+    rotations: &[(f64, Option<Rotation>)],
+    base_costs: &Costs,
+    progress: Progress<'_>,
+) -> Result<Searched, Error> {
+    let total = options.patterns.len() * options.angles_deg.len() * rotations.len();
+    let mut done = 0usize;
+    let mut candidates: Vec<Candidate> = Vec::with_capacity(total);
+    let mut best: Option<(f64, usize)> = None;
+    for &pattern in &options.patterns {
+        let mut cache: HashMap<i64, Vec<Vec<Path>>> = HashMap::new();
+        for &angle in &options.angles_deg {
+            for (rot_deg, rotation) in rotations {
+                if !progress(done as f64 / total as f64) {
+                    return Err(Error::new(0, 0, ErrorKind::Cancelled));
+                }
+                done += 1;
+                let beta = angle - rot_deg;
+                // Concentric loops do not depend on the angle.
+                let key = if pattern == Pattern::Concentric {
+                    0
+                } else {
+                    angle_key(beta)
+                };
+                let plans = cache.entry(key).or_insert_with(|| {
+                    prep.work
+                        .iter()
+                        .map(|w| prep.plan_layer(w, pattern, beta))
+                        .collect()
+                });
+                let refs: Vec<&Vec<Path>> = plans.iter().collect();
+                let (_, motions) = prep.candidate(&refs, rotation.as_ref());
+                let c = replay(&prep.prog, &motions, rotation.as_ref(), &prep.base);
+                let s = score(options.objective, &options.weights, &c, base_costs);
+                if best.is_none_or(|(b, _)| s < b) {
+                    best = Some((s, candidates.len()));
+                }
+                candidates.push(Candidate {
+                    pattern,
+                    angle_deg: angle,
+                    rotation_deg: *rot_deg,
+                    thesis_j: c.thesis_j,
+                    total_j: c.total_j,
+                    time_s: c.time_s,
+                    length_mm: c.length_mm,
+                    filament_mm: c.filament_mm,
+                    infill_length_mm: c.infill.l_total_mm,
+                    infill_turning_points: c.infill.n_turning,
+                    infill_mean_turn_deg: c.infill.mean_turn_deg,
+                });
+            }
+        }
+    }
+    Ok(Searched { candidates, best })
+}
+
+/// The report's best candidate: `chosen` with the costs `result` it was written with.
+fn best_of(
+    chosen: &Candidate,
+    result: &Costs,
+    before_j: f64,
+    layers: Option<Vec<super::LayerChoice>>,
+) -> Best {
+    Best {
         pattern: chosen.pattern,
         angle_deg: chosen.angle_deg,
         rotation_deg: chosen.rotation_deg,
@@ -507,8 +575,12 @@ pub fn infill_with_progress(
             0.0
         },
         layers,
-    };
-    let measured = Measured {
+    }
+}
+
+/// What the search measured of the file.
+fn measured(prep: &Prepared<'_>) -> Measured {
+    Measured {
         spacing_mm: prep.spacing,
         clearance_mm: prep.clearance,
         e_per_mm: prep.habit.e_per_mm,
@@ -517,16 +589,7 @@ pub fn infill_with_progress(
         print_feed_mm_s: prep.habit.print_f / 60.0,
         travel_feed_mm_s: prep.habit.travel_f / 60.0,
         retract_mm: prep.habit.retract_mm,
-    };
-    Ok(InfillReport {
-        before: prep.before,
-        after,
-        best,
-        candidates,
-        measured,
-        rotations_skipped,
-        output,
-    })
+    }
 }
 
 #[cfg(test)]

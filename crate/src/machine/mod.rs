@@ -12,13 +12,15 @@
 
 pub mod arc;
 pub mod extrusion;
+pub mod timeline;
 
 use serde::Serialize;
 
 use crate::error::Warnings;
-use crate::gcode::{Code, Command, Line};
+use crate::gcode::{Code, Command, Line, Params};
 pub use arc::{Arc, ArcSpec, Plane};
 pub use extrusion::{infer_extrusion_mode, ExtrusionInference, ExtrusionMode, ModeSource};
+pub use timeline::{FanEvent, TemperatureEvent};
 
 /// Number of tracked axes: X, Y, Z, E, A, B, C, U, V, W.
 pub const AXES: usize = 10;
@@ -382,167 +384,154 @@ impl Machine {
         line: &Line<'_>,
         warnings: &mut Warnings,
     ) -> Option<Event> {
+        match code.letter {
+            b'G' => self.apply_g(line_no, code, line, warnings),
+            b'M' => self.apply_m(line_no, code.number, line, warnings),
+            b'T' => {
+                self.tool = code.number;
+                None
+            }
+            _ => None,
+        }
+    }
+
+    /// A `G` code: moves, dwells, firmware retraction and the modal settings.
+    fn apply_g(
+        &mut self,
+        line_no: u32,
+        code: Code,
+        line: &Line<'_>,
+        warnings: &mut Warnings,
+    ) -> Option<Event> {
         let p = &line.params;
-        match (code.letter, code.number, code.sub) {
-            (b'G', 0..=3, None) => self.motion(line_no, code.number, line, warnings),
-            (b'G', 4, None) => {
-                let secs = match (p.get(b'S'), p.get(b'P')) {
-                    (Some(s), _) => s,
-                    (None, Some(ms)) => ms / 1000.0,
-                    _ => 0.0,
-                };
-                if !(0.0..=MAX_DWELL_S).contains(&secs) {
-                    warnings.push(
-                        line_no,
-                        format!("dwell of {secs} s ignored (accepted: 0 to {MAX_DWELL_S} s)"),
-                    );
-                    return None;
-                }
-                (secs > 0.0).then_some(Event::Dwell(secs))
-            }
-            (b'G', 10, None) if !p.has(b'P') && !p.has(b'L') => {
-                self.firmware_retract(line_no, true)
-            }
-            (b'G', 11, None) => self.firmware_retract(line_no, false),
-            (b'G', 17, None) => {
+        match (code.number, code.sub) {
+            (0..=3, None) => self.motion(line_no, code.number, line, warnings),
+            (4, None) => dwell(line_no, p, warnings),
+            (10, None) if !p.has(b'P') && !p.has(b'L') => self.firmware_retract(line_no, true),
+            (11, None) => self.firmware_retract(line_no, false),
+            (17, None) => {
                 self.plane = Plane::Xy;
                 None
             }
-            (b'G', 18, None) => {
+            (18, None) => {
                 self.plane = Plane::Zx;
                 None
             }
-            (b'G', 19, None) => {
+            (19, None) => {
                 self.plane = Plane::Yz;
                 None
             }
-            (b'G', 20, None) => {
+            (20, None) => {
                 self.inches = true;
                 None
             }
-            (b'G', 21, None) => {
+            (21, None) => {
                 self.inches = false;
                 None
             }
-            (b'G', 28, None) => self.home(line_no, line),
-            (b'G', 90, None) => {
+            (28, None) => self.home(line_no, line),
+            (90, None) => {
                 self.relative_axes = false;
                 None
             }
-            (b'G', 91, None) => {
+            (91, None) => {
                 self.relative_axes = true;
                 None
             }
-            (b'G', 92, None) => {
+            (92, None) => {
                 self.set_position(line_no, line, warnings);
                 None
             }
-            (b'G', 5, _) => {
+            (5, _) => {
                 warnings.push(
                     line_no,
                     "G5 Bézier moves are not modelled; the move is skipped",
                 );
                 None
             }
-            (b'M', 82, _) => {
-                self.e_mode = ExtrusionMode::Absolute;
-                None
-            }
-            (b'M', 83, _) => {
-                self.e_mode = ExtrusionMode::Relative;
-                None
-            }
-            (b'M', 104 | 109, _) => {
-                let tool = p.get(b'T').map_or(self.tool, to_u16);
-                let target = self.temperature_target(line_no, p, warnings)?;
-                Some(Event::Temperature {
-                    heater: Heater::Hotend(tool),
-                    target_c: target,
-                    wait: code.number == 109,
-                })
-            }
-            (b'M', 140 | 190, _) => {
-                let target = self.temperature_target(line_no, p, warnings)?;
-                Some(Event::Temperature {
-                    heater: Heater::Bed,
-                    target_c: target,
-                    wait: code.number == 190,
-                })
-            }
-            (b'M', 141 | 191, _) => {
-                let target = self.temperature_target(line_no, p, warnings)?;
-                Some(Event::Temperature {
-                    heater: Heater::Chamber,
-                    target_c: target,
-                    wait: code.number == 191,
-                })
-            }
-            (b'M', 106, _) => {
-                let s = p.get(b'S').unwrap_or(255.0);
-                // RepRapFirmware accepts 0..1 fractions; Marlin and Klipper take 0..255.
-                let speed = if s < 1.0 || (s <= 1.0 && s.fract() != 0.0) {
-                    s
-                } else {
-                    s / 255.0
-                };
-                Some(Event::Fan {
+            _ => None,
+        }
+    }
+
+    /// An `M` code: extrusion mode, heaters, fans, retraction settings and overrides.
+    fn apply_m(
+        &mut self,
+        line_no: u32,
+        number: u16,
+        line: &Line<'_>,
+        warnings: &mut Warnings,
+    ) -> Option<Event> {
+        let p = &line.params;
+        let heater = match number {
+            104 | 109 => Some(Heater::Hotend(p.get(b'T').map_or(self.tool, to_u16))),
+            140 | 190 => Some(Heater::Bed),
+            141 | 191 => Some(Heater::Chamber),
+            _ => None,
+        };
+        if let Some(heater) = heater {
+            let target = self.temperature_target(line_no, p, warnings)?;
+            return Some(Event::Temperature {
+                heater,
+                target_c: target,
+                wait: matches!(number, 109 | 190 | 191),
+            });
+        }
+        match number {
+            82 => self.e_mode = ExtrusionMode::Absolute,
+            83 => self.e_mode = ExtrusionMode::Relative,
+            106 => {
+                return Some(Event::Fan {
                     index: p.get(b'P').map_or(0, to_u16),
-                    speed: speed.clamp(0.0, 1.0),
+                    speed: fan_speed(p.get(b'S').unwrap_or(255.0)),
                 })
             }
-            (b'M', 107, _) => Some(Event::Fan {
-                index: p.get(b'P').map_or(0, to_u16),
-                speed: 0.0,
-            }),
-            (b'M', 207, _) => {
+            107 => {
+                return Some(Event::Fan {
+                    index: p.get(b'P').map_or(0, to_u16),
+                    speed: 0.0,
+                })
+            }
+            207 => {
                 if let Some(s) = p.get(b'S').filter(|s| (0.0..=1000.0).contains(s)) {
                     self.retract_mm = s * self.unit();
                 }
                 if let Some(f) = p.get(b'F').filter(|f| *f > 0.0) {
                     self.retract_feed_mm_s = f * self.unit() / 60.0;
                 }
-                None
             }
-            (b'M', 208, _) => {
+            208 => {
                 if let Some(s) = p.get(b'S').filter(|s| (-1000.0..=1000.0).contains(s)) {
                     self.unretract_extra_mm = s * self.unit();
                 }
                 if let Some(f) = p.get(b'F').filter(|f| *f > 0.0) {
                     self.unretract_feed_mm_s = f * self.unit() / 60.0;
                 }
-                None
             }
-            (b'M', 220, _) => {
-                if let Some(s) = p.get(b'S') {
-                    if OVERRIDE_RANGE_PERCENT.contains(&s) {
-                        self.speed_factor = s / 100.0;
-                    } else {
-                        warnings.push(
-                            line_no,
-                            format!("M220 S{s} ignored (accepted: 1 to 1000 %)"),
-                        );
-                    }
-                }
-                None
+            220 | 221 => self.set_override(line_no, number, p.get(b'S'), warnings),
+            _ => {}
+        }
+        None
+    }
+
+    /// `M220 S` (speed factor) or `M221 S` (flow factor), in percent.
+    fn set_override(&mut self, line_no: u32, number: u16, s: Option<f64>, warnings: &mut Warnings) {
+        let Some(s) = s else { return };
+        if number == 220 {
+            if OVERRIDE_RANGE_PERCENT.contains(&s) {
+                self.speed_factor = s / 100.0;
+            } else {
+                warnings.push(
+                    line_no,
+                    format!("M220 S{s} ignored (accepted: 1 to 1000 %)"),
+                );
             }
-            (b'M', 221, _) => {
-                if let Some(s) = p.get(b'S') {
-                    if s == 0.0 || OVERRIDE_RANGE_PERCENT.contains(&s) {
-                        self.flow_factor = s / 100.0;
-                    } else {
-                        warnings.push(
-                            line_no,
-                            format!("M221 S{s} ignored (accepted: 0 or 1 to 1000 %)"),
-                        );
-                    }
-                }
-                None
-            }
-            (b'T', n, _) => {
-                self.tool = n;
-                None
-            }
-            _ => None,
+        } else if s == 0.0 || OVERRIDE_RANGE_PERCENT.contains(&s) {
+            self.flow_factor = s / 100.0;
+        } else {
+            warnings.push(
+                line_no,
+                format!("M221 S{s} ignored (accepted: 0 or 1 to 1000 %)"),
+            );
         }
     }
 
@@ -804,6 +793,34 @@ impl Machine {
             self.logical = [0.0; AXES];
         }
     }
+}
+
+/// A `G4` dwell: `S` seconds or `P` milliseconds; `None` for none or one out of range.
+fn dwell(line_no: u32, p: &Params, warnings: &mut Warnings) -> Option<Event> {
+    let secs = match (p.get(b'S'), p.get(b'P')) {
+        (Some(s), _) => s,
+        (None, Some(ms)) => ms / 1000.0,
+        _ => 0.0,
+    };
+    if !(0.0..=MAX_DWELL_S).contains(&secs) {
+        warnings.push(
+            line_no,
+            format!("dwell of {secs} s ignored (accepted: 0 to {MAX_DWELL_S} s)"),
+        );
+        return None;
+    }
+    (secs > 0.0).then_some(Event::Dwell(secs))
+}
+
+/// Fan speed of `M106 S`, 0..=1: RepRapFirmware accepts 0..1 fractions; Marlin and Klipper
+/// take 0..255.
+fn fan_speed(s: f64) -> f64 {
+    let speed = if s < 1.0 || (s <= 1.0 && s.fract() != 0.0) {
+        s
+    } else {
+        s / 255.0
+    };
+    speed.clamp(0.0, 1.0)
 }
 
 fn to_u16(v: f64) -> u16 {

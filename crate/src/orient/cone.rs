@@ -11,7 +11,7 @@
 //! `+γ/2` about `b × T_S` (the same axis as eq. 5 with the opposite sign). When `T_S` is exactly
 //! opposite `b` any perpendicular axis is used.
 
-use super::vec3::{self, V3};
+use crate::vec3::{self, V3};
 
 /// Result of correcting one vector.
 #[derive(Debug, Clone, Copy, PartialEq)]

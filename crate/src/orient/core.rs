@@ -5,7 +5,7 @@ use super::cone;
 use super::filter::{self, FilterKind, Window};
 use super::kinematics::Kinematics;
 use super::metrics::Sample;
-use super::vec3::{self, V3};
+use crate::vec3::{self, V3};
 
 /// Settings of the per-run smoothing.
 #[derive(Debug, Clone, Copy, PartialEq)]

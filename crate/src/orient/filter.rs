@@ -18,7 +18,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::vec3::{self, V3};
+use crate::vec3::{self, V3};
 
 /// Which filter smooths the orientation.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]

@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use super::vec3::{self, V3};
+use crate::vec3::{self, V3};
 
 /// Local basis at one path point.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

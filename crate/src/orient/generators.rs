@@ -15,8 +15,8 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use serde::{Deserialize, Serialize};
 
 use super::points::PointVector;
-use super::vec3::{self, V3};
 use crate::math;
+use crate::vec3::{self, V3};
 
 /// Size of a generated part.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

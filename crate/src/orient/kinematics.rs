@@ -30,8 +30,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::vec3::{self, V3};
 use crate::math;
+use crate::vec3::{self, V3};
 
 /// Which machine layout the rotary axes have.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]

@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use super::vec3::{self, V3};
+use crate::vec3::{self, V3};
 
 /// One path point as the metrics see it.
 #[derive(Debug, Clone, Copy, PartialEq)]

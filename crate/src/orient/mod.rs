@@ -29,13 +29,13 @@ pub mod kinematics;
 pub mod metrics;
 pub mod points;
 mod program;
-pub mod vec3;
 mod words;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analyze::{AnalyzeOptions, Progress};
+use crate::analyze::AnalyzeOptions;
 use crate::error::{Error, ErrorKind, Warning};
+use crate::progress::Progress;
 
 pub use filter::{FilterKind, Window};
 pub use generators::{quarter_torus, square_tube, PartOptions};

@@ -4,10 +4,10 @@ use super::core::{self, RunSettings};
 use super::metrics::Sample;
 use super::points::PointVector;
 use super::summary::{self, Counts};
-use super::vec3::{self, V3};
 use super::{InputFormat, SmoothOptions, SmoothReport};
-use crate::analyze::Progress;
 use crate::error::{Error, ErrorKind};
+use crate::progress::Progress;
+use crate::vec3::{self, V3};
 
 pub(super) fn run(
     input: &[PointVector],
@@ -16,7 +16,47 @@ pub(super) fn run(
 ) -> Result<(SmoothReport, Vec<PointVector>), Error> {
     let kin = &options.kinematics;
     summary::tick(progress, 0.0)?;
-    // Samples, split into runs where the path number changes.
+    let runs = sample_runs(input, options)?;
+    summary::tick(progress, 0.2)?;
+    let settings = RunSettings {
+        filter: options.filter,
+        window: options.window,
+        half_angle: vec3::rad(0.5 * options.cone_deg),
+        singular_angle: vec3::rad(options.singular_deg.unwrap_or(0.0)),
+    };
+    let mut after = Vec::with_capacity(runs.len());
+    let mut corrected = 0usize;
+    for run in &runs {
+        let out = core::smooth_run(run, kin, &settings, false);
+        corrected += out.corrected;
+        after.push(out.samples);
+    }
+    summary::tick(progress, 0.8)?;
+    let (points, changed) = smoothed_points(input, &after);
+    let report = summary::assemble(
+        options,
+        Counts {
+            format: InputFormat::Json,
+            motion_lines: input.len(),
+            corrected,
+            changed,
+            skip_first: false,
+        },
+        &runs,
+        &after,
+        summary::short_run_warning(&runs, false)
+            .into_iter()
+            .collect(),
+        Vec::new(),
+    );
+    summary::tick(progress, 1.0)?;
+    Ok((report, points))
+}
+
+/// The points as samples, split into runs where the path number changes or the points jump
+/// farther than `max_gap_mm`.
+fn sample_runs(input: &[PointVector], options: &SmoothOptions) -> Result<Vec<Vec<Sample>>, Error> {
+    let kin = &options.kinematics;
     let mut runs: Vec<Vec<Sample>> = Vec::new();
     let mut last_path = None;
     let mut prev_rot = [0.0; 2];
@@ -52,21 +92,11 @@ pub(super) fn run(
             r.push(Sample { p, v, rot, dt });
         }
     }
-    summary::tick(progress, 0.2)?;
-    let settings = RunSettings {
-        filter: options.filter,
-        window: options.window,
-        half_angle: vec3::rad(0.5 * options.cone_deg),
-        singular_angle: vec3::rad(options.singular_deg.unwrap_or(0.0)),
-    };
-    let mut after = Vec::with_capacity(runs.len());
-    let mut corrected = 0usize;
-    for run in &runs {
-        let out = core::smooth_run(run, kin, &settings, false);
-        corrected += out.corrected;
-        after.push(out.samples);
-    }
-    summary::tick(progress, 0.8)?;
+    Ok(runs)
+}
+
+/// The input points with their smoothed vectors, and how many of them changed.
+fn smoothed_points(input: &[PointVector], after: &[Vec<Sample>]) -> (Vec<PointVector>, usize) {
     let mut points = Vec::with_capacity(input.len());
     let mut changed = 0usize;
     for (q, s) in input.iter().zip(after.iter().flatten()) {
@@ -79,22 +109,5 @@ pub(super) fn run(
             ..*q
         });
     }
-    let report = summary::assemble(
-        options,
-        Counts {
-            format: InputFormat::Json,
-            motion_lines: input.len(),
-            corrected,
-            changed,
-            skip_first: false,
-        },
-        &runs,
-        &after,
-        summary::short_run_warning(&runs, false)
-            .into_iter()
-            .collect(),
-        Vec::new(),
-    );
-    summary::tick(progress, 1.0)?;
-    Ok((report, points))
+    (points, changed)
 }

@@ -108,7 +108,7 @@ fn eligible(kin: &Kinematics, m: &PathMove, line: Option<&MotionLine>, max_gap_m
 pub(super) fn tip_length(kin: &Kinematics, m: &PathMove) -> f64 {
     let a = kin.tip(&pose(kin, &m.from));
     let b = kin.tip(&pose(kin, &m.to));
-    super::vec3::norm(super::vec3::sub(b, a))
+    crate::vec3::norm(crate::vec3::sub(b, a))
 }
 
 /// The motion line of each move (`None` for moves from other commands).

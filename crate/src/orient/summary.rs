@@ -1,12 +1,12 @@
 //! Assembling a [`SmoothReport`] from the runs before and after smoothing.
 
 use super::metrics::{self, Sample};
-use super::vec3;
 use super::{InputFormat, Series, SmoothOptions, SmoothReport, SERIES_MAX};
 use crate::error::{Error, ErrorKind, Warning};
+use crate::vec3;
 
 /// Calls `progress`, turning a `false` into [`ErrorKind::Cancelled`].
-pub(super) fn tick(progress: crate::analyze::Progress<'_>, fraction: f64) -> Result<(), Error> {
+pub(super) fn tick(progress: crate::progress::Progress<'_>, fraction: f64) -> Result<(), Error> {
     if progress(fraction) {
         Ok(())
     } else {

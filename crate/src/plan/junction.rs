@@ -181,7 +181,7 @@ fn is_e_only(s: &Segment) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plan::profiles::Profile as MachineProfile;
+    use crate::plan::profiles::MachineProfile;
 
     fn seg(dir: [f64; 2], speed: f64, accel: f64, distance: f64) -> Segment {
         let n = dir[0].hypot(dir[1]);

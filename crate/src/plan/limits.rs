@@ -132,86 +132,98 @@ impl Limits {
     }
 
     fn apply_limit_command(&mut self, line: &Line<'_>, units: FeedUnits) -> bool {
+        if let Some(code) = line.code() {
+            if code.letter != b'M' || code.sub.is_some() {
+                return false;
+            }
+            return self.apply_m_code(code.number, line, units);
+        }
+        if let crate::gcode::Command::Extended(name) = line.command {
+            if name.eq_ignore_ascii_case(b"SET_VELOCITY_LIMIT") {
+                self.apply_set_velocity_limit(line);
+                return true;
+            }
+        }
+        false
+    }
+
+    /// `M201`, `M203`, `M204`, `M205` (Marlin) and `M566` (RepRapFirmware); `false` for any
+    /// other M code.
+    fn apply_m_code(&mut self, number: u16, line: &Line<'_>, units: FeedUnits) -> bool {
         let src = LimitSource::Command;
         let p = &line.params;
         let per_s = |v: Option<f64>| match units {
             FeedUnits::PerSecond => v,
             FeedUnits::PerMinute => v.map(|x| x / 60.0),
         };
-        if let Some(code) = line.code() {
-            if code.letter != b'M' || code.sub.is_some() {
-                return false;
+        match number {
+            201 => {
+                for (i, l) in b"XYZE".iter().enumerate() {
+                    set(&mut self.max_acceleration[i], p.get(*l), src);
+                }
             }
-            match code.number {
-                201 => {
-                    for (i, l) in b"XYZE".iter().enumerate() {
-                        set(&mut self.max_acceleration[i], p.get(*l), src);
-                    }
+            203 => {
+                for (i, l) in b"XYZE".iter().enumerate() {
+                    set(&mut self.max_feedrate[i], per_s(p.get(*l)), src);
                 }
-                203 => {
-                    for (i, l) in b"XYZE".iter().enumerate() {
-                        set(&mut self.max_feedrate[i], per_s(p.get(*l)), src);
-                    }
-                }
-                204 => {
-                    // Marlin: S sets printing and travel acceleration (legacy); P, R, T each.
-                    set(&mut self.acceleration, p.get(b'S'), src);
-                    set(&mut self.travel_acceleration, p.get(b'S'), src);
-                    set(&mut self.acceleration, p.get(b'P'), src);
-                    set(&mut self.retract_acceleration, p.get(b'R'), src);
-                    set(&mut self.travel_acceleration, p.get(b'T'), src);
-                }
-                205 => {
-                    for (i, l) in b"XYZE".iter().enumerate() {
-                        set(&mut self.max_jerk[i], p.get(*l), src);
-                    }
-                    set(&mut self.min_feedrate, p.get(b'S'), src);
-                    set(&mut self.min_travel_feedrate, p.get(b'T'), src);
-                    set(&mut self.junction_deviation, p.get(b'J'), src);
-                }
-                566 => {
-                    // RepRapFirmware: jerk in mm/min.
-                    for (i, l) in b"XYZE".iter().enumerate() {
-                        set(&mut self.max_jerk[i], p.get(*l).map(|v| v / 60.0), src);
-                    }
-                }
-                _ => return false,
             }
-            return true;
+            204 => {
+                // Marlin: S sets printing and travel acceleration (legacy); P, R, T each.
+                set(&mut self.acceleration, p.get(b'S'), src);
+                set(&mut self.travel_acceleration, p.get(b'S'), src);
+                set(&mut self.acceleration, p.get(b'P'), src);
+                set(&mut self.retract_acceleration, p.get(b'R'), src);
+                set(&mut self.travel_acceleration, p.get(b'T'), src);
+            }
+            205 => {
+                for (i, l) in b"XYZE".iter().enumerate() {
+                    set(&mut self.max_jerk[i], p.get(*l), src);
+                }
+                set(&mut self.min_feedrate, p.get(b'S'), src);
+                set(&mut self.min_travel_feedrate, p.get(b'T'), src);
+                set(&mut self.junction_deviation, p.get(b'J'), src);
+            }
+            566 => {
+                // RepRapFirmware: jerk in mm/min.
+                for (i, l) in b"XYZE".iter().enumerate() {
+                    set(&mut self.max_jerk[i], p.get(*l).map(|v| v / 60.0), src);
+                }
+            }
+            _ => return false,
         }
-        if let crate::gcode::Command::Extended(name) = line.command {
-            if name.eq_ignore_ascii_case(b"SET_VELOCITY_LIMIT") {
-                let num = |key: &str| {
-                    line.extended_arg(key)
-                        .and_then(|v| std::str::from_utf8(v).ok())
-                        .and_then(|v| v.parse::<f64>().ok())
-                };
-                if let Some(v) = num("VELOCITY") {
-                    for i in 0..2 {
-                        set(&mut self.max_feedrate[i], Some(v), src);
-                    }
-                }
-                if let Some(a) = num("ACCEL") {
-                    // Klipper's toolhead acceleration: there are no per-axis X/Y limits.
-                    set(&mut self.acceleration, Some(a), src);
-                    set(&mut self.travel_acceleration, Some(a), src);
-                }
-                set(
-                    &mut self.square_corner_velocity,
-                    num("SQUARE_CORNER_VELOCITY"),
-                    src,
-                );
-                // Whichever of the two a file sets last is the one in force.
-                if let Some(ratio) = num("MINIMUM_CRUISE_RATIO") {
-                    set(&mut self.minimum_cruise_ratio, Some(ratio), src);
-                    set(&mut self.accel_to_decel, Some(0.0), src);
-                } else {
-                    set(&mut self.accel_to_decel, num("ACCEL_TO_DECEL"), src);
-                }
-                return true;
+        true
+    }
+
+    /// Klipper's `SET_VELOCITY_LIMIT`.
+    fn apply_set_velocity_limit(&mut self, line: &Line<'_>) {
+        let src = LimitSource::Command;
+        let num = |key: &str| {
+            line.extended_arg(key)
+                .and_then(|v| std::str::from_utf8(v).ok())
+                .and_then(|v| v.parse::<f64>().ok())
+        };
+        if let Some(v) = num("VELOCITY") {
+            for i in 0..2 {
+                set(&mut self.max_feedrate[i], Some(v), src);
             }
         }
-        false
+        if let Some(a) = num("ACCEL") {
+            // Klipper's toolhead acceleration: there are no per-axis X/Y limits.
+            set(&mut self.acceleration, Some(a), src);
+            set(&mut self.travel_acceleration, Some(a), src);
+        }
+        set(
+            &mut self.square_corner_velocity,
+            num("SQUARE_CORNER_VELOCITY"),
+            src,
+        );
+        // Whichever of the two a file sets last is the one in force.
+        if let Some(ratio) = num("MINIMUM_CRUISE_RATIO") {
+            set(&mut self.minimum_cruise_ratio, Some(ratio), src);
+            set(&mut self.accel_to_decel, Some(0.0), src);
+        } else {
+            set(&mut self.accel_to_decel, num("ACCEL_TO_DECEL"), src);
+        }
     }
 
     /// Applies one `; key = value` line of a slicer's settings block (PrusaSlicer, SuperSlicer,
@@ -263,10 +275,12 @@ impl Limits {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plan::profiles::Profile;
+    use crate::plan::profiles::MachineProfile;
 
     fn voron() -> Limits {
-        Profile::preset("voron-klipper").expect("preset").limits
+        MachineProfile::preset("voron-klipper")
+            .expect("preset")
+            .limits
     }
 
     #[test]

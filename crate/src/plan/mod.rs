@@ -31,7 +31,7 @@ use crate::math::Bound;
 use junction::Segment;
 pub use klipper_config::{KlipperConfig, KlipperConfigError, KlipperVersion};
 pub use limits::{FeedUnits, JunctionModel, Limit, LimitSource, Limits};
-pub use profiles::Profile as MachineProfile;
+pub use profiles::MachineProfile;
 pub use trapezoid::Profile;
 
 /// Blocks kept un-finalised at the end of the window (they may still slow down for what follows).
@@ -336,67 +336,12 @@ impl Planner {
         sink: &mut impl FnMut(&PlannedMove),
     ) {
         let l = &self.limits;
-        let xyz = (delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]).sqrt();
-        let (distance, class) = if xyz > 1e-9 {
-            (
-                xyz,
-                if delta[3] > 1e-12 {
-                    MoveClass::Print
-                } else {
-                    MoveClass::Travel
-                },
-            )
-        } else {
-            (delta[3].abs(), MoveClass::Retract)
-        };
-        if distance <= 1e-12 {
+        let Some((distance, class)) = distance_and_class(&delta) else {
             return;
-        }
+        };
         let inv_distance = 1.0 / distance;
-        // Cruise speed: the feed rate (at least the minimum), then every axis within its limit.
-        let min_feed = match class {
-            MoveClass::Travel => l.min_travel_feedrate.value,
-            _ => l.min_feedrate.value,
-        };
-        let mut cruise = feed
-            .at_least(min_feed)
-            .at_least(crate::machine::MIN_FEED_MM_S);
-        let mut axis_feedrate = [0.0; 4];
-        let mut factor: f64 = 1.0;
-        for i in 0..4 {
-            axis_feedrate[i] = cruise * delta[i] * inv_distance;
-            let max = l.max_feedrate[i].value;
-            if max > 0.0 && axis_feedrate[i].abs() > max {
-                factor = factor.at_most(max / axis_feedrate[i].abs());
-            }
-        }
-        cruise *= factor;
-        for v in &mut axis_feedrate {
-            *v *= factor;
-        }
-        // Acceleration: by kind of move, then every axis within its limit.
-        let mut acceleration = match class {
-            MoveClass::Print => l.acceleration.value,
-            MoveClass::Travel => l.travel_acceleration.value,
-            MoveClass::Retract => l.retract_acceleration.value,
-        };
-        // Klipper has no X/Y (or extruder) limit of its own on a move that prints or travels:
-        // `M204` and `SET_VELOCITY_LIMIT ACCEL` set the toolhead's `max_accel`, the limit along
-        // the move, whatever the profile's per-axis values; only Z (`max_z_accel`) and
-        // extrude-only moves (`max_extrude_only_accel`) are limited on their own axis.
-        let axis_limited = |axis: usize| match (self.model, class) {
-            (JunctionModel::Klipper, MoveClass::Retract) => axis >= 2,
-            (JunctionModel::Klipper, _) => axis == 2,
-            _ => true,
-        };
-        for (axis, (d, max)) in delta.iter().zip(&l.max_acceleration).enumerate() {
-            let (d, max) = (d.abs(), max.value);
-            if axis_limited(axis) && d > 1e-12 && max > 0.0 && acceleration * d * inv_distance > max
-            {
-                acceleration = max * distance / d;
-            }
-        }
-        let acceleration = acceleration.at_least(1e-3);
+        let (cruise, axis_feedrate) = cruise_speed(l, class, feed, &delta, inv_distance);
+        let acceleration = self.acceleration(class, &delta, distance, inv_distance);
         let unit = if class == MoveClass::Retract {
             [0.0; 3]
         } else {
@@ -428,23 +373,7 @@ impl Planner {
         };
         let v_allowable = trapezoid::max_allowable_speed(-acceleration, safe, distance);
         let (smooth_delta_v2, max_smoothed_v2) = match self.model {
-            JunctionModel::Klipper => {
-                let accel_to_decel = if l.accel_to_decel.value > 0.0 {
-                    l.accel_to_decel.value.at_most(acceleration)
-                } else {
-                    acceleration * (1.0 - l.minimum_cruise_ratio.value.clamp(0.0, 0.99))
-                };
-                // Klipper's `max_smoothed_v2`: the junction limit, and no more than the chain
-                // of blocks before could reach accelerating at their smoothed rate.
-                let reach = match (&self.prev, self.blocks.last()) {
-                    (Some(_), Some(p)) => p.max_smoothed_v2 + p.smooth_delta_v2,
-                    _ => 0.0,
-                };
-                (
-                    2.0 * distance * accel_to_decel,
-                    (vmax_junction * vmax_junction).at_most(reach),
-                )
-            }
+            JunctionModel::Klipper => self.klipper_smoothing(distance, acceleration, vmax_junction),
             _ => (0.0, 0.0),
         };
         let block = Block {
@@ -472,6 +401,67 @@ impl Planner {
         }
     }
 
+    /// Acceleration of a move: by kind of move, then every axis within its limit.
+    #[inline]
+    fn acceleration(
+        &self,
+        class: MoveClass,
+        delta: &[f64; 4],
+        distance: f64,
+        inv_distance: f64,
+    ) -> f64 {
+        let l = &self.limits;
+        let mut acceleration = match class {
+            MoveClass::Print => l.acceleration.value,
+            MoveClass::Travel => l.travel_acceleration.value,
+            MoveClass::Retract => l.retract_acceleration.value,
+        };
+        // Klipper has no X/Y (or extruder) limit of its own on a move that prints or travels:
+        // `M204` and `SET_VELOCITY_LIMIT ACCEL` set the toolhead's `max_accel`, the limit along
+        // the move, whatever the profile's per-axis values; only Z (`max_z_accel`) and
+        // extrude-only moves (`max_extrude_only_accel`) are limited on their own axis.
+        let axis_limited = |axis: usize| match (self.model, class) {
+            (JunctionModel::Klipper, MoveClass::Retract) => axis >= 2,
+            (JunctionModel::Klipper, _) => axis == 2,
+            _ => true,
+        };
+        for (axis, (d, max)) in delta.iter().zip(&l.max_acceleration).enumerate() {
+            let (d, max) = (d.abs(), max.value);
+            if axis_limited(axis) && d > 1e-12 && max > 0.0 && acceleration * d * inv_distance > max
+            {
+                acceleration = max * distance / d;
+            }
+        }
+        acceleration.at_least(1e-3)
+    }
+
+    /// Klipper's `smooth_delta_v2` and `max_smoothed_v2` of a move of `distance` at
+    /// `acceleration` whose junction allows `vmax_junction`.
+    #[inline]
+    fn klipper_smoothing(
+        &self,
+        distance: f64,
+        acceleration: f64,
+        vmax_junction: f64,
+    ) -> (f64, f64) {
+        let l = &self.limits;
+        let accel_to_decel = if l.accel_to_decel.value > 0.0 {
+            l.accel_to_decel.value.at_most(acceleration)
+        } else {
+            acceleration * (1.0 - l.minimum_cruise_ratio.value.clamp(0.0, 0.99))
+        };
+        // Klipper's `max_smoothed_v2`: the junction limit, and no more than the chain
+        // of blocks before could reach accelerating at their smoothed rate.
+        let reach = match (&self.prev, self.blocks.last()) {
+            (Some(_), Some(p)) => p.max_smoothed_v2 + p.smooth_delta_v2,
+            _ => 0.0,
+        };
+        (
+            2.0 * distance * accel_to_decel,
+            (vmax_junction * vmax_junction).at_most(reach),
+        )
+    }
+
     /// A dwell (`G4`) or any wait: every queued move completes first, then time passes.
     pub fn dwell(&mut self, secs: f64, sink: &mut impl FnMut(&PlannedMove)) {
         self.flush(sink);
@@ -493,65 +483,9 @@ impl Planner {
         if n == 0 {
             return;
         }
-        // Reverse pass: every block must be able to brake to the next block's entry speed.
-        for i in (0..n - 1).rev() {
-            let (head, tail) = blocks.split_at_mut(i + 1);
-            let (b, next) = (&mut head[i], &tail[0]);
-            if b.entry_fixed {
-                continue;
-            }
-            if b.entry != b.max_entry || next.recalculate {
-                // A block of nominal length reaches any junction speed within itself.
-                let entry = if b.nominal_length {
-                    b.max_entry
-                } else {
-                    b.max_entry.at_most(trapezoid::max_allowable_speed(
-                        -b.acceleration,
-                        next.entry,
-                        b.distance,
-                    ))
-                };
-                if entry != b.entry {
-                    b.entry = entry;
-                    b.recalculate = true;
-                }
-            }
-        }
-        // Forward pass: every block must be reachable from the previous block's entry speed.
-        for i in 1..n {
-            let (head, tail) = blocks.split_at_mut(i);
-            let (p, b) = (&head[i - 1], &mut tail[0]);
-            // Marlin and PrusaSlicer skip this check after a block of "nominal length", but they
-            // set that flag from the block's safe speed, not the minimum planner speed, so the
-            // shortcut can let a block start faster than the previous one can reach: a jump in
-            // speed. Checking every block keeps the speed continuous (proptest in
-            // tests/fuzz_regressions.rs); print times move by well under 0.1 %.
-            if p.entry < b.entry {
-                let entry = b.entry.at_most(trapezoid::max_allowable_speed(
-                    -p.acceleration,
-                    p.entry,
-                    p.distance,
-                ));
-                if entry != b.entry {
-                    b.entry = entry;
-                    b.recalculate = true;
-                }
-            }
-        }
-        // Exit speeds: each block exits at the next block's entry speed (the last one at its
-        // safe speed until something follows it).
-        for i in 0..n - 1 {
-            let (head, tail) = blocks.split_at_mut(i + 1);
-            let (b, next) = (&mut head[i], &tail[0]);
-            if b.recalculate || next.recalculate {
-                b.exit = next.entry;
-                b.recalculate = false;
-            }
-        }
-        if let Some(last) = blocks.last_mut() {
-            last.exit = last.safe;
-            last.recalculate = false;
-        }
+        reverse_pass(blocks);
+        forward_pass(blocks);
+        set_exits(blocks);
         let finalize = n.saturating_sub(keep);
         // The profiles first, in a loop of their own: they are independent of each other, and
         // their divisions overlap there instead of waiting, block by block, between sink calls.
@@ -588,6 +522,131 @@ impl Planner {
                 first.entry_fixed = true;
             }
         }
+    }
+}
+
+/// The length of a move (along XYZ, or along E for an extrude-only move) and its class;
+/// `None` for a move that goes nowhere.
+#[inline]
+fn distance_and_class(delta: &[f64; 4]) -> Option<(f64, MoveClass)> {
+    let xyz = (delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]).sqrt();
+    let (distance, class) = if xyz > 1e-9 {
+        (
+            xyz,
+            if delta[3] > 1e-12 {
+                MoveClass::Print
+            } else {
+                MoveClass::Travel
+            },
+        )
+    } else {
+        (delta[3].abs(), MoveClass::Retract)
+    };
+    (distance > 1e-12).then_some((distance, class))
+}
+
+/// Cruise speed of a move and the speed of each axis at it: the feed rate (at least the
+/// minimum), then every axis within its limit.
+#[inline]
+fn cruise_speed(
+    l: &Limits,
+    class: MoveClass,
+    feed: f64,
+    delta: &[f64; 4],
+    inv_distance: f64,
+) -> (f64, [f64; 4]) {
+    let min_feed = match class {
+        MoveClass::Travel => l.min_travel_feedrate.value,
+        _ => l.min_feedrate.value,
+    };
+    let mut cruise = feed
+        .at_least(min_feed)
+        .at_least(crate::machine::MIN_FEED_MM_S);
+    let mut axis_feedrate = [0.0; 4];
+    let mut factor: f64 = 1.0;
+    for i in 0..4 {
+        axis_feedrate[i] = cruise * delta[i] * inv_distance;
+        let max = l.max_feedrate[i].value;
+        if max > 0.0 && axis_feedrate[i].abs() > max {
+            factor = factor.at_most(max / axis_feedrate[i].abs());
+        }
+    }
+    cruise *= factor;
+    for v in &mut axis_feedrate {
+        *v *= factor;
+    }
+    (cruise, axis_feedrate)
+}
+
+/// Reverse pass of the look-ahead: every block must be able to brake to the next block's
+/// entry speed.
+fn reverse_pass(blocks: &mut [Block]) {
+    let n = blocks.len();
+    for i in (0..n - 1).rev() {
+        let (head, tail) = blocks.split_at_mut(i + 1);
+        let (b, next) = (&mut head[i], &tail[0]);
+        if b.entry_fixed {
+            continue;
+        }
+        if b.entry != b.max_entry || next.recalculate {
+            // A block of nominal length reaches any junction speed within itself.
+            let entry = if b.nominal_length {
+                b.max_entry
+            } else {
+                b.max_entry.at_most(trapezoid::max_allowable_speed(
+                    -b.acceleration,
+                    next.entry,
+                    b.distance,
+                ))
+            };
+            if entry != b.entry {
+                b.entry = entry;
+                b.recalculate = true;
+            }
+        }
+    }
+}
+
+/// Forward pass of the look-ahead: every block must be reachable from the previous block's
+/// entry speed.
+fn forward_pass(blocks: &mut [Block]) {
+    for i in 1..blocks.len() {
+        let (head, tail) = blocks.split_at_mut(i);
+        let (p, b) = (&head[i - 1], &mut tail[0]);
+        // Marlin and PrusaSlicer skip this check after a block of "nominal length", but they
+        // set that flag from the block's safe speed, not the minimum planner speed, so the
+        // shortcut can let a block start faster than the previous one can reach: a jump in
+        // speed. Checking every block keeps the speed continuous (proptest in
+        // tests/fuzz_regressions.rs); print times move by well under 0.1 %.
+        if p.entry < b.entry {
+            let entry = b.entry.at_most(trapezoid::max_allowable_speed(
+                -p.acceleration,
+                p.entry,
+                p.distance,
+            ));
+            if entry != b.entry {
+                b.entry = entry;
+                b.recalculate = true;
+            }
+        }
+    }
+}
+
+/// Exit speeds: each block exits at the next block's entry speed (the last one at its safe
+/// speed until something follows it).
+fn set_exits(blocks: &mut [Block]) {
+    let n = blocks.len();
+    for i in 0..n - 1 {
+        let (head, tail) = blocks.split_at_mut(i + 1);
+        let (b, next) = (&mut head[i], &tail[0]);
+        if b.recalculate || next.recalculate {
+            b.exit = next.entry;
+            b.recalculate = false;
+        }
+    }
+    if let Some(last) = blocks.last_mut() {
+        last.exit = last.safe;
+        last.recalculate = false;
     }
 }
 

@@ -7,7 +7,7 @@ use super::limits::{JunctionModel, Limit, Limits};
 
 /// A machine profile.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Profile {
+pub struct MachineProfile {
     /// Short name (`prusa-mk3s`).
     pub name: String,
     /// What the machine is.
@@ -53,7 +53,7 @@ pub const PRESETS: [&str; 4] = [
     "vtg-ldam-servo",
 ];
 
-impl Profile {
+impl MachineProfile {
     /// A built-in preset by name.
     ///
     /// Values are the firmware defaults the machines ship with:
@@ -65,7 +65,7 @@ impl Profile {
     ///   `square_corner_velocity 5`, `minimum_cruise_ratio 0.5`).
     /// - `vtg-ldam-servo`: the large-format ball-screw servo printer of the VTG paper (1000 ×
     ///   800 × 350 mm build volume); its limits are those of typical DC-servo ball-screw stages.
-    pub fn preset(name: &str) -> Option<Profile> {
+    pub fn preset(name: &str) -> Option<MachineProfile> {
         let (description, junction, limits) = match name {
             "prusa-mk3s" => (
                 "Original Prusa i3 MK3S (Prusa firmware, classic jerk, normal mode)",
@@ -121,7 +121,7 @@ impl Profile {
             ),
             _ => return None,
         };
-        Some(Profile {
+        Some(MachineProfile {
             name: name.to_string(),
             description: description.to_string(),
             junction,
@@ -129,8 +129,8 @@ impl Profile {
         })
     }
 
-    /// A profile from JSON (the serde form of [`Profile`]).
-    pub fn from_json(text: &str) -> Result<Profile, serde_json::Error> {
+    /// A profile from JSON (the serde form of [`MachineProfile`]).
+    pub fn from_json(text: &str) -> Result<MachineProfile, serde_json::Error> {
         serde_json::from_str(text)
     }
 }
@@ -142,10 +142,10 @@ mod tests {
     #[test]
     fn every_preset_exists_and_round_trips_through_json() {
         for name in PRESETS {
-            let p = Profile::preset(name).expect(name);
+            let p = MachineProfile::preset(name).expect(name);
             let json = serde_json::to_string(&p).expect("json");
-            assert_eq!(Profile::from_json(&json).expect("parse"), p);
+            assert_eq!(MachineProfile::from_json(&json).expect("parse"), p);
         }
-        assert!(Profile::preset("nope").is_none());
+        assert!(MachineProfile::preset("nope").is_none());
     }
 }

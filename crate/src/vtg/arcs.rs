@@ -14,9 +14,9 @@
 //! `[gcode_arcs]` section). The rewriter measures the path with its arcs against the original
 //! before it keeps them ([`super::deviation::both_ways`]), so the tolerance holds as before.
 
-use super::bspline::{norm, sub};
 use crate::gcode::number::rounded;
 use crate::machine::{Arc, Plane};
+use crate::vec3::{norm, sub};
 
 /// Fewest steps an arc replaces: below that the file gains little.
 pub const MIN_SEGMENTS: usize = 3;

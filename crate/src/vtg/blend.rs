@@ -33,7 +33,7 @@
 //! is then the whole story only for the inside line ([`Line::Inside`]), which the pipeline
 //! still uses where the wider circle cannot be walked.
 
-use super::bspline::{dot, norm, sub};
+use crate::vec3::{dot, norm, sub};
 
 /// Samples per blend given to the fit (its ends included).
 pub const SAMPLES: usize = 9;

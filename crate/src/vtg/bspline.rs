@@ -6,6 +6,8 @@
 //! control points (P&T eq. 3.8); a rational curve is evaluated in homogeneous coordinates and
 //! projected with the quotient rule (P&T eq. 4.8). The tests check both against A2.3.
 
+use crate::vec3::{cross, norm, sub};
+
 /// Degree of the curves.
 pub const DEGREE: usize = 3;
 
@@ -279,28 +281,6 @@ pub fn find_span(knots: &[f64], n: usize, u: f64) -> usize {
     mid.max(DEGREE)
 }
 
-pub(crate) fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-pub(crate) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub(crate) fn norm(a: &[f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}
-
-/// The point at fraction `t` of the way from `a` to `b`.
-#[inline]
-pub(crate) fn lerp(a: &[f64; 3], b: &[f64; 3], t: f64) -> [f64; 3] {
-    [
-        a[0] + (b[0] - a[0]) * t,
-        a[1] + (b[1] - a[1]) * t,
-        a[2] + (b[2] - a[2]) * t,
-    ]
-}
-
 /// Arc length of the polyline `pts` at each of its points (from 0).
 pub(crate) fn arc_lengths(pts: &[[f64; 3]]) -> Vec<f64> {
     let mut arc = Vec::with_capacity(pts.len());
@@ -317,14 +297,6 @@ pub(crate) fn arc_lengths(pts: &[[f64; 3]]) -> Vec<f64> {
 /// length `u` falls in (the first or the last beyond the ends).
 pub(crate) fn segment_at(arc: &[f64], u: f64, segments: usize) -> usize {
     arc.partition_point(|&a| a <= u).clamp(1, segments.max(1)) - 1
-}
-
-pub(crate) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 #[cfg(test)]

@@ -24,9 +24,9 @@
 //! largest the tolerance allows. Of the family's members that fit the legs, the one the
 //! look-ahead (as Klipper plans it: `stretch_time`) runs through fastest is kept.
 
-use super::bspline::{dot, norm, sub};
 use super::deviation::both_ways;
 use super::hairpin::{cross_z, unit, Hairpin};
+use crate::vec3::{dot, norm, sub};
 
 /// What the firmware does at a corner: its limits there and the speeds either side.
 #[derive(Debug, Clone, Copy)]

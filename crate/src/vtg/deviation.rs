@@ -7,8 +7,8 @@
 
 use std::collections::HashMap;
 
-use super::bspline::{dot, lerp, norm, sub};
 use crate::path::{PathMove, PrintPath};
+use crate::vec3::{dot, lerp, norm, sub};
 
 /// Distance from `p` to segment `a`–`b`.
 pub fn point_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {

@@ -2,8 +2,8 @@
 //! lower than the original ran there and, if asked, no higher), and on a classic-jerk firmware
 //! the ramps that let the feed rise again without a stall at the junction.
 
-use super::bspline::{lerp, norm, sub};
 use super::smooth::{Settings, Smoothed};
+use crate::vec3::{lerp, norm, sub};
 
 /// The speed terms of one new segment.
 #[derive(Debug, Clone, Copy, PartialEq)]

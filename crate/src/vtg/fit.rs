@@ -7,7 +7,8 @@
 //! a long straight stays straight while a corner follows its transition. The first and last
 //! points are interpolated (the path keeps its end points).
 
-use super::bspline::{basis_by_degree, find_span, norm, sub, Curve, DEGREE};
+use super::bspline::{basis_by_degree, find_span, Curve, DEGREE};
+use crate::vec3::{norm, sub};
 
 /// Data points per knot span in the first fit.
 const POINTS_PER_SPAN: f64 = 2.5;

@@ -16,8 +16,9 @@
 //! a fine polygon of the arc, which the rest of the pipeline blends, fits and walks like any
 //! other path.
 
-use super::bspline::{arc_lengths, cross, dot, norm, segment_at, sub};
+use super::bspline::{arc_lengths, segment_at};
 use super::deviation::{both_ways, point_polyline};
+use crate::vec3::{cross, dot, norm, sub};
 
 /// Longest connector between the two corners of a hairpin, mm.
 pub const MAX_CONNECTOR_MM: f64 = 2.0;
@@ -66,7 +67,7 @@ impl Hairpin {
     }
 }
 
-/// `v / |v|`, or `None` for a tiny vector. (Divides: `orient::vec3::normalize` multiplies by
+/// `v / |v|`, or `None` for a tiny vector. (Divides: `crate::vec3::normalize` multiplies by
 /// the reciprocal, which rounds differently and would move the arcs in the last bit.)
 pub(super) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
     let l = norm(&v);

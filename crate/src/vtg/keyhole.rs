@@ -18,10 +18,10 @@
 //! spread over it by length (see [`super::hairpin::substitute`]), so the tip gets the material
 //! it had, in the same place.
 
-use super::bspline::{dot, lerp, norm, segment_at, sub};
+use super::bspline::segment_at;
 use super::deviation::{both_ways, point_polyline};
 use super::hairpin::{arc_polygon, cross_z, unit, Hairpin};
-use crate::orient::vec3::angle;
+use crate::vec3::{angle, dot, lerp, norm, sub};
 
 /// Smallest turn a keyhole is tried at, rad (60°: below it a corner fillets within the
 /// tolerance, or the legs are too short for anything).

@@ -36,8 +36,9 @@ pub mod source;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analyze::{AnalyzeOptions, Progress, Report};
+use crate::analyze::{AnalyzeOptions, Report};
 use crate::error::{Error, ErrorKind};
+use crate::progress::Progress;
 pub use report::{Comparison, Table1, Table2, VtgReport};
 
 /// Options of [`vtg`]. Every field is optional in JSON.
@@ -108,7 +109,7 @@ impl Default for VtgOptions {
         Self {
             analyze: AnalyzeOptions::default(),
             tolerance_mm: 0.1,
-            critical_angle_deg: metrics::DEFAULT_CRITICAL_ANGLE_DEG,
+            critical_angle_deg: crate::analyze::toolpath::DEFAULT_CRITICAL_ANGLE_DEG,
             interpolation_period_s: 0.001,
             normal_jerk_mm_s3: None,
             nozzle_diameter_mm: 0.4,

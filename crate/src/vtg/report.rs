@@ -4,9 +4,10 @@
 use serde::Serialize;
 
 use super::kinematics::KinematicLimits;
-use super::metrics::{from_path, ToolpathMetrics};
+use super::metrics::from_path;
 use super::rewrite::Rewritten;
 use super::VtgOptions;
+use crate::analyze::toolpath::ToolpathMetrics;
 use crate::analyze::Report;
 use crate::path::PrintPath;
 

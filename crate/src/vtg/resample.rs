@@ -11,7 +11,8 @@
 //! the paper scales the Newton step. Points are taken on the curve (`P_{i+1} = C(u_{i+1})`),
 //! which line 11 also gives once Newton has converged.
 
-use super::bspline::{dot, norm, sub, Curve, Eval};
+use super::bspline::{Curve, Eval};
+use crate::vec3::{dot, norm, sub};
 
 /// Settings of the walk.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,7 +60,7 @@ pub struct WalkStats {
 
 /// Walks `curve` from start to end. Returns the points (first = `C(start)`, last = `C(end)`)
 /// or `None` if the walk does not converge (degenerate curve).
-pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample>> {
+pub fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample>> {
     let (u_start, u_end) = (curve.start(), curve.end());
     if u_end.is_nan() || u_start.is_nan() || u_end <= u_start {
         return None;
@@ -397,7 +398,7 @@ mod tests {
             newton_tol_mm: 1e-7,
         };
         let mut st = WalkStats::default();
-        let s = walk(&f.curve, &w, &mut st).unwrap();
+        let s = walk_curve(&f.curve, &w, &mut st).unwrap();
         assert!(s.len() >= 5, "{}", s.len());
         for pair in s.windows(2) {
             let got = norm(&sub(&pair[1].p, &pair[0].p));
@@ -443,7 +444,7 @@ mod tests {
                     newton_tol_mm: 1e-7,
                 };
                 let mut st = WalkStats::default();
-                let Some(s) = walk(&f.curve, &w, &mut st) else { return Ok(()) };
+                let Some(s) = walk_curve(&f.curve, &w, &mut st) else { return Ok(()) };
                 let index = CurvatureIndex::new(&f.curve);
                 for x in &s {
                     let on = f.curve.eval(x.u).p;

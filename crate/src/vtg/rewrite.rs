@@ -13,13 +13,12 @@
 
 use super::arcs::{self, Piece};
 use super::block::{self, Frame};
-use super::bspline::{dot, norm, sub};
 use super::budget::{self, Budget, Offer, Outcome};
 use super::deviation::both_ways;
 use super::feed::Written;
 use super::kinematics::KinematicLimits;
 use super::resample::WalkStats;
-use super::smooth::{smooth_path, Path, Settings, Smoothed};
+use super::smooth::{smooth_path, Settings, SmoothPath, Smoothed};
 use super::source::{MoveSource, Sources};
 use super::VtgOptions;
 use crate::energy::Accumulator;
@@ -28,6 +27,7 @@ use crate::gcode::{apply_edits, Edit};
 use crate::machine::{ExtrusionMode, MoveKind};
 use crate::path::{PathMove, PrintPath};
 use crate::plan::{JunctionModel, Limits, Motion, Planner, Profile};
+use crate::vec3::{dot, norm, sub};
 
 /// What the rewrite did.
 #[derive(Debug, Clone, Default)]
@@ -170,7 +170,7 @@ pub fn offers(
     options: &VtgOptions,
     limits: &KinematicLimits,
     variant: Variant,
-    progress: crate::analyze::Progress<'_>,
+    progress: crate::progress::Progress<'_>,
 ) -> Result<Offers, Error> {
     let mut out = Offers {
         variant,
@@ -254,7 +254,7 @@ pub fn offers(
             chunk
                 .iter()
                 .map(|&(i, j)| {
-                    let machine = Machine {
+                    let machine = PlanContext {
                         limits: all.limits_at(i),
                         model: path.junction_model,
                         energy: &energy,
@@ -439,7 +439,7 @@ const CAP_SCALES: [Option<f64>; 8] = [
 /// The firmware a path runs on: the limits in force where it starts, the junction model, and
 /// the motor energy model; and the moves just before and after the path, which are planned
 /// with it.
-struct Machine<'a> {
+struct PlanContext<'a> {
     limits: Option<&'a Limits>,
     model: JunctionModel,
     energy: &'a Accumulator,
@@ -457,7 +457,7 @@ fn motion_of(m: &PathMove) -> Motion {
     }
 }
 
-impl Machine<'_> {
+impl PlanContext<'_> {
     /// The settings for a path here: the jerk and acceleration ceilings of the limits in force.
     fn settings(&self, file: &Settings) -> Settings {
         let mut s = *file;
@@ -484,7 +484,7 @@ impl Machine<'_> {
         self.cost_pieces(start, points, e, &arcs::lines(feed))
     }
 
-    /// [`Machine::cost`] of the path written as `pieces` (lines and arcs) through `points`.
+    /// [`PlanContext::cost`] of the path written as `pieces` (lines and arcs) through `points`.
     fn cost_pieces(
         &self,
         start: [f64; 3],
@@ -545,7 +545,7 @@ fn rewrite_path(
     run: &[PathMove],
     src: &[MoveSource],
     file_settings: &Settings,
-    machine: &Machine<'_>,
+    machine: &PlanContext<'_>,
 ) -> Option<Vec<Outcome>> {
     let settings = &machine.settings(file_settings);
     let (first, first_src) = (run.first()?, src.first()?);
@@ -578,7 +578,7 @@ fn rewrite_path(
         .iter()
         .map_while(|m| m.timing.map(|t| t.profile))
         .collect();
-    let path = Path {
+    let path = SmoothPath {
         pts: &pts,
         e: &e,
         feed: &feed,
@@ -672,7 +672,7 @@ struct Draft<'a> {
     cos_critical: f64,
     smoothed: &'a Smoothed,
     settings: &'a Settings,
-    machine: &'a Machine<'a>,
+    machine: &'a PlanContext<'a>,
 }
 
 impl Draft<'_> {
@@ -793,7 +793,7 @@ fn with_arcs(
     lines_cost: (f64, f64),
     orig: &[[f64; 3]],
     settings: &Settings,
-    machine: &Machine<'_>,
+    machine: &PlanContext<'_>,
 ) -> Option<(Vec<Piece>, f64)> {
     let limits = machine.limits?;
     let max_segment = limits.arc_segment_mm.value;

@@ -10,7 +10,7 @@
 //! cannot be rounded within the tolerance is kept as it was.
 
 use super::blend;
-use super::bspline::{arc_lengths, dot, norm, segment_at, sub};
+use super::bspline::{arc_lengths, segment_at};
 use super::corner;
 use super::deviation::both_ways;
 use super::feed::StepSpeed;
@@ -18,8 +18,9 @@ use super::fit::fit;
 use super::hairpin;
 use super::keyhole;
 use super::kinematics::KinematicLimits;
-use super::resample::{walk, Walk, WalkStats};
+use super::resample::{walk_curve, Walk, WalkStats};
 use crate::plan::Profile;
+use crate::vec3::{dot, norm, sub};
 
 /// Share of the tolerance the corner blends may use: most of it, since the fillet's radius sets
 /// the corner speed (a firmware planner lets a curve of radius `r` be run at `√(a r)`).
@@ -125,7 +126,7 @@ pub struct Smoothed {
 
 /// A path to rewrite: its points, and what the original asks of each stretch.
 #[derive(Debug, Clone, Copy)]
-pub struct Path<'a> {
+pub struct SmoothPath<'a> {
     /// The polyline.
     pub pts: &'a [[f64; 3]],
     /// Filament pushed from the path start to each point, mm (from 0).
@@ -142,7 +143,7 @@ pub struct Path<'a> {
     pub planned: &'a [Profile],
 }
 
-impl<'a> Path<'a> {
+impl<'a> SmoothPath<'a> {
     /// Whether the arrays agree with each other.
     fn consistent(&self) -> bool {
         let n = self.pts.len();
@@ -152,8 +153,8 @@ impl<'a> Path<'a> {
     }
 
     /// The piece from point `a` to point `b` (both included).
-    fn piece(&self, a: usize, b: usize) -> Option<Path<'a>> {
-        Some(Path {
+    fn piece(&self, a: usize, b: usize) -> Option<SmoothPath<'a>> {
+        Some(SmoothPath {
             pts: self.pts.get(a..=b)?,
             e: self.e.get(a..=b)?,
             feed: self.feed.get(a..b)?,
@@ -178,7 +179,7 @@ impl<'a> Path<'a> {
 /// racing-line one, which the fit and walk do not always manage to follow in steps under δθ
 /// (it then stays sharp): where that happened, the path is also rounded on the inside line
 /// (with its hairpins and keyholes) and the one left with fewer sharp turns is kept.
-pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
+pub fn smooth_path(path: &SmoothPath<'_>, s: &Settings) -> Option<Smoothed> {
     let corners = polygon_corners(path, s);
     if corners.is_empty() {
         return smooth_cut(path, s, &[]);
@@ -203,7 +204,7 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
         .zip(&pins)
         .flat_map(|(&k, p)| [k, k + p.arc.len() - 1])
         .collect();
-    let replaced = Path {
+    let replaced = SmoothPath {
         pts: &sub.pts,
         e: &sub.e,
         feed: &sub.feed,
@@ -218,7 +219,7 @@ pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
 
 /// [`smooth_path`] without polygon corners, the path also cut at the points `forced` (whose
 /// pieces are kept as they are unless they have a sharp corner).
-fn smooth_cut(path: &Path<'_>, s: &Settings, forced: &[usize]) -> Option<Smoothed> {
+fn smooth_cut(path: &SmoothPath<'_>, s: &Settings, forced: &[usize]) -> Option<Smoothed> {
     let (result, rescued) = smooth_on(path, s, forced);
     if !rescued {
         return result;
@@ -247,7 +248,7 @@ fn smooth_cut(path: &Path<'_>, s: &Settings, forced: &[usize]) -> Option<Smoothe
 
 /// [`smooth_path`] on the line `s` asks for; and whether the racing line made a corner
 /// roundable that the inside fillet could not round.
-fn smooth_on(path: &Path<'_>, s: &Settings, forced: &[usize]) -> (Option<Smoothed>, bool) {
+fn smooth_on(path: &SmoothPath<'_>, s: &Settings, forced: &[usize]) -> (Option<Smoothed>, bool) {
     let pts = path.pts;
     if pts.len() < 3 || !path.consistent() {
         return (None, false);
@@ -409,7 +410,7 @@ fn smooth_on(path: &Path<'_>, s: &Settings, forced: &[usize]) -> (Option<Smoothe
 /// fits within the tolerance and the legs' room (all of the leg where it ends the path, half
 /// where it is shared, less a shortest step), and the firmware runs it no slower than
 /// [`Settings::min_speed_share`] of its speed through the sharp corner.
-fn polygon_corners(path: &Path<'_>, s: &Settings) -> Vec<corner::Corner> {
+fn polygon_corners(path: &SmoothPath<'_>, s: &Settings) -> Vec<corner::Corner> {
     let mut out = Vec::new();
     let Some(scv) = s.klipper_scv_mm_s else {
         return out;
@@ -509,7 +510,7 @@ impl Settings {
 /// One piece between kept corners, with its hairpins (`at` counted in the piece) as found with
 /// the full blend share of the tolerance.
 fn smooth_piece(
-    path: &Path<'_>,
+    path: &SmoothPath<'_>,
     s: &Settings,
     has_sharp: bool,
     pins: &[hairpin::Hairpin],
@@ -519,7 +520,7 @@ fn smooth_piece(
     }
     let e0 = *path.e.first()?;
     let e: Vec<f64> = path.e.iter().map(|x| x - e0).collect();
-    let from_zero = Path { e: &e, ..*path };
+    let from_zero = SmoothPath { e: &e, ..*path };
     let mut share = BLEND_SHARE;
     for _ in 0..ATTEMPTS {
         let tol = share * s.tolerance_mm;
@@ -609,7 +610,7 @@ fn min_hairpin_radius(s: &Settings) -> f64 {
 /// [`attempt`] on `path` with its hairpins `pins` replaced by their arcs, checked against the
 /// original; with `again`, the arcs are found anew within the smaller `blend_tol`.
 fn with_hairpins(
-    path: &Path<'_>,
+    path: &SmoothPath<'_>,
     s: &Settings,
     blend_tol: f64,
     pins: &[hairpin::Hairpin],
@@ -630,7 +631,7 @@ fn with_hairpins(
         pins
     };
     let sub = hairpin::substitute(pts, path.e, path.feed, path.planned, pins);
-    let replaced = Path {
+    let replaced = SmoothPath {
         pts: &sub.pts,
         e: &sub.e,
         feed: &sub.feed,
@@ -642,12 +643,12 @@ fn with_hairpins(
 /// Blend, fit, walk `path` (filament from 0) with blends within `blend_tol`, and check the
 /// result against the polyline `original` (the same path, or the one it stands for).
 fn attempt(
-    path: &Path<'_>,
+    path: &SmoothPath<'_>,
     original: &[[f64; 3]],
     s: &Settings,
     blend_tol: f64,
 ) -> Option<Smoothed> {
-    let Path {
+    let SmoothPath {
         pts,
         e,
         feed,
@@ -670,7 +671,7 @@ fn attempt(
         newton_tol_mm: 1e-7,
     };
     let mut stats = WalkStats::default();
-    let walked = walk(&f.curve, &w, &mut stats)?;
+    let walked = walk_curve(&f.curve, &w, &mut stats)?;
     let mut points: Vec<[f64; 3]> = walked.iter().map(|x| x.p).collect();
     // Pin the ends to the original ones exactly.
     if let (Some(first), Some(p0)) = (points.first_mut(), pts.first()) {
@@ -834,7 +835,7 @@ mod tests {
         let pts = [[0.0, 0.0, 0.2], [10.0, 0.0, 0.2], [10.0, 10.0, 0.2]];
         let e = [0.0, 0.4, 0.8];
         let feed = [50.0, 50.0];
-        let path = Path {
+        let path = SmoothPath {
             pts: &pts,
             e: &e,
             feed: &feed,
@@ -876,12 +877,12 @@ mod tests {
         ];
         let mut e = vec![0.0];
         for w in pts.windows(2) {
-            let l = super::super::bspline::norm(&super::super::bspline::sub(&w[1], &w[0]));
+            let l = crate::vec3::norm(crate::vec3::sub(&w[1], &w[0]));
             e.push(e.last().unwrap() + 0.03 * l);
         }
         let feed = vec![20.0; pts.len() - 1];
         let s = settings();
-        let path = Path {
+        let path = SmoothPath {
             pts: &pts,
             e: &e,
             feed: &feed,
@@ -914,7 +915,7 @@ mod tests {
         pts.extend((1..=20).map(|k| leg(k, -1.0)));
         let e: Vec<f64> = (0..pts.len()).map(|k| 0.002 * k as f64).collect();
         let feed = vec![30.0; pts.len() - 1];
-        let path = Path {
+        let path = SmoothPath {
             pts: &pts,
             e: &e,
             feed: &feed,
@@ -956,7 +957,7 @@ mod tests {
         ];
         let e = [0.0, 0.4, 0.4112, 0.8112];
         let feed = [40.0; 3];
-        let path = Path {
+        let path = SmoothPath {
             pts: &pts,
             e: &e,
             feed: &feed,

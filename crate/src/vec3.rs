@@ -1,5 +1,11 @@
 //! Small 3-vector helpers on `[f64; 3]` (portable: every transcendental call goes through
 //! [`crate::math`] or `libm`, so native and wasm results are bit-identical).
+//!
+//! One module for every user: the tool-orientation smoother ([`crate::orient`]) passes vectors
+//! by value, the toolpath rewriter ([`crate::vtg`]) by reference to the points it keeps; the
+//! arithmetic helpers take either (`impl Borrow<V3>`).
+
+use std::borrow::Borrow;
 
 use crate::math;
 
@@ -8,31 +14,36 @@ pub type V3 = [f64; 3];
 
 /// `a + b`.
 #[inline]
-pub fn add(a: V3, b: V3) -> V3 {
+pub fn add(a: impl Borrow<V3>, b: impl Borrow<V3>) -> V3 {
+    let (a, b) = (a.borrow(), b.borrow());
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
 /// `a - b`.
 #[inline]
-pub fn sub(a: V3, b: V3) -> V3 {
+pub fn sub(a: impl Borrow<V3>, b: impl Borrow<V3>) -> V3 {
+    let (a, b) = (a.borrow(), b.borrow());
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// `k a`.
 #[inline]
-pub fn scale(a: V3, k: f64) -> V3 {
+pub fn scale(a: impl Borrow<V3>, k: f64) -> V3 {
+    let a = a.borrow();
     [a[0] * k, a[1] * k, a[2] * k]
 }
 
 /// Dot product.
 #[inline]
-pub fn dot(a: V3, b: V3) -> f64 {
+pub fn dot(a: impl Borrow<V3>, b: impl Borrow<V3>) -> f64 {
+    let (a, b) = (a.borrow(), b.borrow());
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// Cross product `a × b`.
 #[inline]
-pub fn cross(a: V3, b: V3) -> V3 {
+pub fn cross(a: impl Borrow<V3>, b: impl Borrow<V3>) -> V3 {
+    let (a, b) = (a.borrow(), b.borrow());
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -42,7 +53,8 @@ pub fn cross(a: V3, b: V3) -> V3 {
 
 /// Euclidean norm.
 #[inline]
-pub fn norm(a: V3) -> f64 {
+pub fn norm(a: impl Borrow<V3>) -> f64 {
+    let a = a.borrow();
     dot(a, a).sqrt()
 }
 
@@ -62,8 +74,20 @@ pub fn normalize(a: V3) -> Option<V3> {
 /// Eq. 4 of the paper writes it as `arccos(a·b / |a||b|)`; `atan2(|a×b|, a·b)` is the same
 /// angle but keeps full precision near 0 and π, where the cone test must be exact.
 #[inline]
-pub fn angle(a: V3, b: V3) -> f64 {
+pub fn angle(a: impl Borrow<V3>, b: impl Borrow<V3>) -> f64 {
+    let (a, b) = (a.borrow(), b.borrow());
     math::atan2(norm(cross(a, b)), dot(a, b))
+}
+
+/// The point at fraction `t` of the way from `a` to `b`.
+#[inline]
+pub fn lerp(a: impl Borrow<V3>, b: impl Borrow<V3>, t: f64) -> V3 {
+    let (a, b) = (a.borrow(), b.borrow());
+    [
+        a[0] + (b[0] - a[0]) * t,
+        a[1] + (b[1] - a[1]) * t,
+        a[2] + (b[2] - a[2]) * t,
+    ]
 }
 
 /// Whether all three components are finite.
