@@ -134,6 +134,7 @@ async function analyze() {
         fx(a.dwell_s),
         fx(est),
         est ? pct(change(est, a.time_s), 1) : '–',
+        est ? pct(change(est, a.time_s - a.dwell_s), 1) : '–',
         fx(a.filament_mm / 1000, 2),
         fx(a.material_g, 1),
         sig(a.energy.total_kwh),
@@ -149,12 +150,12 @@ async function analyze() {
       '\nEvery corpus file (`../shared/corpus/`) and fixture (`tests/fixtures/gcode/`), default options ' +
       '(each file on the machine `analyze` picks for it). "slicer est." is `file.slicer_time_s`, the ' +
       "estimate the slicer wrote into the file; diff = (ours − slicer's) / slicer's. Ours includes " +
-      'dwells (`dwell_s`), which PrusaSlicer\'s estimate leaves out. Energy is `energy.total_kwh` ' +
+      'dwells (`dwell_s`), which PrusaSlicer\'s estimate leaves out: "diff − dwell" compares `time_s − dwell_s`. Energy is `energy.total_kwh` ' +
       '(steppers, melting, heaters, fans, electronics); stepper is `energy.thesis_j`. Warnings: ' +
       '`warnings` plus `warnings_dropped`.\n\n' +
       table(
-        ['file', 'set', 'slicer', 'lines', 'layers', 'time s', 'dwell s', 'slicer est. s', 'diff', 'filament m', 'material g', 'energy kWh', 'stepper kJ', 'warnings', 'wall s'],
-        ['---', '---', '---', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:'],
+        ['file', 'set', 'slicer', 'lines', 'layers', 'time s', 'dwell s', 'slicer est. s', 'diff', 'diff − dwell', 'filament m', 'material g', 'energy kWh', 'stepper kJ', 'warnings', 'wall s'],
+        ['---', '---', '---', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:'],
         rows,
       ),
   );
@@ -248,9 +249,10 @@ async function infill() {
     'infill.md',
     header('infill: best candidate against the original', 'quietpath infill FILE -o OUT --angles 0,90 --patterns rectilinear,concentric --json') +
       '\nEvery corpus file and fixture; four candidates each (rectilinear and concentric at 0° and 90°, ' +
-      'rotation 0), objective energy. Original: `before` (the analyze report of the input); best: ' +
-      '`best` (whole-file figures with that candidate applied). Total energy: `energy.total_j` / ' +
-      '`best.total_j`; stepper energy (thesis eq. 28, what the search compares first): ' +
+      'rotation 0), objective energy (the lowest `total_j` wins). Original: `before` (the analyze ' +
+      'report of the input); best: `best` (whole-file figures with that candidate applied). The ' +
+      "original's own angle and pattern need not be among the four, so the best can cost more than " +
+      'the original. Total energy: `energy.total_j` / `best.total_j`; stepper energy (thesis eq. 28): ' +
       '`energy.thesis_j` / `best.thesis_j`; time: `time_s` / `best.time_s`. Wall time of the whole ' +
       'command (search, regenerate, write, re-analyse).\n\n' +
       table(
