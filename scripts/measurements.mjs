@@ -44,7 +44,9 @@ const failures = [];
 const sh = (cmd, args) => execFileSync(cmd, args, { cwd: root, encoding: 'utf8' }).trim();
 const commit = sh('git', ['rev-parse', '--short', 'HEAD']);
 // Uncommitted changes to anything but the generated tables themselves would make the commit lie.
-const dirty = sh('git', ['status', '--porcelain', '--', '.', `:(exclude)${path.relative(root, outDir)}`]) !== '';
+const outRel = path.relative(root, outDir);
+const inRepo = outRel && !outRel.startsWith('..') && !path.isAbsolute(outRel);
+const dirty = sh('git', ['status', '--porcelain', '--', '.', ...(inRepo ? [`:(exclude)${outRel}`] : [])]) !== '';
 const cpu = fs.readFileSync('/proc/cpuinfo', 'utf8').match(/^model name\s*:\s*(.*)$/m)?.[1] ?? 'unknown CPU';
 const memKb = Number(fs.readFileSync('/proc/meminfo', 'utf8').match(/^MemTotal:\s*(\d+)/m)?.[1] ?? NaN);
 const header = (title, command) =>
