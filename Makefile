@@ -8,7 +8,7 @@ export PATH := $(CURDIR)/node_modules/.bin:$(HOME)/.cargo/bin:$(PATH)
 CORPUS ?= $(CURDIR)/../shared/corpus
 LARGE := $(CORPUS)/curaengine-4.13.0_extruder-idler-x2.5_large.gcode
 
-.PHONY: all setup setup-test pkg serve test test-rust test-wasm test-js test-fuzz lint cli bench fuzz clean
+.PHONY: all setup setup-test pkg serve test test-rust test-wasm test-js test-fuzz lint cli bench measurements fuzz clean
 
 all: pkg cli
 
@@ -64,6 +64,12 @@ bench: cli
 	target/release/quietpath bench "$(LARGE)"
 	cargo bench -p quietpath --bench parse
 	cargo test --release -p quietpath-conformance --test infill -- --ignored --nocapture
+
+## The generated tables in docs/measurements/generated/ (analyze, vtg, infill, smooth on every
+## corpus file and fixture, from the CLI's --json; a few minutes). CORPUS=… for another corpus folder.
+measurements:
+	cargo build --release
+	CORPUS="$(CORPUS)" node scripts/measurements.mjs
 
 ## Short, reproducible (seeded, fixed-count) fuzzing smoke run of every target (make test).
 test-fuzz:
