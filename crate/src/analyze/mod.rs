@@ -13,7 +13,7 @@ use crate::machine::{axis, Event, Machine};
 use crate::plan::{Limits, Planner};
 use crate::progress::Progress;
 pub use crate::read::{prescan, AnalyzeOptions, ExtrusionModeOption};
-use crate::read::{At, Flow, Fold, Reader};
+use crate::read::{At, Flow, Fold, Reader, Setup};
 use accounting::{Accounts, TimeBook, TimeMsg, Timing};
 pub use report::*;
 
@@ -155,20 +155,11 @@ fn report(
     } = reader;
     let (mut layer_list, layer_source) = layers.finish();
     let filament_mm = machine.position()[axis::E];
-    let diameter = options
-        .filament_diameter_mm
-        .or(info.filament_diameter_mm)
-        .unwrap_or(DEFAULT_FILAMENT_DIAMETER_MM);
-    let density = options
-        .density_g_cm3
-        .or(info.filament_density_g_cm3)
-        .unwrap_or(DEFAULT_DENSITY_G_CM3);
-    let volume = filament_mm * std::f64::consts::PI * diameter * diameter / 4.0;
+    let (extrusion, volume, material_g) = extrusion(options, &info, &setup, filament_mm);
     if travel.moves > 0 {
         features.push(travel);
     }
     let time_s = planner.elapsed_s();
-    let material_g = volume * density / 1000.0;
     let energy = energy_acc.finish(time_s, material_g, &temperatures, &fans);
     share_aux_energy(energy.aux_j, time_s, &mut features, &mut layer_list);
     let (warnings, warnings_dropped) = setup.warnings.into_parts();
@@ -201,12 +192,7 @@ fn report(
         filament_volume_mm3: volume,
         material_g,
         retractions: totals.retractions,
-        extrusion: ExtrusionInfo {
-            mode: setup.mode,
-            source: setup.source,
-            filament_diameter_mm: diameter,
-            density_g_cm3: density,
-        },
+        extrusion,
         bounds: totals.bounds,
         features,
         layer_list,
@@ -217,6 +203,33 @@ fn report(
         warnings,
         warnings_dropped,
     }
+}
+
+/// The extrusion settings used (the file's mode, and the filament's diameter and density from
+/// the options, else the file, else the defaults), and the volume (mm³) and mass (g) of
+/// `filament_mm` of that filament.
+fn extrusion(
+    options: &AnalyzeOptions,
+    info: &SlicerInfo,
+    setup: &Setup,
+    filament_mm: f64,
+) -> (ExtrusionInfo, f64, f64) {
+    let diameter = options
+        .filament_diameter_mm
+        .or(info.filament_diameter_mm)
+        .unwrap_or(DEFAULT_FILAMENT_DIAMETER_MM);
+    let density = options
+        .density_g_cm3
+        .or(info.filament_density_g_cm3)
+        .unwrap_or(DEFAULT_DENSITY_G_CM3);
+    let volume = filament_mm * std::f64::consts::PI * diameter * diameter / 4.0;
+    let info = ExtrusionInfo {
+        mode: setup.mode,
+        source: setup.source,
+        filament_diameter_mm: diameter,
+        density_g_cm3: density,
+    };
+    (info, volume, volume * density / 1000.0)
 }
 
 /// Shares auxiliary energy out to features and layers by time (see [`crate::energy`]). Shares
