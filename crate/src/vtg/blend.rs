@@ -125,15 +125,53 @@ fn fillet_point(v: &[f64; 3], a: &[f64; 3], b: &[f64; 3], turn: f64, l: f64, t: 
 /// would take the leg a sharp neighbour needs.
 pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64, line: Line) -> Vec<Blend> {
     let n = pts.len();
-    let mut out = vec![Blend::NONE; n];
     if n < 3 {
+        return vec![Blend::NONE; n];
+    }
+    let (mut out, through) = inside_fillets(pts, tolerance_mm, enough_curvature);
+    if line == Line::Inside {
         return out;
     }
+    // Then, corner by corner, the racing line where the path has room for it: up to the
+    // nearest vertex either way that is not straight (less what its own blend takes), or the
+    // path's end.
+    let along = super::bspline::arc_lengths(pts);
+    for i in 1..n - 1 {
+        if out[i].extent_mm <= 0.0 || out[i].max_curvature <= enough_curvature {
+            continue;
+        }
+        let room = |other: usize| {
+            let used = if other == 0 || other == n - 1 {
+                0.0
+            } else {
+                out[other].reach()
+            };
+            LEG_SHARE * (along[i] - along[other]).abs() - used
+        };
+        let back = (0..i).rev().find(|&k| !through[k]).unwrap_or(0);
+        let on = (i + 1..n).find(|&k| !through[k]).unwrap_or(n - 1);
+        let room = room(back).min(room(on));
+        if let Some(r) = racing(out[i], tolerance_mm, enough_curvature, room) {
+            out[i] = r;
+        }
+    }
+    out
+}
+
+/// [`plan`] on the inside line (at least three points): each corner's fillet with the legs
+/// shared between neighbours; and the vertices a ramp out to a racing line may run through
+/// (the path is straight there), which the racing lines are then fitted between.
+fn inside_fillets(
+    pts: &[[f64; 3]],
+    tolerance_mm: f64,
+    enough_curvature: f64,
+) -> (Vec<Blend>, Vec<bool>) {
+    let n = pts.len();
+    let mut out = vec![Blend::NONE; n];
     let lens: Vec<f64> = pts.windows(2).map(|w| norm(&sub(&w[1], &w[0]))).collect();
     // What each corner asks for.
     let mut want = vec![0.0f64; n];
     let mut shapes = vec![(0.0, 0.0); n];
-    // Vertices a ramp out to a racing line may run through: the path is straight there.
     let mut through = vec![false; n];
     for i in 1..n - 1 {
         let (la, lb) = (lens[i - 1], lens[i]);
@@ -187,33 +225,7 @@ pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64, line: Li
         out[i].deviation_mm = c * l;
         out[i].max_curvature = k / l;
     }
-    if line == Line::Inside {
-        return out;
-    }
-    // Then, corner by corner, the racing line where the path has room for it: up to the
-    // nearest vertex either way that is not straight (less what its own blend takes), or the
-    // path's end.
-    let along = super::bspline::arc_lengths(pts);
-    for i in 1..n - 1 {
-        if out[i].extent_mm <= 0.0 || out[i].max_curvature <= enough_curvature {
-            continue;
-        }
-        let room = |other: usize| {
-            let used = if other == 0 || other == n - 1 {
-                0.0
-            } else {
-                out[other].reach()
-            };
-            LEG_SHARE * (along[i] - along[other]).abs() - used
-        };
-        let back = (0..i).rev().find(|&k| !through[k]).unwrap_or(0);
-        let on = (i + 1..n).find(|&k| !through[k]).unwrap_or(n - 1);
-        let room = room(back).min(room(on));
-        if let Some(r) = racing(out[i], tolerance_mm, enough_curvature, room) {
-            out[i] = r;
-        }
-    }
-    out
+    (out, through)
 }
 
 /// Which side of the vertex a blend may use.
@@ -294,48 +306,20 @@ fn racing(inside: Blend, tolerance_mm: f64, enough_curvature: f64, room: f64) ->
 /// most `spacing_mm` apart, denser near the blends so the knot spans grow gradually.
 pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64; 3]>, Vec<f64>) {
     let n = pts.len();
-    let mut data = Vec::with_capacity(n * (SAMPLES + 4));
-    let mut par = Vec::with_capacity(n * (SAMPLES + 4));
-    if n == 0 || blends.len() != n {
-        return (data, par);
-    }
-    let push = |p: [f64; 3], u: f64, data: &mut Vec<[f64; 3]>, par: &mut Vec<f64>| {
-        if par.last().is_none_or(|&last| u > last + 1e-9) {
-            data.push(p);
-            par.push(u);
-        }
+    let mut out = Sampled {
+        data: Vec::with_capacity(n * (SAMPLES + 4)),
+        par: Vec::with_capacity(n * (SAMPLES + 4)),
     };
-    push(pts[0], 0.0, &mut data, &mut par);
+    if n == 0 || blends.len() != n {
+        return (out.data, out.par);
+    }
+    out.push(pts[0], 0.0);
     // The ramps out to the racing lines: each runs from its blend's end along the straight
     // stretch, possibly past straight vertices (no turn, so no blend), so each leg looks for
     // the nearest blend either way through those.
-    let racers: Vec<Option<Racer>> = blends
-        .iter()
-        .enumerate()
-        .map(|(j, bl)| {
-            let o = (bl.offset_mm > 0.0 && bl.ramp_mm > 0.0)
-                .then(|| Outward::at(pts, j))
-                .flatten()?;
-            Some(Racer { blend: *bl, o })
-        })
-        .collect();
+    let racers = Racer::all(pts, blends);
     let along = super::bspline::arc_lengths(pts);
-    // The blend at vertex `i` itself, or `None` past a turn without one (a path end included).
-    let here = |i: usize| {
-        if i == 0 || i + 1 == n || blends[i].turn_rad != 0.0 {
-            Some((blends[i].extent_mm > 0.0).then_some(i))
-        } else {
-            None
-        }
-    };
-    let mut prev_blend = vec![None; n];
-    let mut next_blend = vec![None; n];
-    for i in 0..n {
-        prev_blend[i] = here(i).unwrap_or_else(|| prev_blend[i - 1]);
-    }
-    for i in (0..n).rev() {
-        next_blend[i] = here(i).unwrap_or_else(|| next_blend[i + 1]);
-    }
+    let (prev_blend, next_blend) = nearest_blends(blends);
     let mut ts = Vec::new();
     for i in 0..n - 1 {
         let (a, b) = (pts[i], pts[i + 1]);
@@ -383,44 +367,95 @@ pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64
             }
             ts.sort_by(f64::total_cmp);
             for &t in &ts {
-                push(at(t), arc + t, &mut data, &mut par);
+                out.push(at(t), arc + t);
             }
         }
         // The blend at the far end of the leg.
         let bl = &blends[i + 1];
         if i + 2 < n && bl.extent_mm > 0.0 {
-            let c = pts[i + 2];
-            let lc = norm(&sub(&c, &b));
-            let out_dir = [(c[0] - b[0]) / lc, (c[1] - b[1]) / lc, (c[2] - b[2]) / lc];
-            let l = bl.extent_mm;
-            // A racing line's fillet is tangent to the legs' offsets, which meet outside the
-            // vertex.
-            let (vertex, reach) = match racers[i + 1] {
-                Some(r) => {
-                    let half = 0.5 * bl.turn_rad;
-                    let away = bl.offset_mm / crate::math::cos(half);
-                    let w = r.o.bisector;
-                    (
-                        [b[0] + w[0] * away, b[1] + w[1] * away, b[2] + w[2] * away],
-                        l + bl.offset_mm * crate::math::tan(half),
-                    )
-                }
-                None => (b, l),
-            };
-            for k in 0..SAMPLES {
-                let u = k as f64 / (SAMPLES - 1) as f64;
-                push(
-                    fillet_point(&vertex, &dir, &out_dir, bl.turn_rad, reach, u),
-                    arc + len - l + 2.0 * l * u,
-                    &mut data,
-                    &mut par,
-                );
-            }
+            out.fillet(pts, i + 1, bl, racers[i + 1], &dir, arc + len);
         } else {
-            push(b, arc + len, &mut data, &mut par);
+            out.push(b, arc + len);
         }
     }
-    (data, par)
+    (out.data, out.par)
+}
+
+/// The blend nearest each vertex looking back and looking on, through straight vertices (a
+/// turn without a blend, the path's ends included, stops the search with `None`): where the
+/// racing-line ramps reaching into each leg come from.
+fn nearest_blends(blends: &[Blend]) -> (Vec<Option<usize>>, Vec<Option<usize>>) {
+    let n = blends.len();
+    // The blend at vertex `i` itself, or `None` past a turn without one (a path end included).
+    let here = |i: usize| {
+        if i == 0 || i + 1 == n || blends[i].turn_rad != 0.0 {
+            Some((blends[i].extent_mm > 0.0).then_some(i))
+        } else {
+            None
+        }
+    };
+    let mut prev_blend = vec![None; n];
+    let mut next_blend = vec![None; n];
+    for i in 0..n {
+        prev_blend[i] = here(i).unwrap_or_else(|| prev_blend[i - 1]);
+    }
+    for i in (0..n).rev() {
+        next_blend[i] = here(i).unwrap_or_else(|| next_blend[i + 1]);
+    }
+    (prev_blend, next_blend)
+}
+
+/// The fit's data points and their parameters, as [`samples`] builds them.
+struct Sampled {
+    data: Vec<[f64; 3]>,
+    par: Vec<f64>,
+}
+
+impl Sampled {
+    /// Adds point `p` at parameter `u`, unless `u` does not move on from the last one.
+    fn push(&mut self, p: [f64; 3], u: f64) {
+        if self.par.last().is_none_or(|&last| u > last + 1e-9) {
+            self.data.push(p);
+            self.par.push(u);
+        }
+    }
+
+    /// The points of blend `bl` at vertex `v` of `pts` (neither end), entered along `dir`,
+    /// `vertex_arc` the original's arc length at the vertex; on a racing line (`racer`) the
+    /// fillet is tangent to the legs' offsets, which meet outside the vertex.
+    fn fillet(
+        &mut self,
+        pts: &[[f64; 3]],
+        v: usize,
+        bl: &Blend,
+        racer: Option<Racer>,
+        dir: &[f64; 3],
+        vertex_arc: f64,
+    ) {
+        let (b, c) = (pts[v], pts[v + 1]);
+        let lc = norm(&sub(&c, &b));
+        let out_dir = [(c[0] - b[0]) / lc, (c[1] - b[1]) / lc, (c[2] - b[2]) / lc];
+        let l = bl.extent_mm;
+        let (vertex, reach) = match racer {
+            Some(r) => {
+                let half = 0.5 * bl.turn_rad;
+                let away = bl.offset_mm / crate::math::cos(half);
+                let w = r.o.bisector;
+                (
+                    [b[0] + w[0] * away, b[1] + w[1] * away, b[2] + w[2] * away],
+                    l + bl.offset_mm * crate::math::tan(half),
+                )
+            }
+            None => (b, l),
+        };
+        for k in 0..SAMPLES {
+            let u = k as f64 / (SAMPLES - 1) as f64;
+            self.push(
+                fillet_point(&vertex, dir, &out_dir, bl.turn_rad, reach, u),
+                vertex_arc - l + 2.0 * l * u,
+            );
+        }
+    }
 }
 
 /// A blend on a racing line, with its outward directions.
@@ -428,6 +463,23 @@ pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64
 struct Racer {
     blend: Blend,
     o: Outward,
+}
+
+impl Racer {
+    /// The racing-line blend at each vertex of `pts`, with its outward directions (`None`:
+    /// no ramp there).
+    fn all(pts: &[[f64; 3]], blends: &[Blend]) -> Vec<Option<Racer>> {
+        blends
+            .iter()
+            .enumerate()
+            .map(|(j, bl)| {
+                let o = (bl.offset_mm > 0.0 && bl.ramp_mm > 0.0)
+                    .then(|| Outward::at(pts, j))
+                    .flatten()?;
+                Some(Racer { blend: *bl, o })
+            })
+            .collect()
+    }
 }
 
 /// Samples across each ramp out to a racing line (its ends excluded).

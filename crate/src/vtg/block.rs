@@ -82,19 +82,7 @@ pub fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &[Piece]
         }
         from_xy = [rounded(p[0], 3), rounded(p[1], 3)];
         let last = k + 1 == pieces.len();
-        text.push_str(" E");
-        match frame.mode {
-            ExtrusionMode::Absolute if last => {
-                let _ = write!(text, "{}", frame.last_e_word);
-            }
-            ExtrusionMode::Absolute => push_trimmed(&mut text, frame.e_before + ek, 5),
-            ExtrusionMode::Relative => {
-                let target = if last { frame.total_e } else { ek };
-                let written = rounded(target, 5);
-                push_trimmed(&mut text, written - e_written, 5);
-                e_written = written;
-            }
-        }
+        push_e(&mut text, frame, ek, last, &mut e_written);
         // No F is written into a file that has none yet.
         if let Some(now) = f_now {
             let f = rounded(piece.feed * 60.0, 1);
@@ -117,4 +105,24 @@ pub fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &[Piece]
         }
     }
     text
+}
+
+/// The ` E` word of the point with filament `ek` from the path start (`last`: the block's last
+/// point), as the frame's extrusion mode writes it: absolute mode ends on the original's last
+/// word exactly, relative mode writes differences of rounded running totals (`e_written`) so
+/// the words add up to the path's filament.
+fn push_e(text: &mut String, frame: &Frame<'_>, ek: f64, last: bool, e_written: &mut f64) {
+    text.push_str(" E");
+    match frame.mode {
+        ExtrusionMode::Absolute if last => {
+            let _ = write!(text, "{}", frame.last_e_word);
+        }
+        ExtrusionMode::Absolute => push_trimmed(text, frame.e_before + ek, 5),
+        ExtrusionMode::Relative => {
+            let target = if last { frame.total_e } else { ek };
+            let written = rounded(target, 5);
+            push_trimmed(text, written - *e_written, 5);
+            *e_written = written;
+        }
+    }
 }

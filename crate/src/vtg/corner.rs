@@ -163,6 +163,32 @@ pub fn find(pts: &[[f64; 3]], i: usize, bounds: &Bounds, fw: &Firmware) -> Optio
     })
 }
 
+/// The minimum of `f` on `[lo, hi]` by golden-section search in [`PLACEMENT_STEPS`] steps, and
+/// where it lies: the apex height at which a shape strays least from the corner.
+fn golden_min(mut lo: f64, mut hi: f64, f: impl Fn(f64) -> f64) -> (f64, f64) {
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    for _ in 0..PLACEMENT_STEPS {
+        if f1 <= f2 {
+            hi = x2;
+            (x2, f2) = (x1, f1);
+            x1 = hi - g * (hi - lo);
+            f1 = f(x1);
+        } else {
+            lo = x1;
+            (x1, f1) = (x2, f2);
+            x2 = lo + g * (hi - lo);
+            f2 = f(x2);
+        }
+    }
+    if f1 <= f2 {
+        (x1, f1)
+    } else {
+        (x2, f2)
+    }
+}
+
 /// One member of the family, placed and sized, in the corner's frame: the corner at the
 /// origin, the turn to the left, x along the mid-direction of the legs.
 #[derive(Debug, Clone)]
@@ -237,24 +263,7 @@ impl Shape {
             return None;
         };
         let span = 2.0 * (mf + 1.0);
-        let (mut lo, mut hi) = (y_max - span, y_max - 1e-9 * span);
-        let g = 0.5 * (5f64.sqrt() - 1.0);
-        let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-        let (mut f1, mut f2) = (spread(x1), spread(x2));
-        for _ in 0..PLACEMENT_STEPS {
-            if f1 <= f2 {
-                hi = x2;
-                (x2, f2) = (x1, f1);
-                x1 = hi - g * (hi - lo);
-                f1 = spread(x1);
-            } else {
-                lo = x1;
-                (x1, f1) = (x2, f2);
-                x2 = lo + g * (hi - lo);
-                f2 = spread(x2);
-            }
-        }
-        let (y, unit_spread) = if f1 <= f2 { (x1, f1) } else { (x2, f2) };
+        let (y, unit_spread) = golden_min(y_max - span, y_max - 1e-9 * span, spread);
         if !(unit_spread.is_finite() && unit_spread > 0.0) {
             return None;
         }

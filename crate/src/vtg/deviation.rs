@@ -68,74 +68,25 @@ pub fn polyline_deviation(out: &[[f64; 3]], orig: &[[f64; 3]], step: f64, accept
             (false, None) => f64::INFINITY,
         };
     }
-    let seg_dist = |p: &[f64; 3], j: usize| point_segment(p, &orig[j], &orig[j + 1]);
-    // Nearest original segment to `p`, searched around `cursor` first, then everywhere.
-    let nearest = |p: &[f64; 3], cursor: usize| -> (usize, f64) {
-        const WINDOW: usize = 6;
-        let lo = cursor.saturating_sub(WINDOW);
-        let hi = (cursor + WINDOW).min(segs - 1);
-        let mut best = (cursor.min(segs - 1), f64::INFINITY);
-        for j in lo..=hi {
-            let d = seg_dist(p, j);
-            if d < best.1 {
-                best = (j, d);
-            }
-        }
-        best
-    };
-    // Nearest segment over the whole polyline: where the window has lost track (the other
-    // polyline is much denser here, or doubles back), it puts the cursor back.
-    let nearest_anywhere = |p: &[f64; 3]| -> (usize, f64) {
-        (0..segs).fold((0, f64::INFINITY), |best, j| {
-            let d = seg_dist(p, j);
-            if d < best.1 {
-                (j, d)
-            } else {
-                best
-            }
-        })
-    };
+    let o = Original { orig, segs };
     let mut worst = 0.0f64;
     let mut cursor = 0usize;
     let mut prev: Option<([f64; 3], usize, f64)> = None;
     for p in out {
-        let (mut j, mut d) = nearest(p, cursor);
+        let (mut j, mut d) = o.nearest(p, cursor);
         if d > worst.max(step).max(accept) {
-            (j, d) = nearest_anywhere(p);
+            (j, d) = o.nearest_anywhere(p);
         }
         cursor = j;
         if let Some((q, jq, dq)) = prev {
             // Certificate: both ends near one segment (either end's nearest).
-            let c1 = dq.max(seg_dist(p, jq));
-            let c2 = seg_dist(&q, j).max(d);
+            let c1 = dq.max(o.seg_dist(p, jq));
+            let c2 = o.seg_dist(&q, j).max(d);
             let cert = c1.min(c2);
             let bound = if cert <= worst.max(step).max(accept) {
                 cert
             } else {
-                // Walk the segment. Distance is 1-Lipschitz, so from a point at distance d the
-                // next `accept − d` mm cannot exceed `accept`: the walk strides there and steps
-                // `step` mm only where the segment comes close to the limit.
-                let len = norm(&sub(p, &q));
-                let mut m = 0.0f64;
-                let mut t = 0.0f64;
-                let mut c = jq;
-                let mut guard = 0usize;
-                loop {
-                    let f = if len > 0.0 { (t / len).min(1.0) } else { 1.0 };
-                    let x = lerp(&q, p, f);
-                    let (mut jj, mut dx) = nearest(&x, c);
-                    if dx > m.max(accept) {
-                        (jj, dx) = nearest_anywhere(&x);
-                    }
-                    c = jj;
-                    m = m.max(dx);
-                    guard += 1;
-                    if f >= 1.0 || guard > 1_000_000 {
-                        break;
-                    }
-                    t += step.max(accept - dx);
-                }
-                cert.min(if accept > 0.0 { m } else { m + step / 2.0 })
+                cert.min(o.walk(&q, p, jq, step, accept))
             };
             worst = worst.max(bound);
             if accept > 0.0 && worst > accept {
@@ -148,6 +99,81 @@ pub fn polyline_deviation(out: &[[f64; 3]], orig: &[[f64; 3]], step: f64, accept
         prev = Some((*p, j, d));
     }
     worst
+}
+
+/// The original polyline of [`polyline_deviation`] (at least one segment), with the nearest-
+/// segment searches its measurement is made of.
+struct Original<'a> {
+    orig: &'a [[f64; 3]],
+    segs: usize,
+}
+
+impl Original<'_> {
+    /// Distance from `p` to segment `j`.
+    fn seg_dist(&self, p: &[f64; 3], j: usize) -> f64 {
+        point_segment(p, &self.orig[j], &self.orig[j + 1])
+    }
+
+    /// Nearest original segment to `p`, searched around `cursor` first, then everywhere.
+    fn nearest(&self, p: &[f64; 3], cursor: usize) -> (usize, f64) {
+        const WINDOW: usize = 6;
+        let segs = self.segs;
+        let lo = cursor.saturating_sub(WINDOW);
+        let hi = (cursor + WINDOW).min(segs - 1);
+        let mut best = (cursor.min(segs - 1), f64::INFINITY);
+        for j in lo..=hi {
+            let d = self.seg_dist(p, j);
+            if d < best.1 {
+                best = (j, d);
+            }
+        }
+        best
+    }
+
+    /// Nearest segment over the whole polyline: where the window has lost track (the other
+    /// polyline is much denser here, or doubles back), it puts the cursor back.
+    fn nearest_anywhere(&self, p: &[f64; 3]) -> (usize, f64) {
+        (0..self.segs).fold((0, f64::INFINITY), |best, j| {
+            let d = self.seg_dist(p, j);
+            if d < best.1 {
+                (j, d)
+            } else {
+                best
+            }
+        })
+    }
+
+    /// The largest distance along the output segment `q`–`p` (`q` nearest segment `jq`), by
+    /// walking it. Distance is 1-Lipschitz, so from a point at distance d the next
+    /// `accept − d` mm cannot exceed `accept`: the walk strides there and steps `step` mm only
+    /// where the segment comes close to the limit.
+    fn walk(&self, q: &[f64; 3], p: &[f64; 3], jq: usize, step: f64, accept: f64) -> f64 {
+        let len = norm(&sub(p, q));
+        let mut m = 0.0f64;
+        let mut t = 0.0f64;
+        let mut c = jq;
+        let mut guard = 0usize;
+        loop {
+            let f = if len > 0.0 { (t / len).min(1.0) } else { 1.0 };
+            let x = lerp(q, p, f);
+            let (mut jj, mut dx) = self.nearest(&x, c);
+            if dx > m.max(accept) {
+                (jj, dx) = self.nearest_anywhere(&x);
+            }
+            c = jj;
+            m = m.max(dx);
+            guard += 1;
+            if f >= 1.0 || guard > 1_000_000 {
+                break;
+            }
+            t += step.max(accept - dx);
+        }
+        if accept > 0.0 {
+            m
+        } else {
+            m + step / 2.0
+        }
+    }
 }
 
 /// Segments bucketed by 2-D cell (XY) for nearest-segment queries.

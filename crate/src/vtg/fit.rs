@@ -120,40 +120,13 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<Curve> {
     let n = count - 1;
     let (q0, qm) = (*data.first()?, *data.last()?);
     let unknowns = n - 1;
-    let mut band = vec![[0.0f64; DEGREE + 1]; unknowns];
-    let mut rhs = vec![[0.0f64; 3]; unknowns];
-    // Adds one least-squares row Σ c_j P_j ≈ target (control indices 0..=n).
-    let mut add_row = |coef: &[(usize, f64)], target: [f64; 3]| {
-        let mut t = target;
-        for &(j, c) in coef {
-            let fixed = if j == 0 {
-                Some(q0)
-            } else if j == n {
-                Some(qm)
-            } else {
-                None
-            };
-            if let Some(p) = fixed {
-                for k in 0..3 {
-                    t[k] -= c * p[k];
-                }
-            }
-        }
-        for &(j, cj) in coef {
-            if j == 0 || j >= n {
-                continue;
-            }
-            let row = j - 1;
-            for k in 0..3 {
-                rhs[row][k] += cj * t[k];
-            }
-            for &(l, cl) in coef {
-                if l >= j && l < n && l - j <= DEGREE {
-                    band[row][l - j] += cj * cl;
-                }
-            }
-        }
+    let mut eq = Normal {
+        band: vec![[0.0f64; DEGREE + 1]; unknowns],
+        rhs: vec![[0.0f64; 3]; unknowns],
+        n,
+        ends: [q0, qm],
     };
+    let mut add_row = |coef: &[(usize, f64)], target: [f64; 3]| eq.add_row(coef, target);
     for (q, &u) in data.iter().zip(params) {
         let span = find_span(knots, n, u);
         let b = basis_by_degree(knots, span, u)[2];
@@ -189,12 +162,60 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<Curve> {
             [0.0; 3],
         );
     }
-    let x = cholesky_band_solve(&mut band, &mut rhs)?;
+    let x = cholesky_band_solve(&mut eq.band, &mut eq.rhs)?;
     let mut ctrl = Vec::with_capacity(n + 1);
     ctrl.push(q0);
     ctrl.extend(x);
     ctrl.push(qm);
     Some(Curve::new(knots.to_vec(), ctrl))
+}
+
+/// The normal equations of [`solve`] being built: the band of `NᵀN` and `NᵀR` over the inner
+/// control points (the end points, fixed, are moved to the right-hand side).
+struct Normal {
+    band: Vec<[f64; DEGREE + 1]>,
+    rhs: Vec<[f64; 3]>,
+    /// Index of the last control point.
+    n: usize,
+    /// The fixed first and last control points.
+    ends: [[f64; 3]; 2],
+}
+
+impl Normal {
+    /// Adds one least-squares row Σ c_j P_j ≈ target (control indices 0..=n).
+    #[allow(clippy::needless_range_loop)] // per axis, as the rows below are indexed
+    fn add_row(&mut self, coef: &[(usize, f64)], target: [f64; 3]) {
+        let n = self.n;
+        let mut t = target;
+        for &(j, c) in coef {
+            let fixed = if j == 0 {
+                Some(self.ends[0])
+            } else if j == n {
+                Some(self.ends[1])
+            } else {
+                None
+            };
+            if let Some(p) = fixed {
+                for k in 0..3 {
+                    t[k] -= c * p[k];
+                }
+            }
+        }
+        for &(j, cj) in coef {
+            if j == 0 || j >= n {
+                continue;
+            }
+            let row = j - 1;
+            for k in 0..3 {
+                self.rhs[row][k] += cj * t[k];
+            }
+            for &(l, cl) in coef {
+                if l >= j && l < n && l - j <= DEGREE {
+                    self.band[row][l - j] += cj * cl;
+                }
+            }
+        }
+    }
 }
 
 /// Solves `A x = b` for a symmetric positive definite band matrix stored by rows as

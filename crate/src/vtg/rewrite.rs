@@ -183,7 +183,64 @@ pub fn offers(
     if !aligned {
         return Ok(out);
     }
-    let settings = Settings {
+    let settings = file_settings(path, options, limits, variant);
+    let energy = Accumulator::new(
+        &options.analyze.energy.clone().unwrap_or_default(),
+        &path.profile.name,
+    );
+    let cos_critical = crate::math::cos(settings.critical_rad);
+    // The candidates first (cheap), then the paths rewritten in parallel batches: each path is
+    // independent, results are merged in file order (the same output on any number of
+    // threads), and progress and cancellation are checked between batches.
+    let candidates = candidates(moves, sources, cos_critical);
+    out.candidate_paths = candidates.len() as u64;
+    let offering = Offering {
+        input,
+        path,
+        all,
+        energy: &energy,
+        settings,
+        dearer: DEARER_SPEED_SHARES.map(|min_speed_share| Settings {
+            min_speed_share,
+            ..settings
+        }),
+        // Dearer variants only where they can differ from the free rewrite.
+        buy_time: options.allow_slower_pct > 0.0 && settings.speed_share_matters(),
+    };
+    let mut offers: Vec<Offer> = Vec::with_capacity(candidates.len());
+    let mut saved = [0.0f64; 2];
+    for (b, batch) in candidates.chunks(BATCH_PATHS).enumerate() {
+        if !progress((b * BATCH_PATHS) as f64 / candidates.len().max(1) as f64) {
+            return Err(Error::new(0, 0, ErrorKind::Cancelled));
+        }
+        // One offer per path, added up here in file order: sums are then the same to the
+        // last bit as a sequential run's (the wasm build's, which the CLI's JSON must equal).
+        let parts = crate::parallel::map_chunks(batch, |chunk| {
+            chunk.iter().map(|&(i, j)| offering.offer(i, j)).collect()
+        });
+        for offer in parts {
+            if let Some(free) = &offer.free {
+                saved[0] -= free.added[0];
+                saved[1] -= free.added[1];
+            }
+            offers.push(offer);
+        }
+    }
+    out.offers = offers;
+    out.saved = saved;
+    Ok(out)
+}
+
+/// The settings every path of the file starts from: the options, the variant tried, and what
+/// the file's firmware and limits say (each path then takes the limits in force where it
+/// starts, [`Machine::settings`]).
+fn file_settings(
+    path: &PrintPath,
+    options: &VtgOptions,
+    limits: &KinematicLimits,
+    variant: Variant,
+) -> Settings {
+    Settings {
         tolerance_mm: options.tolerance_mm,
         critical_rad: options.critical_angle_deg.to_radians(),
         limits: *limits,
@@ -213,15 +270,15 @@ pub fn offers(
         } else {
             super::blend::Line::Racing
         },
-    };
-    let energy = Accumulator::new(
-        &options.analyze.energy.clone().unwrap_or_default(),
-        &path.profile.name,
-    );
-    let cos_critical = crate::math::cos(settings.critical_rad);
-    // The candidates first (cheap), then the paths rewritten in parallel batches: each path is
-    // independent, results are merged in file order (the same output on any number of
-    // threads), and progress and cancellation are checked between batches.
+    }
+}
+
+/// The paths worth rewriting, as move ranges `i..j`: those with a sharp corner.
+fn candidates(
+    moves: &[PathMove],
+    sources: &[MoveSource],
+    cos_critical: f64,
+) -> Vec<(usize, usize)> {
     let mut candidates: Vec<(usize, usize)> = Vec::new();
     let mut i = 0usize;
     while i < moves.len() {
@@ -235,66 +292,56 @@ pub fn offers(
         }
         i = j;
     }
-    out.candidate_paths = candidates.len() as u64;
-    let dearer = DEARER_SPEED_SHARES.map(|min_speed_share| Settings {
-        min_speed_share,
-        ..settings
-    });
-    // Dearer variants only where they can differ from the free rewrite.
-    let buy_time = options.allow_slower_pct > 0.0 && settings.speed_share_matters();
-    let mut offers: Vec<Offer> = Vec::with_capacity(candidates.len());
-    let mut saved = [0.0f64; 2];
-    for (b, batch) in candidates.chunks(BATCH_PATHS).enumerate() {
-        if !progress((b * BATCH_PATHS) as f64 / candidates.len().max(1) as f64) {
-            return Err(Error::new(0, 0, ErrorKind::Cancelled));
-        }
-        // One offer per path, added up here in file order: sums are then the same to the
-        // last bit as a sequential run's (the wasm build's, which the CLI's JSON must equal).
-        let parts = crate::parallel::map_chunks(batch, |chunk| {
-            chunk
+    candidates
+}
+
+/// What every path's offer is made with; one value shared by the parallel batches so each
+/// path's offer is one call.
+struct Offering<'a> {
+    input: &'a [u8],
+    path: &'a PrintPath,
+    all: &'a Sources,
+    energy: &'a Accumulator,
+    /// The free rewrite's settings.
+    settings: Settings,
+    /// The dearer variants' ([`DEARER_SPEED_SHARES`]).
+    dearer: [Settings; 2],
+    /// Whether time may be spent and the dearer variants can differ from the free one.
+    buy_time: bool,
+}
+
+impl Offering<'_> {
+    /// The ways of writing moves `i..j`: the free rewrite, and with time to spend the dearer
+    /// variants that round more corners.
+    fn offer(&self, i: usize, j: usize) -> Offer {
+        let (moves, sources) = (&self.path.moves, &self.all.moves[..]);
+        let machine = Machine {
+            limits: self.all.limits_at(i),
+            model: self.path.junction_model,
+            energy: self.energy,
+            context: [
+                i.checked_sub(1).map(|k| motion_of(&moves[k])),
+                moves.get(j).map(motion_of),
+            ],
+        };
+        let write =
+            |s: &Settings| rewrite_path(self.input, &moves[i..j], &sources[i..j], s, &machine);
+        let base = write(&self.settings).unwrap_or_default();
+        let kept = base.iter().map(|o| o.corners_removed).max().unwrap_or(0);
+        // With time to spend, the variants that round the corners the firmware takes faster
+        // sharp, too: first those it takes nearly as fast round.
+        let mut offer = Offer::default();
+        base.into_iter().for_each(|o| offer.push(o));
+        if self.buy_time {
+            self.dearer
                 .iter()
-                .map(|&(i, j)| {
-                    let machine = Machine {
-                        limits: all.limits_at(i),
-                        model: path.junction_model,
-                        energy: &energy,
-                        context: [
-                            i.checked_sub(1).map(|k| motion_of(&moves[k])),
-                            moves.get(j).map(motion_of),
-                        ],
-                    };
-                    let write = |s: &Settings| {
-                        rewrite_path(input, &moves[i..j], &sources[i..j], s, &machine)
-                    };
-                    let base = write(&settings).unwrap_or_default();
-                    let kept = base.iter().map(|o| o.corners_removed).max().unwrap_or(0);
-                    // With time to spend, the variants that round the corners the firmware
-                    // takes faster sharp, too: first those it takes nearly as fast round.
-                    let mut offer = Offer::default();
-                    base.into_iter().for_each(|o| offer.push(o));
-                    if buy_time {
-                        dearer
-                            .iter()
-                            .filter_map(write)
-                            .flatten()
-                            .filter(|o| o.corners_removed > kept)
-                            .for_each(|o| offer.push(o));
-                    }
-                    offer
-                })
-                .collect()
-        });
-        for offer in parts {
-            if let Some(free) = &offer.free {
-                saved[0] -= free.added[0];
-                saved[1] -= free.added[1];
-            }
-            offers.push(offer);
+                .filter_map(write)
+                .flatten()
+                .filter(|o| o.corners_removed > kept)
+                .for_each(|o| offer.push(o));
         }
+        offer
     }
-    out.offers = offers;
-    out.saved = saved;
-    Ok(out)
 }
 
 impl Offers {
@@ -345,6 +392,18 @@ impl Offers {
 const BATCH_PATHS: usize = 4096;
 
 impl Rewritten {
+    /// The counts of a path written with its eq. 29 speeds at `scale`: raised above the
+    /// settings' first scale, or dropped (`None`).
+    fn at_scale(scale: Option<f64>, settings: &Settings) -> Self {
+        let mut part = Rewritten::default();
+        match scale {
+            None if settings.limit_feed => part.uncapped_paths += 1,
+            Some(k) if k > settings.feed_cap_scale => part.raised_caps_paths += 1,
+            _ => {}
+        }
+        part
+    }
+
     /// Adds the counts of a part of the file rewritten separately.
     fn add(&mut self, part: &Rewritten) {
         self.rewritten_paths += part.rewritten_paths;
@@ -548,54 +607,132 @@ fn rewrite_path(
     machine: &Machine<'_>,
 ) -> Option<Vec<Outcome>> {
     let settings = &machine.settings(file_settings);
-    let (first, first_src) = (run.first()?, src.first()?);
-    let xyz = |p: &crate::machine::Pos| [p[0], p[1], p[2]];
-    let mut pts = Vec::with_capacity(run.len() + 1);
-    pts.push(xyz(&first.from));
-    pts.extend(run.iter().map(|m| xyz(&m.to)));
-    // Filament from the path start at each vertex, in E words.
-    let mode = first_src.mode;
-    let mut e = Vec::with_capacity(pts.len());
-    e.push(0.0);
-    let mut sum = 0.0;
-    for s in src {
-        sum = match mode {
-            ExtrusionMode::Relative => sum + s.e_word,
-            ExtrusionMode::Absolute => s.e_word - first_src.e_before,
-        };
-        e.push(sum);
-    }
-    if sum.is_nan() || sum <= 0.0 || e.windows(2).any(|w| w[1] < w[0] - 1e-9) {
-        return None;
-    }
-    let feed: Vec<f64> = src
-        .iter()
-        .zip(run)
-        .map(|(s, m)| s.f_after.map_or(m.feed_mm_s, |f| f / 60.0))
-        .collect();
-    // How the planner ran each original move, when the path was planned.
-    let planned: Vec<Profile> = run
-        .iter()
-        .map_while(|m| m.timing.map(|t| t.profile))
-        .collect();
+    let o = Polyline::of(run, src)?;
+    let (pts, e, feed) = (&o.pts, &o.e, &o.feed);
     let path = Path {
-        pts: &pts,
-        e: &e,
-        feed: &feed,
-        planned: if planned.len() == run.len() {
-            &planned
+        pts,
+        e,
+        feed,
+        planned: if o.planned.len() == run.len() {
+            &o.planned
         } else {
             &[]
         },
     };
     let smoothed = smooth_path(&path, settings)?;
-    let (original_s, original_j) = machine.cost(pts[0], &pts[1..], &e[1..], &feed);
-    let cost = |w: &Written| machine.cost(pts[0], &w.points, &w.e, &w.feed_mm_s);
-    let added_by = |(s, j): (f64, f64)| [s - original_s, j - original_j];
-    let dearer = |a: &[f64; 2]| a[0] > original_s * 1e-9 || a[1] > original_j * 1e-9;
-    // The eq. 29 speeds as they are, then raised step by step, then no caps at all, each
-    // first as fast as the firmware will go elsewhere, then no faster than the original: the
-    // first that costs neither time nor energy, else the one that costs least energy.
+    let original = machine.cost(pts[0], &pts[1..], &e[1..], feed);
+    let costs = Costs { original };
+    let (cheapest, fastest) = cheapest_and_fastest(&smoothed, pts[0], settings, machine, costs);
+    let (scale, written, written_cost) = cheapest?;
+    let cos_critical = crate::math::cos(settings.critical_rad);
+    let draft = Draft {
+        sharp_before: sharp_turns(pts, cos_critical),
+        cos_critical,
+        input,
+        run,
+        src,
+        pts,
+        e,
+        smoothed: &smoothed,
+        settings,
+        machine,
+    };
+    let added = costs.added_by(written_cost);
+    let mut out =
+        vec![draft.outcome(scale, &written, written_cost, added, costs.dearer(&added))?];
+    if let Some((k, ceiling, total)) = fastest.filter(|f| f.2 .0 < written_cost.0) {
+        let w = smoothed.written(k, ceiling, pts[0], settings);
+        out.extend(draft.outcome(k, &w, total, costs.added_by(total), true));
+    }
+    Some(out)
+}
+
+/// An original path as the smoothing reads it: vertices (start point first), filament from
+/// the path start at each vertex in E words, feed per segment, and how the planner ran each
+/// move (as far as it was planned).
+struct Polyline {
+    pts: Vec<[f64; 3]>,
+    e: Vec<f64>,
+    feed: Vec<f64>,
+    planned: Vec<Profile>,
+}
+
+impl Polyline {
+    /// The path of `run`; `None` where its filament is not a positive, rising total.
+    fn of(run: &[PathMove], src: &[MoveSource]) -> Option<Self> {
+        let (first, first_src) = (run.first()?, src.first()?);
+        let xyz = |p: &crate::machine::Pos| [p[0], p[1], p[2]];
+        let mut pts = Vec::with_capacity(run.len() + 1);
+        pts.push(xyz(&first.from));
+        pts.extend(run.iter().map(|m| xyz(&m.to)));
+        // Filament from the path start at each vertex, in E words.
+        let mode = first_src.mode;
+        let mut e = Vec::with_capacity(pts.len());
+        e.push(0.0);
+        let mut sum = 0.0;
+        for s in src {
+            sum = match mode {
+                ExtrusionMode::Relative => sum + s.e_word,
+                ExtrusionMode::Absolute => s.e_word - first_src.e_before,
+            };
+            e.push(sum);
+        }
+        if sum.is_nan() || sum <= 0.0 || e.windows(2).any(|w| w[1] < w[0] - 1e-9) {
+            return None;
+        }
+        let feed: Vec<f64> = src
+            .iter()
+            .zip(run)
+            .map(|(s, m)| s.f_after.map_or(m.feed_mm_s, |f| f / 60.0))
+            .collect();
+        // How the planner ran each original move, when the path was planned.
+        let planned: Vec<Profile> = run
+            .iter()
+            .map_while(|m| m.timing.map(|t| t.profile))
+            .collect();
+        Some(Polyline {
+            pts,
+            e,
+            feed,
+            planned,
+        })
+    }
+}
+
+/// The original path's time (s) and motor energy (J), against which a writing's are weighed.
+#[derive(Clone, Copy)]
+struct Costs {
+    original: (f64, f64),
+}
+
+impl Costs {
+    /// Time and energy a writing costing `(s, j)` adds to the original's.
+    fn added_by(&self, (s, j): (f64, f64)) -> [f64; 2] {
+        [s - self.original.0, j - self.original.1]
+    }
+
+    /// Whether what a writing adds makes it dearer than the original.
+    fn dearer(&self, a: &[f64; 2]) -> bool {
+        a[0] > self.original.0 * 1e-9 || a[1] > self.original.1 * 1e-9
+    }
+}
+
+/// A writing of a smoothed path: the eq. 29 speeds' scale (`None`: no caps), and the path
+/// written with it (or whether it had a ceiling), with its time (s) and energy (J).
+type Writing<W> = (Option<f64>, W, (f64, f64));
+
+/// The eq. 29 speeds as they are, then raised step by step, then no caps at all, each first
+/// as fast as the firmware will go elsewhere, then no faster than the original: the first
+/// writing that costs neither time nor energy, else the one that costs least energy; and the
+/// fastest if that is not the first (to be written again at the end if it is another way).
+fn cheapest_and_fastest(
+    smoothed: &Smoothed,
+    start: [f64; 3],
+    settings: &Settings,
+    machine: &Machine<'_>,
+    costs: Costs,
+) -> (Option<Writing<Written>>, Option<Writing<bool>>) {
+    let cost = |w: &Written| machine.cost(start, &w.points, &w.e, &w.feed_mm_s);
     let base = settings.feed_cap_scale;
     let capped = CAP_SCALES.map(|k| k.map(|k| k * base));
     let scales: &[Option<f64>] = if settings.limit_feed {
@@ -603,29 +740,27 @@ fn rewrite_path(
     } else {
         &[None]
     };
-    // (scale, the path as written, its time and energy)
-    let mut cheapest: Option<(Option<f64>, Written, (f64, f64))> = None;
-    // (scale, ceiling, its time and energy): written again at the end if it is another way.
-    let mut fastest: Option<(Option<f64>, bool, (f64, f64))> = None;
+    let mut cheapest: Option<Writing<Written>> = None;
+    let mut fastest: Option<Writing<bool>> = None;
     for (k, ceiling) in scales.iter().flat_map(|&k| [(k, false), (k, true)]) {
-        let w = smoothed.written(k, ceiling, pts[0], settings);
+        let w = smoothed.written(k, ceiling, start, settings);
         let total = cost(&w);
-        let a = added_by(total);
+        let a = costs.added_by(total);
         if a.iter().any(|x| x.is_nan()) {
             continue;
         }
         let better = cheapest.as_ref().is_none_or(|c| {
-            let b = added_by(c.2);
+            let b = costs.added_by(c.2);
             (a[1], a[0]) < (b[1], b[0])
         });
-        let stop = !dearer(&a);
+        let stop = !costs.dearer(&a);
         if stop {
             cheapest = Some((k, w, total));
             fastest = None;
             break;
         }
         let quicker = fastest.as_ref().is_none_or(|c| {
-            let b = added_by(c.2);
+            let b = costs.added_by(c.2);
             (a[0], a[1]) < (b[0], b[1])
         });
         if quicker {
@@ -635,27 +770,7 @@ fn rewrite_path(
             cheapest = Some((k, w, total));
         }
     }
-    let (scale, written, written_cost) = cheapest?;
-    let cos_critical = crate::math::cos(settings.critical_rad);
-    let draft = Draft {
-        sharp_before: sharp_turns(&pts, cos_critical),
-        cos_critical,
-        input,
-        run,
-        src,
-        pts: &pts,
-        e: &e,
-        smoothed: &smoothed,
-        settings,
-        machine,
-    };
-    let added = added_by(written_cost);
-    let mut out = vec![draft.outcome(scale, &written, written_cost, added, dearer(&added))?];
-    if let Some((k, ceiling, total)) = fastest.filter(|f| f.2 .0 < written_cost.0) {
-        let w = smoothed.written(k, ceiling, pts[0], settings);
-        out.extend(draft.outcome(k, &w, total, added_by(total), true));
-    }
-    Some(out)
+    (cheapest, fastest)
 }
 
 /// A path and its smoothed form, to be written one way or another.
@@ -701,29 +816,13 @@ impl Draft<'_> {
         let (first_src, last_src) = (src.first()?, src.last()?);
         let mode = first_src.mode;
         let sum = *e.last()?;
-        let base = settings.feed_cap_scale;
-        let mut part = Rewritten::default();
-        match scale {
-            None if settings.limit_feed => part.uncapped_paths += 1,
-            Some(k) if k > base => part.raised_caps_paths += 1,
-            _ => {}
-        }
+        let mut part = Rewritten::at_scale(scale, settings);
         let removed = sharp_before.saturating_sub(sharp_turns(
             std::iter::once(&pts[0]).chain(&written.points),
             cos_critical,
         ));
         let out = &mut part;
-        // Annotation lines between the original moves (`;WIDTH:`), each with the filament pushed
-        // where it stood.
-        let mut notes = Vec::new();
-        for (s, &at) in src.iter().zip(e).skip(1) {
-            if s.notes.lines > 0 {
-                notes.push((
-                    at,
-                    std::str::from_utf8(input.get(s.notes.from..s.notes.to)?).ok()?,
-                ));
-            }
-        }
+        let notes = notes(input, src, e)?;
         // Runs on a circle as arcs, if asked for and if the path with them still keeps the
         // tolerance both ways (measured on the arcs themselves).
         let all: Vec<[f64; 3]> = std::iter::once(pts[0])
@@ -761,25 +860,48 @@ impl Draft<'_> {
         out.max_deviation_mm = out.max_deviation_mm.max(deviation);
         out.walk.steps += smoothed.stats.steps;
         out.walk.fluctuation_sum += smoothed.stats.fluctuation_sum;
-        let mut edits = Vec::with_capacity(src.len());
-        edits.push(Edit {
-            line: first_src.line,
-            replacement: text.into_bytes(),
-        });
-        for s in src.iter().skip(1) {
-            edits.extend((s.line - s.notes.lines..=s.line).map(|line| Edit {
-                line,
-                replacement: Vec::new(),
-            }));
-        }
         Some(Outcome {
-            edits,
+            edits: edits(src, text),
             part,
             added,
             dearer,
             corners_removed: removed as u64,
         })
     }
+}
+
+/// Annotation lines between the original moves (`;WIDTH:`), each with the filament pushed
+/// where it stood (`e`, from the path start): the new block writes them back in place.
+fn notes<'i>(input: &'i [u8], src: &[MoveSource], e: &[f64]) -> Option<Vec<(f64, &'i str)>> {
+    let mut notes = Vec::new();
+    for (s, &at) in src.iter().zip(e).skip(1) {
+        if s.notes.lines > 0 {
+            notes.push((
+                at,
+                std::str::from_utf8(input.get(s.notes.from..s.notes.to)?).ok()?,
+            ));
+        }
+    }
+    Some(notes)
+}
+
+/// The edits replacing a path's first line with the new block `text` and deleting its other
+/// lines (with the annotations between them, which the block writes again).
+fn edits(src: &[MoveSource], text: String) -> Vec<Edit> {
+    let mut edits = Vec::with_capacity(src.len());
+    if let Some(first) = src.first() {
+        edits.push(Edit {
+            line: first.line,
+            replacement: text.into_bytes(),
+        });
+    }
+    for s in src.iter().skip(1) {
+        edits.extend((s.line - s.notes.lines..=s.line).map(|line| Edit {
+            line,
+            replacement: Vec::new(),
+        }));
+    }
+    edits
 }
 
 /// The written path `all` (start point first; `written` after it) with its runs on a circle as

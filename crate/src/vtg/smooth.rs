@@ -18,7 +18,7 @@ use super::fit::fit;
 use super::hairpin;
 use super::keyhole;
 use super::kinematics::KinematicLimits;
-use super::resample::{walk, Walk, WalkStats};
+use super::resample::{walk, Sample, Walk, WalkStats};
 use crate::plan::Profile;
 
 /// Share of the tolerance the corner blends may use: most of it, since the fillet's radius sets
@@ -252,105 +252,165 @@ fn smooth_on(path: &Path<'_>, s: &Settings, forced: &[usize]) -> (Option<Smoothe
     if pts.len() < 3 || !path.consistent() {
         return (None, false);
     }
-    let cos_critical = crate::math::cos(s.critical_rad);
-    let plan = |line| {
-        blend::plan(
-            pts,
-            BLEND_SHARE * s.tolerance_mm,
-            s.limits.critical_curvature(),
-            line,
-        )
-    };
-    let blends = plan(s.line);
-    let inside = (s.line != blend::Line::Inside).then(|| plan(blend::Line::Inside));
-    let mut rescued = false;
-    let n = pts.len();
-    // Each corner: sharp, and whether it can be rounded on its own.
-    let mut sharp = vec![false; n];
-    let mut alone = vec![true; n];
-    let mut degenerate = vec![false; n];
-    // Too tight to round within the tolerance (rather than not worth it).
-    let mut tight = vec![false; n];
-    for i in 1..n - 1 {
-        let a = sub(&pts[i], &pts[i - 1]);
-        let b = sub(&pts[i + 1], &pts[i]);
-        let (la, lb) = (norm(&a), norm(&b));
-        if la <= 0.0 || lb <= 0.0 {
-            degenerate[i] = true;
-            continue;
-        }
-        let cos = (dot(&a, &b) / (la * lb)).clamp(-1.0, 1.0);
-        if cos >= cos_critical {
-            continue;
-        }
-        sharp[i] = true;
-        tight[i] = !roundable(&blends[i], s);
-        rescued |= !tight[i] && inside.as_ref().is_some_and(|b| !roundable(&b[i], s));
-        alone[i] = !tight[i] && pays(blends[i].max_curvature, path.planned.get(i - 1), s);
+    let mut c = Corners::classify(path, s);
+    let arc = arc_lengths(pts);
+    let pins = c.pin(path, &arc, s);
+    let cuts = c.cuts(&pins, &arc, forced);
+    let rescued = c.rescued;
+    match smooth_pieces(path, s, &cuts, &c.sharp, &pins) {
+        Some((out, changed)) => ((changed || !forced.is_empty()).then_some(out), rescued),
+        None => (None, rescued),
     }
-    // Two sharp corners across a short leg, at least one of them too tight alone: a hairpin,
-    // rounded as one turn if it can be.
-    let mut pinned = vec![false; n];
-    let mut pins: Vec<hairpin::Hairpin> = Vec::new();
-    let mut i = 1;
-    while i + 2 < n {
-        if sharp[i] && sharp[i + 1] && !(alone[i] && alone[i + 1]) {
-            if let Some(pin) = find_hairpin(pts, i, BLEND_SHARE * s.tolerance_mm, s) {
-                pinned[i] = true;
-                pinned[i + 1] = true;
-                pins.push(pin);
-                i += 2;
+}
+
+/// What each point of a path is as a corner; kept in one place because the hairpin, keyhole
+/// and cut decisions all read (and the cuts clear) the same flags.
+struct Corners {
+    /// A turn above the critical angle.
+    sharp: Vec<bool>,
+    /// Can be rounded on its own, at no loss of speed.
+    alone: Vec<bool>,
+    /// A zero-length leg meets it.
+    degenerate: Vec<bool>,
+    /// Too tight to round within the tolerance (rather than not worth it).
+    tight: Vec<bool>,
+    /// Turned into a hairpin or keyhole.
+    pinned: Vec<bool>,
+    /// The racing line made a corner roundable that the inside fillet could not round.
+    rescued: bool,
+}
+
+impl Corners {
+    /// Each corner: sharp, and whether it can be rounded on its own.
+    fn classify(path: &Path<'_>, s: &Settings) -> Self {
+        let pts = path.pts;
+        let cos_critical = crate::math::cos(s.critical_rad);
+        let plan = |line| {
+            blend::plan(
+                pts,
+                BLEND_SHARE * s.tolerance_mm,
+                s.limits.critical_curvature(),
+                line,
+            )
+        };
+        let blends = plan(s.line);
+        let inside = (s.line != blend::Line::Inside).then(|| plan(blend::Line::Inside));
+        let n = pts.len();
+        let mut c = Corners {
+            sharp: vec![false; n],
+            alone: vec![true; n],
+            degenerate: vec![false; n],
+            tight: vec![false; n],
+            pinned: vec![false; n],
+            rescued: false,
+        };
+        for i in 1..n - 1 {
+            let a = sub(&pts[i], &pts[i - 1]);
+            let b = sub(&pts[i + 1], &pts[i]);
+            let (la, lb) = (norm(&a), norm(&b));
+            if la <= 0.0 || lb <= 0.0 {
+                c.degenerate[i] = true;
                 continue;
             }
+            let cos = (dot(&a, &b) / (la * lb)).clamp(-1.0, 1.0);
+            if cos >= cos_critical {
+                continue;
+            }
+            c.sharp[i] = true;
+            c.tight[i] = !roundable(&blends[i], s);
+            c.rescued |= !c.tight[i] && inside.as_ref().is_some_and(|b| !roundable(&b[i], s));
+            c.alone[i] = !c.tight[i] && pays(blends[i].max_curvature, path.planned.get(i - 1), s);
         }
-        i += 1;
+        c
     }
-    // Single corners too tight to round: a keyhole loop, where one fits between the neighbours
-    // and the machine runs round it at least as fast as through the corner.
-    let arc = arc_lengths(pts);
-    let loop_pays = |i: usize| pays(1.0 / min_hairpin_radius(s), path.planned.get(i - 1), s);
-    for i in 1..n - 1 {
-        if s.keyholes && tight[i] && !pinned[i] && loop_pays(i) {
-            if let Some(k) = find_keyhole(pts, &arc, i, &sharp, &pinned, &degenerate, s) {
-                pinned[i] = true;
-                pins.push(k);
+
+    /// The hairpins and keyholes of the path, in order: the corners that cannot be rounded
+    /// alone but can as one turn (two across a short leg) or round a loop (one too tight).
+    fn pin(&mut self, path: &Path<'_>, arc: &[f64], s: &Settings) -> Vec<hairpin::Hairpin> {
+        let pts = path.pts;
+        let n = pts.len();
+        // Two sharp corners across a short leg, at least one of them too tight alone: a
+        // hairpin, rounded as one turn if it can be.
+        let mut pins: Vec<hairpin::Hairpin> = Vec::new();
+        let mut i = 1;
+        while i + 2 < n {
+            if self.sharp[i] && self.sharp[i + 1] && !(self.alone[i] && self.alone[i + 1]) {
+                if let Some(pin) = find_hairpin(pts, i, BLEND_SHARE * s.tolerance_mm, s) {
+                    self.pinned[i] = true;
+                    self.pinned[i + 1] = true;
+                    pins.push(pin);
+                    i += 2;
+                    continue;
+                }
+            }
+            i += 1;
+        }
+        // Single corners too tight to round: a keyhole loop, where one fits between the
+        // neighbours and the machine runs round it at least as fast as through the corner.
+        let loop_pays = |i: usize| pays(1.0 / min_hairpin_radius(s), path.planned.get(i - 1), s);
+        for i in 1..n - 1 {
+            if s.keyholes && self.tight[i] && !self.pinned[i] && loop_pays(i) {
+                let found =
+                    find_keyhole(pts, arc, i, &self.sharp, &self.pinned, &self.degenerate, s);
+                if let Some(k) = found {
+                    self.pinned[i] = true;
+                    pins.push(k);
+                }
             }
         }
+        pins.sort_by_key(|p| p.at);
+        pins
     }
-    pins.sort_by_key(|p| p.at);
-    let mut cuts = vec![0usize];
-    for i in 1..n - 1 {
-        if degenerate[i] || (sharp[i] && !alone[i] && !pinned[i]) {
-            cuts.push(i);
-            sharp[i] = false;
+
+    /// The points the path is cut at (its ends included): corners kept sharp (no longer
+    /// counted as sharp), either side of a keyhole, and `forced`.
+    fn cuts(&mut self, pins: &[hairpin::Hairpin], arc: &[f64], forced: &[usize]) -> Vec<usize> {
+        let n = self.sharp.len();
+        let mut cuts = vec![0usize];
+        for i in 1..n - 1 {
+            if self.degenerate[i] || (self.sharp[i] && !self.alone[i] && !self.pinned[i]) {
+                cuts.push(i);
+                self.sharp[i] = false;
+            }
         }
+        // A keyhole is fitted on its own, between the original points either side of the
+        // stretch it replaces (on its straight legs): the rest of a long side need not be
+        // fitted again.
+        let spans: Vec<(f64, f64)> = pins.iter().map(|p| p.span(arc)).collect();
+        let free = |j: usize| {
+            j > 0
+                && j + 1 < n
+                && !self.sharp[j]
+                && !self.pinned[j]
+                && spans.iter().all(|&(u0, u1)| arc[j] <= u0 || arc[j] >= u1)
+        };
+        for (k, &(u0, u1)) in pins.iter().zip(&spans).filter(|(p, _)| p.corners == 1) {
+            let before = (0..k.at).rev().find(|&j| arc[j] <= u0);
+            let after = (k.at + 1..n).find(|&j| arc[j] >= u1);
+            cuts.extend(before.into_iter().chain(after).filter(|&j| free(j)));
+        }
+        cuts.extend(forced.iter().filter(|&&j| j < n));
+        cuts.push(n - 1);
+        cuts.sort_unstable();
+        cuts.dedup();
+        cuts
     }
-    // A keyhole is fitted on its own, between the original points either side of the stretch
-    // it replaces (on its straight legs): the rest of a long side need not be fitted again.
-    let spans: Vec<(f64, f64)> = pins.iter().map(|p| p.span(&arc)).collect();
-    let free = |j: usize| {
-        j > 0
-            && j + 1 < n
-            && !sharp[j]
-            && !pinned[j]
-            && spans.iter().all(|&(u0, u1)| arc[j] <= u0 || arc[j] >= u1)
-    };
-    for (k, &(u0, u1)) in pins.iter().zip(&spans).filter(|(p, _)| p.corners == 1) {
-        let before = (0..k.at).rev().find(|&j| arc[j] <= u0);
-        let after = (k.at + 1..n).find(|&j| arc[j] >= u1);
-        cuts.extend(before.into_iter().chain(after).filter(|&j| free(j)));
-    }
-    cuts.extend(forced.iter().filter(|&&j| j < n));
-    cuts.push(pts.len() - 1);
-    cuts.sort_unstable();
-    cuts.dedup();
+}
+
+/// Each piece between two `cuts` smoothed on its own (or kept) and joined; and whether any was
+/// rewritten. `None` when a cut falls outside the path.
+fn smooth_pieces(
+    path: &Path<'_>,
+    s: &Settings,
+    cuts: &[usize],
+    sharp: &[bool],
+    pins: &[hairpin::Hairpin],
+) -> Option<(Smoothed, bool)> {
     let mut out = Smoothed::default();
-    let mut changed = !forced.is_empty();
+    let mut changed = false;
     for w in cuts.windows(2) {
         let (a, b) = (w[0], w[1]);
-        let Some(piece) = path.piece(a, b) else {
-            return (None, rescued);
-        };
+        let piece = path.piece(a, b)?;
         let has_sharp = sharp.get(a + 1..b).is_some_and(|v| v.iter().any(|&x| x));
         let here: Vec<hairpin::Hairpin> = pins
             .iter()
@@ -375,33 +435,43 @@ fn smooth_on(path: &Path<'_>, s: &Settings, forced: &[usize]) -> (Option<Smoothe
         match done {
             Some(p) => {
                 changed = true;
-                out.points.extend(p.points);
-                out.e.extend(p.e);
-                out.steps.extend(p.steps);
-                out.above_k_cr += p.above_k_cr;
-                out.deviation_mm = out.deviation_mm.max(p.deviation_mm);
-                out.stats.steps += p.stats.steps;
-                out.stats.fluctuation_sum += p.stats.fluctuation_sum;
-                out.keyholes += p.keyholes;
+                out.append(p);
             }
-            None => {
-                out.points.extend(piece.pts.iter().skip(1).copied());
-                out.e.extend(piece.e.iter().skip(1).copied());
-                out.steps
-                    .extend(piece.feed.iter().enumerate().map(|(k, &f)| {
-                        let planned = piece.planned.get(k);
-                        StepSpeed {
-                            programmed: f,
-                            limit: f64::INFINITY,
-                            floor: 0.0,
-                            ceiling: planned.map_or(f64::INFINITY, |p| p.peak),
-                            accel: planned.map_or(0.0, |p| p.acceleration),
-                        }
-                    }));
-            }
+            None => out.keep(&piece),
         }
     }
-    (changed.then_some(out), rescued)
+    Some((out, changed))
+}
+
+impl Smoothed {
+    /// Appends a rewritten piece.
+    fn append(&mut self, p: Smoothed) {
+        self.points.extend(p.points);
+        self.e.extend(p.e);
+        self.steps.extend(p.steps);
+        self.above_k_cr += p.above_k_cr;
+        self.deviation_mm = self.deviation_mm.max(p.deviation_mm);
+        self.stats.steps += p.stats.steps;
+        self.stats.fluctuation_sum += p.stats.fluctuation_sum;
+        self.keyholes += p.keyholes;
+    }
+
+    /// Appends a piece kept as it was, its segments at their own feeds and planned peaks.
+    fn keep(&mut self, piece: &Path<'_>) {
+        self.points.extend(piece.pts.iter().skip(1).copied());
+        self.e.extend(piece.e.iter().skip(1).copied());
+        self.steps
+            .extend(piece.feed.iter().enumerate().map(|(k, &f)| {
+                let planned = piece.planned.get(k);
+                StepSpeed {
+                    programmed: f,
+                    limit: f64::INFINITY,
+                    floor: 0.0,
+                    ceiling: planned.map_or(f64::INFINITY, |p| p.peak),
+                    accel: planned.map_or(0.0, |p| p.acceleration),
+                }
+            }));
+    }
 }
 
 /// The sharp corners of `path` to turn as polygons placed for Klipper's look-ahead
@@ -647,17 +717,81 @@ fn attempt(
     s: &Settings,
     blend_tol: f64,
 ) -> Option<Smoothed> {
-    let Path {
-        pts,
-        e,
-        feed,
-        planned,
-    } = *path;
+    let Walked {
+        samples: walked,
+        mut points,
+        deviation_mm: deviation,
+        stats,
+    } = walk_within(path, original, s, blend_tol)?;
+    let total_e = *path.e.last()?;
+    let mut out = Smoothed {
+        deviation_mm: deviation,
+        stats,
+        ..Smoothed::default()
+    };
+    let o = Original {
+        arc: arc_lengths(path.pts),
+        path,
+        s,
+    };
+    let k_cr = s.limits.critical_curvature();
+    let (e, feed) = (path.e, path.feed);
+    let mut seg = 0usize;
+    let mut u_prev = 0.0;
+    for x in walked.iter().skip(1) {
+        // The original segment this parameter (an arc length of the original) falls in.
+        while seg + 1 < feed.len() && o.arc.get(seg + 1).is_some_and(|&a| a <= x.u) {
+            seg += 1;
+        }
+        let (a0, a1) = (o.arc.get(seg).copied()?, o.arc.get(seg + 1).copied()?);
+        let t = if a1 > a0 {
+            ((x.u - a0) / (a1 - a0)).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let (e0, e1) = (e.get(seg).copied()?, e.get(seg + 1).copied()?);
+        let local = o.limits_at(seg);
+        let mut step = StepSpeed {
+            programmed: feed.get(seg).copied()?,
+            limit: f64::INFINITY,
+            floor: 0.0,
+            ceiling: o.top(u_prev, x.u),
+            accel: local.normal_accel_mm_s2,
+        };
+        if x.mean_kappa > k_cr {
+            out.above_k_cr += 1;
+            if s.limit_feed {
+                step.limit = local.feed_limit(x.mean_kappa);
+                step.floor = o.speed(u_prev).min(o.speed(x.u));
+            }
+        }
+        u_prev = x.u;
+        out.e.push(e0 + (e1 - e0) * t);
+        out.steps.push(step);
+    }
+    points.remove(0);
+    if let Some(last) = out.e.last_mut() {
+        *last = total_e;
+    }
+    out.points = points;
+    Some(out)
+}
+
+/// The blended, fitted and walked curve of `path` with its ends pinned to the original's,
+/// its points, their deviation from `original` and the walk's statistics; `None` when the
+/// fit or walk fails or the deviation exceeds the tolerance. Apart from [`attempt`] so the
+/// geometry (VTG eq. 18–28) reads apart from the feeds given to it.
+fn walk_within(
+    path: &Path<'_>,
+    original: &[[f64; 3]],
+    s: &Settings,
+    blend_tol: f64,
+) -> Option<Walked> {
+    let pts = path.pts;
     let tol = s.tolerance_mm;
     // Room for the 3-decimal rounding of written coordinates.
     let budget = tol - 0.001;
     let k_cr = s.limits.critical_curvature();
-    let arc = arc_lengths(pts);
     let blends = blend::plan(pts, blend_tol, k_cr, s.line);
     let (data, params) = blend::samples(pts, &blends, STRAIGHT_SPACING_MM);
     let f = fit(&data, &params, FIT_SHARE * tol)?;
@@ -684,79 +818,70 @@ fn attempt(
     if deviation.is_nan() || deviation > budget {
         return None;
     }
-    let total_e = *e.last()?;
-    let mut out = Smoothed {
+    Some(Walked {
+        samples: walked,
+        points,
         deviation_mm: deviation,
         stats,
-        ..Smoothed::default()
-    };
-    // The original segment at arc length `u`.
-    let segment = |u: f64| segment_at(&arc, u, feed.len());
-    // The original's planned speed at arc length `u`.
-    let original_speed = |u: f64| -> f64 {
-        let seg = segment(u);
-        planned.get(seg).map_or(0.0, |p| p.speed_at(u - arc[seg]))
-    };
-    // The original's highest planned speed between arc lengths `u0 ≤ u1`.
-    let original_top = |u0: f64, u1: f64| -> f64 {
-        (segment(u0)..=segment(u1))
+    })
+}
+
+/// What [`walk_within`] gives: the walk's samples, their points with the ends pinned, the
+/// measured deviation (mm) and the walk's statistics.
+struct Walked {
+    samples: Vec<Sample>,
+    points: Vec<[f64; 3]>,
+    deviation_mm: f64,
+    stats: WalkStats,
+}
+
+/// What the original asked at each arc length of a path: the planned speeds and the limits
+/// that bound the feed of the new points laid over it.
+struct Original<'p, 'a> {
+    /// Arc length at each original point.
+    arc: Vec<f64>,
+    path: &'p Path<'a>,
+    s: &'p Settings,
+}
+
+impl Original<'_, '_> {
+    /// The original segment at arc length `u`.
+    fn segment(&self, u: f64) -> usize {
+        segment_at(&self.arc, u, self.path.feed.len())
+    }
+
+    /// The original's planned speed at arc length `u`.
+    fn speed(&self, u: f64) -> f64 {
+        let seg = self.segment(u);
+        self.path
+            .planned
+            .get(seg)
+            .map_or(0.0, |p| p.speed_at(u - self.arc[seg]))
+    }
+
+    /// The original's highest planned speed between arc lengths `u0 ≤ u1`.
+    fn top(&self, u0: f64, u1: f64) -> f64 {
+        (self.segment(u0)..=self.segment(u1))
             .map(|k| {
-                planned.get(k).map_or(f64::INFINITY, |p| {
-                    p.max_speed_between(u0 - arc[k], u1 - arc[k])
+                self.path.planned.get(k).map_or(f64::INFINITY, |p| {
+                    p.max_speed_between(u0 - self.arc[k], u1 - self.arc[k])
                 })
             })
             .fold(0.0, f64::max)
-    };
-    // The limits of original segment `seg`: `A_n` the acceleration the firmware ran it with.
-    let limits_at = |seg: usize| -> KinematicLimits {
+    }
+
+    /// The limits of original segment `seg`: `A_n` the acceleration the firmware ran it with.
+    fn limits_at(&self, seg: usize) -> KinematicLimits {
+        let s = self.s;
         let mut l = s.limits;
-        if let Some(p) = planned.get(seg).filter(|p| p.acceleration > 0.0) {
+        if let Some(p) = self.path.planned.get(seg).filter(|p| p.acceleration > 0.0) {
             l.normal_accel_mm_s2 = p.acceleration.min(s.max_normal_accel_mm_s2);
             if let Some(f1) = s.jerk_per_accel_hz {
                 l.normal_jerk_mm_s3 = l.normal_accel_mm_s2 * f1;
             }
         }
         l
-    };
-    let mut seg = 0usize;
-    let mut u_prev = 0.0;
-    for x in walked.iter().skip(1) {
-        // The original segment this parameter (an arc length of the original) falls in.
-        while seg + 1 < feed.len() && arc.get(seg + 1).is_some_and(|&a| a <= x.u) {
-            seg += 1;
-        }
-        let (a0, a1) = (arc.get(seg).copied()?, arc.get(seg + 1).copied()?);
-        let t = if a1 > a0 {
-            ((x.u - a0) / (a1 - a0)).clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
-        let (e0, e1) = (e.get(seg).copied()?, e.get(seg + 1).copied()?);
-        let local = limits_at(seg);
-        let mut step = StepSpeed {
-            programmed: feed.get(seg).copied()?,
-            limit: f64::INFINITY,
-            floor: 0.0,
-            ceiling: original_top(u_prev, x.u),
-            accel: local.normal_accel_mm_s2,
-        };
-        if x.mean_kappa > k_cr {
-            out.above_k_cr += 1;
-            if s.limit_feed {
-                step.limit = local.feed_limit(x.mean_kappa);
-                step.floor = original_speed(u_prev).min(original_speed(x.u));
-            }
-        }
-        u_prev = x.u;
-        out.e.push(e0 + (e1 - e0) * t);
-        out.steps.push(step);
     }
-    points.remove(0);
-    if let Some(last) = out.e.last_mut() {
-        *last = total_e;
-    }
-    out.points = points;
-    Some(out)
 }
 
 #[cfg(test)]
