@@ -36,33 +36,33 @@
 use super::bspline::{dot, norm, sub};
 
 /// Samples per blend given to the fit (its ends included).
-pub const SAMPLES: usize = 9;
+pub(crate) const SAMPLES: usize = 9;
 /// Turns at or below this are treated as straight, rad (0.5°: nothing to round).
 const STRAIGHT_RAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
 /// Turns above this are not blended, rad (160°: the fillet's radius falls towards nothing and
 /// such reversals cannot be rounded within any useful tolerance anyway).
-pub const MAX_TURN_RAD: f64 = 160.0 * std::f64::consts::PI / 180.0;
+pub(crate) const MAX_TURN_RAD: f64 = 160.0 * std::f64::consts::PI / 180.0;
 /// Share of a leg the blends at its two ends may use together (the rest stays straight, so the
 /// fit sees where one blend ends and the next begins).
-pub const LEG_SHARE: f64 = 0.9;
+pub(crate) const LEG_SHARE: f64 = 0.9;
 
 /// A corner transition at one vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Blend {
+pub(crate) struct Blend {
     /// Extent along each leg from the vertex, mm (0: the vertex is kept as it is).
-    pub extent_mm: f64,
+    pub(crate) extent_mm: f64,
     /// Turn of the path at the vertex, rad.
-    pub turn_rad: f64,
+    pub(crate) turn_rad: f64,
     /// Largest distance of the transition from the vertex, mm.
-    pub deviation_mm: f64,
+    pub(crate) deviation_mm: f64,
     /// Largest curvature of the transition, 1/mm.
-    pub max_curvature: f64,
+    pub(crate) max_curvature: f64,
     /// How far outside the legs the fillet's tangent lines run (the racing line), mm; 0: the
     /// fillet is tangent to the legs themselves.
-    pub offset_mm: f64,
+    pub(crate) offset_mm: f64,
     /// Length of leg beyond `extent_mm` over which the path eases out to the offset and back
     /// onto the leg, mm (0 without an offset).
-    pub ramp_mm: f64,
+    pub(crate) ramp_mm: f64,
 }
 
 impl Blend {
@@ -83,7 +83,7 @@ impl Blend {
 
 /// The shape constants of a fillet turning by `turn` (rad) for `L = 1`: the distance from the
 /// vertex to the fillet, and the curvature.
-pub fn shape(turn: f64) -> (f64, f64) {
+pub(crate) fn shape(turn: f64) -> (f64, f64) {
     let half = 0.5 * turn;
     let tan = crate::math::tan(half);
     let radius = 1.0 / tan;
@@ -123,7 +123,12 @@ fn fillet_point(v: &[f64; 3], a: &[f64; 3], b: &[f64; 3], turn: f64, l: f64, t: 
 /// curvature down to `enough_curvature` (1/mm; the curvature at which the machine's limits no
 /// longer slow it, `K_cr`): a gentle turn could be spread over metres within the tolerance, and
 /// would take the leg a sharp neighbour needs.
-pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64, line: Line) -> Vec<Blend> {
+pub(crate) fn plan(
+    pts: &[[f64; 3]],
+    tolerance_mm: f64,
+    enough_curvature: f64,
+    line: Line,
+) -> Vec<Blend> {
     let n = pts.len();
     if n < 3 {
         return vec![Blend::NONE; n];
@@ -230,7 +235,7 @@ fn inside_fillets(
 
 /// Which side of the vertex a blend may use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Line {
+pub(crate) enum Line {
     /// Fillets tangent to the legs: the path stays on or inside the corner.
     Inside,
     /// The racing line where there is room for it, else the inside fillet.
@@ -304,7 +309,11 @@ fn racing(inside: Blend, tolerance_mm: f64, enough_curvature: f64, room: f64) ->
 /// stands for the original point at the same fraction of the stretch it replaces), so the
 /// filament pushed up to a point is read off the original. Straight stretches get points at
 /// most `spacing_mm` apart, denser near the blends so the knot spans grow gradually.
-pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64; 3]>, Vec<f64>) {
+pub(crate) fn samples(
+    pts: &[[f64; 3]],
+    blends: &[Blend],
+    spacing_mm: f64,
+) -> (Vec<[f64; 3]>, Vec<f64>) {
     let n = pts.len();
     let mut out = Sampled {
         data: Vec::with_capacity(n * (SAMPLES + 4)),

@@ -11,31 +11,31 @@ use crate::machine::ExtrusionMode;
 
 /// What the block must agree with in the file around it.
 #[derive(Debug, Clone)]
-pub struct Frame<'a> {
+pub(crate) struct Frame<'a> {
     /// Where the path starts (the position before its first move).
-    pub start: [f64; 3],
+    pub(crate) start: [f64; 3],
     /// The path climbs along its length (spiral vase): every point keeps a fine Z.
-    pub climbs: bool,
+    pub(crate) climbs: bool,
     /// The original's extrusion mode.
-    pub mode: ExtrusionMode,
+    pub(crate) mode: ExtrusionMode,
     /// Logical E before the path (absolute mode).
-    pub e_before: f64,
+    pub(crate) e_before: f64,
     /// The original's last `E` word (absolute mode: the block ends on it exactly).
-    pub last_e_word: f64,
+    pub(crate) last_e_word: f64,
     /// Filament of the whole path (relative mode: the rounded words add up to it).
-    pub total_e: f64,
+    pub(crate) total_e: f64,
     /// The modal feed before the path, mm/min (`None`: no `F` so far, none is written).
-    pub f_before: Option<f64>,
+    pub(crate) f_before: Option<f64>,
     /// The modal feed the original leaves behind, mm/min.
-    pub f_after: Option<f64>,
+    pub(crate) f_after: Option<f64>,
     /// Annotation lines with the filament pushed where each stood; each is written before the
     /// first new point past it.
-    pub notes: Vec<(f64, &'a str)>,
+    pub(crate) notes: Vec<(f64, &'a str)>,
 }
 
 /// The block for new `points` after the start (filament `e` from the path start to each), as
 /// `pieces` (each ending at point `end`, counted with the start point as 0).
-pub fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &[Piece]) -> String {
+pub(crate) fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &[Piece]) -> String {
     let mut text = String::with_capacity(pieces.len() * 40);
     let mut z_now = frame.start[2];
     // A path whose Z changes along it (spiral vase, FullControl designs) keeps a Z on every

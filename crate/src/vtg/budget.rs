@@ -20,35 +20,35 @@ use crate::gcode::Edit;
 /// Share of what the rewrites that cost nothing saved (time and motor energy, each) that may be
 /// spent on rewrites that cost something, so the file as a whole still prints faster and on
 /// less energy than the original, by at least half of what the free rewrites saved.
-pub const SPEND_SHARE: f64 = 0.5;
+pub(crate) const SPEND_SHARE: f64 = 0.5;
 
 /// One way of writing a path.
 #[derive(Debug)]
-pub struct Outcome {
+pub(crate) struct Outcome {
     /// The edits that write it.
-    pub edits: Vec<Edit>,
+    pub(crate) edits: Vec<Edit>,
     /// Its counts.
-    pub part: Rewritten,
+    pub(crate) part: Rewritten,
     /// Time (s) and motor energy (J) it adds to the path's own (negative: saves).
-    pub added: [f64; 2],
+    pub(crate) added: [f64; 2],
     /// Whether it costs more time or energy than the original.
-    pub dearer: bool,
+    pub(crate) dearer: bool,
     /// Sharp corners it removes.
-    pub corners_removed: u64,
+    pub(crate) corners_removed: u64,
 }
 
 /// The ways one path can be written.
 #[derive(Debug, Default)]
-pub struct Offer {
+pub(crate) struct Offer {
     /// One that costs nothing: written unless a dearer one is bought in its place.
-    pub free: Option<Outcome>,
+    pub(crate) free: Option<Outcome>,
     /// Ones that cost time or energy; at most one is bought.
-    pub dearer: Vec<Outcome>,
+    pub(crate) dearer: Vec<Outcome>,
 }
 
 impl Offer {
     /// Files `outcome` as free or dearer.
-    pub fn push(&mut self, outcome: Outcome) {
+    pub(crate) fn push(&mut self, outcome: Outcome) {
         if outcome.dearer {
             self.dearer.push(outcome);
         } else if self
@@ -68,16 +68,16 @@ impl Offer {
 /// the Creality benchies at `--allow-slower 1`: the K1's sharp corners −74.3 % and energy
 /// +0.22 % with energy not counted, −70.0 % and −0.77 % with half, −62.2 % and −1.25 % with
 /// the whole; the K1C's −45.4 % and −0.04 %, −44.1 % and −0.21 %, −40.8 % and −0.39 %.
-pub const ENERGY_WEIGHT: f64 = 0.5;
+pub(crate) const ENERGY_WEIGHT: f64 = 0.5;
 
 /// What may be spent: time s, motor energy J; and, when energy is not limited, the seconds a
 /// joule counts for in the order of the purchases.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Budget {
+pub(crate) struct Budget {
     /// Time s and motor energy J that may be spent.
-    pub limits: [f64; 2],
+    pub(crate) limits: [f64; 2],
     /// Seconds a joule counts for where energy is not limited.
-    pub seconds_per_joule: f64,
+    pub(crate) seconds_per_joule: f64,
 }
 
 impl Budget {
@@ -89,7 +89,7 @@ impl Budget {
     /// time, the one that costs less energy comes first, so the allowance does not raise the
     /// energy where it need not. Without time allowed, both must have been saved for anything
     /// to be spent.
-    pub fn new(saved: [f64; 2], allowed_s: f64, mean_power_w: f64) -> Self {
+    pub(crate) fn new(saved: [f64; 2], allowed_s: f64, mean_power_w: f64) -> Self {
         let share = saved.map(|x| SPEND_SHARE * x.max(0.0));
         let seconds_per_joule = if mean_power_w.is_finite() && mean_power_w > 0.0 {
             ENERGY_WEIGHT / mean_power_w
@@ -133,7 +133,7 @@ struct Step {
 /// steps that remove the most sharp corners for their cost first, while they fit the budget
 /// (a step that does not fit ends its path's climb; other paths' cheaper steps are still
 /// tried). Ties go to file order, so the choice is the same on any number of threads.
-pub fn choose(offers: &[Offer], budget: Budget) -> Vec<Option<usize>> {
+pub(crate) fn choose(offers: &[Offer], budget: Budget) -> Vec<Option<usize>> {
     let mut choice = vec![None; offers.len()];
     if budget.limits.iter().any(|&b| b.is_nan() || b <= 0.0) {
         return choice;

@@ -30,44 +30,45 @@ use super::hairpin::{cross_z, unit, Hairpin};
 
 /// What the firmware does at a corner: its limits there and the speeds either side.
 #[derive(Debug, Clone, Copy)]
-pub struct Firmware {
+pub(crate) struct Firmware {
     /// Acceleration of the moves, mm/s².
-    pub accel_mm_s2: f64,
+    pub(crate) accel_mm_s2: f64,
     /// Junction deviation equivalent to the square-corner velocity, mm.
-    pub junction_deviation_mm: f64,
+    pub(crate) junction_deviation_mm: f64,
     /// Programmed feed of the leg before and of the leg after, mm/s.
-    pub feed_mm_s: [f64; 2],
+    pub(crate) feed_mm_s: [f64; 2],
     /// Planned speed at the far end of each leg (the start of the one before, the end of the
     /// one after), mm/s.
-    pub ends_mm_s: [f64; 2],
+    pub(crate) ends_mm_s: [f64; 2],
 }
 
 /// The constraints of a polygon corner.
 #[derive(Debug, Clone, Copy)]
-pub struct Bounds {
+pub(crate) struct Bounds {
     /// Largest distance from the original both ways, mm.
-    pub tolerance_mm: f64,
+    pub(crate) tolerance_mm: f64,
     /// Largest turn of one vertex, rad.
-    pub max_turn_rad: f64,
+    pub(crate) max_turn_rad: f64,
     /// Shortest step, mm.
-    pub min_step_mm: f64,
+    pub(crate) min_step_mm: f64,
     /// How far along each leg from the corner the polygon may reach, mm.
-    pub room_mm: [f64; 2],
+    pub(crate) room_mm: [f64; 2],
 }
 
 /// A corner's polygon, and how the firmware runs it.
 #[derive(Debug, Clone)]
-pub struct Corner {
+pub(crate) struct Corner {
     /// The polygon as a one-corner [`Hairpin`] (for [`super::hairpin::substitute`]).
-    pub pin: Hairpin,
+    pub(crate) pin: Hairpin,
     /// Measured largest distance from the original, both ways, mm.
-    pub deviation_mm: f64,
+    pub(crate) deviation_mm: f64,
     /// Slowest speed through the polygon, mm/s.
-    pub slowest_mm_s: f64,
+    pub(crate) slowest_mm_s: f64,
     /// Slowest speed through the sharp corner, mm/s (the same model).
-    pub sharp_mm_s: f64,
+    pub(crate) sharp_mm_s: f64,
     /// Time through the legs and the sharp corner, s.
-    pub sharp_time_s: f64,
+    #[cfg_attr(not(test), allow(dead_code))] // checked by the tests only
+    pub(crate) sharp_time_s: f64,
 }
 
 /// Shares of the largest turn tried at the apex.
@@ -83,7 +84,7 @@ const TOLERANCE_SHARE: f64 = 0.97;
 const PLACEMENT_STEPS: usize = 48;
 
 /// The polygon for corner `i` of `pts` that the firmware runs through fastest, if one fits.
-pub fn find(pts: &[[f64; 3]], i: usize, bounds: &Bounds, fw: &Firmware) -> Option<Corner> {
+pub(crate) fn find(pts: &[[f64; 3]], i: usize, bounds: &Bounds, fw: &Firmware) -> Option<Corner> {
     let (p0, v, p2) = (*pts.get(i.checked_sub(1)?)?, *pts.get(i)?, *pts.get(i + 1)?);
     if (p0[2] - v[2]).abs() > 1e-9 || (p2[2] - v[2]).abs() > 1e-9 {
         return None;

@@ -11,7 +11,7 @@ use super::bspline::{dot, lerp, norm, sub};
 use crate::path::{PathMove, PrintPath};
 
 /// Distance from `p` to segment `a`–`b`.
-pub fn point_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
+pub(crate) fn point_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
     let ab = sub(b, a);
     let ap = sub(p, a);
     let l2 = dot(&ab, &ab);
@@ -24,7 +24,7 @@ pub fn point_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
 }
 
 /// Distance from `p` to the polyline `poly`.
-pub fn point_polyline(p: &[f64; 3], poly: &[[f64; 3]]) -> f64 {
+pub(crate) fn point_polyline(p: &[f64; 3], poly: &[[f64; 3]]) -> f64 {
     match poly {
         [] => f64::INFINITY,
         [a] => norm(&sub(p, a)),
@@ -59,7 +59,12 @@ fn samples(poly: &[[f64; 3]], step: f64, mut each: impl FnMut(&[f64; 3])) {
 /// `accept` mm are taken as they are (they are upper bounds); set it to the tolerance to check
 /// against, or to 0 for the tightest figure. With `accept > 0` the measurement stops as soon as
 /// it exceeds `accept`.
-pub fn polyline_deviation(out: &[[f64; 3]], orig: &[[f64; 3]], step: f64, accept: f64) -> f64 {
+pub(crate) fn polyline_deviation(
+    out: &[[f64; 3]],
+    orig: &[[f64; 3]],
+    step: f64,
+    accept: f64,
+) -> f64 {
     let segs = orig.len().saturating_sub(1);
     if segs == 0 {
         return match (out.is_empty(), orig.first()) {
@@ -239,7 +244,7 @@ impl Grid {
 
 /// The larger of [`polyline_deviation`] from `a` to `b` and from `b` to `a`: `a` stays near
 /// `b`, and `b` is covered by `a` (a path that cuts a corner short fails the second).
-pub fn both_ways(a: &[[f64; 3]], b: &[[f64; 3]], step: f64, accept: f64) -> f64 {
+pub(crate) fn both_ways(a: &[[f64; 3]], b: &[[f64; 3]], step: f64, accept: f64) -> f64 {
     polyline_deviation(a, b, step, accept).max(polyline_deviation(b, a, step, accept))
 }
 
@@ -284,7 +289,7 @@ pub fn file_deviation(original: &PrintPath, output: &PrintPath, step: f64) -> f6
 
 /// Points along an arc move (`G2`/`G3`) from its start to its end, the chords between them
 /// within `step / 10` of the arc; `None` for any other move.
-pub fn arc_points(m: &PathMove, step: f64) -> Option<Vec<[f64; 3]>> {
+pub(crate) fn arc_points(m: &PathMove, step: f64) -> Option<Vec<[f64; 3]>> {
     let a = m.kind.arc()?;
     let (i, j, k) = a.plane.axes();
     let rise = m.to[k] - m.from[k];

@@ -7,31 +7,31 @@ use super::smooth::{Settings, Smoothed};
 
 /// The speed terms of one new segment.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StepSpeed {
+pub(crate) struct StepSpeed {
     /// The original's programmed feed there, mm/s.
-    pub programmed: f64,
+    pub(crate) programmed: f64,
     /// The speed eq. 29 allows for the segment's curvature, mm/s (infinite below `K_cr`).
-    pub limit: f64,
+    pub(crate) limit: f64,
     /// The original's planned speed over the stretch the segment replaces, mm/s: the feed is
     /// never lowered below it.
-    pub floor: f64,
+    pub(crate) floor: f64,
     /// The original's highest planned speed over that stretch, mm/s (infinite when unknown).
-    pub ceiling: f64,
+    pub(crate) ceiling: f64,
     /// The acceleration the firmware used there, mm/s² (0: unknown).
-    pub accel: f64,
+    pub(crate) accel: f64,
 }
 
 /// A rewritten path as it is written: points, filament and feed of each segment.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct Written {
+pub(crate) struct Written {
     /// Points after the start point.
-    pub points: Vec<[f64; 3]>,
+    pub(crate) points: Vec<[f64; 3]>,
     /// Filament pushed from the path start to each point, mm.
-    pub e: Vec<f64>,
+    pub(crate) e: Vec<f64>,
     /// Feed of the segment ending at each point, mm/s.
-    pub feed_mm_s: Vec<f64>,
+    pub(crate) feed_mm_s: Vec<f64>,
     /// Segments written with a lowered feed.
-    pub lowered: u64,
+    pub(crate) lowered: u64,
 }
 
 impl Smoothed {
@@ -42,7 +42,7 @@ impl Smoothed {
     /// energy). On a classic-jerk firmware rising feeds are ramped: such a planner counts a
     /// rise of the feed from one block to the next as jerk against the new block's full speed,
     /// so the segment where it rises is cut into pieces that each rise by a share of the jerk.
-    pub fn written(
+    pub(crate) fn written(
         &self,
         scale: Option<f64>,
         ceiling: bool,

@@ -19,17 +19,18 @@ const MAX_ROUNDS: usize = 6;
 
 /// A fitted curve with the data it was fitted to.
 #[derive(Debug, Clone)]
-pub struct Fit {
+pub(crate) struct Fit {
     /// The curve, parametrised by the arc length of the original polyline.
-    pub curve: Curve,
+    pub(crate) curve: Curve,
     /// Largest distance from a data point to the curve at its parameter, mm.
-    pub max_residual_mm: f64,
+    #[cfg_attr(not(test), allow(dead_code))] // checked by the tests only
+    pub(crate) max_residual_mm: f64,
 }
 
 /// Fits a clamped cubic B-spline to `data` at parameters `params` (non-decreasing, distinct
 /// ends) so that every data point lies within `tol_mm` of the curve at its parameter. `None`
 /// when the data are degenerate or the tolerance cannot be met.
-pub fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit> {
+pub(crate) fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit> {
     let m = data.len().checked_sub(1)?;
     if params.len() != data.len() || m < DEGREE || !tol_mm.is_finite() || tol_mm <= 0.0 {
         return None;
@@ -222,7 +223,7 @@ impl Normal {
 /// `a[i][k] = A[i][i+k]` (Cholesky `A = UᵀU`, then two triangular solves). `None` if `A` is
 /// not positive definite.
 #[allow(clippy::needless_range_loop)] // band indices, as in the textbook algorithm
-pub fn cholesky_band_solve(
+pub(crate) fn cholesky_band_solve(
     a: &mut [[f64; DEGREE + 1]],
     b: &mut [[f64; 3]],
 ) -> Option<Vec<[f64; 3]>> {

@@ -20,7 +20,7 @@ use super::bspline::{arc_lengths, cross, dot, norm, segment_at, sub};
 use super::deviation::{both_ways, point_polyline};
 
 /// Longest connector between the two corners of a hairpin, mm.
-pub const MAX_CONNECTOR_MM: f64 = 2.0;
+pub(crate) const MAX_CONNECTOR_MM: f64 = 2.0;
 /// Smallest combined turn of a hairpin, rad (90°: below it the corners are separate turns).
 const MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_2;
 /// Largest combined turn, rad (200°: legs that diverge a little past parallel).
@@ -33,21 +33,21 @@ const COARSE_STEPS: i32 = 16;
 
 /// The arc a hairpin is rounded to.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Hairpin {
+pub(crate) struct Hairpin {
     /// Index of the first of the corners it replaces.
-    pub at: usize,
+    pub(crate) at: usize,
     /// How many corners it replaces: 2 for a hairpin (the second is the next point), 1 for a
     /// [`super::keyhole`].
-    pub corners: usize,
+    pub(crate) corners: usize,
     /// Radius, mm.
-    pub radius_mm: f64,
+    pub(crate) radius_mm: f64,
     /// Points of the arc, from where it leaves the first long leg to where it meets the second.
-    pub arc: Vec<[f64; 3]>,
+    pub(crate) arc: Vec<[f64; 3]>,
     /// Distance from the first corner back along the first leg to where the arc starts, mm
     /// (negative: on the leg's extension past the corner).
-    pub before_mm: f64,
+    pub(crate) before_mm: f64,
     /// Distance from the second corner along the second leg to where the arc ends, mm.
-    pub after_mm: f64,
+    pub(crate) after_mm: f64,
 }
 
 impl Hairpin {
@@ -58,7 +58,7 @@ impl Hairpin {
 
     /// The stretch of the original it replaces, as arc lengths `(u0, u1)` along it (`arc`:
     /// the original's arc length at each point).
-    pub fn span(&self, arc: &[f64]) -> (f64, f64) {
+    pub(crate) fn span(&self, arc: &[f64]) -> (f64, f64) {
         (
             arc[self.at] - self.before_mm.max(0.0),
             arc[self.last_corner(arc.len())] + self.after_mm.max(0.0),
@@ -104,7 +104,7 @@ pub(super) fn cross_z(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 /// constant Z, and an arc of radius at least `min_radius_mm` rounds them within `tolerance_mm`
 /// starting no more than `room_mm[0]` before corner `i` and ending no more than `room_mm[1]`
 /// after corner `i + 1`.
-pub fn find(
+pub(crate) fn find(
     pts: &[[f64; 3]],
     i: usize,
     tolerance_mm: f64,
@@ -278,17 +278,17 @@ impl UTurn {
 /// A path with its hairpins replaced by their arcs: points, filament at each, and the feed and
 /// planned profile of each segment (those of the original segment its middle stands for).
 #[derive(Debug, Clone, Default)]
-pub struct Substituted {
+pub(crate) struct Substituted {
     /// The points.
-    pub pts: Vec<[f64; 3]>,
+    pub(crate) pts: Vec<[f64; 3]>,
     /// Filament pushed from the path start to each point.
-    pub e: Vec<f64>,
+    pub(crate) e: Vec<f64>,
     /// Feed of each segment, mm/s.
-    pub feed: Vec<f64>,
+    pub(crate) feed: Vec<f64>,
     /// Planned profile of each segment (empty if the original had none).
-    pub planned: Vec<crate::plan::Profile>,
+    pub(crate) planned: Vec<crate::plan::Profile>,
     /// Index of each pin's first point (its arc then runs on for `arc.len()` points).
-    pub starts: Vec<usize>,
+    pub(crate) starts: Vec<usize>,
 }
 
 /// `pts` (filament `e`, feeds `feed`, profiles `planned`) with each of `pins` (sorted, apart)
@@ -296,7 +296,7 @@ pub struct Substituted {
 /// for the original point at the same fraction of length along the stretch, so the filament
 /// pushed up to it is read off the original (spread by length over the new stretch) and the
 /// path's total is unchanged.
-pub fn substitute(
+pub(crate) fn substitute(
     pts: &[[f64; 3]],
     e: &[f64],
     feed: &[f64],

@@ -106,7 +106,7 @@ fn tangent_point(
 /// more than `room_mm[0]` before the corner and rejoining it no more than `room_mm[1]` after,
 /// with counter-turns of at most `max_kink_rad` where it leaves and rejoins. The stretch must
 /// lie in one plane of constant Z and turn by 60–170° in all.
-pub fn find(
+pub(crate) fn find(
     pts: &[[f64; 3]],
     arc: &[f64],
     i: usize,

@@ -1,44 +1,56 @@
-//! Vibration-suppressed toolpath generation (VTG paper section 3, eq. 18–31, Algorithm 1).
+//! Vibration-suppressed toolpath generation (VTG paper section 3, eq. 21–31, Algorithm 1).
 //!
-//! [`vtg`] reads a file, finds its extrusion paths (runs of consecutive printing moves within
-//! one feature), and rewrites each path that has a sharp corner (a turn above the critical
-//! angle δθ): its corners are blended with the largest fillets the tolerance and the legs
-//! allow ([`blend`]; two sharp corners across a short leg, such as infill turning back, are
-//! rounded as one arc, [`hairpin`]), a cubic B-spline is fitted to the blended path by least squares
-//! ([`fit`]), walked with the second-order Taylor interpolator and Newton correction of
-//! Algorithm 1 ([`resample`]) in steps that each turn by less than 0.9 δθ, and the path's
-//! filament is spread over the new points ([`rewrite`]). Where the curvature is above `K_cr`
-//! (eq. 30, [`kinematics`]) the feed is lowered so `a_n`, `j_n` and the interpolation chord
-//! error stay within eq. 29, never below the speed the machine had at the same place on the
-//! original, and on classic-jerk firmware rising feeds are ramped so no junction stalls
-//! ([`smooth`]). Travels, retractions and every other line are kept byte for byte. The result
-//! is checked against the original independently ([`deviation`]) and compared with
-//! [`metrics`] (Table 1) and the analysis (Table 2).
+//! [`vtg`] reads a file, finds its extrusion paths (runs of consecutive printing moves of one
+//! feature) and rewrites each that turns by more than the critical angle δθ (VTG eq. 26).
+//! Three parts do the work:
+//!
+//! - **The paper's stages**, per path: corners blended into fillets within the tolerance
+//!   (`blend`), a cubic B-spline fitted to the blended points by least squares (`bspline`,
+//!   VTG eq. 21–22; `fit`), walked by Algorithm 1 (`resample`: the second-order Taylor step of
+//!   VTG eq. 27 with Newton correction, speed fluctuation VTG eq. 28) in steps that turn by
+//!   less than δθ, the filament spread over the new points, and the feed lowered where the
+//!   curvature exceeds `K_cr` so `a_n`, `j_n` and the chord error stay within VTG eq. 29–30
+//!   (`kinematics`, `feed`), never below the original's own speed there.
+//! - **Corners the fillet cannot round well**: two sharp corners across a short leg as one arc
+//!   (`hairpin`), a corner too tight to fillet round a loop (`keyhole`), the racing line out
+//!   and back (`blend`), polygons placed for Klipper's look-ahead (`corner`), and runs on a
+//!   circle written as `G2`/`G3` (`arcs`).
+//! - **The search**: each path offered written its free way and, where time may be spent,
+//!   dearer ways (`rewrite`, `budget`); the file-level choice within the allowed time; and,
+//!   where the dynamics model finds the result ringing more than the original, the whole file
+//!   again with quieter variants.
+//!
+//! Travels, retractions and every other line are kept byte for byte. The result is checked
+//! against the original independently ([`deviation`]) and compared with [`metrics`] (Table 1,
+//! VTG eq. 24–26 and 31) and the analysis (Table 2).
 
-pub mod arcs;
-pub mod blend;
-pub mod block;
-pub mod bspline;
-pub mod budget;
-pub mod corner;
+mod arcs;
+mod blend;
+mod block;
+mod bspline;
+mod budget;
+mod corner;
 pub mod deviation;
-pub mod feed;
-pub mod fit;
-pub mod hairpin;
-pub mod keyhole;
-pub mod kinematics;
+mod feed;
+mod fit;
+mod hairpin;
+mod keyhole;
+mod kinematics;
 pub mod metrics;
-pub mod report;
-pub mod resample;
-pub mod rewrite;
-pub mod smooth;
+mod report;
+mod resample;
+mod rewrite;
+mod smooth;
 pub mod source;
 
 use serde::{Deserialize, Serialize};
 
 use crate::analyze::{AnalyzeOptions, Progress, Report};
 use crate::error::{Error, ErrorKind};
-pub use report::{Comparison, Table1, Table2, VtgReport};
+pub use kinematics::KinematicLimits;
+pub use report::{
+    Comparison, DeviationComparison, LayerMetrics, PathCounts, Table1, Table2, VtgReport,
+};
 
 /// Options of [`vtg`]. Every field is optional in JSON.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -73,7 +85,7 @@ pub struct VtgOptions {
     /// original (default true; it costs about as much as the rewrite itself, more when it
     /// rewrites again). See `with_simulated_deviation`.
     pub dynamics: bool,
-    /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`arcs`]) to cut the
+    /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`) to cut the
     /// line count (default false: the firmware must have arcs enabled, Marlin's `ARC_SUPPORT`
     /// or Klipper's `[gcode_arcs]`).
     pub arcs: bool,
@@ -82,7 +94,7 @@ pub struct VtgOptions {
     /// firmware takes sharp corners faster than any fillet within the tolerance (Klipper with a
     /// square-corner velocity of 50–100 mm/s) rounding costs time, and motor and standby
     /// energy with it: this buys the corners that remove the most sharp turns for their time
-    /// first, energy weighed in ([`budget::ENERGY_WEIGHT`]). Where rounding costs nothing
+    /// first, energy weighed in. Where rounding costs nothing
     /// (every Marlin file of the corpus) it changes nothing. 0: the print gets no slower and
     /// uses no more energy, the corners that would cost being paid only out of what the other
     /// rewrites save. 100 rounds every corner the tolerance allows.

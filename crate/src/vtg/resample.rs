@@ -15,51 +15,51 @@ use super::bspline::{dot, norm, sub, Curve, Eval};
 
 /// Settings of the walk.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Walk {
+pub(crate) struct Walk {
     /// Chord tolerance between the curve and each step's chord, mm.
-    pub chord_tol_mm: f64,
+    pub(crate) chord_tol_mm: f64,
     /// Largest turn a step may cover, rad.
-    pub max_turn_rad: f64,
+    pub(crate) max_turn_rad: f64,
     /// Longest step, mm.
-    pub max_step_mm: f64,
+    pub(crate) max_step_mm: f64,
     /// Shortest step, mm: below it the written coordinates' rounding (0.001 mm) would turn the
     /// direction of a segment by more than a couple of degrees. Where the curve is tighter than
     /// this step allows, the step is taken anyway (the turn is then sharper than asked).
-    pub min_step_mm: f64,
+    pub(crate) min_step_mm: f64,
     /// Newton damping φ (1 = plain Newton).
-    pub phi: f64,
+    pub(crate) phi: f64,
     /// Newton stops when `|‖C(u) − P_i‖ − L_i| ≤ newton_tol_mm`.
-    pub newton_tol_mm: f64,
+    pub(crate) newton_tol_mm: f64,
 }
 
 /// One interpolated point.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Sample {
+pub(crate) struct Sample {
     /// Curve parameter.
-    pub u: f64,
+    pub(crate) u: f64,
     /// `C(u)`.
-    pub p: [f64; 3],
+    pub(crate) p: [f64; 3],
     /// Largest curvature of the curve over the step that ends here, 1/mm.
-    pub kappa: f64,
+    pub(crate) kappa: f64,
     /// Mean curvature over that step (turn of the tangent over the chord), 1/mm: what the
     /// feed rate of the written segment must respect.
-    pub mean_kappa: f64,
+    pub(crate) mean_kappa: f64,
     /// The step `L_i` asked for (0 for the first point and the shortened last step).
-    pub step_mm: f64,
+    pub(crate) step_mm: f64,
 }
 
 /// Steps walked, and the Newton error (eq. 28's speed fluctuation in mm).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct WalkStats {
+pub(crate) struct WalkStats {
     /// Steps taken.
-    pub steps: u64,
+    pub(crate) steps: u64,
     /// Sum of `|L_i − ‖P_{i+1} − P_i‖| / L_i` (eq. 28) over full steps.
-    pub fluctuation_sum: f64,
+    pub(crate) fluctuation_sum: f64,
 }
 
 /// Walks `curve` from start to end. Returns the points (first = `C(start)`, last = `C(end)`)
 /// or `None` if the walk does not converge (degenerate curve).
-pub fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample>> {
+pub(crate) fn walk(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample>> {
     let (u_start, u_end) = (curve.start(), curve.end());
     if u_end.is_nan() || u_start.is_nan() || u_end <= u_start {
         return None;
@@ -291,7 +291,7 @@ fn fits(kappa: f64, step: f64, w: &Walk) -> bool {
 /// are computed once: a long step over many spans costs only table reads, and a partly
 /// covered span its samples inside the interval and the curvature at the interval's ends.
 #[derive(Debug, Clone)]
-pub struct CurvatureIndex {
+pub(crate) struct CurvatureIndex {
     /// Distinct knots.
     breaks: Vec<f64>,
     /// Curvature of span `i` (`breaks[i]..breaks[i+1]`) at `SPAN_SAMPLES` equally spaced
@@ -306,7 +306,7 @@ const SPAN_SAMPLES: usize = 6;
 
 impl CurvatureIndex {
     /// Samples every span of `curve`.
-    pub fn new(curve: &Curve) -> Self {
+    pub(crate) fn new(curve: &Curve) -> Self {
         let mut breaks: Vec<f64> = Vec::new();
         for &k in curve.knots() {
             if breaks.last().is_none_or(|&b| k > b) {
@@ -334,14 +334,21 @@ impl CurvatureIndex {
     }
 
     /// Largest curvature on `[a, b]`.
-    pub fn max(&self, curve: &Curve, a: f64, b: f64) -> f64 {
+    #[cfg(test)]
+    pub(crate) fn max(&self, curve: &Curve, a: f64, b: f64) -> f64 {
         self.max_with_ends(curve, a, b, [None, None])
     }
 
     /// [`Self::max`] given the curvature at `a` and/or `b` where the caller has already
     /// evaluated the curve there (the walk has, at its current point and at the Newton
     /// solution): the same figure without evaluating again.
-    pub fn max_with_ends(&self, curve: &Curve, a: f64, b: f64, ends: [Option<f64>; 2]) -> f64 {
+    pub(crate) fn max_with_ends(
+        &self,
+        curve: &Curve,
+        a: f64,
+        b: f64,
+        ends: [Option<f64>; 2],
+    ) -> f64 {
         // Spans: i such that breaks[i] < b and breaks[i+1] > a.
         let first = self.breaks.partition_point(|&k| k <= a).saturating_sub(1);
         let mut best = 0.0f64;
@@ -373,12 +380,6 @@ impl CurvatureIndex {
         }
         best
     }
-}
-
-/// Largest curvature on `[a, b]` (see [`CurvatureIndex`]; builds the index, so for one-off
-/// queries).
-pub fn max_curvature(curve: &Curve, a: f64, b: f64) -> f64 {
-    CurvatureIndex::new(curve).max(curve, a, b)
 }
 
 /// Eq. 27 predictor and Newton corrector: `u` past `u_i` with `‖C(u) − P_i‖ = L`; `e` is the

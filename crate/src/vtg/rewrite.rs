@@ -31,43 +31,43 @@ use crate::plan::{JunctionModel, Limits, Motion, Planner, Profile};
 
 /// What the rewrite did.
 #[derive(Debug, Clone, Default)]
-pub struct Rewritten {
+pub(crate) struct Rewritten {
     /// The new file.
-    pub output: Vec<u8>,
+    pub(crate) output: Vec<u8>,
     /// Paths with a sharp corner (candidates).
-    pub candidate_paths: u64,
+    pub(crate) candidate_paths: u64,
     /// Of those, paths rewritten.
-    pub rewritten_paths: u64,
+    pub(crate) rewritten_paths: u64,
     /// Moves replaced.
-    pub replaced_moves: u64,
+    pub(crate) replaced_moves: u64,
     /// Moves written in their place.
-    pub written_moves: u64,
+    pub(crate) written_moves: u64,
     /// Segments whose feed was lowered (eq. 29).
-    pub lowered_segments: u64,
+    pub(crate) lowered_segments: u64,
     /// Segments whose curvature stays above `K_cr`.
-    pub above_k_cr_segments: u64,
+    pub(crate) above_k_cr_segments: u64,
     /// Largest measured distance of a rewritten path from its original, mm.
-    pub max_deviation_mm: f64,
+    pub(crate) max_deviation_mm: f64,
     /// Rewritten paths whose eq. 29 feed caps were raised so they cost no time.
-    pub raised_caps_paths: u64,
+    pub(crate) raised_caps_paths: u64,
     /// Rewritten paths written without the eq. 29 feed caps, which even raised would have made
     /// them slower than the original.
-    pub uncapped_paths: u64,
+    pub(crate) uncapped_paths: u64,
     /// Rewritten paths that plan slower or cost more motor energy than the original, paid for
     /// out of what the other rewrites saved or with the time the options allow (see
     /// [`super::budget`]).
-    pub paid_paths: u64,
+    pub(crate) paid_paths: u64,
     /// Paths kept as they were because even rounded without caps they plan slower or cost more
     /// motor energy, and the savings elsewhere could not pay for them.
-    pub kept_for_time: u64,
+    pub(crate) kept_for_time: u64,
     /// Algorithm 1 statistics.
-    pub walk: WalkStats,
+    pub(crate) walk: WalkStats,
     /// The first scale of the eq. 29 speeds each rewrite was tried with.
-    pub feed_cap_scale: f64,
+    pub(crate) feed_cap_scale: f64,
     /// Arcs (`G2`/`G3`) written.
-    pub arcs_written: u64,
+    pub(crate) arcs_written: u64,
     /// Corners turned round keyhole loops.
-    pub keyholes: u64,
+    pub(crate) keyholes: u64,
 }
 
 /// The eq. 30 limits for a file: `v_max` from the machine's X/Y feed limits (`M203`), `A_n` the
@@ -79,7 +79,7 @@ pub struct Rewritten {
 /// the quality of the print, and what junction-deviation and Klipper planners themselves hold
 /// the centripetal acceleration of a curve to (`M201` is often far above it: 9000 mm/s² in
 /// PrusaSlicer's MK3S profile, printing at 1250).
-pub fn limits_for(path: &PrintPath, options: &VtgOptions) -> KinematicLimits {
+pub(crate) fn limits_for(path: &PrintPath, options: &VtgOptions) -> KinematicLimits {
     let l = &path.print_limits;
     let pick = |a: f64, b: f64, default: f64| {
         let v = a.min(b);
@@ -108,7 +108,7 @@ pub fn limits_for(path: &PrintPath, options: &VtgOptions) -> KinematicLimits {
 }
 
 /// The machine's lowest natural frequency (see [`VtgOptions::normal_jerk_mm_s3`]), Hz.
-pub fn first_mode_hz(path: &PrintPath) -> f64 {
+pub(crate) fn first_mode_hz(path: &PrintPath) -> f64 {
     let name = crate::dynamics::parameters::preset_for_machine(&path.profile.name);
     let f1 = crate::dynamics::parameters::MachineDynamics::preset(name)
         .map_or(f64::NAN, |d| d.lowest_frequency_hz());
@@ -130,11 +130,11 @@ pub fn first_mode_hz(path: &PrintPath) -> f64 {
 /// tolerance, before `BLEND_SHARE` rose to 0.9): sharp corners −32.1 % with the all-corners
 /// variant alone, −33.9 % with this rung added, −34.0 % with four rungs (0.9, 0.7, 0.5, 0) at
 /// 1.6 times the run time of two.
-pub const DEARER_SPEED_SHARES: [f64; 2] = [0.8, 0.0];
+pub(crate) const DEARER_SPEED_SHARES: [f64; 2] = [0.8, 0.0];
 
 /// Every path's ways of being written, before the file-level choice ([`budget`]).
 #[derive(Debug, Default)]
-pub struct Offers {
+pub(crate) struct Offers {
     offers: Vec<Offer>,
     /// Time (s) and motor energy (J) the free rewrites save.
     saved: [f64; 2],
@@ -145,11 +145,11 @@ pub struct Offers {
 /// What a whole-file rewrite is tried with; [`super::vtg`] tries others where the dynamics
 /// model finds the first one ringing more than the original.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Variant {
+pub(crate) struct Variant {
     /// The first scale of the eq. 29 speeds ([`Settings::feed_cap_scale`]).
-    pub feed_cap_scale: f64,
+    pub(crate) feed_cap_scale: f64,
     /// Turn corners too tight to fillet round keyhole loops ([`Settings::keyholes`]).
-    pub keyholes: bool,
+    pub(crate) keyholes: bool,
 }
 
 impl Default for Variant {
@@ -163,7 +163,7 @@ impl Default for Variant {
 
 /// Rewrites every eligible path of `input` in every way worth offering: the free rewrite, and
 /// the dearer ones (see [`budget`]); [`Offers::write`] then writes the file with the choice.
-pub fn offers(
+pub(crate) fn offers(
     input: &[u8],
     path: &PrintPath,
     all: &Sources,
@@ -347,14 +347,14 @@ impl Offering<'_> {
 impl Offers {
     /// Whether any path offers a rewrite that costs time or energy: otherwise what the budget
     /// allows changes nothing.
-    pub fn has_dearer(&self) -> bool {
+    pub(crate) fn has_dearer(&self) -> bool {
         self.offers.iter().any(|o| !o.dearer.is_empty())
     }
 
     /// The file with the free rewrites and the dearer ones bought with half of what the free
     /// ones saved plus `allowed_s` of time, energy weighed at the print's `mean_power_w` where
     /// time is allowed ([`budget::choose`]).
-    pub fn write(&self, input: &[u8], allowed_s: f64, mean_power_w: f64) -> Rewritten {
+    pub(crate) fn write(&self, input: &[u8], allowed_s: f64, mean_power_w: f64) -> Rewritten {
         let mut out = Rewritten {
             candidate_paths: self.candidate_paths,
             feed_cap_scale: self.variant.feed_cap_scale,

@@ -46,12 +46,12 @@ const ATTEMPTS: usize = 4;
 const RETRY_SCALE: f64 = 0.7;
 /// Shortest interpolation step on firmware that plans every segment (Klipper), mm (see
 /// [`Walk::min_step_mm`]).
-pub const MIN_STEP_MM: f64 = 0.03;
+pub(crate) const MIN_STEP_MM: f64 = 0.03;
 /// Shortest interpolation step on Marlin and Prusa firmware, mm: they drop a block of fewer than
 /// `MIN_STEPS_PER_SEGMENT` (6) steps, or of at most `DROP_SEGMENTS` (5), and fold its distance
 /// into the next, which at 80–100 steps/mm is anything under 0.05–0.075 mm. Shorter steps
 /// would be merged by the firmware into segments that turn twice as much as written.
-pub const MARLIN_MIN_STEP_MM: f64 = 0.06;
+pub(crate) const MARLIN_MIN_STEP_MM: f64 = 0.06;
 /// Longest gap between data points on straight runs, mm.
 const STRAIGHT_SPACING_MM: f64 = 3.0;
 /// Largest turn of one interpolation step, as a share of the critical angle.
@@ -62,76 +62,76 @@ const KINK_SHARE: f64 = 0.8;
 
 /// Settings for [`smooth_path`].
 #[derive(Debug, Clone, Copy)]
-pub struct Settings {
+pub(crate) struct Settings {
     /// Tolerance, mm.
-    pub tolerance_mm: f64,
+    pub(crate) tolerance_mm: f64,
     /// Critical angle δθ, rad.
-    pub critical_rad: f64,
+    pub(crate) critical_rad: f64,
     /// Kinematic limits (eq. 29–30).
-    pub limits: KinematicLimits,
+    pub(crate) limits: KinematicLimits,
     /// Lower the feed where the curvature is above what the limits allow (eq. 29).
-    pub limit_feed: bool,
+    pub(crate) limit_feed: bool,
     /// The machine's X/Y acceleration limit (`M201`), mm/s²: the ceiling of `A_n`. Where the
     /// original's planned moves are known, `A_n` of a stretch is the acceleration the firmware
     /// used there (files change it per feature), within this.
-    pub max_normal_accel_mm_s2: f64,
+    pub(crate) max_normal_accel_mm_s2: f64,
     /// `f₁` when `J_n` follows `A_n` (`J_n = A_n f₁`, the default), Hz; `None` keeps
     /// `limits.normal_jerk_mm_s3` everywhere.
-    pub jerk_per_accel_hz: Option<f64>,
+    pub(crate) jerk_per_accel_hz: Option<f64>,
     /// Shortest interpolation step, mm ([`MIN_STEP_MM`] or [`MARLIN_MIN_STEP_MM`]).
-    pub min_step_mm: f64,
+    pub(crate) min_step_mm: f64,
     /// The per-axis jerk of a classic-jerk firmware, mm/s (`None` on junction-deviation and
     /// Klipper planners): rising feeds are then ramped, since such a planner counts a rise of
     /// the feed from one block to the next as jerk against the new block's full speed.
-    pub classic_jerk_mm_s: Option<f64>,
+    pub(crate) classic_jerk_mm_s: Option<f64>,
     /// The first scale of the eq. 29 speeds a rewrite is tried with (1: the speeds as they
     /// are); [`crate::vtg::vtg`] raises it where the dynamics model finds the rewrite at 1
     /// rings more than the original.
-    pub feed_cap_scale: f64,
+    pub(crate) feed_cap_scale: f64,
     /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`super::arcs`]).
-    pub arcs: bool,
+    pub(crate) arcs: bool,
     /// The slowest a rounded corner may be run, as a share of the firmware's speed through the
     /// sharp one: 1 rounds only the corners the machine runs round at least as fast (the free
     /// rewrite); below 1, the dearer variants of a path that
     /// [`super::VtgOptions::allow_slower_pct`] may buy (0 rounds every corner it can).
-    pub min_speed_share: f64,
+    pub(crate) min_speed_share: f64,
     /// Turn single corners too tight to fillet round a [`keyhole`] loop where one fits.
-    pub keyholes: bool,
+    pub(crate) keyholes: bool,
     /// Which side of its corners a path may be rounded on ([`blend::Line`]).
-    pub line: blend::Line,
+    pub(crate) line: blend::Line,
     /// Klipper's square-corner velocity, mm/s, on a Klipper machine (`None` elsewhere): its
     /// sharp corners are then turned as polygons placed for its look-ahead ([`corner`]).
-    pub klipper_scv_mm_s: Option<f64>,
+    pub(crate) klipper_scv_mm_s: Option<f64>,
 }
 
 /// A rewritten path: the new geometry, and what the feed of each new segment is made of.
 #[derive(Debug, Clone, Default)]
-pub struct Smoothed {
+pub(crate) struct Smoothed {
     /// New points after the start point (the last equals the original end).
-    pub points: Vec<[f64; 3]>,
+    pub(crate) points: Vec<[f64; 3]>,
     /// Filament pushed from the path start to each point, mm.
-    pub e: Vec<f64>,
+    pub(crate) e: Vec<f64>,
     /// The speed terms of the segment ending at each point.
-    pub steps: Vec<StepSpeed>,
+    pub(crate) steps: Vec<StepSpeed>,
     /// Segments whose curvature stays above `K_cr`.
-    pub above_k_cr: u64,
+    pub(crate) above_k_cr: u64,
     /// Measured largest distance to the original polyline, mm.
-    pub deviation_mm: f64,
+    pub(crate) deviation_mm: f64,
     /// Walk statistics (eq. 28).
-    pub stats: WalkStats,
+    pub(crate) stats: WalkStats,
     /// Corners turned round a keyhole loop.
-    pub keyholes: u64,
+    pub(crate) keyholes: u64,
 }
 
 /// A path to rewrite: its points, and what the original asks of each stretch.
 #[derive(Debug, Clone, Copy)]
-pub struct Path<'a> {
+pub(crate) struct Path<'a> {
     /// The polyline.
-    pub pts: &'a [[f64; 3]],
+    pub(crate) pts: &'a [[f64; 3]],
     /// Filament pushed from the path start to each point, mm (from 0).
-    pub e: &'a [f64],
+    pub(crate) e: &'a [f64],
     /// Feed of segment `i` (from `pts[i]` to `pts[i+1]`), mm/s.
-    pub feed: &'a [f64],
+    pub(crate) feed: &'a [f64],
     /// How the firmware's planner runs each original segment (empty when not known): the eq.
     /// 29 feed cap never asks for less than the speed the machine had at the same place on the
     /// original. At that speed the sharp corner is a step in velocity and the rounded one a
@@ -139,7 +139,7 @@ pub struct Path<'a> {
     /// with a high square-corner velocity, eq. 29's normal-jerk term would slow every corner
     /// down, and even at a classic-jerk corner the machine is back at speed within a few
     /// tenths of a millimetre on either side of the vertex).
-    pub planned: &'a [Profile],
+    pub(crate) planned: &'a [Profile],
 }
 
 impl<'a> Path<'a> {
@@ -178,7 +178,7 @@ impl<'a> Path<'a> {
 /// racing-line one, which the fit and walk do not always manage to follow in steps under δθ
 /// (it then stays sharp): where that happened, the path is also rounded on the inside line
 /// (with its hairpins and keyholes) and the one left with fewer sharp turns is kept.
-pub fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
+pub(crate) fn smooth_path(path: &Path<'_>, s: &Settings) -> Option<Smoothed> {
     let corners = polygon_corners(path, s);
     if corners.is_empty() {
         return smooth_cut(path, s, &[]);
@@ -571,7 +571,7 @@ impl Settings {
     /// Whether [`Settings::min_speed_share`] can change which corners are rounded: only where
     /// the firmware takes a sharp corner as a virtual arc that a fillet must keep up with (see
     /// `pays`); a classic-jerk planner's corners all pay already.
-    pub fn speed_share_matters(&self) -> bool {
+    pub(crate) fn speed_share_matters(&self) -> bool {
         self.classic_jerk_mm_s.is_none()
     }
 }
