@@ -15,6 +15,7 @@
 //! before it keeps them ([`super::deviation::both_ways`]), so the tolerance holds as before.
 
 use super::bspline::{norm, sub};
+use super::tuning::TUNING;
 use crate::gcode::number::rounded;
 use crate::machine::{Arc, Plane};
 
@@ -25,13 +26,6 @@ const MAX_SEGMENTS: usize = 256;
 /// Largest sweep of one arc, rad (under a half turn, where `I`/`J` from a rounded start point
 /// still place the centre on the right side).
 const MAX_SWEEP: f64 = 0.95 * std::f64::consts::PI;
-/// Smallest radius, mm: the centre is written to 4 decimals and the end point to 3, and a
-/// firmware rejects an arc whose end is not on its circle to within a fraction of the radius.
-const MIN_RADIUS_MM: f64 = 0.2;
-/// Largest radius, mm: flatter runs are straight enough as lines.
-const MAX_RADIUS_MM: f64 = 500.0;
-/// Largest spread of the feed rates an arc joins (the arc takes the lowest).
-const FEED_SPREAD: f64 = 1.05;
 /// Largest relative mismatch between the start and end radius as written.
 const RADIUS_MISMATCH: f64 = 0.002;
 
@@ -125,7 +119,7 @@ fn arc_over(
     let run = pts.get(i..=j)?;
     let (first, last) = (run.first()?, run.last()?);
     let (center, r) = circle_through(first, &run[run.len() / 2], last)?;
-    if !(MIN_RADIUS_MM..=MAX_RADIUS_MM).contains(&r) {
+    if !(TUNING.arc_min_radius_mm..=TUNING.arc_max_radius_mm).contains(&r) {
         return None;
     }
     if run.iter().any(|p| (p[2] - first[2]).abs() > 1e-9) {
@@ -135,7 +129,7 @@ fn arc_over(
     let (lo, hi) = speeds.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &f| {
         (lo.min(f), hi.max(f))
     });
-    if !(lo > 0.0 && hi <= lo * FEED_SPREAD) {
+    if !(lo > 0.0 && hi <= lo * TUNING.arc_feed_spread) {
         return None;
     }
     // Every point on the circle, every step turning the same way by less than a quarter turn.

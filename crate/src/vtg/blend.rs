@@ -34,6 +34,7 @@
 //! still uses where the wider circle cannot be walked.
 
 use super::bspline::{dot, norm, sub};
+use super::tuning::TUNING;
 
 /// Samples per blend given to the fit (its ends included).
 pub(crate) const SAMPLES: usize = 9;
@@ -42,9 +43,6 @@ const STRAIGHT_RAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
 /// Turns above this are not blended, rad (160°: the fillet's radius falls towards nothing and
 /// such reversals cannot be rounded within any useful tolerance anyway).
 pub(crate) const MAX_TURN_RAD: f64 = 160.0 * std::f64::consts::PI / 180.0;
-/// Share of a leg the blends at its two ends may use together (the rest stays straight, so the
-/// fit sees where one blend ends and the next begins).
-pub(crate) const LEG_SHARE: f64 = 0.9;
 
 /// A corner transition at one vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -151,7 +149,7 @@ pub(crate) fn plan(
             } else {
                 out[other].reach()
             };
-            LEG_SHARE * (along[i] - along[other]).abs() - used
+            TUNING.leg_share * (along[i] - along[other]).abs() - used
         };
         let back = (0..i).rev().find(|&k| !through[k]).unwrap_or(0);
         let on = (i + 1..n).find(|&k| !through[k]).unwrap_or(n - 1);
@@ -205,7 +203,7 @@ fn inside_fillets(
     // curvatures is as small as it can be: a blend's curvature is k(θ)/L, so in proportion to
     // k(θ), each at most what it asked for, and what one does not need goes to the other.
     let share = |leg: usize, me: usize, other: Option<usize>| -> f64 {
-        let room = LEG_SHARE * lens[leg];
+        let room = TUNING.leg_share * lens[leg];
         let Some(j) = other.filter(|&j| want[j] > 0.0) else {
             return room;
         };
@@ -242,11 +240,6 @@ pub(crate) enum Line {
     Racing,
 }
 
-/// Shares of the tolerance tried as the racing line's offset, largest first.
-const OFFSET_SHARES: [f64; 3] = [1.0, 0.5, 0.25];
-/// Peak curvature of a ramp out to the racing line, as a share of the fillet's: low, since
-/// the ramp lies where the machine is still faster than on the fillet.
-const RAMP_CURVATURE_SHARE: f64 = 0.15;
 /// Peak of `|o''|` of the quintic ease `o(x) = 1 − (10x³ − 15x⁴ + 6x⁵)` on `0..1` (at
 /// `x = 1/2 ± √3/6`): `10/√3`.
 const EASE_PEAK: f64 = 5.773_502_691_896_258;
@@ -270,7 +263,7 @@ fn ease(x: f64) -> f64 {
 /// that, which on firmware that takes sharp corners fast (Klipper's square-corner velocity)
 /// makes rounding a corner cost no time where the inside fillet did. No radius beyond the
 /// `enough_curvature` one is asked for. The ramps are quintic eases whose peak curvature is
-/// [`RAMP_CURVATURE_SHARE`] of the fillet's.
+/// `Tuning::ramp_curvature_share` of the fillet's.
 fn racing(inside: Blend, tolerance_mm: f64, enough_curvature: f64, room: f64) -> Option<Blend> {
     let half = 0.5 * inside.turn_rad;
     let sec = 1.0 / crate::math::cos(half);
@@ -284,7 +277,7 @@ fn racing(inside: Blend, tolerance_mm: f64, enough_curvature: f64, room: f64) ->
         f64::INFINITY
     };
     let inside_radius = 1.0 / inside.max_curvature;
-    OFFSET_SHARES.iter().find_map(|&share| {
+    TUNING.racing_offset_shares.iter().find_map(|&share| {
         let radius = ((tolerance_mm + share * tolerance_mm * sec) / (sec - 1.0)).min(cap);
         let offset = ((sec - 1.0) * radius - tolerance_mm) / sec;
         let offset = offset.clamp(0.0, tolerance_mm);
@@ -292,7 +285,7 @@ fn racing(inside: Blend, tolerance_mm: f64, enough_curvature: f64, room: f64) ->
             return None;
         }
         let extent = (radius - offset) * tan;
-        let ramp = (EASE_PEAK * offset * radius / RAMP_CURVATURE_SHARE).sqrt();
+        let ramp = (EASE_PEAK * offset * radius / TUNING.ramp_curvature_share).sqrt();
         (extent > 0.0 && extent + ramp <= room).then_some(Blend {
             extent_mm: extent,
             turn_rad: inside.turn_rad,
@@ -629,7 +622,7 @@ mod tests {
         assert!((racing.deviation_mm - eps).abs() < 1e-12);
         // The ramp's peak curvature is its share of the fillet's.
         let ramp_peak = EASE_PEAK * eps / (racing.ramp_mm * racing.ramp_mm);
-        assert!((ramp_peak * radius - RAMP_CURVATURE_SHARE).abs() < 1e-12);
+        assert!((ramp_peak * radius - TUNING.ramp_curvature_share).abs() < 1e-12);
         // The samples: within ε of the corner both ways, outside the first leg by ε where the
         // fillet starts, on the leg again beyond the ramp, and ε inside the vertex at the
         // fillet's middle.
@@ -665,7 +658,7 @@ mod tests {
         // A leg of 1 mm leaves no room for the full ramp: a smaller offset, or none.
         let short = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 10.0, 0.0]];
         let b = plan(&short, eps, 0.0, Line::Racing)[1];
-        assert!(b.reach() <= LEG_SHARE * 1.0 + 1e-12, "{b:?}");
+        assert!(b.reach() <= TUNING.leg_share * 1.0 + 1e-12, "{b:?}");
         assert!(b.offset_mm < eps);
         // The same corner with its first leg cut by straight vertices has the room of the
         // whole leg, and samples that stay within ε.
@@ -711,7 +704,7 @@ mod tests {
         let (c, _) = shape(sharp.turn_rad);
         assert!((sharp.extent_mm - tol / c).abs() < 1e-12, "{sharp:?}");
         let leg = super::norm(&super::sub(&pts[3], &pts[2]));
-        assert!(b[2].extent_mm + sharp.extent_mm <= LEG_SHARE * leg + 1e-12);
+        assert!(b[2].extent_mm + sharp.extent_mm <= TUNING.leg_share * leg + 1e-12);
         assert!(b[2].extent_mm > 0.0);
     }
 }

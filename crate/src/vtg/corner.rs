@@ -27,6 +27,7 @@
 use super::bspline::{dot, norm, sub};
 use super::deviation::both_ways;
 use super::hairpin::{cross_z, unit, Hairpin};
+use super::tuning::TUNING;
 
 /// What the firmware does at a corner: its limits there and the speeds either side.
 #[derive(Debug, Clone, Copy)]
@@ -77,9 +78,6 @@ const APEX_SHARES: [f64; 2] = [1.0, 0.85];
 const RAMP_DEG: [f64; 8] = [1.5, 2.5, 4.0, 6.0, 9.0, 13.0, 18.0, 24.0];
 /// Most vertices either side of the apex.
 const MAX_SIDE_VERTICES: usize = 12;
-/// Share of the tolerance the polygon is sized for (the rest: rounding of written coordinates
-/// and the sampling of the check).
-const TOLERANCE_SHARE: f64 = 0.97;
 /// Golden-section steps of the placement search.
 const PLACEMENT_STEPS: usize = 48;
 
@@ -98,7 +96,7 @@ pub(crate) fn find(pts: &[[f64; 3]], i: usize, bounds: &Bounds, fw: &Firmware) -
     }
     let legs = [norm(&sub(&v, &p0)), norm(&sub(&p2, &v))];
     let sharp = stretch_time(&legs_frame(theta, legs, Vec::new()), fw);
-    let budget = TOLERANCE_SHARE * bounds.tolerance_mm;
+    let budget = TUNING.corner_tolerance_share * bounds.tolerance_mm;
     // Most corners have short legs: where the most compact member (the steepest ramp, the
     // fewest vertices) reaches past the room, so would every other.
     let steepest = RAMP_DEG[RAMP_DEG.len() - 1].to_radians();

@@ -4,6 +4,7 @@
 
 use super::bspline::{lerp, norm, sub};
 use super::smooth::{Settings, Smoothed};
+use super::tuning::TUNING;
 
 /// The speed terms of one new segment.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -79,12 +80,6 @@ impl Smoothed {
     }
 }
 
-/// Share of the jerk limit a ramp's feed may rise by from one piece to the next (the rest is
-/// left for the change of direction at the same junction).
-const RAMP_JERK_SHARE: f64 = 0.7;
-/// Shortest ramp piece, mm.
-const MIN_RAMP_PIECE_MM: f64 = 0.02;
-
 /// Splits segments where the written feed rises by more than a classic-jerk planner takes
 /// without slowing down.
 ///
@@ -95,12 +90,12 @@ const MIN_RAMP_PIECE_MM: f64 = 0.02;
 /// 30 to 80 mm/s against a 7 mm/s jerk limit brings the junction down to 4 mm/s. Lowering the
 /// feed on a curve (eq. 29) would cost a near-stop wherever the feed rises again. So a segment
 /// whose feed rises by more than the limit is cut into collinear pieces whose feeds rise by
-/// `RAMP_JERK_SHARE` of it at a time, each as long as the machine needs to accelerate through
+/// `Tuning::ramp_jerk_share` of it at a time, each as long as the machine needs to accelerate through
 /// it at `accel[i]` (segment `i`'s acceleration): the speed profile is the one it would have
 /// had anyway, and no junction is penalised. The pieces lie on the segment and share its
 /// filament by length.
 fn ramp_up(out: &mut Written, start: [f64; 3], start_feed: f64, jerk: f64, accel: &[f64]) {
-    let rise = RAMP_JERK_SHARE * jerk;
+    let rise = TUNING.ramp_jerk_share * jerk;
     if rise <= 0.0
         || accel.len() != out.points.len()
         || out.feed_mm_s.windows(2).all(|w| w[1] <= w[0] + jerk)
@@ -120,8 +115,8 @@ fn ramp_up(out: &mut Written, start: [f64; 3], start_feed: f64, jerk: f64, accel
         if i > 0 && target > now + jerk && len > 0.0 && a > 0.0 {
             loop {
                 let next = (now + rise).min(target);
-                let piece = ((next * next - now * now) / (2.0 * a)).max(MIN_RAMP_PIECE_MM);
-                if next >= target || done + piece >= len - MIN_RAMP_PIECE_MM {
+                let piece = ((next * next - now * now) / (2.0 * a)).max(TUNING.min_ramp_piece_mm);
+                if next >= target || done + piece >= len - TUNING.min_ramp_piece_mm {
                     break;
                 }
                 done += piece;

@@ -8,14 +8,7 @@
 //! points are interpolated (the path keeps its end points).
 
 use super::bspline::{basis_by_degree, find_span, norm, sub, Curve, DEGREE};
-
-/// Data points per knot span in the first fit.
-const POINTS_PER_SPAN: f64 = 2.5;
-/// Weight of the penalty on the curve's second derivative: tiny, it only makes the normal
-/// equations definite where a span holds no data (see [`solve`]).
-const PENALTY: f64 = 1e-3;
-/// Refinement rounds (each inserts a knot in every span that misses the tolerance).
-const MAX_ROUNDS: usize = 6;
+use super::tuning::TUNING;
 
 /// A fitted curve with the data it was fitted to.
 #[derive(Debug, Clone)]
@@ -40,7 +33,7 @@ pub(crate) fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit>
         return None;
     }
     // A9.7 (eq. 9.68–9.69): n + 1 control points, interior knots averaging the parameters.
-    let n = (((m + 1) as f64 / POINTS_PER_SPAN) as usize).clamp(DEGREE, m);
+    let n = (((m + 1) as f64 / TUNING.points_per_span) as usize).clamp(DEGREE, m);
     let d = (m + 1) as f64 / (n - DEGREE + 1) as f64;
     let mut knots = vec![u0; DEGREE + 1];
     for j in 1..=(n - DEGREE) {
@@ -52,7 +45,7 @@ pub(crate) fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit>
         knots.push(k.max(prev));
     }
     knots.extend([u1; DEGREE + 1]);
-    for _ in 0..MAX_ROUNDS {
+    for _ in 0..TUNING.fit_rounds {
         let curve = solve(data, params, &knots)?;
         let mut worst = 0.0f64;
         let mut bad_spans: Vec<usize> = Vec::new();
@@ -145,7 +138,7 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<Curve> {
     // line's control points are unevenly spaced, and where the spans are tiny that penalty
     // outweighs the data and bends the curve into a hook. C'' of a straight line parametrised
     // by its length is zero whatever the knots, so this penalty leaves straights alone.
-    let w = PENALTY.sqrt();
+    let w = TUNING.fit_penalty.sqrt();
     for i in 0..n - 1 {
         let span = |a: usize, b: usize| knots[b] - knots[a];
         let (s1, s2, s12) = (span(i + 1, i + 4), span(i + 2, i + 5), span(i + 2, i + 4));

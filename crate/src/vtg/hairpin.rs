@@ -18,16 +18,12 @@
 
 use super::bspline::{arc_lengths, cross, dot, norm, segment_at, sub};
 use super::deviation::{both_ways, point_polyline};
+use super::tuning::TUNING;
 
-/// Longest connector between the two corners of a hairpin, mm.
-pub(crate) const MAX_CONNECTOR_MM: f64 = 2.0;
 /// Smallest combined turn of a hairpin, rad (90°: below it the corners are separate turns).
 const MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_2;
 /// Largest combined turn, rad (200°: legs that diverge a little past parallel).
 const MAX_TURN_RAD: f64 = 200.0 * std::f64::consts::PI / 180.0;
-/// Turn of one side of the polygon that stands for the arc, rad (15°: its sagitta is 0.009 r,
-/// and the blends at its corners round it back towards the circle).
-const POLYGON_TURN_RAD: f64 = 15.0 * std::f64::consts::PI / 180.0;
 /// Centres tried along the bisector on the coarse pass, each side of the closest one.
 const COARSE_STEPS: i32 = 16;
 
@@ -100,7 +96,7 @@ pub(super) fn cross_z(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 }
 
 /// The hairpin at corners `i` and `i + 1` of `pts`, if the two corners turn the same way by 90°
-/// to 200° together across a connector of at most [`MAX_CONNECTOR_MM`], lie in one plane of
+/// to 200° together across a connector of at most `Tuning::hairpin_max_connector_mm`, lie in one plane of
 /// constant Z, and an arc of radius at least `min_radius_mm` rounds them within `tolerance_mm`
 /// starting no more than `room_mm[0]` before corner `i` and ending no more than `room_mm[1]`
 /// after corner `i + 1`.
@@ -125,7 +121,7 @@ pub(crate) fn find(
     let b = unit(sub(&p3, &v2))?;
     let connector = sub(&v2, &v1);
     let c_len = norm(&connector);
-    if !(c_len > 0.0 && c_len <= MAX_CONNECTOR_MM) {
+    if !(c_len > 0.0 && c_len <= TUNING.hairpin_max_connector_mm) {
         return None;
     }
     let c = unit(connector)?;
@@ -160,7 +156,7 @@ pub(crate) fn find(
         turn,
         room: [room_a, room_b],
         original: [pa, v1, v2, pb],
-        segments: (turn / POLYGON_TURN_RAD).ceil().max(2.0) as usize,
+        segments: (turn / TUNING.polygon_turn_rad).ceil().max(2.0) as usize,
         tolerance_mm,
         min_radius_mm,
     };

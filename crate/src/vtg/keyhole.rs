@@ -21,6 +21,7 @@
 use super::bspline::{dot, lerp, norm, segment_at, sub};
 use super::deviation::{both_ways, point_polyline};
 use super::hairpin::{arc_polygon, cross_z, unit, Hairpin};
+use super::tuning::TUNING;
 use crate::orient::vec3::angle;
 
 /// Smallest turn a keyhole is tried at, rad (60°: below it a corner fillets within the
@@ -28,8 +29,6 @@ use crate::orient::vec3::angle;
 const MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_3;
 /// Largest turn, rad (170°: past it the legs are too close for a loop of any useful radius).
 const MAX_TURN_RAD: f64 = 170.0 * std::f64::consts::PI / 180.0;
-/// Turn of one side of the polygon that stands for the circle, rad (as for hairpins).
-const POLYGON_TURN_RAD: f64 = 15.0 * std::f64::consts::PI / 180.0;
 /// Centres tried along the bisector.
 const CENTRES: usize = 12;
 /// Spacing of the departure points tried along each leg, mm.
@@ -236,7 +235,7 @@ impl Wedge<'_> {
         if span > self.turn + 2.0 * self.max_kink_rad + 1e-9 {
             return None;
         }
-        let segments = (span / POLYGON_TURN_RAD).ceil().max(1.0) as usize;
+        let segments = (span / TUNING.polygon_turn_rad).ceil().max(1.0) as usize;
         let mut loop_pts = Vec::with_capacity(segments + 3);
         loop_pts.push(da);
         loop_pts.extend(arc_polygon(&centre, &ta, side * span, segments));
@@ -316,7 +315,7 @@ mod tests {
         for w in h.arc[1..h.arc.len() - 1].windows(2) {
             assert!((norm(&sub(&w[1], &w[0])) - chord).abs() < 1e-9);
         }
-        assert!(chord <= r * POLYGON_TURN_RAD + 1e-9);
+        assert!(chord <= r * TUNING.polygon_turn_rad + 1e-9);
         let d = both_ways(&whole, &p, 1e-3, 0.0);
         assert!(d <= tol + 1e-3, "{d}");
         // The tip itself is passed within the tolerance.

@@ -42,8 +42,10 @@ mod resample;
 mod rewrite;
 mod smooth;
 pub mod source;
+mod tuning;
 
 use serde::{Deserialize, Serialize};
+use tuning::TUNING;
 
 use crate::analyze::{AnalyzeOptions, Progress, Report};
 use crate::error::{Error, ErrorKind};
@@ -108,11 +110,9 @@ pub struct VtgOptions {
     pub inside_corners: bool,
 }
 
-/// The print time the rewrite may add by default, percent: the issue's bar. With it every file
-/// of the corpus meets every bar of the issue; with 0 the two Creality benchies for Klipper at
-/// a 50–100 mm/s square-corner velocity keep most of their corners sharp (−31.7 % and −9.1 %
-/// of them rounded, against −70.0 % and −44.1 % within 1 %; README, "Where the issue's bar is
-/// not met").
+/// The print time the rewrite may add by default, percent: the issue's bar. More rounds more
+/// corners on machines that take sharp corners faster than round ones; 0 keeps every print
+/// from getting slower (figures in `docs/method/vtg-tuning-notes.md`).
 pub const DEFAULT_ALLOW_SLOWER_PCT: f64 = 1.0;
 
 impl Default for VtgOptions {
@@ -246,10 +246,9 @@ pub fn vtg_with_progress(
 /// whole file, and the analysis it was measured with (`None`: no time allowed, or no path that
 /// could spend it, not analysed).
 /// The choice counts the time each path adds as planned with its neighbours only; across the
-/// file the firmware's look-ahead adds a little more (3–9 % of the allowance on the
-/// Creality benchies), so where the whole file comes out slower than allowed the allowance is
-/// cut by the excess and the choice made again (at most [`TIME_ROUNDS`] times, then without
-/// any allowance).
+/// file the firmware's look-ahead adds a little more, so where the whole file comes out slower
+/// than allowed the allowance is cut by the excess and the choice made again (at most
+/// `Tuning::time_rounds` times, then without any allowance).
 fn within_allowed_time(
     input: &[u8],
     offers: &rewrite::Offers,
@@ -264,7 +263,7 @@ fn within_allowed_time(
     };
     let mut allowed_s = allowed;
     let mean_power_w = before.energy.total_j / before.time_s;
-    for _ in 0..TIME_ROUNDS {
+    for _ in 0..TUNING.time_rounds {
         if allowed_s <= 0.0 {
             break;
         }
@@ -274,29 +273,22 @@ fn within_allowed_time(
         if added <= allowed {
             return Ok((rewritten, Some(after)));
         }
-        allowed_s -= TIME_MARGIN * (added - allowed);
+        allowed_s -= TUNING.time_margin * (added - allowed);
     }
     Ok((offers.write(input, 0.0, mean_power_w), None))
 }
-
-/// Choices made against the whole file's time before giving up the allowance.
-const TIME_ROUNDS: usize = 4;
-/// Each round cuts the allowance by this many times the excess measured.
-const TIME_MARGIN: f64 = 1.2;
-
-/// Scales of the eq. 29 speeds tried, in turn, when the rewrite at 1 leaves the machine
-/// ringing more than the original did; then the same scales without keyhole loops.
-const QUIETER_SCALES: [f64; 3] = [1.0, 1.5, 2.0];
 
 /// The variants tried after the first (scale 1 with keyholes), in turn.
 fn quieter_variants() -> impl Iterator<Item = rewrite::Variant> {
     [true, false]
         .into_iter()
         .flat_map(|keyholes| {
-            QUIETER_SCALES.map(|feed_cap_scale| rewrite::Variant {
-                feed_cap_scale,
-                keyholes,
-            })
+            TUNING
+                .quieter_scales
+                .map(|feed_cap_scale| rewrite::Variant {
+                    feed_cap_scale,
+                    keyholes,
+                })
         })
         .skip(1)
 }
@@ -307,19 +299,15 @@ fn quieter_variants() -> impl Iterator<Item = rewrite::Variant> {
 /// Eq. 29's speeds (`J_n = A_n f₁`) are meant to keep a rounded corner from exciting the frame
 /// more than the sharp one did, and on nearly every file they do. They are a rule of thumb,
 /// though: the ringing a corner leaves depends on how its timing falls against the modes,
-/// which no bound on `a_n` and `j_n` sees. On the thesis triangle (with inside fillets, before
-/// corners took the racing line), whose 75° infill corners the firmware takes at 14 mm/s,
-/// fillets at eq. 29's 20 mm/s raised the mean deviation by 1.2 %, while at 1.5× (30 mm/s) it
-/// fell by 1.1 % (and at 0.5× it rose by 4 %: not monotonic). So when the simulated mean
-/// deviation does not fall, the file is rewritten again with the speeds starting at each of
-/// [`QUIETER_SCALES`] in turn, and the rewrite with the lowest simulated mean deviation is
+/// which no bound on `a_n` and `j_n` sees, and not monotonically (figures in
+/// `docs/method/vtg-tuning-notes.md`). So when the simulated mean deviation does not fall, the
+/// file is rewritten again with the speeds starting at each of `Tuning::quieter_scales` in turn, and the rewrite with the lowest simulated mean deviation is
 /// kept: every variant still passes the no-dearer check path by path, so time and energy fall
 /// as before.
 ///
 /// Keyhole loops ([`keyhole`]) are the other thing the model can object to: the machine no
 /// longer stops at the tip of a wedge, but it swings round a loop of a tenth of a millimetre
-/// or so in radius, and on some files (the thesis triangle's, oval's and teardrop's infill
-/// tips, before the racing line) that rang more than the stop did. If no scale brings the
+/// or so in radius, and on some files that rang more than the stop did. If no scale brings the
 /// mean below the original's with them, the scales are tried again without keyholes.
 ///
 /// `None` rows when the model cannot run (a print too long to simulate, for instance): the

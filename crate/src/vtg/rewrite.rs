@@ -21,6 +21,7 @@ use super::kinematics::KinematicLimits;
 use super::resample::WalkStats;
 use super::smooth::{smooth_path, Path, Settings, Smoothed};
 use super::source::{MoveSource, Sources};
+use super::tuning::TUNING;
 use super::VtgOptions;
 use crate::energy::Accumulator;
 use crate::error::{Error, ErrorKind};
@@ -120,18 +121,6 @@ pub(crate) fn first_mode_hz(path: &PrintPath) -> f64 {
     }
 }
 
-/// The dearer variants offered for each path when time may be spent
-/// ([`super::VtgOptions::allow_slower_pct`]), as [`Settings::min_speed_share`]: the corners
-/// the machine runs round at 80 % or more of its speed through the sharp one, then every
-/// corner. A path's corners differ in what rounding them costs (on the K1C benchy a wall's
-/// short chamfers cost little, its right angles at 50 mm/s square-corner velocity much more),
-/// and one all-or-nothing variant makes the budget pay for a path's dear corners to buy its
-/// cheap ones. Measured on the K1C benchy at `--allow-slower 1` (blends at 0.8 of the
-/// tolerance, before `BLEND_SHARE` rose to 0.9): sharp corners −32.1 % with the all-corners
-/// variant alone, −33.9 % with this rung added, −34.0 % with four rungs (0.9, 0.7, 0.5, 0) at
-/// 1.6 times the run time of two.
-pub(crate) const DEARER_SPEED_SHARES: [f64; 2] = [0.8, 0.0];
-
 /// Every path's ways of being written, before the file-level choice ([`budget`]).
 #[derive(Debug, Default)]
 pub(crate) struct Offers {
@@ -200,7 +189,7 @@ pub(crate) fn offers(
         all,
         energy: &energy,
         settings,
-        dearer: DEARER_SPEED_SHARES.map(|min_speed_share| Settings {
+        dearer: TUNING.dearer_speed_shares.map(|min_speed_share| Settings {
             min_speed_share,
             ..settings
         }),
@@ -252,9 +241,9 @@ fn file_settings(
             .is_none()
             .then(|| first_mode_hz(path)),
         min_step_mm: if path.junction_model == JunctionModel::Klipper {
-            super::smooth::MIN_STEP_MM
+            TUNING.klipper_min_step_mm
         } else {
-            super::smooth::MARLIN_MIN_STEP_MM
+            TUNING.marlin_min_step_mm
         },
         classic_jerk_mm_s: (path.junction_model == JunctionModel::ClassicJerk)
             .then(|| xy_jerk(&path.print_limits)),
@@ -304,7 +293,7 @@ struct Offering<'a> {
     energy: &'a Accumulator,
     /// The free rewrite's settings.
     settings: Settings,
-    /// The dearer variants' ([`DEARER_SPEED_SHARES`]).
+    /// The dearer variants' (`Tuning::dearer_speed_shares`).
     dearer: [Settings; 2],
     /// Whether time may be spent and the dearer variants can differ from the free one.
     buy_time: bool,
@@ -479,22 +468,6 @@ fn xy_jerk(limits: &Limits) -> f64 {
     limits.max_jerk[0].value.min(limits.max_jerk[1].value)
 }
 
-/// Share of the tolerance within which a run of new points must lie on a circle to be written
-/// as an arc (the path with its arcs is then measured against the original as a whole).
-const ARC_SHARE: f64 = 0.05;
-
-/// Scales of the eq. 29 speeds tried in turn (`None`: no caps), until a rewrite costs no time.
-const CAP_SCALES: [Option<f64>; 8] = [
-    Some(1.0),
-    Some(1.2),
-    Some(1.44),
-    Some(1.73),
-    Some(2.07),
-    Some(2.5),
-    Some(3.0),
-    None,
-];
-
 /// The firmware a path runs on: the limits in force where it starts, the junction model, and
 /// the motor energy model; and the moves just before and after the path, which are planned
 /// with it.
@@ -596,9 +569,7 @@ impl Machine<'_> {
 /// square-corner velocity, gains nothing in time from rounding), the cheapest in energy is
 /// returned marked dearer, for [`budget::choose`] to take or leave, and after it the fastest if
 /// that is another: the lowered feeds that save motor energy cost time, and where time is what
-/// buys corners the fastest way buys more of them. On the K1C benchy at `--allow-slower 1`,
-/// offered both, the rewrite rounds −44.1 % of the sharp corners instead of −35.9 %, within the
-/// same 0.98 % of time, the energy still falling (−0.21 %).
+/// buys corners the fastest way buys more of them.
 fn rewrite_path(
     input: &[u8],
     run: &[PathMove],
@@ -734,7 +705,7 @@ fn cheapest_and_fastest(
 ) -> (Option<Writing<Written>>, Option<Writing<bool>>) {
     let cost = |w: &Written| machine.cost(start, &w.points, &w.e, &w.feed_mm_s);
     let base = settings.feed_cap_scale;
-    let capped = CAP_SCALES.map(|k| k.map(|k| k * base));
+    let capped = TUNING.cap_scales.map(|k| k.map(|k| k * base));
     let scales: &[Option<f64>] = if settings.limit_feed {
         &capped
     } else {
@@ -927,10 +898,10 @@ fn with_arcs(
     };
     let firmware = arcs::Firmware {
         segments: &segments,
-        max_turn_rad: super::smooth::STEP_TURN_SHARE * settings.critical_rad,
+        max_turn_rad: TUNING.step_turn_share * settings.critical_rad,
     };
     let tol = settings.tolerance_mm;
-    let pieces = arcs::pieces(all, &written.feed_mm_s, ARC_SHARE * tol, &firmware);
+    let pieces = arcs::pieces(all, &written.feed_mm_s, TUNING.arc_share * tol, &firmware);
     if pieces.iter().all(|p| p.arc.is_none()) {
         return None;
     }

@@ -3,8 +3,8 @@
 //! where the curvature is above `K_cr`, and check the result against the original polyline.
 //! The feed each new segment is then written with is [`super::feed`]'s business.
 //!
-//! The tolerance is shared: the corner blends ([`super::blend`]) may use `BLEND_SHARE` of it,
-//! the fit's residuals `FIT_SHARE` and the chords of the walk `CHORD_SHARE` (together a little
+//! The tolerance is shared: the corner blends ([`super::blend`]) may use `Tuning::blend_share` of it,
+//! the fit's residuals `Tuning::fit_share` and the chords of the walk `Tuning::chord_share` (together a little
 //! more than all of it: they seldom peak at the same point). If the measured deviation still
 //! exceeds the tolerance, the blends are made smaller and the path tried again; a path that
 //! cannot be rounded within the tolerance is kept as it was.
@@ -19,46 +19,8 @@ use super::hairpin;
 use super::keyhole;
 use super::kinematics::KinematicLimits;
 use super::resample::{walk, Sample, Walk, WalkStats};
+use super::tuning::TUNING;
 use crate::plan::Profile;
-
-/// Share of the tolerance the corner blends may use: most of it, since the fillet's radius sets
-/// the corner speed (a firmware planner lets a curve of radius `r` be run at `√(a r)`).
-///
-/// With the fit's and the chords' shares this adds up to more than the whole tolerance, on
-/// purpose: the three seldom peak at the same point (the fit's residuals are largest where a
-/// blend meets its legs, the blend's deviation at its apex), and the measured check after the
-/// walk catches the paths where they do, which are tried again with smaller blends. Measured
-/// against 0.8 on the 31 files by default: sharp corners fell further on 17 (less far on 6,
-/// none below the 40 %), energy further on 25, every output still within the
-/// tolerance, the 34 MB file no slower; and the K1C benchy's trade at `--allow-slower 1` rose
-/// from −33.9 % to −35.9 % of its sharp corners. (0.92 gained 0.2 points more on the K1C; the
-/// margin left to the fit is then a tenth of what it asks for.)
-const BLEND_SHARE: f64 = 0.9;
-/// Share of the tolerance the fit may use (the blended data are smooth: a small share does).
-const FIT_SHARE: f64 = 0.1;
-/// Share of the tolerance the walk's chords may use. In a fillet the turn per step binds first
-/// (a step turning by φ on radius `r` sags `r (1 − cos(φ/2))`, 0.03 r at 27°), so little is
-/// needed.
-const CHORD_SHARE: f64 = 0.09;
-/// Attempts, each with blends `RETRY_SCALE` the size of the previous one.
-const ATTEMPTS: usize = 4;
-/// Blend size of a retry relative to the attempt before.
-const RETRY_SCALE: f64 = 0.7;
-/// Shortest interpolation step on firmware that plans every segment (Klipper), mm (see
-/// [`Walk::min_step_mm`]).
-pub(crate) const MIN_STEP_MM: f64 = 0.03;
-/// Shortest interpolation step on Marlin and Prusa firmware, mm: they drop a block of fewer than
-/// `MIN_STEPS_PER_SEGMENT` (6) steps, or of at most `DROP_SEGMENTS` (5), and fold its distance
-/// into the next, which at 80–100 steps/mm is anything under 0.05–0.075 mm. Shorter steps
-/// would be merged by the firmware into segments that turn twice as much as written.
-pub(crate) const MARLIN_MIN_STEP_MM: f64 = 0.06;
-/// Longest gap between data points on straight runs, mm.
-const STRAIGHT_SPACING_MM: f64 = 3.0;
-/// Largest turn of one interpolation step, as a share of the critical angle.
-pub(crate) const STEP_TURN_SHARE: f64 = 0.9;
-/// Largest counter-turn where a keyhole leaves or rejoins the path, as a share of the critical
-/// angle (below the walk's share: the leg itself may bend a little there).
-const KINK_SHARE: f64 = 0.8;
 
 /// Settings for [`smooth_path`].
 #[derive(Debug, Clone, Copy)]
@@ -78,7 +40,7 @@ pub(crate) struct Settings {
     /// `f₁` when `J_n` follows `A_n` (`J_n = A_n f₁`, the default), Hz; `None` keeps
     /// `limits.normal_jerk_mm_s3` everywhere.
     pub(crate) jerk_per_accel_hz: Option<f64>,
-    /// Shortest interpolation step, mm ([`MIN_STEP_MM`] or [`MARLIN_MIN_STEP_MM`]).
+    /// Shortest interpolation step, mm (`Tuning::klipper_min_step_mm` or `Tuning::marlin_min_step_mm`).
     pub(crate) min_step_mm: f64,
     /// The per-axis jerk of a classic-jerk firmware, mm/s (`None` on junction-deviation and
     /// Klipper planners): rising feeds are then ramped, since such a planner counts a rise of
@@ -288,7 +250,7 @@ impl Corners {
         let plan = |line| {
             blend::plan(
                 pts,
-                BLEND_SHARE * s.tolerance_mm,
+                TUNING.blend_share * s.tolerance_mm,
                 s.limits.critical_curvature(),
                 line,
             )
@@ -335,7 +297,7 @@ impl Corners {
         let mut i = 1;
         while i + 2 < n {
             if self.sharp[i] && self.sharp[i + 1] && !(self.alone[i] && self.alone[i + 1]) {
-                if let Some(pin) = find_hairpin(pts, i, BLEND_SHARE * s.tolerance_mm, s) {
+                if let Some(pin) = find_hairpin(pts, i, TUNING.blend_share * s.tolerance_mm, s) {
                     self.pinned[i] = true;
                     self.pinned[i + 1] = true;
                     pins.push(pin);
@@ -494,13 +456,13 @@ fn polygon_corners(path: &Path<'_>, s: &Settings) -> Vec<corner::Corner> {
     // rings less than a polygon of the largest turns.
     let blends = blend::plan(
         pts,
-        BLEND_SHARE * s.tolerance_mm,
+        TUNING.blend_share * s.tolerance_mm,
         s.limits.critical_curvature(),
         s.line,
     );
     let room = |from: usize, to: usize, end: bool| {
         let l = norm(&sub(&pts[to], &pts[from]));
-        (if end { blend::LEG_SHARE } else { 0.5 } * l - s.min_step_mm).max(0.0)
+        (if end { TUNING.leg_share } else { 0.5 } * l - s.min_step_mm).max(0.0)
     };
     let free = Settings {
         min_speed_share: 1.0,
@@ -521,7 +483,7 @@ fn polygon_corners(path: &Path<'_>, s: &Settings) -> Vec<corner::Corner> {
         }
         let bounds = corner::Bounds {
             tolerance_mm: s.tolerance_mm - 0.001,
-            max_turn_rad: STEP_TURN_SHARE * s.critical_rad,
+            max_turn_rad: TUNING.step_turn_share * s.critical_rad,
             min_step_mm: s.min_step_mm,
             room_mm: [room(i - 1, i, i == 1), room(i, i + 1, i + 2 == n)],
         };
@@ -543,7 +505,7 @@ fn polygon_corners(path: &Path<'_>, s: &Settings) -> Vec<corner::Corner> {
 /// Whether a corner's blend can be walked in steps of at least the minimum step, each turning
 /// less than the critical angle (a tighter blend would only trade one sharp turn for several).
 fn roundable(b: &blend::Blend, s: &Settings) -> bool {
-    b.extent_mm > 0.0 && b.max_curvature * s.min_step_mm <= STEP_TURN_SHARE * s.critical_rad
+    b.extent_mm > 0.0 && b.max_curvature * s.min_step_mm <= TUNING.step_turn_share * s.critical_rad
 }
 
 /// Whether rounding a corner on a curve of the largest curvature `curvature` (a fillet's, or a
@@ -590,13 +552,13 @@ fn smooth_piece(
     let e0 = *path.e.first()?;
     let e: Vec<f64> = path.e.iter().map(|x| x - e0).collect();
     let from_zero = Path { e: &e, ..*path };
-    let mut share = BLEND_SHARE;
-    for _ in 0..ATTEMPTS {
+    let mut share = TUNING.blend_share;
+    for _ in 0..TUNING.attempts {
         let tol = share * s.tolerance_mm;
         let done = if pins.is_empty() {
             attempt(&from_zero, path.pts, s, tol)
         } else {
-            with_hairpins(&from_zero, s, tol, pins, share < BLEND_SHARE)
+            with_hairpins(&from_zero, s, tol, pins, share < TUNING.blend_share)
         };
         if let Some(mut r) = done {
             for x in &mut r.e {
@@ -604,14 +566,14 @@ fn smooth_piece(
             }
             return Some(r);
         }
-        share *= RETRY_SCALE;
+        share *= TUNING.retry_scale;
     }
     None
 }
 
 /// [`hairpin::find`] at corners `i`, `i + 1` of `pts` within `blend_tol`, for an arc the walk
 /// can follow in steps of at least the minimum step each turning by less than its share of the
-/// critical angle (with 5 % to spare), reaching along each long leg [`blend::LEG_SHARE`] of it
+/// critical angle (with 5 % to spare), reaching along each long leg `Tuning::leg_share` of it
 /// where the leg ends the path and half that where another corner shares it.
 fn find_hairpin(
     pts: &[[f64; 3]],
@@ -623,7 +585,7 @@ fn find_hairpin(
     let room = |leg: usize, far_end: usize| {
         let l = norm(&sub(pts.get(leg + 1)?, pts.get(leg)?));
         let shared = far_end != 0 && far_end + 1 != n;
-        Some(blend::LEG_SHARE * l * if shared { 0.5 } else { 1.0 })
+        Some(TUNING.leg_share * l * if shared { 0.5 } else { 1.0 })
     };
     let min_radius = min_hairpin_radius(s);
     let rooms = [room(i.checked_sub(1)?, i - 1)?, room(i + 1, i + 2)?];
@@ -632,8 +594,8 @@ fn find_hairpin(
 
 /// [`keyhole::find`] at corner `i` of `pts` (arc lengths `arc`) within the blend share of the
 /// tolerance, on a loop of the hairpins' smallest radius, with counter-turns of at most
-/// `KINK_SHARE` of the critical angle. The loop may reach along the path up to
-/// [`blend::LEG_SHARE`] of the way to the path's ends and half the way to the nearest corner
+/// `Tuning::kink_share` of the critical angle. The loop may reach along the path up to
+/// `Tuning::leg_share` of the way to the path's ends and half the way to the nearest corner
 /// that is sharp, already replaced or degenerate (which the piece may be cut at).
 fn find_keyhole(
     pts: &[[f64; 3]],
@@ -648,7 +610,7 @@ fn find_keyhole(
     let stop = |k: usize| k == 0 || k + 1 == n || sharp[k] || pinned[k] || degenerate[k];
     let share = |k: usize| {
         if k == 0 || k + 1 == n {
-            blend::LEG_SHARE
+            TUNING.leg_share
         } else {
             0.5
         }
@@ -663,9 +625,9 @@ fn find_keyhole(
         pts,
         arc,
         i,
-        BLEND_SHARE * s.tolerance_mm,
+        TUNING.blend_share * s.tolerance_mm,
         min_hairpin_radius(s),
-        KINK_SHARE * s.critical_rad,
+        TUNING.kink_share * s.critical_rad,
         room,
     )
 }
@@ -673,7 +635,7 @@ fn find_keyhole(
 /// The smallest radius of a loop the walk can follow in steps of at least the minimum step,
 /// each turning by less than its share of the critical angle, with 5 % to spare.
 fn min_hairpin_radius(s: &Settings) -> f64 {
-    1.05 * s.min_step_mm / (STEP_TURN_SHARE * s.critical_rad)
+    1.05 * s.min_step_mm / (TUNING.step_turn_share * s.critical_rad)
 }
 
 /// [`attempt`] on `path` with its hairpins `pins` replaced by their arcs, checked against the
@@ -793,11 +755,11 @@ fn walk_within(
     let budget = tol - 0.001;
     let k_cr = s.limits.critical_curvature();
     let blends = blend::plan(pts, blend_tol, k_cr, s.line);
-    let (data, params) = blend::samples(pts, &blends, STRAIGHT_SPACING_MM);
-    let f = fit(&data, &params, FIT_SHARE * tol)?;
+    let (data, params) = blend::samples(pts, &blends, TUNING.straight_spacing_mm);
+    let f = fit(&data, &params, TUNING.fit_share * tol)?;
     let w = Walk {
-        chord_tol_mm: CHORD_SHARE * tol,
-        max_turn_rad: STEP_TURN_SHARE * s.critical_rad,
+        chord_tol_mm: TUNING.chord_share * tol,
+        max_turn_rad: TUNING.step_turn_share * s.critical_rad,
         max_step_mm: 1e4,
         min_step_mm: s.min_step_mm,
         phi: 1.0,
@@ -909,7 +871,7 @@ mod tests {
             limit_feed: true,
             max_normal_accel_mm_s2: 1000.0,
             jerk_per_accel_hz: None,
-            min_step_mm: MIN_STEP_MM,
+            min_step_mm: TUNING.klipper_min_step_mm,
             classic_jerk_mm_s: None,
             feed_cap_scale: 1.0,
             arcs: false,
@@ -1046,7 +1008,7 @@ mod tests {
             planned: &[],
         };
         let s = Settings {
-            min_step_mm: MARLIN_MIN_STEP_MM,
+            min_step_mm: TUNING.marlin_min_step_mm,
             ..settings()
         };
         let r = smooth_path(&path, &s).expect("keyhole");
@@ -1088,7 +1050,7 @@ mod tests {
             planned: &[],
         };
         let on = Settings {
-            min_step_mm: MARLIN_MIN_STEP_MM,
+            min_step_mm: TUNING.marlin_min_step_mm,
             ..settings()
         };
         let off = Settings {
