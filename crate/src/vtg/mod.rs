@@ -2,57 +2,53 @@
 //!
 //! [`vtg`] reads a file, finds its extrusion paths (runs of consecutive printing moves of one
 //! feature) and rewrites each that turns by more than the critical angle δθ (VTG eq. 26).
-//! Three parts do the work:
+//! Three parts do the work, each a folder:
 //!
-//! - **The paper's stages**, per path: corners blended into fillets within the tolerance
-//!   (`blend`), a cubic B-spline fitted to the blended points by least squares (`bspline`,
-//!   VTG eq. 21–22; `fit`), walked by Algorithm 1 (`resample`: the second-order Taylor step of
-//!   VTG eq. 27 with Newton correction, speed fluctuation VTG eq. 28) in steps that turn by
-//!   less than δθ, the filament spread over the new points, and the feed lowered where the
-//!   curvature exceeds `K_cr` so `a_n`, `j_n` and the chord error stay within VTG eq. 29–30
-//!   (`kinematics`, `feed`), never below the original's own speed there.
-//! - **Corners the fillet cannot round well**: two sharp corners across a short leg as one arc
-//!   (`hairpin`), a corner too tight to fillet round a loop (`keyhole`), the racing line out
-//!   and back (`blend`), polygons placed for Klipper's look-ahead (`corner`), and runs on a
+//! - **`stages`, the paper's**, per path: a cubic B-spline (VTG eq. 21–22, `bspline`) fitted by
+//!   least squares to the path with its corners blended (`fit`), walked by Algorithm 1
+//!   (`resample`: the second-order Taylor step of VTG eq. 27 with Newton correction, speed
+//!   fluctuation VTG eq. 28) in steps that each turn by less than δθ, the filament spread over
+//!   the new points, and the feed lowered where the curvature exceeds `K_cr` so `a_n`, `j_n`
+//!   and the chord error stay within VTG eq. 29–30 (`kinematics`, `feed`), never below the
+//!   original's own speed there.
+//! - **`corners`, replacements for sharp corners**: the fillet or racing line (`blend`), two
+//!   corners across a short leg as one arc (`hairpin`), a loop round a corner too tight to
+//!   fillet (`keyhole`), a polygon placed for Klipper's look-ahead (`klipper`), and runs on a
 //!   circle written as `G2`/`G3` (`arcs`).
-//! - **The search**: each path offered written its free way and, where time may be spent,
-//!   dearer ways (`rewrite`, `budget`); the file-level choice within the allowed time; and,
-//!   where the dynamics model finds the result ringing more than the original, the whole file
-//!   again with quieter variants.
+//! - **`search`**: each path through the stages with its corners chosen and retried
+//!   (`smooth`), offered written its free way and, where time may be spent, dearer ways
+//!   (`rewrite`); the file-level choice within the allowed time (`budget`); and, where the
+//!   dynamics model finds the result ringing more than the original, the whole file again
+//!   with quieter variants. Its ladders of variants are one table, in `search`'s doc; the
+//!   values they trade with are one struct, `tuning::Tuning`.
 //!
 //! Travels, retractions and every other line are kept byte for byte. The result is checked
 //! against the original independently ([`deviation`]) and compared with [`metrics`] (Table 1,
 //! VTG eq. 24–26 and 31) and the analysis (Table 2).
 
-mod arcs;
-mod blend;
 mod block;
-mod bspline;
-mod budget;
-mod corner;
+mod corners;
 pub mod deviation;
-mod feed;
-mod fit;
-mod hairpin;
-mod keyhole;
-mod kinematics;
 pub mod metrics;
 mod report;
-mod resample;
-mod rewrite;
-mod smooth;
+mod search;
 pub mod source;
+mod stages;
 mod tuning;
+
+use corners::{arcs, blend, hairpin, keyhole, klipper};
+use search::{budget, rewrite, smooth};
+use stages::{bspline, feed, fit, kinematics, resample};
 
 use serde::{Deserialize, Serialize};
 use tuning::TUNING;
 
 use crate::analyze::{AnalyzeOptions, Progress, Report};
 use crate::error::{Error, ErrorKind};
-pub use kinematics::KinematicLimits;
 pub use report::{
     Comparison, DeviationComparison, LayerMetrics, PathCounts, Table1, Table2, VtgReport,
 };
+pub use stages::kinematics::KinematicLimits;
 
 /// Options of [`vtg`]. Every field is optional in JSON.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -192,7 +188,7 @@ pub fn vtg_with_progress(
     }
     let limits = rewrite::limits_for(&path, options);
     // One rewrite tried as `variant`, analysed and reported.
-    let attempt = |variant: rewrite::Variant, before: Report, progress: Progress<'_>| {
+    let attempt = |variant: search::Variant, before: Report, progress: Progress<'_>| {
         let mut step = |f: f64| progress(0.8 * f);
         let offers = rewrite::offers(input, &path, &sources, options, &limits, variant, &mut step)?;
         if !progress(0.8) {
@@ -228,7 +224,7 @@ pub fn vtg_with_progress(
             rewritten,
         ))
     };
-    let first = rewrite::Variant::default();
+    let first = search::Variant::default();
     let mut report = attempt(first, before, &mut |f| progress(0.3 + 0.4 * f))?;
     if !progress(0.7) {
         return Err(cancelled());
@@ -278,32 +274,17 @@ fn within_allowed_time(
     Ok((offers.write(input, 0.0, mean_power_w), None))
 }
 
-/// The variants tried after the first (scale 1 with keyholes), in turn.
-fn quieter_variants() -> impl Iterator<Item = rewrite::Variant> {
-    [true, false]
-        .into_iter()
-        .flat_map(|keyholes| {
-            TUNING
-                .quieter_scales
-                .map(|feed_cap_scale| rewrite::Variant {
-                    feed_cap_scale,
-                    keyholes,
-                })
-        })
-        .skip(1)
-}
-
 /// Fills Table 2's deviation rows with the dynamics model, run on the original and on the
 /// rewritten file over printing moves (travels are not rewritten), and closes the loop on it.
 ///
-/// Eq. 29's speeds (`J_n = A_n f₁`) are meant to keep a rounded corner from exciting the frame
-/// more than the sharp one did, and on nearly every file they do. They are a rule of thumb,
-/// though: the ringing a corner leaves depends on how its timing falls against the modes,
-/// which no bound on `a_n` and `j_n` sees, and not monotonically (figures in
-/// `docs/method/vtg-tuning-notes.md`). So when the simulated mean deviation does not fall, the
-/// file is rewritten again with the speeds starting at each of `Tuning::quieter_scales` in turn, and the rewrite with the lowest simulated mean deviation is
-/// kept: every variant still passes the no-dearer check path by path, so time and energy fall
-/// as before.
+/// Eq. 29's speeds (`J_n = A_n f₁`) are meant to keep a rounded corner from exciting the frame more
+/// than the sharp one did, and on nearly every file they do. They are a rule of thumb, though: the
+/// ringing a corner leaves depends on how its timing falls against the modes, which no bound on
+/// `a_n` and `j_n` sees, and not monotonically (figures in `docs/method/vtg-tuning-notes.md`). So
+/// when the simulated mean deviation does not fall, the file is rewritten again with the speeds
+/// starting at each of `Tuning::quieter_scales` in turn, and the rewrite with the lowest simulated
+/// mean deviation is kept: every variant still passes the no-dearer check path by path, so time and
+/// energy fall as before.
 ///
 /// Keyhole loops ([`keyhole`]) are the other thing the model can object to: the machine no
 /// longer stops at the tip of a wedge, but it swings round a loop of a tenth of a millimetre
@@ -316,7 +297,7 @@ fn with_simulated_deviation(
     input: &[u8],
     first: VtgReport,
     options: &VtgOptions,
-    again: &mut dyn FnMut(rewrite::Variant, Report, f64) -> Result<VtgReport, Error>,
+    again: &mut dyn FnMut(search::Variant, Report, f64) -> Result<VtgReport, Error>,
 ) -> Result<VtgReport, Error> {
     let vibration = crate::dynamics::VibrationOptions {
         analyze: options.analyze.clone(),
@@ -344,7 +325,7 @@ fn with_simulated_deviation(
         return Ok(best);
     }
     let mut best_mean = a.mean;
-    for (k, variant) in quieter_variants().enumerate() {
+    for (k, variant) in search::quieter_variants().enumerate() {
         if best_mean < b.mean {
             break;
         }

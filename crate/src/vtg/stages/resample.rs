@@ -11,7 +11,7 @@
 //! the paper scales the Newton step. Points are taken on the curve (`P_{i+1} = C(u_{i+1})`),
 //! which line 11 also gives once Newton has converged.
 
-use super::bspline::{dot, norm, sub, Curve, Eval};
+use crate::vtg::bspline::{dot, norm, sub, Curve, Eval};
 
 /// Settings of the walk.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -33,8 +33,8 @@
 //! is then the whole story only for the inside line ([`Line::Inside`]), which the pipeline
 //! still uses where the wider circle cannot be walked.
 
-use super::bspline::{dot, norm, sub};
-use super::tuning::TUNING;
+use crate::vtg::bspline::{dot, norm, sub};
+use crate::vtg::tuning::TUNING;
 
 /// Samples per blend given to the fit (its ends included).
 pub(crate) const SAMPLES: usize = 9;
@@ -138,7 +138,7 @@ pub(crate) fn plan(
     // Then, corner by corner, the racing line where the path has room for it: up to the
     // nearest vertex either way that is not straight (less what its own blend takes), or the
     // path's end.
-    let along = super::bspline::arc_lengths(pts);
+    let along = crate::vtg::bspline::arc_lengths(pts);
     for i in 1..n - 1 {
         if out[i].extent_mm <= 0.0 || out[i].max_curvature <= enough_curvature {
             continue;
@@ -320,7 +320,7 @@ pub(crate) fn samples(
     // stretch, possibly past straight vertices (no turn, so no blend), so each leg looks for
     // the nearest blend either way through those.
     let racers = Racer::all(pts, blends);
-    let along = super::bspline::arc_lengths(pts);
+    let along = crate::vtg::bspline::arc_lengths(pts);
     let (prev_blend, next_blend) = nearest_blends(blends);
     let mut ts = Vec::new();
     for i in 0..n - 1 {
@@ -501,7 +501,7 @@ struct Outward {
 impl Outward {
     /// At vertex `i` of `pts` (neither end), if it turns.
     fn at(pts: &[[f64; 3]], i: usize) -> Option<Outward> {
-        let unit = super::hairpin::unit;
+        let unit = crate::vtg::hairpin::unit;
         let a = unit(sub(pts.get(i)?, pts.get(i.checked_sub(1)?)?))?;
         let b = unit(sub(pts.get(i + 1)?, pts.get(i)?))?;
         let w = unit(sub(&a, &b))?;
@@ -594,7 +594,7 @@ mod tests {
         let (data, par) = samples(&wide, &b, 2.0);
         assert!(par.windows(2).all(|w| w[1] > w[0]));
         for p in &data {
-            let d = super::super::deviation::point_polyline(p, &wide);
+            let d = crate::vtg::deviation::point_polyline(p, &wide);
             assert!(d <= 0.05 + 1e-12, "{d}");
         }
         assert_eq!(data.first(), wide.first());
@@ -629,7 +629,7 @@ mod tests {
         let blends = [Blend::NONE, racing, Blend::NONE];
         let (data, par) = samples(&pts, &blends, 2.0);
         assert!(par.windows(2).all(|w| w[1] > w[0]));
-        let d = super::super::deviation::both_ways(&data, &pts, 1e-3, 0.0);
+        let d = crate::vtg::deviation::both_ways(&data, &pts, 1e-3, 0.0);
         assert!((d - eps).abs() <= 0.5e-3 + 1e-9, "{d}");
         let near = |x: f64| {
             data.iter()
@@ -675,7 +675,7 @@ mod tests {
         assert!(blends[..10].iter().all(|b| b.extent_mm == 0.0));
         let (data, par) = samples(&cut, &blends, 2.0);
         assert!(par.windows(2).all(|w| w[1] > w[0]));
-        let d = super::super::deviation::both_ways(&data, &cut, 1e-3, 0.0);
+        let d = crate::vtg::deviation::both_ways(&data, &cut, 1e-3, 0.0);
         assert!((d - eps).abs() <= 0.5e-3 + 1e-9, "{d}");
         // Ramp samples were placed on the legs it crosses.
         let on_ramp = data

@@ -1,22 +1,21 @@
 //! The file-level choice of which rewrites to write when some of them cost time or energy.
 //!
-//! Each path is rewritten on its own and planned on the firmware's own model before and after
-//! (see [`super::rewrite`]). Most rewrites cost nothing; on a firmware that takes sharp corners
-//! faster than a fillet within the tolerance allows (Klipper with a high square-corner
-//! velocity, a junction-deviation planner with a large deviation), rounding a corner costs a
-//! little time and energy. Those rewrites are bought out of a budget: `Tuning::spend_share` of what
-//! the free rewrites saved, plus whatever time the user allows
-//! ([`super::VtgOptions::allow_slower_pct`]), the rewrites that remove the most sharp corners
-//! for their cost first: a multiple-choice knapsack, solved greedily on each path's convex
-//! hull of cost against corners removed (a path may offer a free rewrite that keeps its dear
-//! corners sharp and dearer ones that round some or all of them too,
-//! `Tuning::dearer_speed_shares`, each written the way that costs least energy and
-//! the way that costs least time; buying a dearer one is then an increment over the free
-//! one).
+//! Each path is rewritten on its own and planned on the firmware's own model before and after (see
+//! [`crate::vtg::rewrite`]). Most rewrites cost nothing; on a firmware that takes sharp corners
+//! faster than a fillet within the tolerance allows (Klipper with a high square-corner velocity, a
+//! junction-deviation planner with a large deviation), rounding a corner costs a little time and
+//! energy. Those rewrites are bought out of a budget: `Tuning::spend_share` of what the free
+//! rewrites saved, plus whatever time the user allows
+//! ([`crate::vtg::VtgOptions::allow_slower_pct`]), the rewrites that remove the most sharp corners
+//! for their cost first: a multiple-choice knapsack, solved greedily on each path's convex hull of
+//! cost against corners removed (a path may offer a free rewrite that keeps its dear corners sharp
+//! and dearer ones that round some or all of them too, `Tuning::dearer_speed_shares`, each written
+//! the way that costs least energy and the way that costs least time; buying a dearer one is then
+//! an increment over the free one).
 
-use super::rewrite::Rewritten;
-use super::tuning::TUNING;
 use crate::gcode::Edit;
+use crate::vtg::rewrite::Rewritten;
+use crate::vtg::tuning::TUNING;
 
 /// One way of writing a path.
 #[derive(Debug)]
@@ -68,14 +67,13 @@ pub(crate) struct Budget {
 }
 
 impl Budget {
-    /// `Tuning::spend_share` of `saved` (time s, energy J, by the free rewrites), plus `allowed_s` of
-    /// time. With time allowed, energy is not limited: the user has chosen to spend time on
-    /// quiet, and energy follows time (the electronics, fans and motors run as long as the
-    /// print does). It still counts in the order of the purchases, at `Tuning::energy_weight` of the
-    /// print's mean power `mean_power_w`: of two ways to remove corners for about the same
-    /// time, the one that costs less energy comes first, so the allowance does not raise the
-    /// energy where it need not. Without time allowed, both must have been saved for anything
-    /// to be spent.
+    /// `Tuning::spend_share` of `saved` (time s, energy J, by the free rewrites), plus `allowed_s`
+    /// of time. With time allowed, energy is not limited: the user has chosen to spend time on
+    /// quiet, and energy follows time (the electronics, fans and motors run as long as the print
+    /// does). It still counts in the order of the purchases, at `Tuning::energy_weight` of the
+    /// print's mean power `mean_power_w`: of two ways to remove corners for about the same time,
+    /// the one that costs less energy comes first, so the allowance does not raise the energy where
+    /// it need not. Without time allowed, both must have been saved for anything to be spent.
     pub(crate) fn new(saved: [f64; 2], allowed_s: f64, mean_power_w: f64) -> Self {
         let share = saved.map(|x| TUNING.spend_share * x.max(0.0));
         let seconds_per_joule = if mean_power_w.is_finite() && mean_power_w > 0.0 {

@@ -12,12 +12,12 @@
 //!
 //! Arcs are off by default: not every firmware has them (Marlin's `ARC_SUPPORT`, Klipper's
 //! `[gcode_arcs]` section). The rewriter measures the path with its arcs against the original
-//! before it keeps them ([`super::deviation::both_ways`]), so the tolerance holds as before.
+//! before it keeps them ([`crate::vtg::deviation::both_ways`]), so the tolerance holds as before.
 
-use super::bspline::{norm, sub};
-use super::tuning::TUNING;
 use crate::gcode::number::rounded;
 use crate::machine::{Arc, Plane};
+use crate::vtg::bspline::{norm, sub};
+use crate::vtg::tuning::TUNING;
 
 /// Fewest steps an arc replaces: below that the file gains little.
 pub(crate) const MIN_SEGMENTS: usize = 3;
@@ -73,7 +73,7 @@ pub(crate) struct Piece {
 }
 
 /// The circle through three points in the XY plane: centre and radius.
-pub(super) fn circle_through(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Option<([f64; 2], f64)> {
+pub(crate) fn circle_through(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Option<([f64; 2], f64)> {
     let (bx, by) = (b[0] - a[0], b[1] - a[1]);
     let (cx, cy) = (c[0] - a[0], c[1] - a[1]);
     let d = 2.0 * (bx * cy - by * cx);

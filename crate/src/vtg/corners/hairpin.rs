@@ -16,9 +16,9 @@
 //! a fine polygon of the arc, which the rest of the pipeline blends, fits and walks like any
 //! other path.
 
-use super::bspline::{arc_lengths, cross, dot, norm, segment_at, sub};
-use super::deviation::{both_ways, point_polyline};
-use super::tuning::TUNING;
+use crate::vtg::bspline::{arc_lengths, cross, dot, norm, segment_at, sub};
+use crate::vtg::deviation::{both_ways, point_polyline};
+use crate::vtg::tuning::TUNING;
 
 /// Smallest combined turn of a hairpin, rad (90°: below it the corners are separate turns).
 const MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_2;
@@ -33,7 +33,7 @@ pub(crate) struct Hairpin {
     /// Index of the first of the corners it replaces.
     pub(crate) at: usize,
     /// How many corners it replaces: 2 for a hairpin (the second is the next point), 1 for a
-    /// [`super::keyhole`].
+    /// [`crate::vtg::keyhole`].
     pub(crate) corners: usize,
     /// Radius, mm.
     pub(crate) radius_mm: f64,
@@ -64,7 +64,7 @@ impl Hairpin {
 
 /// `v / |v|`, or `None` for a tiny vector. (Divides: `orient::vec3::normalize` multiplies by
 /// the reciprocal, which rounds differently and would move the arcs in the last bit.)
-pub(super) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
+pub(crate) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
     let l = norm(&v);
     (l > 1e-12).then(|| [v[0] / l, v[1] / l, v[2] / l])
 }
@@ -72,7 +72,7 @@ pub(super) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
 /// The `segments + 1` points of a circular arc in the plane of constant Z through `centre`,
 /// from `start` on, sweeping `sweep` rad (positive: anticlockwise seen from above): the radius
 /// vector turned step by step.
-pub(super) fn arc_polygon(
+pub(crate) fn arc_polygon(
     centre: &[f64; 3],
     start: &[f64; 3],
     sweep: f64,
@@ -91,15 +91,15 @@ pub(super) fn arc_polygon(
 }
 
 /// The Z component of `a × b` (the turn's sense, seen from above).
-pub(super) fn cross_z(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+pub(crate) fn cross_z(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     cross(a, b)[2]
 }
 
-/// The hairpin at corners `i` and `i + 1` of `pts`, if the two corners turn the same way by 90°
-/// to 200° together across a connector of at most `Tuning::hairpin_max_connector_mm`, lie in one plane of
-/// constant Z, and an arc of radius at least `min_radius_mm` rounds them within `tolerance_mm`
-/// starting no more than `room_mm[0]` before corner `i` and ending no more than `room_mm[1]`
-/// after corner `i + 1`.
+/// The hairpin at corners `i` and `i + 1` of `pts`, if the two corners turn the same way by 90° to
+/// 200° together across a connector of at most `Tuning::hairpin_max_connector_mm`, lie in one plane
+/// of constant Z, and an arc of radius at least `min_radius_mm` rounds them within `tolerance_mm`
+/// starting no more than `room_mm[0]` before corner `i` and ending no more than `room_mm[1]` after
+/// corner `i + 1`.
 pub(crate) fn find(
     pts: &[[f64; 3]],
     i: usize,

@@ -1,14 +1,14 @@
 //! Least-squares cubic B-spline fit of a polyline within a tolerance (Piegl & Tiller A9.7 with
 //! data-placed knots, banded normal equations, knot insertion where the error is too large).
 //!
-//! The data are the path with its corners blended ([`super::blend::samples`]): densely sampled
+//! The data are the path with its corners blended ([`crate::vtg::blend::samples`]): densely sampled
 //! over each corner transition, sparsely along straight runs. Because A9.7 puts the same number
 //! of data points in every knot span, the knots crowd at corners and thin out on straights, so
 //! a long straight stays straight while a corner follows its transition. The first and last
 //! points are interpolated (the path keeps its end points).
 
-use super::bspline::{basis_by_degree, find_span, norm, sub, Curve, DEGREE};
-use super::tuning::TUNING;
+use crate::vtg::bspline::{basis_by_degree, find_span, norm, sub, Curve, DEGREE};
+use crate::vtg::tuning::TUNING;
 
 /// A fitted curve with the data it was fitted to.
 #[derive(Debug, Clone)]

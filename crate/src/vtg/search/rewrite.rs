@@ -11,24 +11,25 @@
 //! last `E` word exactly, so every later line stays valid; in relative mode the written amounts
 //! are differences of rounded running totals and add up to the original total.
 
-use super::arcs::{self, Piece};
-use super::block::{self, Frame};
-use super::bspline::{dot, norm, sub};
-use super::budget::{self, Budget, Offer, Outcome};
-use super::deviation::both_ways;
-use super::feed::Written;
-use super::kinematics::KinematicLimits;
-use super::resample::WalkStats;
-use super::smooth::{smooth_path, Path, Settings, Smoothed};
-use super::source::{MoveSource, Sources};
-use super::tuning::TUNING;
-use super::VtgOptions;
+use super::Variant;
 use crate::energy::Accumulator;
 use crate::error::{Error, ErrorKind};
 use crate::gcode::{apply_edits, Edit};
 use crate::machine::{ExtrusionMode, MoveKind};
 use crate::path::{PathMove, PrintPath};
 use crate::plan::{JunctionModel, Limits, Motion, Planner, Profile};
+use crate::vtg::arcs::{self, Piece};
+use crate::vtg::block::{self, Frame};
+use crate::vtg::bspline::{dot, norm, sub};
+use crate::vtg::budget::{self, Budget, Offer, Outcome};
+use crate::vtg::deviation::both_ways;
+use crate::vtg::feed::Written;
+use crate::vtg::kinematics::KinematicLimits;
+use crate::vtg::resample::WalkStats;
+use crate::vtg::smooth::{smooth_path, Path, Settings, Smoothed};
+use crate::vtg::source::{MoveSource, Sources};
+use crate::vtg::tuning::TUNING;
+use crate::vtg::VtgOptions;
 
 /// What the rewrite did.
 #[derive(Debug, Clone, Default)]
@@ -56,7 +57,7 @@ pub(crate) struct Rewritten {
     pub(crate) uncapped_paths: u64,
     /// Rewritten paths that plan slower or cost more motor energy than the original, paid for
     /// out of what the other rewrites saved or with the time the options allow (see
-    /// [`super::budget`]).
+    /// [`crate::vtg::budget`]).
     pub(crate) paid_paths: u64,
     /// Paths kept as they were because even rounded without caps they plan slower or cost more
     /// motor energy, and the savings elsewhere could not pay for them.
@@ -129,25 +130,6 @@ pub(crate) struct Offers {
     saved: [f64; 2],
     candidate_paths: u64,
     variant: Variant,
-}
-
-/// What a whole-file rewrite is tried with; [`super::vtg`] tries others where the dynamics
-/// model finds the first one ringing more than the original.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Variant {
-    /// The first scale of the eq. 29 speeds ([`Settings::feed_cap_scale`]).
-    pub(crate) feed_cap_scale: f64,
-    /// Turn corners too tight to fillet round keyhole loops ([`Settings::keyholes`]).
-    pub(crate) keyholes: bool,
-}
-
-impl Default for Variant {
-    fn default() -> Self {
-        Variant {
-            feed_cap_scale: 1.0,
-            keyholes: true,
-        }
-    }
 }
 
 /// Rewrites every eligible path of `input` in every way worth offering: the free rewrite, and
@@ -255,9 +237,9 @@ fn file_settings(
             .then(|| square_corner_velocity(&path.print_limits))
             .flatten(),
         line: if options.inside_corners {
-            super::blend::Line::Inside
+            crate::vtg::blend::Line::Inside
         } else {
-            super::blend::Line::Racing
+            crate::vtg::blend::Line::Racing
         },
     }
 }
@@ -444,7 +426,7 @@ fn has_sharp_corner(run: &[PathMove], cos_critical: f64) -> bool {
 
 /// Whether the turn from direction `a` to direction `b` (neither normalised) is above the
 /// critical angle (cosine `cos_critical`); a zero-length side turns nothing.
-pub(super) fn is_sharp(a: &[f64; 3], b: &[f64; 3], cos_critical: f64) -> bool {
+pub(crate) fn is_sharp(a: &[f64; 3], b: &[f64; 3], cos_critical: f64) -> bool {
     let (la, lb) = (norm(a), norm(b));
     la > 0.0 && lb > 0.0 && dot(a, b) / (la * lb) < cos_critical
 }
@@ -704,16 +686,9 @@ fn cheapest_and_fastest(
     costs: Costs,
 ) -> (Option<Writing<Written>>, Option<Writing<bool>>) {
     let cost = |w: &Written| machine.cost(start, &w.points, &w.e, &w.feed_mm_s);
-    let base = settings.feed_cap_scale;
-    let capped = TUNING.cap_scales.map(|k| k.map(|k| k * base));
-    let scales: &[Option<f64>] = if settings.limit_feed {
-        &capped
-    } else {
-        &[None]
-    };
     let mut cheapest: Option<Writing<Written>> = None;
     let mut fastest: Option<Writing<bool>> = None;
-    for (k, ceiling) in scales.iter().flat_map(|&k| [(k, false), (k, true)]) {
+    for (k, ceiling) in super::writings(settings) {
         let w = smoothed.written(k, ceiling, start, settings);
         let total = cost(&w);
         let a = costs.added_by(total);
@@ -920,7 +895,7 @@ fn with_arcs(
 }
 
 /// Turns above the critical angle (cosine `cos_critical`) along the polyline through `pts`.
-pub(super) fn sharp_turns<'a>(
+pub(crate) fn sharp_turns<'a>(
     pts: impl IntoIterator<Item = &'a [f64; 3]>,
     cos_critical: f64,
 ) -> usize {

@@ -1,7 +1,7 @@
 //! Cubic NURBS curves in 3-D (the VTG paper's eq. 21–22).
 //!
 //! Most fits keep every weight 1, and eq. 21 reduces to a B-spline; [`Curve::rational`] takes
-//! weights where the fit finds they help ([`super::fit`]). Basis functions follow Piegl &
+//! weights where the fit finds they help ([`crate::vtg::fit`]). Basis functions follow Piegl &
 //! Tiller's A2.2 (the Cox–de Boor recursion of eq. 22), derivatives the derivative curves'
 //! control points (P&T eq. 3.8); a rational curve is evaluated in homogeneous coordinates and
 //! projected with the quotient rule (P&T eq. 4.8). The tests check both against A2.3.

@@ -2,9 +2,9 @@
 //! lower than the original ran there and, if asked, no higher), and on a classic-jerk firmware
 //! the ramps that let the feed rise again without a stall at the junction.
 
-use super::bspline::{lerp, norm, sub};
-use super::smooth::{Settings, Smoothed};
-use super::tuning::TUNING;
+use crate::vtg::bspline::{lerp, norm, sub};
+use crate::vtg::smooth::{Settings, Smoothed};
+use crate::vtg::tuning::TUNING;
 
 /// The speed terms of one new segment.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -83,17 +83,16 @@ impl Smoothed {
 /// Splits segments where the written feed rises by more than a classic-jerk planner takes
 /// without slowing down.
 ///
-/// Such a planner (Marlin's and Prusa firmware's classic jerk, and the slicers' estimators
-/// that copy it) compares the *nominal* speeds of the two blocks at a junction: where the
-/// feed falls, the previous block's speed is scaled down to the junction speed first, but
-/// where it rises, the new block's full feed counts against the old one's, and a rise from
-/// 30 to 80 mm/s against a 7 mm/s jerk limit brings the junction down to 4 mm/s. Lowering the
-/// feed on a curve (eq. 29) would cost a near-stop wherever the feed rises again. So a segment
-/// whose feed rises by more than the limit is cut into collinear pieces whose feeds rise by
-/// `Tuning::ramp_jerk_share` of it at a time, each as long as the machine needs to accelerate through
-/// it at `accel[i]` (segment `i`'s acceleration): the speed profile is the one it would have
-/// had anyway, and no junction is penalised. The pieces lie on the segment and share its
-/// filament by length.
+/// Such a planner (Marlin's and Prusa firmware's classic jerk, and the slicers' estimators that
+/// copy it) compares the *nominal* speeds of the two blocks at a junction: where the feed falls,
+/// the previous block's speed is scaled down to the junction speed first, but where it rises, the
+/// new block's full feed counts against the old one's, and a rise from 30 to 80 mm/s against a 7
+/// mm/s jerk limit brings the junction down to 4 mm/s. Lowering the feed on a curve (eq. 29) would
+/// cost a near-stop wherever the feed rises again. So a segment whose feed rises by more than the
+/// limit is cut into collinear pieces whose feeds rise by `Tuning::ramp_jerk_share` of it at a
+/// time, each as long as the machine needs to accelerate through it at `accel[i]` (segment `i`'s
+/// acceleration): the speed profile is the one it would have had anyway, and no junction is
+/// penalised. The pieces lie on the segment and share its filament by length.
 fn ramp_up(out: &mut Written, start: [f64; 3], start_feed: f64, jerk: f64, accel: &[f64]) {
     let rise = TUNING.ramp_jerk_share * jerk;
     if rise <= 0.0

@@ -24,10 +24,10 @@
 //! largest the tolerance allows. Of the family's members that fit the legs, the one the
 //! look-ahead (as Klipper plans it: `stretch_time`) runs through fastest is kept.
 
-use super::bspline::{dot, norm, sub};
-use super::deviation::both_ways;
-use super::hairpin::{cross_z, unit, Hairpin};
-use super::tuning::TUNING;
+use crate::vtg::bspline::{dot, norm, sub};
+use crate::vtg::deviation::both_ways;
+use crate::vtg::hairpin::{cross_z, unit, Hairpin};
+use crate::vtg::tuning::TUNING;
 
 /// What the firmware does at a corner: its limits there and the speeds either side.
 #[derive(Debug, Clone, Copy)]
@@ -59,7 +59,7 @@ pub(crate) struct Bounds {
 /// A corner's polygon, and how the firmware runs it.
 #[derive(Debug, Clone)]
 pub(crate) struct Corner {
-    /// The polygon as a one-corner [`Hairpin`] (for [`super::hairpin::substitute`]).
+    /// The polygon as a one-corner [`Hairpin`] (for [`crate::vtg::hairpin::substitute`]).
     pub(crate) pin: Hairpin,
     /// Measured largest distance from the original, both ways, mm.
     pub(crate) deviation_mm: f64,

@@ -15,14 +15,14 @@
 //! ways (ranked by the distances of the two polylines' points, then measured in full), is
 //! taken; the departure points are the nearest to the tip whose counter-turn stays
 //! within its limit. The loop is longer than the stretch it replaces; the stretch's filament is
-//! spread over it by length (see [`super::hairpin::substitute`]), so the tip gets the material
+//! spread over it by length (see [`crate::vtg::hairpin::substitute`]), so the tip gets the material
 //! it had, in the same place.
 
-use super::bspline::{dot, lerp, norm, segment_at, sub};
-use super::deviation::{both_ways, point_polyline};
-use super::hairpin::{arc_polygon, cross_z, unit, Hairpin};
-use super::tuning::TUNING;
 use crate::orient::vec3::angle;
+use crate::vtg::bspline::{dot, lerp, norm, segment_at, sub};
+use crate::vtg::deviation::{both_ways, point_polyline};
+use crate::vtg::hairpin::{arc_polygon, cross_z, unit, Hairpin};
+use crate::vtg::tuning::TUNING;
 
 /// Smallest turn a keyhole is tried at, rad (60°: below it a corner fillets within the
 /// tolerance, or the legs are too short for anything).

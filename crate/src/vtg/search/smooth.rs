@@ -1,26 +1,26 @@
 //! One extrusion path through the VTG pipeline: blend its corners, fit (within tolerance), walk
 //! the curve with Algorithm 1, spread the path's filament over the new points, cap the feed
 //! where the curvature is above `K_cr`, and check the result against the original polyline.
-//! The feed each new segment is then written with is [`super::feed`]'s business.
+//! The feed each new segment is then written with is [`crate::vtg::feed`]'s business.
 //!
-//! The tolerance is shared: the corner blends ([`super::blend`]) may use `Tuning::blend_share` of it,
-//! the fit's residuals `Tuning::fit_share` and the chords of the walk `Tuning::chord_share` (together a little
-//! more than all of it: they seldom peak at the same point). If the measured deviation still
-//! exceeds the tolerance, the blends are made smaller and the path tried again; a path that
-//! cannot be rounded within the tolerance is kept as it was.
+//! The tolerance is shared: the corner blends ([`crate::vtg::blend`]) may use `Tuning::blend_share`
+//! of it, the fit's residuals `Tuning::fit_share` and the chords of the walk `Tuning::chord_share`
+//! (together a little more than all of it: they seldom peak at the same point). If the measured
+//! deviation still exceeds the tolerance, the blends are made smaller and the path tried again; a
+//! path that cannot be rounded within the tolerance is kept as it was.
 
-use super::blend;
-use super::bspline::{arc_lengths, dot, norm, segment_at, sub};
-use super::corner;
-use super::deviation::both_ways;
-use super::feed::StepSpeed;
-use super::fit::fit;
-use super::hairpin;
-use super::keyhole;
-use super::kinematics::KinematicLimits;
-use super::resample::{walk, Sample, Walk, WalkStats};
-use super::tuning::TUNING;
 use crate::plan::Profile;
+use crate::vtg::blend;
+use crate::vtg::bspline::{arc_lengths, dot, norm, segment_at, sub};
+use crate::vtg::deviation::both_ways;
+use crate::vtg::feed::StepSpeed;
+use crate::vtg::fit::fit;
+use crate::vtg::hairpin;
+use crate::vtg::keyhole;
+use crate::vtg::kinematics::KinematicLimits;
+use crate::vtg::klipper;
+use crate::vtg::resample::{walk, Sample, Walk, WalkStats};
+use crate::vtg::tuning::TUNING;
 
 /// Settings for [`smooth_path`].
 #[derive(Debug, Clone, Copy)]
@@ -40,7 +40,8 @@ pub(crate) struct Settings {
     /// `f₁` when `J_n` follows `A_n` (`J_n = A_n f₁`, the default), Hz; `None` keeps
     /// `limits.normal_jerk_mm_s3` everywhere.
     pub(crate) jerk_per_accel_hz: Option<f64>,
-    /// Shortest interpolation step, mm (`Tuning::klipper_min_step_mm` or `Tuning::marlin_min_step_mm`).
+    /// Shortest interpolation step, mm (`Tuning::klipper_min_step_mm` or
+    /// `Tuning::marlin_min_step_mm`).
     pub(crate) min_step_mm: f64,
     /// The per-axis jerk of a classic-jerk firmware, mm/s (`None` on junction-deviation and
     /// Klipper planners): rising feeds are then ramped, since such a planner counts a rise of
@@ -50,19 +51,19 @@ pub(crate) struct Settings {
     /// are); [`crate::vtg::vtg`] raises it where the dynamics model finds the rewrite at 1
     /// rings more than the original.
     pub(crate) feed_cap_scale: f64,
-    /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`super::arcs`]).
+    /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`crate::vtg::arcs`]).
     pub(crate) arcs: bool,
     /// The slowest a rounded corner may be run, as a share of the firmware's speed through the
     /// sharp one: 1 rounds only the corners the machine runs round at least as fast (the free
     /// rewrite); below 1, the dearer variants of a path that
-    /// [`super::VtgOptions::allow_slower_pct`] may buy (0 rounds every corner it can).
+    /// [`crate::vtg::VtgOptions::allow_slower_pct`] may buy (0 rounds every corner it can).
     pub(crate) min_speed_share: f64,
     /// Turn single corners too tight to fillet round a [`keyhole`] loop where one fits.
     pub(crate) keyholes: bool,
     /// Which side of its corners a path may be rounded on ([`blend::Line`]).
     pub(crate) line: blend::Line,
     /// Klipper's square-corner velocity, mm/s, on a Klipper machine (`None` elsewhere): its
-    /// sharp corners are then turned as polygons placed for its look-ahead ([`corner`]).
+    /// sharp corners are then turned as polygons placed for its look-ahead ([`klipper`]).
     pub(crate) klipper_scv_mm_s: Option<f64>,
 }
 
@@ -188,7 +189,7 @@ fn smooth_cut(path: &Path<'_>, s: &Settings, forced: &[usize]) -> Option<Smoothe
     let cos_critical = crate::math::cos(s.critical_rad);
     let left = |r: &Option<Smoothed>| {
         r.as_ref().map_or(usize::MAX, |r| {
-            super::rewrite::sharp_turns(path.pts.iter().take(1).chain(&r.points), cos_critical)
+            crate::vtg::rewrite::sharp_turns(path.pts.iter().take(1).chain(&r.points), cos_critical)
         })
     };
     let left_wide = left(&result);
@@ -437,11 +438,11 @@ impl Smoothed {
 }
 
 /// The sharp corners of `path` to turn as polygons placed for Klipper's look-ahead
-/// ([`corner`]): on a Klipper machine, where the original's planned speeds are known, a polygon
+/// ([`klipper`]): on a Klipper machine, where the original's planned speeds are known, a polygon
 /// fits within the tolerance and the legs' room (all of the leg where it ends the path, half
 /// where it is shared, less a shortest step), and the firmware runs it no slower than
 /// [`Settings::min_speed_share`] of its speed through the sharp corner.
-fn polygon_corners(path: &Path<'_>, s: &Settings) -> Vec<corner::Corner> {
+fn polygon_corners(path: &Path<'_>, s: &Settings) -> Vec<klipper::Corner> {
     let mut out = Vec::new();
     let Some(scv) = s.klipper_scv_mm_s else {
         return out;
@@ -470,7 +471,7 @@ fn polygon_corners(path: &Path<'_>, s: &Settings) -> Vec<corner::Corner> {
     };
     for i in 1..n - 1 {
         let (u, w) = (sub(&pts[i], &pts[i - 1]), sub(&pts[i + 1], &pts[i]));
-        if !super::rewrite::is_sharp(&u, &w, cos_critical) {
+        if !crate::vtg::rewrite::is_sharp(&u, &w, cos_critical) {
             continue;
         }
         let (before, after) = (&path.planned[i - 1], &path.planned[i]);
@@ -481,19 +482,19 @@ fn polygon_corners(path: &Path<'_>, s: &Settings) -> Vec<corner::Corner> {
         if accel.is_nan() || accel <= 0.0 {
             continue;
         }
-        let bounds = corner::Bounds {
+        let bounds = klipper::Bounds {
             tolerance_mm: s.tolerance_mm - 0.001,
             max_turn_rad: TUNING.step_turn_share * s.critical_rad,
             min_step_mm: s.min_step_mm,
             room_mm: [room(i - 1, i, i == 1), room(i, i + 1, i + 2 == n)],
         };
-        let fw = corner::Firmware {
+        let fw = klipper::Firmware {
             accel_mm_s2: accel,
             junction_deviation_mm: crate::plan::junction::klipper_junction_deviation(scv, accel),
             feed_mm_s: [path.feed[i - 1], path.feed[i]],
             ends_mm_s: [before.entry, after.exit],
         };
-        if let Some(c) = corner::find(pts, i, &bounds, &fw)
+        if let Some(c) = klipper::find(pts, i, &bounds, &fw)
             .filter(|c| c.slowest_mm_s >= s.min_speed_share * c.sharp_mm_s)
         {
             out.push(c);
@@ -552,8 +553,7 @@ fn smooth_piece(
     let e0 = *path.e.first()?;
     let e: Vec<f64> = path.e.iter().map(|x| x - e0).collect();
     let from_zero = Path { e: &e, ..*path };
-    let mut share = TUNING.blend_share;
-    for _ in 0..TUNING.attempts {
+    for share in super::blend_shares() {
         let tol = share * s.tolerance_mm;
         let done = if pins.is_empty() {
             attempt(&from_zero, path.pts, s, tol)
@@ -566,7 +566,6 @@ fn smooth_piece(
             }
             return Some(r);
         }
-        share *= TUNING.retry_scale;
     }
     None
 }
@@ -938,7 +937,7 @@ mod tests {
             assert_eq!(sharp_turns_from(pts[0], &r.points), 0);
             let tightest = all
                 .windows(3)
-                .filter_map(|w| super::super::arcs::circle_through(&w[0], &w[1], &w[2]))
+                .filter_map(|w| crate::vtg::arcs::circle_through(&w[0], &w[1], &w[2]))
                 .map(|(_, r)| r)
                 .fold(f64::INFINITY, f64::min);
             let outside = all.iter().map(|p| -p[1]).fold(0.0, f64::max);
@@ -963,7 +962,7 @@ mod tests {
         ];
         let mut e = vec![0.0];
         for w in pts.windows(2) {
-            let l = super::super::bspline::norm(&super::super::bspline::sub(&w[1], &w[0]));
+            let l = crate::vtg::bspline::norm(&crate::vtg::bspline::sub(&w[1], &w[0]));
             e.push(e.last().unwrap() + 0.03 * l);
         }
         let feed = vec![20.0; pts.len() - 1];
