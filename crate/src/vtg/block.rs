@@ -11,31 +11,31 @@ use crate::machine::ExtrusionMode;
 
 /// What the block must agree with in the file around it.
 #[derive(Debug, Clone)]
-pub struct Frame<'a> {
+pub(crate) struct Frame<'a> {
     /// Where the path starts (the position before its first move).
-    pub start: [f64; 3],
+    pub(crate) start: [f64; 3],
     /// The path climbs along its length (spiral vase): every point keeps a fine Z.
-    pub climbs: bool,
+    pub(crate) climbs: bool,
     /// The original's extrusion mode.
-    pub mode: ExtrusionMode,
+    pub(crate) mode: ExtrusionMode,
     /// Logical E before the path (absolute mode).
-    pub e_before: f64,
+    pub(crate) e_before: f64,
     /// The original's last `E` word (absolute mode: the block ends on it exactly).
-    pub last_e_word: f64,
+    pub(crate) last_e_word: f64,
     /// Filament of the whole path (relative mode: the rounded words add up to it).
-    pub total_e: f64,
+    pub(crate) total_e: f64,
     /// The modal feed before the path, mm/min (`None`: no `F` so far, none is written).
-    pub f_before: Option<f64>,
+    pub(crate) f_before: Option<f64>,
     /// The modal feed the original leaves behind, mm/min.
-    pub f_after: Option<f64>,
+    pub(crate) f_after: Option<f64>,
     /// Annotation lines with the filament pushed where each stood; each is written before the
     /// first new point past it.
-    pub notes: Vec<(f64, &'a str)>,
+    pub(crate) notes: Vec<(f64, &'a str)>,
 }
 
 /// The block for new `points` after the start (filament `e` from the path start to each), as
 /// `pieces` (each ending at point `end`, counted with the start point as 0).
-pub fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &[Piece]) -> String {
+pub(crate) fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &[Piece]) -> String {
     let mut text = String::with_capacity(pieces.len() * 40);
     let mut z_now = frame.start[2];
     // A path whose Z changes along it (spiral vase, FullControl designs) keeps a Z on every
@@ -82,19 +82,7 @@ pub fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &[Piece]
         }
         from_xy = [rounded(p[0], 3), rounded(p[1], 3)];
         let last = k + 1 == pieces.len();
-        text.push_str(" E");
-        match frame.mode {
-            ExtrusionMode::Absolute if last => {
-                let _ = write!(text, "{}", frame.last_e_word);
-            }
-            ExtrusionMode::Absolute => push_trimmed(&mut text, frame.e_before + ek, 5),
-            ExtrusionMode::Relative => {
-                let target = if last { frame.total_e } else { ek };
-                let written = rounded(target, 5);
-                push_trimmed(&mut text, written - e_written, 5);
-                e_written = written;
-            }
-        }
+        push_e(&mut text, frame, ek, last, &mut e_written);
         // No F is written into a file that has none yet.
         if let Some(now) = f_now {
             let f = rounded(piece.feed * 60.0, 1);
@@ -117,4 +105,24 @@ pub fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &[Piece]
         }
     }
     text
+}
+
+/// The ` E` word of the point with filament `ek` from the path start (`last`: the block's last
+/// point), as the frame's extrusion mode writes it: absolute mode ends on the original's last
+/// word exactly, relative mode writes differences of rounded running totals (`e_written`) so
+/// the words add up to the path's filament.
+fn push_e(text: &mut String, frame: &Frame<'_>, ek: f64, last: bool, e_written: &mut f64) {
+    text.push_str(" E");
+    match frame.mode {
+        ExtrusionMode::Absolute if last => {
+            let _ = write!(text, "{}", frame.last_e_word);
+        }
+        ExtrusionMode::Absolute => push_trimmed(text, frame.e_before + ek, 5),
+        ExtrusionMode::Relative => {
+            let target = if last { frame.total_e } else { ek };
+            let written = rounded(target, 5);
+            push_trimmed(text, written - *e_written, 5);
+            *e_written = written;
+        }
+    }
 }

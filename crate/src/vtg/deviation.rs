@@ -11,7 +11,7 @@ use crate::path::{PathMove, PrintPath};
 use crate::vec3::{dot, lerp, norm, sub};
 
 /// Distance from `p` to segment `a`–`b`.
-pub fn point_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
+pub(crate) fn point_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
     let ab = sub(b, a);
     let ap = sub(p, a);
     let l2 = dot(&ab, &ab);
@@ -24,7 +24,7 @@ pub fn point_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
 }
 
 /// Distance from `p` to the polyline `poly`.
-pub fn point_polyline(p: &[f64; 3], poly: &[[f64; 3]]) -> f64 {
+pub(crate) fn point_polyline(p: &[f64; 3], poly: &[[f64; 3]]) -> f64 {
     match poly {
         [] => f64::INFINITY,
         [a] => norm(&sub(p, a)),
@@ -59,7 +59,12 @@ fn samples(poly: &[[f64; 3]], step: f64, mut each: impl FnMut(&[f64; 3])) {
 /// `accept` mm are taken as they are (they are upper bounds); set it to the tolerance to check
 /// against, or to 0 for the tightest figure. With `accept > 0` the measurement stops as soon as
 /// it exceeds `accept`.
-pub fn polyline_deviation(out: &[[f64; 3]], orig: &[[f64; 3]], step: f64, accept: f64) -> f64 {
+pub(crate) fn polyline_deviation(
+    out: &[[f64; 3]],
+    orig: &[[f64; 3]],
+    step: f64,
+    accept: f64,
+) -> f64 {
     let segs = orig.len().saturating_sub(1);
     if segs == 0 {
         return match (out.is_empty(), orig.first()) {
@@ -68,74 +73,25 @@ pub fn polyline_deviation(out: &[[f64; 3]], orig: &[[f64; 3]], step: f64, accept
             (false, None) => f64::INFINITY,
         };
     }
-    let seg_dist = |p: &[f64; 3], j: usize| point_segment(p, &orig[j], &orig[j + 1]);
-    // Nearest original segment to `p`, searched around `cursor` first, then everywhere.
-    let nearest = |p: &[f64; 3], cursor: usize| -> (usize, f64) {
-        const WINDOW: usize = 6;
-        let lo = cursor.saturating_sub(WINDOW);
-        let hi = (cursor + WINDOW).min(segs - 1);
-        let mut best = (cursor.min(segs - 1), f64::INFINITY);
-        for j in lo..=hi {
-            let d = seg_dist(p, j);
-            if d < best.1 {
-                best = (j, d);
-            }
-        }
-        best
-    };
-    // Nearest segment over the whole polyline: where the window has lost track (the other
-    // polyline is much denser here, or doubles back), it puts the cursor back.
-    let nearest_anywhere = |p: &[f64; 3]| -> (usize, f64) {
-        (0..segs).fold((0, f64::INFINITY), |best, j| {
-            let d = seg_dist(p, j);
-            if d < best.1 {
-                (j, d)
-            } else {
-                best
-            }
-        })
-    };
+    let o = Original { orig, segs };
     let mut worst = 0.0f64;
     let mut cursor = 0usize;
     let mut prev: Option<([f64; 3], usize, f64)> = None;
     for p in out {
-        let (mut j, mut d) = nearest(p, cursor);
+        let (mut j, mut d) = o.nearest(p, cursor);
         if d > worst.max(step).max(accept) {
-            (j, d) = nearest_anywhere(p);
+            (j, d) = o.nearest_anywhere(p);
         }
         cursor = j;
         if let Some((q, jq, dq)) = prev {
             // Certificate: both ends near one segment (either end's nearest).
-            let c1 = dq.max(seg_dist(p, jq));
-            let c2 = seg_dist(&q, j).max(d);
+            let c1 = dq.max(o.seg_dist(p, jq));
+            let c2 = o.seg_dist(&q, j).max(d);
             let cert = c1.min(c2);
             let bound = if cert <= worst.max(step).max(accept) {
                 cert
             } else {
-                // Walk the segment. Distance is 1-Lipschitz, so from a point at distance d the
-                // next `accept − d` mm cannot exceed `accept`: the walk strides there and steps
-                // `step` mm only where the segment comes close to the limit.
-                let len = norm(&sub(p, &q));
-                let mut m = 0.0f64;
-                let mut t = 0.0f64;
-                let mut c = jq;
-                let mut guard = 0usize;
-                loop {
-                    let f = if len > 0.0 { (t / len).min(1.0) } else { 1.0 };
-                    let x = lerp(&q, p, f);
-                    let (mut jj, mut dx) = nearest(&x, c);
-                    if dx > m.max(accept) {
-                        (jj, dx) = nearest_anywhere(&x);
-                    }
-                    c = jj;
-                    m = m.max(dx);
-                    guard += 1;
-                    if f >= 1.0 || guard > 1_000_000 {
-                        break;
-                    }
-                    t += step.max(accept - dx);
-                }
-                cert.min(if accept > 0.0 { m } else { m + step / 2.0 })
+                cert.min(o.walk(&q, p, jq, step, accept))
             };
             worst = worst.max(bound);
             if accept > 0.0 && worst > accept {
@@ -148,6 +104,81 @@ pub fn polyline_deviation(out: &[[f64; 3]], orig: &[[f64; 3]], step: f64, accept
         prev = Some((*p, j, d));
     }
     worst
+}
+
+/// The original polyline of [`polyline_deviation`] (at least one segment), with the nearest-
+/// segment searches its measurement is made of.
+struct Original<'a> {
+    orig: &'a [[f64; 3]],
+    segs: usize,
+}
+
+impl Original<'_> {
+    /// Distance from `p` to segment `j`.
+    fn seg_dist(&self, p: &[f64; 3], j: usize) -> f64 {
+        point_segment(p, &self.orig[j], &self.orig[j + 1])
+    }
+
+    /// Nearest original segment to `p`, searched around `cursor` first, then everywhere.
+    fn nearest(&self, p: &[f64; 3], cursor: usize) -> (usize, f64) {
+        const WINDOW: usize = 6;
+        let segs = self.segs;
+        let lo = cursor.saturating_sub(WINDOW);
+        let hi = (cursor + WINDOW).min(segs - 1);
+        let mut best = (cursor.min(segs - 1), f64::INFINITY);
+        for j in lo..=hi {
+            let d = self.seg_dist(p, j);
+            if d < best.1 {
+                best = (j, d);
+            }
+        }
+        best
+    }
+
+    /// Nearest segment over the whole polyline: where the window has lost track (the other
+    /// polyline is much denser here, or doubles back), it puts the cursor back.
+    fn nearest_anywhere(&self, p: &[f64; 3]) -> (usize, f64) {
+        (0..self.segs).fold((0, f64::INFINITY), |best, j| {
+            let d = self.seg_dist(p, j);
+            if d < best.1 {
+                (j, d)
+            } else {
+                best
+            }
+        })
+    }
+
+    /// The largest distance along the output segment `q`–`p` (`q` nearest segment `jq`), by
+    /// walking it. Distance is 1-Lipschitz, so from a point at distance d the next
+    /// `accept − d` mm cannot exceed `accept`: the walk strides there and steps `step` mm only
+    /// where the segment comes close to the limit.
+    fn walk(&self, q: &[f64; 3], p: &[f64; 3], jq: usize, step: f64, accept: f64) -> f64 {
+        let len = norm(&sub(p, q));
+        let mut m = 0.0f64;
+        let mut t = 0.0f64;
+        let mut c = jq;
+        let mut guard = 0usize;
+        loop {
+            let f = if len > 0.0 { (t / len).min(1.0) } else { 1.0 };
+            let x = lerp(q, p, f);
+            let (mut jj, mut dx) = self.nearest(&x, c);
+            if dx > m.max(accept) {
+                (jj, dx) = self.nearest_anywhere(&x);
+            }
+            c = jj;
+            m = m.max(dx);
+            guard += 1;
+            if f >= 1.0 || guard > 1_000_000 {
+                break;
+            }
+            t += step.max(accept - dx);
+        }
+        if accept > 0.0 {
+            m
+        } else {
+            m + step / 2.0
+        }
+    }
 }
 
 /// Segments bucketed by 2-D cell (XY) for nearest-segment queries.
@@ -213,7 +244,7 @@ impl Grid {
 
 /// The larger of [`polyline_deviation`] from `a` to `b` and from `b` to `a`: `a` stays near
 /// `b`, and `b` is covered by `a` (a path that cuts a corner short fails the second).
-pub fn both_ways(a: &[[f64; 3]], b: &[[f64; 3]], step: f64, accept: f64) -> f64 {
+pub(crate) fn both_ways(a: &[[f64; 3]], b: &[[f64; 3]], step: f64, accept: f64) -> f64 {
     polyline_deviation(a, b, step, accept).max(polyline_deviation(b, a, step, accept))
 }
 
@@ -258,7 +289,7 @@ pub fn file_deviation(original: &PrintPath, output: &PrintPath, step: f64) -> f6
 
 /// Points along an arc move (`G2`/`G3`) from its start to its end, the chords between them
 /// within `step / 10` of the arc; `None` for any other move.
-pub fn arc_points(m: &PathMove, step: f64) -> Option<Vec<[f64; 3]>> {
+pub(crate) fn arc_points(m: &PathMove, step: f64) -> Option<Vec<[f64; 3]>> {
     let a = m.kind.arc()?;
     let (i, j, k) = a.plane.axes();
     let rise = m.to[k] - m.from[k];

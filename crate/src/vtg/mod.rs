@@ -1,45 +1,55 @@
-//! Vibration-suppressed toolpath generation (VTG paper section 3, eq. 18–31, Algorithm 1).
+//! Vibration-suppressed toolpath generation (VTG paper section 3, eq. 21–31, Algorithm 1).
 //!
-//! [`vtg`] reads a file, finds its extrusion paths (runs of consecutive printing moves within
-//! one feature), and rewrites each path that has a sharp corner (a turn above the critical
-//! angle δθ): its corners are blended with the largest fillets the tolerance and the legs
-//! allow ([`blend`]; two sharp corners across a short leg, such as infill turning back, are
-//! rounded as one arc, [`hairpin`]), a cubic B-spline is fitted to the blended path by least squares
-//! ([`fit`]), walked with the second-order Taylor interpolator and Newton correction of
-//! Algorithm 1 ([`resample`]) in steps that each turn by less than 0.9 δθ, and the path's
-//! filament is spread over the new points ([`rewrite`]). Where the curvature is above `K_cr`
-//! (eq. 30, [`kinematics`]) the feed is lowered so `a_n`, `j_n` and the interpolation chord
-//! error stay within eq. 29, never below the speed the machine had at the same place on the
-//! original, and on classic-jerk firmware rising feeds are ramped so no junction stalls
-//! ([`smooth`]). Travels, retractions and every other line are kept byte for byte. The result
-//! is checked against the original independently ([`deviation`]) and compared with
-//! [`metrics`] (Table 1) and the analysis (Table 2).
+//! [`vtg`] reads a file, finds its extrusion paths (runs of consecutive printing moves of one
+//! feature) and rewrites each that turns by more than the critical angle δθ (VTG eq. 26).
+//! Three parts do the work, each a folder:
+//!
+//! - **`stages`, the paper's**, per path: a cubic B-spline (VTG eq. 21–22, `bspline`) fitted by
+//!   least squares to the path with its corners blended (`fit`), walked by Algorithm 1
+//!   (`resample`: the second-order Taylor step of VTG eq. 27 with Newton correction, speed
+//!   fluctuation VTG eq. 28) in steps that each turn by less than δθ, the filament spread over
+//!   the new points, and the feed lowered where the curvature exceeds `K_cr` so `a_n`, `j_n`
+//!   and the chord error stay within VTG eq. 29–30 (`kinematics`, `feed`), never below the
+//!   original's own speed there.
+//! - **`corners`, replacements for sharp corners**: the fillet or racing line (`blend`), two
+//!   corners across a short leg as one arc (`hairpin`), a loop round a corner too tight to
+//!   fillet (`keyhole`), a polygon placed for Klipper's look-ahead (`klipper`), and runs on a
+//!   circle written as `G2`/`G3` (`arcs`).
+//! - **`search`**: each path through the stages with its corners chosen and retried
+//!   (`smooth`), offered written its free way and, where time may be spent, dearer ways
+//!   (`rewrite`); the file-level choice within the allowed time (`budget`); and, where the
+//!   dynamics model finds the result ringing more than the original, the whole file again
+//!   with quieter variants. Its ladders of variants are one table, in `search`'s doc; the
+//!   values they trade with are one struct, `tuning::Tuning`.
+//!
+//! Travels, retractions and every other line are kept byte for byte. The result is checked
+//! against the original independently ([`deviation`]) and compared with [`metrics`] (Table 1,
+//! VTG eq. 24–26 and 31) and the analysis (Table 2).
 
-pub mod arcs;
-pub mod blend;
-pub mod block;
-pub mod bspline;
-pub mod budget;
-pub mod corner;
+mod block;
+mod corners;
 pub mod deviation;
-pub mod feed;
-pub mod fit;
-pub mod hairpin;
-pub mod keyhole;
-pub mod kinematics;
 pub mod metrics;
-pub mod report;
-pub mod resample;
-pub mod rewrite;
-pub mod smooth;
+mod report;
+mod search;
 pub mod source;
+mod stages;
+mod tuning;
+
+use corners::{arcs, blend, hairpin, keyhole, klipper};
+use search::{budget, rewrite, smooth};
+use stages::{bspline, feed, fit, kinematics, resample};
 
 use serde::{Deserialize, Serialize};
+use tuning::TUNING;
 
 use crate::analyze::{AnalyzeOptions, Report};
 use crate::error::{Error, ErrorKind};
 use crate::progress::Progress;
-pub use report::{Comparison, Table1, Table2, VtgReport};
+pub use report::{
+    Comparison, DeviationComparison, LayerMetrics, PathCounts, Table1, Table2, VtgReport,
+};
+pub use stages::kinematics::KinematicLimits;
 
 /// Options of [`vtg`]. Every field is optional in JSON.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -74,7 +84,7 @@ pub struct VtgOptions {
     /// original (default true; it costs about as much as the rewrite itself, more when it
     /// rewrites again). See `with_simulated_deviation`.
     pub dynamics: bool,
-    /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`arcs`]) to cut the
+    /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`) to cut the
     /// line count (default false: the firmware must have arcs enabled, Marlin's `ARC_SUPPORT`
     /// or Klipper's `[gcode_arcs]`).
     pub arcs: bool,
@@ -83,7 +93,7 @@ pub struct VtgOptions {
     /// firmware takes sharp corners faster than any fillet within the tolerance (Klipper with a
     /// square-corner velocity of 50–100 mm/s) rounding costs time, and motor and standby
     /// energy with it: this buys the corners that remove the most sharp turns for their time
-    /// first, energy weighed in ([`budget::ENERGY_WEIGHT`]). Where rounding costs nothing
+    /// first, energy weighed in. Where rounding costs nothing
     /// (every Marlin file of the corpus) it changes nothing. 0: the print gets no slower and
     /// uses no more energy, the corners that would cost being paid only out of what the other
     /// rewrites save. 100 rounds every corner the tolerance allows.
@@ -97,11 +107,9 @@ pub struct VtgOptions {
     pub inside_corners: bool,
 }
 
-/// The print time the rewrite may add by default, percent: the issue's bar. With it every file
-/// of the corpus meets every bar of the issue; with 0 the two Creality benchies for Klipper at
-/// a 50–100 mm/s square-corner velocity keep most of their corners sharp (−31.7 % and −9.1 %
-/// of them rounded, against −70.0 % and −44.1 % within 1 %; README, "Where the issue's bar is
-/// not met").
+/// The print time the rewrite may add by default, percent: the issue's bar. More rounds more
+/// corners on machines that take sharp corners faster than round ones; 0 keeps every print
+/// from getting slower (figures in `docs/method/vtg-tuning-notes.md`).
 pub const DEFAULT_ALLOW_SLOWER_PCT: f64 = 1.0;
 
 impl Default for VtgOptions {
@@ -181,7 +189,7 @@ pub fn vtg_with_progress(
     }
     let limits = rewrite::limits_for(&path, options);
     // One rewrite tried as `variant`, analysed and reported.
-    let attempt = |variant: rewrite::Variant, before: Report, progress: Progress<'_>| {
+    let attempt = |variant: search::Variant, before: Report, progress: Progress<'_>| {
         let mut step = |f: f64| progress(0.8 * f);
         let offers = rewrite::offers(input, &path, &sources, options, &limits, variant, &mut step)?;
         if !progress(0.8) {
@@ -217,7 +225,7 @@ pub fn vtg_with_progress(
             rewritten,
         ))
     };
-    let first = rewrite::Variant::default();
+    let first = search::Variant::default();
     let mut report = attempt(first, before, &mut |f| progress(0.3 + 0.4 * f))?;
     if !progress(0.7) {
         return Err(cancelled());
@@ -235,10 +243,9 @@ pub fn vtg_with_progress(
 /// whole file, and the analysis it was measured with (`None`: no time allowed, or no path that
 /// could spend it, not analysed).
 /// The choice counts the time each path adds as planned with its neighbours only; across the
-/// file the firmware's look-ahead adds a little more (3–9 % of the allowance on the
-/// Creality benchies), so where the whole file comes out slower than allowed the allowance is
-/// cut by the excess and the choice made again (at most [`TIME_ROUNDS`] times, then without
-/// any allowance).
+/// file the firmware's look-ahead adds a little more, so where the whole file comes out slower
+/// than allowed the allowance is cut by the excess and the choice made again (at most
+/// `Tuning::time_rounds` times, then without any allowance).
 fn within_allowed_time(
     input: &[u8],
     offers: &rewrite::Offers,
@@ -253,7 +260,7 @@ fn within_allowed_time(
     };
     let mut allowed_s = allowed;
     let mean_power_w = before.energy.total_j / before.time_s;
-    for _ in 0..TIME_ROUNDS {
+    for _ in 0..TUNING.time_rounds {
         if allowed_s <= 0.0 {
             break;
         }
@@ -263,52 +270,26 @@ fn within_allowed_time(
         if added <= allowed {
             return Ok((rewritten, Some(after)));
         }
-        allowed_s -= TIME_MARGIN * (added - allowed);
+        allowed_s -= TUNING.time_margin * (added - allowed);
     }
     Ok((offers.write(input, 0.0, mean_power_w), None))
-}
-
-/// Choices made against the whole file's time before giving up the allowance.
-const TIME_ROUNDS: usize = 4;
-/// Each round cuts the allowance by this many times the excess measured.
-const TIME_MARGIN: f64 = 1.2;
-
-/// Scales of the eq. 29 speeds tried, in turn, when the rewrite at 1 leaves the machine
-/// ringing more than the original did; then the same scales without keyhole loops.
-const QUIETER_SCALES: [f64; 3] = [1.0, 1.5, 2.0];
-
-/// The variants tried after the first (scale 1 with keyholes), in turn.
-fn quieter_variants() -> impl Iterator<Item = rewrite::Variant> {
-    [true, false]
-        .into_iter()
-        .flat_map(|keyholes| {
-            QUIETER_SCALES.map(|feed_cap_scale| rewrite::Variant {
-                feed_cap_scale,
-                keyholes,
-            })
-        })
-        .skip(1)
 }
 
 /// Fills Table 2's deviation rows with the dynamics model, run on the original and on the
 /// rewritten file over printing moves (travels are not rewritten), and closes the loop on it.
 ///
-/// Eq. 29's speeds (`J_n = A_n f₁`) are meant to keep a rounded corner from exciting the frame
-/// more than the sharp one did, and on nearly every file they do. They are a rule of thumb,
-/// though: the ringing a corner leaves depends on how its timing falls against the modes,
-/// which no bound on `a_n` and `j_n` sees. On the thesis triangle (with inside fillets, before
-/// corners took the racing line), whose 75° infill corners the firmware takes at 14 mm/s,
-/// fillets at eq. 29's 20 mm/s raised the mean deviation by 1.2 %, while at 1.5× (30 mm/s) it
-/// fell by 1.1 % (and at 0.5× it rose by 4 %: not monotonic). So when the simulated mean
-/// deviation does not fall, the file is rewritten again with the speeds starting at each of
-/// [`QUIETER_SCALES`] in turn, and the rewrite with the lowest simulated mean deviation is
-/// kept: every variant still passes the no-dearer check path by path, so time and energy fall
-/// as before.
+/// Eq. 29's speeds (`J_n = A_n f₁`) are meant to keep a rounded corner from exciting the frame more
+/// than the sharp one did, and on nearly every file they do. They are a rule of thumb, though: the
+/// ringing a corner leaves depends on how its timing falls against the modes, which no bound on
+/// `a_n` and `j_n` sees, and not monotonically (figures in `docs/method/vtg-tuning-notes.md`). So
+/// when the simulated mean deviation does not fall, the file is rewritten again with the speeds
+/// starting at each of `Tuning::quieter_scales` in turn, and the rewrite with the lowest simulated
+/// mean deviation is kept: every variant still passes the no-dearer check path by path, so time and
+/// energy fall as before.
 ///
 /// Keyhole loops ([`keyhole`]) are the other thing the model can object to: the machine no
 /// longer stops at the tip of a wedge, but it swings round a loop of a tenth of a millimetre
-/// or so in radius, and on some files (the thesis triangle's, oval's and teardrop's infill
-/// tips, before the racing line) that rang more than the stop did. If no scale brings the
+/// or so in radius, and on some files that rang more than the stop did. If no scale brings the
 /// mean below the original's with them, the scales are tried again without keyholes.
 ///
 /// `None` rows when the model cannot run (a print too long to simulate, for instance): the
@@ -317,7 +298,7 @@ fn with_simulated_deviation(
     input: &[u8],
     first: VtgReport,
     options: &VtgOptions,
-    again: &mut dyn FnMut(rewrite::Variant, Report, f64) -> Result<VtgReport, Error>,
+    again: &mut dyn FnMut(search::Variant, Report, f64) -> Result<VtgReport, Error>,
 ) -> Result<VtgReport, Error> {
     let vibration = crate::dynamics::VibrationOptions {
         analyze: options.analyze.clone(),
@@ -345,7 +326,7 @@ fn with_simulated_deviation(
         return Ok(best);
     }
     let mut best_mean = a.mean;
-    for (k, variant) in quieter_variants().enumerate() {
+    for (k, variant) in search::quieter_variants().enumerate() {
         if best_mean < b.mean {
             break;
         }

@@ -124,7 +124,7 @@ pub struct PathCounts {
     /// Arcs (`G2`/`G3`) written (with the `arcs` option), each in place of several steps.
     pub arcs_written: u64,
     /// Single corners too tight to fillet that were turned round a keyhole loop instead
-    /// ([`crate::vtg::keyhole`]); 0 where the dynamics model found the loops left the machine
+    /// (`keyhole`); 0 where the dynamics model found the loops left the machine
     /// ringing more than the original (see [`crate::vtg::VtgOptions::dynamics`]).
     pub keyholes: u64,
 }

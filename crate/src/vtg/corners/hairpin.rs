@@ -16,39 +16,35 @@
 //! a fine polygon of the arc, which the rest of the pipeline blends, fits and walks like any
 //! other path.
 
-use super::bspline::{arc_lengths, segment_at};
-use super::deviation::{both_ways, point_polyline};
 use crate::vec3::{cross, dot, norm, sub};
+use crate::vtg::bspline::{arc_lengths, segment_at};
+use crate::vtg::deviation::{both_ways, point_polyline};
+use crate::vtg::tuning::TUNING;
 
-/// Longest connector between the two corners of a hairpin, mm.
-pub const MAX_CONNECTOR_MM: f64 = 2.0;
 /// Smallest combined turn of a hairpin, rad (90°: below it the corners are separate turns).
 const MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_2;
 /// Largest combined turn, rad (200°: legs that diverge a little past parallel).
 const MAX_TURN_RAD: f64 = 200.0 * std::f64::consts::PI / 180.0;
-/// Turn of one side of the polygon that stands for the arc, rad (15°: its sagitta is 0.009 r,
-/// and the blends at its corners round it back towards the circle).
-const POLYGON_TURN_RAD: f64 = 15.0 * std::f64::consts::PI / 180.0;
 /// Centres tried along the bisector on the coarse pass, each side of the closest one.
 const COARSE_STEPS: i32 = 16;
 
 /// The arc a hairpin is rounded to.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Hairpin {
+pub(crate) struct Hairpin {
     /// Index of the first of the corners it replaces.
-    pub at: usize,
+    pub(crate) at: usize,
     /// How many corners it replaces: 2 for a hairpin (the second is the next point), 1 for a
-    /// [`super::keyhole`].
-    pub corners: usize,
+    /// [`crate::vtg::keyhole`].
+    pub(crate) corners: usize,
     /// Radius, mm.
-    pub radius_mm: f64,
+    pub(crate) radius_mm: f64,
     /// Points of the arc, from where it leaves the first long leg to where it meets the second.
-    pub arc: Vec<[f64; 3]>,
+    pub(crate) arc: Vec<[f64; 3]>,
     /// Distance from the first corner back along the first leg to where the arc starts, mm
     /// (negative: on the leg's extension past the corner).
-    pub before_mm: f64,
+    pub(crate) before_mm: f64,
     /// Distance from the second corner along the second leg to where the arc ends, mm.
-    pub after_mm: f64,
+    pub(crate) after_mm: f64,
 }
 
 impl Hairpin {
@@ -59,7 +55,7 @@ impl Hairpin {
 
     /// The stretch of the original it replaces, as arc lengths `(u0, u1)` along it (`arc`:
     /// the original's arc length at each point).
-    pub fn span(&self, arc: &[f64]) -> (f64, f64) {
+    pub(crate) fn span(&self, arc: &[f64]) -> (f64, f64) {
         (
             arc[self.at] - self.before_mm.max(0.0),
             arc[self.last_corner(arc.len())] + self.after_mm.max(0.0),
@@ -69,7 +65,7 @@ impl Hairpin {
 
 /// `v / |v|`, or `None` for a tiny vector. (Divides: `crate::vec3::normalize` multiplies by
 /// the reciprocal, which rounds differently and would move the arcs in the last bit.)
-pub(super) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
+pub(crate) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
     let l = norm(&v);
     (l > 1e-12).then(|| [v[0] / l, v[1] / l, v[2] / l])
 }
@@ -77,7 +73,7 @@ pub(super) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
 /// The `segments + 1` points of a circular arc in the plane of constant Z through `centre`,
 /// from `start` on, sweeping `sweep` rad (positive: anticlockwise seen from above): the radius
 /// vector turned step by step.
-pub(super) fn arc_polygon(
+pub(crate) fn arc_polygon(
     centre: &[f64; 3],
     start: &[f64; 3],
     sweep: f64,
@@ -96,16 +92,16 @@ pub(super) fn arc_polygon(
 }
 
 /// The Z component of `a × b` (the turn's sense, seen from above).
-pub(super) fn cross_z(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+pub(crate) fn cross_z(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     cross(a, b)[2]
 }
 
-/// The hairpin at corners `i` and `i + 1` of `pts`, if the two corners turn the same way by 90°
-/// to 200° together across a connector of at most [`MAX_CONNECTOR_MM`], lie in one plane of
-/// constant Z, and an arc of radius at least `min_radius_mm` rounds them within `tolerance_mm`
-/// starting no more than `room_mm[0]` before corner `i` and ending no more than `room_mm[1]`
-/// after corner `i + 1`.
-pub fn find(
+/// The hairpin at corners `i` and `i + 1` of `pts`, if the two corners turn the same way by 90° to
+/// 200° together across a connector of at most `Tuning::hairpin_max_connector_mm`, lie in one plane
+/// of constant Z, and an arc of radius at least `min_radius_mm` rounds them within `tolerance_mm`
+/// starting no more than `room_mm[0]` before corner `i` and ending no more than `room_mm[1]` after
+/// corner `i + 1`.
+pub(crate) fn find(
     pts: &[[f64; 3]],
     i: usize,
     tolerance_mm: f64,
@@ -126,23 +122,11 @@ pub fn find(
     let b = unit(sub(&p3, &v2))?;
     let connector = sub(&v2, &v1);
     let c_len = norm(&connector);
-    if !(c_len > 0.0 && c_len <= MAX_CONNECTOR_MM) {
+    if !(c_len > 0.0 && c_len <= TUNING.hairpin_max_connector_mm) {
         return None;
     }
     let c = unit(connector)?;
-    // Both corners turn the same way.
-    let (t1, t2) = (cross_z(&a, &c), cross_z(&c, &b));
-    if t1 * t2 <= 0.0 {
-        return None;
-    }
-    let side = t1.signum();
-    let mut turn = crate::math::atan2(side * cross_z(&a, &b), dot(&a, &b));
-    if turn < 0.0 {
-        turn += 2.0 * std::f64::consts::PI;
-    }
-    if !(MIN_TURN_RAD..=MAX_TURN_RAD).contains(&turn) {
-        return None;
-    }
+    let (side, turn) = turn_of(&a, &c, &b)?;
     // Normals towards the inside of the turn; the centre `C` has n_a·(C − v1) = n_b·(C − v2)
     // = r > 0, a line m·C = k.
     let (na, nb) = (
@@ -156,51 +140,26 @@ pub fn find(
     }
     let k = dot(&na, &v1) - dot(&nb, &v2);
     let s0 = (k - dot(&m, &v1)) / m2;
-    let c0 = [v1[0] + m[0] * s0, v1[1] + m[1] * s0, z];
     let ml = m2.sqrt();
-    let along = [-m[1] / ml, m[0] / ml, 0.0];
     // The original around the hairpin, and the same stretch with the arc in place.
     let (la, lb) = (norm(&sub(&v1, &p0)), norm(&sub(&p3, &v2)));
     let (room_a, room_b) = (room_mm[0].min(la), room_mm[1].min(lb));
     let pa = [v1[0] - a[0] * room_a, v1[1] - a[1] * room_a, z];
     let pb = [v2[0] + b[0] * room_b, v2[1] + b[1] * room_b, z];
-    let original = [pa, v1, v2, pb];
-    let segments = (turn / POLYGON_TURN_RAD).ceil().max(2.0) as usize;
-    let candidate = |t: f64| -> Option<Hairpin> {
-        let centre = [c0[0] + along[0] * t, c0[1] + along[1] * t, z];
-        let r = dot(&na, &sub(&centre, &v1));
-        if !(r >= min_radius_mm && r.is_finite()) {
-            return None;
-        }
-        let ta = [centre[0] - na[0] * r, centre[1] - na[1] * r, z];
-        let tb = [centre[0] - nb[0] * r, centre[1] - nb[1] * r, z];
-        let before = dot(&a, &sub(&v1, &ta));
-        let after = dot(&b, &sub(&tb, &v2));
-        if before > room_a || after > room_b {
-            return None;
-        }
-        let arc: Vec<[f64; 3]> = arc_polygon(&centre, &ta, side * turn, segments).collect();
-        let mut new = Vec::with_capacity(arc.len() + 2);
-        new.push(pa);
-        new.extend_from_slice(&arc);
-        new.push(pb);
-        // Points the full measurement below would take anyway, first: the middle of the arc
-        // and the two corners (most centres fail on one of them).
-        if point_polyline(&arc[segments / 2], &original) > tolerance_mm
-            || point_polyline(&v1, &new) > tolerance_mm
-            || point_polyline(&v2, &new) > tolerance_mm
-        {
-            return None;
-        }
-        let step = tolerance_mm / 10.0;
-        (both_ways(&new, &original, step, tolerance_mm) <= tolerance_mm).then_some(Hairpin {
-            at: i,
-            corners: 2,
-            radius_mm: r,
-            arc,
-            before_mm: before,
-            after_mm: after,
-        })
+    let u = UTurn {
+        i,
+        legs: [a, b],
+        normals: [na, nb],
+        corners: [v1, v2],
+        c0: [v1[0] + m[0] * s0, v1[1] + m[1] * s0, z],
+        along: [-m[1] / ml, m[0] / ml, 0.0],
+        side,
+        turn,
+        room: [room_a, room_b],
+        original: [pa, v1, v2, pb],
+        segments: (turn / TUNING.polygon_turn_rad).ceil().max(2.0) as usize,
+        tolerance_mm,
+        min_radius_mm,
     };
     // Coarse then fine: centres every `span / COARSE_STEPS` either side of the one closest to
     // the first corner, then around the best of those.
@@ -208,7 +167,7 @@ pub fn find(
     let coarse = span / COARSE_STEPS as f64;
     let best = |from: f64, step: f64, n: i32| {
         (-n..=n)
-            .filter_map(|j| candidate(from + step * j as f64).map(|c| (j, c)))
+            .filter_map(|j| u.candidate(from + step * j as f64).map(|c| (j, c)))
             .max_by(|x, y| {
                 (x.1.radius_mm)
                     .total_cmp(&y.1.radius_mm)
@@ -220,20 +179,113 @@ pub fn find(
     Some(best(t, coarse / 8.0, 8).map_or(first, |(_, c)| c))
 }
 
+/// The sense about +Z and the size (rad) of the turn from unit direction `a` through `c` to
+/// `b`, if both corners turn the same way and by 90° to 200° together: the shape [`find`]
+/// rounds as one arc.
+fn turn_of(a: &[f64; 3], c: &[f64; 3], b: &[f64; 3]) -> Option<(f64, f64)> {
+    // Both corners turn the same way.
+    let (t1, t2) = (cross_z(a, c), cross_z(c, b));
+    if t1 * t2 <= 0.0 {
+        return None;
+    }
+    let side = t1.signum();
+    let mut turn = crate::math::atan2(side * cross_z(a, b), dot(a, b));
+    if turn < 0.0 {
+        turn += 2.0 * std::f64::consts::PI;
+    }
+    if !(MIN_TURN_RAD..=MAX_TURN_RAD).contains(&turn) {
+        return None;
+    }
+    Some((side, turn))
+}
+
+/// Two corners [`find`] may round as one arc, with what every candidate centre is measured
+/// against: split from it so the search over centres reads apart from building one arc.
+struct UTurn {
+    /// The first corner's index.
+    i: usize,
+    /// Unit directions of the legs into the first corner and out of the second.
+    legs: [[f64; 3]; 2],
+    /// The legs' normals towards the inside of the turn.
+    normals: [[f64; 3]; 2],
+    /// The two corners.
+    corners: [[f64; 3]; 2],
+    /// The centre closest to the first corner, and the unit direction of the line of centres.
+    c0: [f64; 3],
+    along: [f64; 3],
+    /// The turn's sense about +Z, and its size, rad.
+    side: f64,
+    turn: f64,
+    /// Room before the first corner and after the second, mm.
+    room: [f64; 2],
+    /// The original stretch around the hairpin.
+    original: [[f64; 3]; 4],
+    /// Sides of the arc's polygon.
+    segments: usize,
+    tolerance_mm: f64,
+    min_radius_mm: f64,
+}
+
+impl UTurn {
+    /// The hairpin round the centre `t` along the line of centres from `c0`, if its radius is
+    /// large enough, it fits in the room and it keeps the tolerance both ways.
+    fn candidate(&self, t: f64) -> Option<Hairpin> {
+        let (c0, along, z) = (self.c0, self.along, self.c0[2]);
+        let ([a, b], [na, nb], [v1, v2]) = (self.legs, self.normals, self.corners);
+        let [pa, _, _, pb] = self.original;
+        let (tolerance_mm, segments) = (self.tolerance_mm, self.segments);
+        let centre = [c0[0] + along[0] * t, c0[1] + along[1] * t, z];
+        let r = dot(&na, &sub(&centre, &v1));
+        if !(r >= self.min_radius_mm && r.is_finite()) {
+            return None;
+        }
+        let ta = [centre[0] - na[0] * r, centre[1] - na[1] * r, z];
+        let tb = [centre[0] - nb[0] * r, centre[1] - nb[1] * r, z];
+        let before = dot(&a, &sub(&v1, &ta));
+        let after = dot(&b, &sub(&tb, &v2));
+        if before > self.room[0] || after > self.room[1] {
+            return None;
+        }
+        let arc: Vec<[f64; 3]> =
+            arc_polygon(&centre, &ta, self.side * self.turn, segments).collect();
+        let mut new = Vec::with_capacity(arc.len() + 2);
+        new.push(pa);
+        new.extend_from_slice(&arc);
+        new.push(pb);
+        // Points the full measurement below would take anyway, first: the middle of the arc
+        // and the two corners (most centres fail on one of them).
+        if point_polyline(&arc[segments / 2], &self.original) > tolerance_mm
+            || point_polyline(&v1, &new) > tolerance_mm
+            || point_polyline(&v2, &new) > tolerance_mm
+        {
+            return None;
+        }
+        let step = tolerance_mm / 10.0;
+        (both_ways(&new, &self.original, step, tolerance_mm) <= tolerance_mm).then_some(Hairpin {
+            at: self.i,
+            corners: 2,
+            radius_mm: r,
+            arc,
+            before_mm: before,
+            after_mm: after,
+        })
+    }
+}
+
 /// A path with its hairpins replaced by their arcs: points, filament at each, and the feed and
 /// planned profile of each segment (those of the original segment its middle stands for).
 #[derive(Debug, Clone, Default)]
-pub struct Substituted {
+pub(crate) struct Substituted {
     /// The points.
-    pub pts: Vec<[f64; 3]>,
+    pub(crate) pts: Vec<[f64; 3]>,
     /// Filament pushed from the path start to each point.
-    pub e: Vec<f64>,
+    pub(crate) e: Vec<f64>,
     /// Feed of each segment, mm/s.
-    pub feed: Vec<f64>,
+    pub(crate) feed: Vec<f64>,
     /// Planned profile of each segment (empty if the original had none).
-    pub planned: Vec<crate::plan::Profile>,
+    pub(crate) planned: Vec<crate::plan::Profile>,
     /// Index of each pin's first point (its arc then runs on for `arc.len()` points).
-    pub starts: Vec<usize>,
+    pub(crate) starts: Vec<usize>,
 }
 
 /// `pts` (filament `e`, feeds `feed`, profiles `planned`) with each of `pins` (sorted, apart)
@@ -241,7 +293,7 @@ pub struct Substituted {
 /// for the original point at the same fraction of length along the stretch, so the filament
 /// pushed up to it is read off the original (spread by length over the new stretch) and the
 /// path's total is unchanged.
-pub fn substitute(
+pub(crate) fn substitute(
     pts: &[[f64; 3]],
     e: &[f64],
     feed: &[f64],
@@ -301,33 +353,51 @@ pub fn substitute(
         at.push(arc_len[k]);
         pin_of.push(None);
     }
-    // The original's planned speed at original arc length `u`.
-    let speed_at = |u: f64| {
-        let k = segment(u);
-        planned.get(k).map(|p| p.speed_at(u - arc_len[k]))
-    };
-    for j in 0..at.len().saturating_sub(1) {
-        let k = segment(0.5 * (at[j] + at[j + 1]));
-        out.feed.push(feed[k]);
-        let Some(p) = planned.get(k) else { continue };
-        // A side of an arc moves at the speed the original had where it stands for, the
-        // lower of its two ends' (the original segment's own profile would be read at
-        // distances along the new path, which do not match it).
-        let on_arc = pin_of[j].is_some() && pin_of[j] == pin_of[j + 1];
-        match (on_arc, speed_at(at[j]), speed_at(at[j + 1])) {
-            (true, Some(v0), Some(v1)) => {
-                let v = v0.min(v1);
-                let len = norm(&sub(&out.pts[j + 1], &out.pts[j]));
-                out.planned
-                    .push(crate::plan::Profile::new(len, v, v, v, p.acceleration));
+    out.segments(&at, &pin_of, &arc_len, feed, planned);
+    out
+}
+
+impl Substituted {
+    /// The feed and planned profile of each new segment, from the points' original arc
+    /// lengths `at` (on `arc_len`) and the pin each is on: apart from [`substitute`] since
+    /// the speeds on an arc are a rule of their own.
+    fn segments(
+        &mut self,
+        at: &[f64],
+        pin_of: &[Option<usize>],
+        arc_len: &[f64],
+        feed: &[f64],
+        planned: &[crate::plan::Profile],
+    ) {
+        let out = self;
+        let segment = |u: f64| segment_at(arc_len, u, feed.len());
+        // The original's planned speed at original arc length `u`.
+        let speed_at = |u: f64| {
+            let k = segment(u);
+            planned.get(k).map(|p| p.speed_at(u - arc_len[k]))
+        };
+        for j in 0..at.len().saturating_sub(1) {
+            let k = segment(0.5 * (at[j] + at[j + 1]));
+            out.feed.push(feed[k]);
+            let Some(p) = planned.get(k) else { continue };
+            // A side of an arc moves at the speed the original had where it stands for, the
+            // lower of its two ends' (the original segment's own profile would be read at
+            // distances along the new path, which do not match it).
+            let on_arc = pin_of[j].is_some() && pin_of[j] == pin_of[j + 1];
+            match (on_arc, speed_at(at[j]), speed_at(at[j + 1])) {
+                (true, Some(v0), Some(v1)) => {
+                    let v = v0.min(v1);
+                    let len = norm(&sub(&out.pts[j + 1], &out.pts[j]));
+                    out.planned
+                        .push(crate::plan::Profile::new(len, v, v, v, p.acceleration));
+                }
+                _ => out.planned.push(*p),
             }
-            _ => out.planned.push(*p),
+        }
+        if out.planned.len() != out.feed.len() {
+            out.planned.clear();
         }
     }
-    if out.planned.len() != out.feed.len() {
-        out.planned.clear();
-    }
-    out
 }
 
 #[cfg(test)]

@@ -26,7 +26,7 @@ pub struct KinematicLimits {
 
 impl KinematicLimits {
     /// Eq. 30: `K_cr = min(8δ/((v_max T_s)² + 4δ²), A_n/v_max², sqrt(J_n/v_max³), 1/R_n)`, 1/mm.
-    pub fn critical_curvature(&self) -> f64 {
+    pub(crate) fn critical_curvature(&self) -> f64 {
         let v = self.v_max_mm_s;
         let d = self.chord_tolerance_mm;
         let vt = v * self.interpolation_period_s;
@@ -44,7 +44,7 @@ impl KinematicLimits {
     /// The highest feed rate (mm/s) at which a stretch of curvature `kappa` keeps eq. 30's
     /// first three terms, i.e. the chord error of one interpolation period, `a_n = v²κ` and
     /// `j_n = v³κ²`, within their limits; `v_max` on straights.
-    pub fn feed_limit(&self, kappa: f64) -> f64 {
+    pub(crate) fn feed_limit(&self, kappa: f64) -> f64 {
         if kappa.is_nan() || kappa <= 1e-12 {
             return self.v_max_mm_s;
         }

@@ -1,54 +1,49 @@
 //! The file-level choice of which rewrites to write when some of them cost time or energy.
 //!
-//! Each path is rewritten on its own and planned on the firmware's own model before and after
-//! (see [`super::rewrite`]). Most rewrites cost nothing; on a firmware that takes sharp corners
-//! faster than a fillet within the tolerance allows (Klipper with a high square-corner
-//! velocity, a junction-deviation planner with a large deviation), rounding a corner costs a
-//! little time and energy. Those rewrites are bought out of a budget: [`SPEND_SHARE`] of what
-//! the free rewrites saved, plus whatever time the user allows
-//! ([`super::VtgOptions::allow_slower_pct`]), the rewrites that remove the most sharp corners
-//! for their cost first: a multiple-choice knapsack, solved greedily on each path's convex
-//! hull of cost against corners removed (a path may offer a free rewrite that keeps its dear
-//! corners sharp and dearer ones that round some or all of them too,
-//! [`super::rewrite::DEARER_SPEED_SHARES`], each written the way that costs least energy and
-//! the way that costs least time; buying a dearer one is then an increment over the free
-//! one).
+//! Each path is rewritten on its own and planned on the firmware's own model before and after (see
+//! [`crate::vtg::rewrite`]). Most rewrites cost nothing; on a firmware that takes sharp corners
+//! faster than a fillet within the tolerance allows (Klipper with a high square-corner velocity, a
+//! junction-deviation planner with a large deviation), rounding a corner costs a little time and
+//! energy. Those rewrites are bought out of a budget: `Tuning::spend_share` of what the free
+//! rewrites saved, plus whatever time the user allows
+//! ([`crate::vtg::VtgOptions::allow_slower_pct`]), the rewrites that remove the most sharp corners
+//! for their cost first: a multiple-choice knapsack, solved greedily on each path's convex hull of
+//! cost against corners removed (a path may offer a free rewrite that keeps its dear corners sharp
+//! and dearer ones that round some or all of them too, `Tuning::dearer_speed_shares`, each written
+//! the way that costs least energy and the way that costs least time; buying a dearer one is then
+//! an increment over the free one).
 
-use super::rewrite::Rewritten;
 use crate::gcode::Edit;
-
-/// Share of what the rewrites that cost nothing saved (time and motor energy, each) that may be
-/// spent on rewrites that cost something, so the file as a whole still prints faster and on
-/// less energy than the original, by at least half of what the free rewrites saved.
-pub const SPEND_SHARE: f64 = 0.5;
+use crate::vtg::rewrite::Rewritten;
+use crate::vtg::tuning::TUNING;
 
 /// One way of writing a path.
 #[derive(Debug)]
-pub struct Outcome {
+pub(crate) struct Outcome {
     /// The edits that write it.
-    pub edits: Vec<Edit>,
+    pub(crate) edits: Vec<Edit>,
     /// Its counts.
-    pub part: Rewritten,
+    pub(crate) part: Rewritten,
     /// Time (s) and motor energy (J) it adds to the path's own (negative: saves).
-    pub added: [f64; 2],
+    pub(crate) added: [f64; 2],
     /// Whether it costs more time or energy than the original.
-    pub dearer: bool,
+    pub(crate) dearer: bool,
     /// Sharp corners it removes.
-    pub corners_removed: u64,
+    pub(crate) corners_removed: u64,
 }
 
 /// The ways one path can be written.
 #[derive(Debug, Default)]
-pub struct Offer {
+pub(crate) struct Offer {
     /// One that costs nothing: written unless a dearer one is bought in its place.
-    pub free: Option<Outcome>,
+    pub(crate) free: Option<Outcome>,
     /// Ones that cost time or energy; at most one is bought.
-    pub dearer: Vec<Outcome>,
+    pub(crate) dearer: Vec<Outcome>,
 }
 
 impl Offer {
     /// Files `outcome` as free or dearer.
-    pub fn push(&mut self, outcome: Outcome) {
+    pub(crate) fn push(&mut self, outcome: Outcome) {
         if outcome.dearer {
             self.dearer.push(outcome);
         } else if self
@@ -61,38 +56,28 @@ impl Offer {
     }
 }
 
-/// The weight of a joule against a second when time is allowed, as a share of the time the
-/// print takes to spend one joule (its mean power): with half, a rewrite that saves 1 J is
-/// worth as much as one 8 ms faster on a print drawing 62 W (the K1C benchy). Only the order
-/// of the purchases depends on it; the time allowed still bounds what is bought. Measured on
-/// the Creality benchies at `--allow-slower 1`: the K1's sharp corners −74.3 % and energy
-/// +0.22 % with energy not counted, −70.0 % and −0.77 % with half, −62.2 % and −1.25 % with
-/// the whole; the K1C's −45.4 % and −0.04 %, −44.1 % and −0.21 %, −40.8 % and −0.39 %.
-pub const ENERGY_WEIGHT: f64 = 0.5;
-
 /// What may be spent: time s, motor energy J; and, when energy is not limited, the seconds a
 /// joule counts for in the order of the purchases.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Budget {
+pub(crate) struct Budget {
     /// Time s and motor energy J that may be spent.
-    pub limits: [f64; 2],
+    pub(crate) limits: [f64; 2],
     /// Seconds a joule counts for where energy is not limited.
-    pub seconds_per_joule: f64,
+    pub(crate) seconds_per_joule: f64,
 }
 
 impl Budget {
-    /// [`SPEND_SHARE`] of `saved` (time s, energy J, by the free rewrites), plus `allowed_s` of
-    /// time. With time allowed, energy is not limited: the user has chosen to spend time on
-    /// quiet, and energy follows time (the electronics, fans and motors run as long as the
-    /// print does). It still counts in the order of the purchases, at [`ENERGY_WEIGHT`] of the
-    /// print's mean power `mean_power_w`: of two ways to remove corners for about the same
-    /// time, the one that costs less energy comes first, so the allowance does not raise the
-    /// energy where it need not. Without time allowed, both must have been saved for anything
-    /// to be spent.
-    pub fn new(saved: [f64; 2], allowed_s: f64, mean_power_w: f64) -> Self {
-        let share = saved.map(|x| SPEND_SHARE * x.max(0.0));
+    /// `Tuning::spend_share` of `saved` (time s, energy J, by the free rewrites), plus `allowed_s`
+    /// of time. With time allowed, energy is not limited: the user has chosen to spend time on
+    /// quiet, and energy follows time (the electronics, fans and motors run as long as the print
+    /// does). It still counts in the order of the purchases, at `Tuning::energy_weight` of the
+    /// print's mean power `mean_power_w`: of two ways to remove corners for about the same time,
+    /// the one that costs less energy comes first, so the allowance does not raise the energy where
+    /// it need not. Without time allowed, both must have been saved for anything to be spent.
+    pub(crate) fn new(saved: [f64; 2], allowed_s: f64, mean_power_w: f64) -> Self {
+        let share = saved.map(|x| TUNING.spend_share * x.max(0.0));
         let seconds_per_joule = if mean_power_w.is_finite() && mean_power_w > 0.0 {
-            ENERGY_WEIGHT / mean_power_w
+            TUNING.energy_weight / mean_power_w
         } else {
             0.0
         };
@@ -133,7 +118,7 @@ struct Step {
 /// steps that remove the most sharp corners for their cost first, while they fit the budget
 /// (a step that does not fit ends its path's climb; other paths' cheaper steps are still
 /// tried). Ties go to file order, so the choice is the same on any number of threads.
-pub fn choose(offers: &[Offer], budget: Budget) -> Vec<Option<usize>> {
+pub(crate) fn choose(offers: &[Offer], budget: Budget) -> Vec<Option<usize>> {
     let mut choice = vec![None; offers.len()];
     if budget.limits.iter().any(|&b| b.is_nan() || b <= 0.0) {
         return choice;
@@ -275,7 +260,7 @@ mod tests {
         path.push(outcome(1.2, -50.0, 5));
         let offers = [path, offer(outcome(1.1, 0.0, 4))];
         let weighed = Budget::new([0.0, 0.0], 2.4, 50.0);
-        assert_eq!(weighed.seconds_per_joule, ENERGY_WEIGHT / 50.0);
+        assert_eq!(weighed.seconds_per_joule, TUNING.energy_weight / 50.0);
         // Per corner: 0.2 + 0.2 = 0.4 s or 0.24 - 0.1 = 0.14 s; the other 0.275 s.
         assert_eq!(choose(&offers, weighed), [Some(1), Some(0)]);
         // Energy not counted: the faster way, and the other path still fits.

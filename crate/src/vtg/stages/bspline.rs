@@ -1,7 +1,7 @@
 //! Cubic NURBS curves in 3-D (the VTG paper's eq. 21–22).
 //!
 //! Most fits keep every weight 1, and eq. 21 reduces to a B-spline; [`Curve::rational`] takes
-//! weights where the fit finds they help ([`super::fit`]). Basis functions follow Piegl &
+//! weights where the fit finds they help ([`crate::vtg::fit`]). Basis functions follow Piegl &
 //! Tiller's A2.2 (the Cox–de Boor recursion of eq. 22), derivatives the derivative curves'
 //! control points (P&T eq. 3.8); a rational curve is evaluated in homogeneous coordinates and
 //! projected with the quotient rule (P&T eq. 4.8). The tests check both against A2.3.
@@ -9,13 +9,13 @@
 use crate::vec3::{cross, norm, sub};
 
 /// Degree of the curves.
-pub const DEGREE: usize = 3;
+pub(crate) const DEGREE: usize = 3;
 
 /// A clamped cubic B-spline: `knots.len() == ctrl.len() + 4`, first and last knots repeated
 /// four times. The control points of its first and second derivative curves are kept beside
 /// it (P&T eq. 3.8), so a point and both derivatives cost one pass of the basis recursion.
 #[derive(Debug, Clone)]
-pub struct Curve {
+pub(crate) struct Curve {
     knots: Vec<f64>,
     /// The control points (of a rational curve: the weighted points `w_i P_i`).
     ctrl: Net<3>,
@@ -66,18 +66,18 @@ impl<const D: usize> Net<D> {
 
 /// A point of the curve with its first and second derivatives.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Eval {
+pub(crate) struct Eval {
     /// `C(u)`.
-    pub p: [f64; 3],
+    pub(crate) p: [f64; 3],
     /// `C'(u)`.
-    pub d1: [f64; 3],
+    pub(crate) d1: [f64; 3],
     /// `C''(u)`.
-    pub d2: [f64; 3],
+    pub(crate) d2: [f64; 3],
 }
 
 impl Eval {
     /// Curvature `|C' × C''| / |C'|³`.
-    pub fn curvature(&self) -> f64 {
+    pub(crate) fn curvature(&self) -> f64 {
         let c = cross(&self.d1, &self.d2);
         let s = norm(&self.d1);
         if s < 1e-12 {
@@ -119,7 +119,7 @@ fn diff<const D: usize>(
 impl Curve {
     /// The curve with these knots and control points (derivative control points computed here;
     /// a zero-length knot interval gives a zero difference, P&T's 0/0 = 0).
-    pub fn new(knots: Vec<f64>, ctrl: Vec<[f64; 3]>) -> Self {
+    pub(crate) fn new(knots: Vec<f64>, ctrl: Vec<[f64; 3]>) -> Self {
         Self {
             ctrl: Net::new(&knots, ctrl),
             knots,
@@ -130,7 +130,8 @@ impl Curve {
 
     /// The rational curve (eq. 21) with these knots, control points and positive weights (one
     /// per control point; all 1 gives [`Curve::new`]'s curve).
-    pub fn rational(knots: Vec<f64>, ctrl: Vec<[f64; 3]>, weights: Vec<f64>) -> Self {
+    #[cfg(test)]
+    pub(crate) fn rational(knots: Vec<f64>, ctrl: Vec<[f64; 3]>, weights: Vec<f64>) -> Self {
         if weights.len() != ctrl.len() || weights.iter().all(|&w| w == 1.0) {
             return Self::new(knots, ctrl);
         }
@@ -147,7 +148,8 @@ impl Curve {
     }
 
     /// Whether the curve has weights other than 1.
-    pub fn is_rational(&self) -> bool {
+    #[cfg(test)]
+    pub(crate) fn is_rational(&self) -> bool {
         self.weights.is_some()
     }
 
@@ -170,28 +172,28 @@ impl Curve {
     }
 
     /// Knot vector.
-    pub fn knots(&self) -> &[f64] {
+    pub(crate) fn knots(&self) -> &[f64] {
         &self.knots
     }
 
     /// Control points (of a rational curve: weighted, `w_i P_i`).
-    pub fn ctrl(&self) -> &[[f64; 3]] {
+    pub(crate) fn ctrl(&self) -> &[[f64; 3]] {
         &self.ctrl.p
     }
 
     /// First parameter.
-    pub fn start(&self) -> f64 {
+    pub(crate) fn start(&self) -> f64 {
         self.knots.first().copied().unwrap_or(0.0)
     }
 
     /// Last parameter.
-    pub fn end(&self) -> f64 {
+    pub(crate) fn end(&self) -> f64 {
         self.knots.last().copied().unwrap_or(0.0)
     }
 
     /// Point and derivatives at `u` (clamped to the curve's range): one pass of A2.2 gives
     /// the basis functions of degrees 1, 2 and 3, which weigh `R`, `Q` and `P`.
-    pub fn eval(&self, u: f64) -> Eval {
+    pub(crate) fn eval(&self, u: f64) -> Eval {
         let n = self.ctrl.p.len();
         let zero = Eval {
             p: [0.0; 3],
@@ -236,7 +238,7 @@ impl Curve {
 /// its intermediate rows): `[N_{span−1..=span,1}, N_{span−2..=span,2}, N_{span−3..=span,3}]`,
 /// each padded to four entries.
 #[inline]
-pub fn basis_by_degree(knots: &[f64], span: usize, u: f64) -> [[f64; 4]; 3] {
+pub(crate) fn basis_by_degree(knots: &[f64], span: usize, u: f64) -> [[f64; 4]; 3] {
     let mut out = [[0.0; 4]; 3];
     if span < DEGREE || span + DEGREE >= knots.len() {
         return out;
@@ -261,7 +263,7 @@ pub fn basis_by_degree(knots: &[f64], span: usize, u: f64) -> [[f64; 4]; 3] {
 }
 
 /// Index of the knot span holding `u` (A2.1), for `n + 1` control points.
-pub fn find_span(knots: &[f64], n: usize, u: f64) -> usize {
+pub(crate) fn find_span(knots: &[f64], n: usize, u: f64) -> usize {
     let (Some(&hi), true) = (knots.get(n + 1), knots.len() > n + 1) else {
         return DEGREE;
     };

@@ -1,36 +1,30 @@
 //! Least-squares cubic B-spline fit of a polyline within a tolerance (Piegl & Tiller A9.7 with
 //! data-placed knots, banded normal equations, knot insertion where the error is too large).
 //!
-//! The data are the path with its corners blended ([`super::blend::samples`]): densely sampled
+//! The data are the path with its corners blended ([`crate::vtg::blend::samples`]): densely sampled
 //! over each corner transition, sparsely along straight runs. Because A9.7 puts the same number
 //! of data points in every knot span, the knots crowd at corners and thin out on straights, so
 //! a long straight stays straight while a corner follows its transition. The first and last
 //! points are interpolated (the path keeps its end points).
 
-use super::bspline::{basis_by_degree, find_span, Curve, DEGREE};
 use crate::vec3::{norm, sub};
-
-/// Data points per knot span in the first fit.
-const POINTS_PER_SPAN: f64 = 2.5;
-/// Weight of the penalty on the curve's second derivative: tiny, it only makes the normal
-/// equations definite where a span holds no data (see [`solve`]).
-const PENALTY: f64 = 1e-3;
-/// Refinement rounds (each inserts a knot in every span that misses the tolerance).
-const MAX_ROUNDS: usize = 6;
+use crate::vtg::bspline::{basis_by_degree, find_span, Curve, DEGREE};
+use crate::vtg::tuning::TUNING;
 
 /// A fitted curve with the data it was fitted to.
 #[derive(Debug, Clone)]
-pub struct Fit {
+pub(crate) struct Fit {
     /// The curve, parametrised by the arc length of the original polyline.
-    pub curve: Curve,
+    pub(crate) curve: Curve,
     /// Largest distance from a data point to the curve at its parameter, mm.
-    pub max_residual_mm: f64,
+    #[cfg_attr(not(test), allow(dead_code))] // checked by the tests only
+    pub(crate) max_residual_mm: f64,
 }
 
 /// Fits a clamped cubic B-spline to `data` at parameters `params` (non-decreasing, distinct
 /// ends) so that every data point lies within `tol_mm` of the curve at its parameter. `None`
 /// when the data are degenerate or the tolerance cannot be met.
-pub fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit> {
+pub(crate) fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit> {
     let m = data.len().checked_sub(1)?;
     if params.len() != data.len() || m < DEGREE || !tol_mm.is_finite() || tol_mm <= 0.0 {
         return None;
@@ -40,7 +34,7 @@ pub fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit> {
         return None;
     }
     // A9.7 (eq. 9.68–9.69): n + 1 control points, interior knots averaging the parameters.
-    let n = (((m + 1) as f64 / POINTS_PER_SPAN) as usize).clamp(DEGREE, m);
+    let n = (((m + 1) as f64 / TUNING.points_per_span) as usize).clamp(DEGREE, m);
     let d = (m + 1) as f64 / (n - DEGREE + 1) as f64;
     let mut knots = vec![u0; DEGREE + 1];
     for j in 1..=(n - DEGREE) {
@@ -52,7 +46,7 @@ pub fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit> {
         knots.push(k.max(prev));
     }
     knots.extend([u1; DEGREE + 1]);
-    for _ in 0..MAX_ROUNDS {
+    for _ in 0..TUNING.fit_rounds {
         let curve = solve(data, params, &knots)?;
         let mut worst = 0.0f64;
         let mut bad_spans: Vec<usize> = Vec::new();
@@ -121,40 +115,13 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<Curve> {
     let n = count - 1;
     let (q0, qm) = (*data.first()?, *data.last()?);
     let unknowns = n - 1;
-    let mut band = vec![[0.0f64; DEGREE + 1]; unknowns];
-    let mut rhs = vec![[0.0f64; 3]; unknowns];
-    // Adds one least-squares row Σ c_j P_j ≈ target (control indices 0..=n).
-    let mut add_row = |coef: &[(usize, f64)], target: [f64; 3]| {
-        let mut t = target;
-        for &(j, c) in coef {
-            let fixed = if j == 0 {
-                Some(q0)
-            } else if j == n {
-                Some(qm)
-            } else {
-                None
-            };
-            if let Some(p) = fixed {
-                for k in 0..3 {
-                    t[k] -= c * p[k];
-                }
-            }
-        }
-        for &(j, cj) in coef {
-            if j == 0 || j >= n {
-                continue;
-            }
-            let row = j - 1;
-            for k in 0..3 {
-                rhs[row][k] += cj * t[k];
-            }
-            for &(l, cl) in coef {
-                if l >= j && l < n && l - j <= DEGREE {
-                    band[row][l - j] += cj * cl;
-                }
-            }
-        }
+    let mut eq = Normal {
+        band: vec![[0.0f64; DEGREE + 1]; unknowns],
+        rhs: vec![[0.0f64; 3]; unknowns],
+        n,
+        ends: [q0, qm],
     };
+    let mut add_row = |coef: &[(usize, f64)], target: [f64; 3]| eq.add_row(coef, target);
     for (q, &u) in data.iter().zip(params) {
         let span = find_span(knots, n, u);
         let b = basis_by_degree(knots, span, u)[2];
@@ -172,7 +139,7 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<Curve> {
     // line's control points are unevenly spaced, and where the spans are tiny that penalty
     // outweighs the data and bends the curve into a hook. C'' of a straight line parametrised
     // by its length is zero whatever the knots, so this penalty leaves straights alone.
-    let w = PENALTY.sqrt();
+    let w = TUNING.fit_penalty.sqrt();
     for i in 0..n - 1 {
         let span = |a: usize, b: usize| knots[b] - knots[a];
         let (s1, s2, s12) = (span(i + 1, i + 4), span(i + 2, i + 5), span(i + 2, i + 4));
@@ -190,7 +157,7 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<Curve> {
             [0.0; 3],
         );
     }
-    let x = cholesky_band_solve(&mut band, &mut rhs)?;
+    let x = cholesky_band_solve(&mut eq.band, &mut eq.rhs)?;
     let mut ctrl = Vec::with_capacity(n + 1);
     ctrl.push(q0);
     ctrl.extend(x);
@@ -198,11 +165,59 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<Curve> {
     Some(Curve::new(knots.to_vec(), ctrl))
 }
 
+/// The normal equations of [`solve`] being built: the band of `NᵀN` and `NᵀR` over the inner
+/// control points (the end points, fixed, are moved to the right-hand side).
+struct Normal {
+    band: Vec<[f64; DEGREE + 1]>,
+    rhs: Vec<[f64; 3]>,
+    /// Index of the last control point.
+    n: usize,
+    /// The fixed first and last control points.
+    ends: [[f64; 3]; 2],
+}
+
+impl Normal {
+    /// Adds one least-squares row Σ c_j P_j ≈ target (control indices 0..=n).
+    #[allow(clippy::needless_range_loop)] // per axis, as the rows below are indexed
+    fn add_row(&mut self, coef: &[(usize, f64)], target: [f64; 3]) {
+        let n = self.n;
+        let mut t = target;
+        for &(j, c) in coef {
+            let fixed = if j == 0 {
+                Some(self.ends[0])
+            } else if j == n {
+                Some(self.ends[1])
+            } else {
+                None
+            };
+            if let Some(p) = fixed {
+                for k in 0..3 {
+                    t[k] -= c * p[k];
+                }
+            }
+        }
+        for &(j, cj) in coef {
+            if j == 0 || j >= n {
+                continue;
+            }
+            let row = j - 1;
+            for k in 0..3 {
+                self.rhs[row][k] += cj * t[k];
+            }
+            for &(l, cl) in coef {
+                if l >= j && l < n && l - j <= DEGREE {
+                    self.band[row][l - j] += cj * cl;
+                }
+            }
+        }
+    }
+}
+
 /// Solves `A x = b` for a symmetric positive definite band matrix stored by rows as
 /// `a[i][k] = A[i][i+k]` (Cholesky `A = UᵀU`, then two triangular solves). `None` if `A` is
 /// not positive definite.
 #[allow(clippy::needless_range_loop)] // band indices, as in the textbook algorithm
-pub fn cholesky_band_solve(
+pub(crate) fn cholesky_band_solve(
     a: &mut [[f64; DEGREE + 1]],
     b: &mut [[f64; 3]],
 ) -> Option<Vec<[f64; 3]>> {

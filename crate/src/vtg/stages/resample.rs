@@ -11,56 +11,56 @@
 //! the paper scales the Newton step. Points are taken on the curve (`P_{i+1} = C(u_{i+1})`),
 //! which line 11 also gives once Newton has converged.
 
-use super::bspline::{Curve, Eval};
 use crate::vec3::{dot, norm, sub};
+use crate::vtg::bspline::{Curve, Eval};
 
 /// Settings of the walk.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Walk {
+pub(crate) struct Walk {
     /// Chord tolerance between the curve and each step's chord, mm.
-    pub chord_tol_mm: f64,
+    pub(crate) chord_tol_mm: f64,
     /// Largest turn a step may cover, rad.
-    pub max_turn_rad: f64,
+    pub(crate) max_turn_rad: f64,
     /// Longest step, mm.
-    pub max_step_mm: f64,
+    pub(crate) max_step_mm: f64,
     /// Shortest step, mm: below it the written coordinates' rounding (0.001 mm) would turn the
     /// direction of a segment by more than a couple of degrees. Where the curve is tighter than
     /// this step allows, the step is taken anyway (the turn is then sharper than asked).
-    pub min_step_mm: f64,
+    pub(crate) min_step_mm: f64,
     /// Newton damping φ (1 = plain Newton).
-    pub phi: f64,
+    pub(crate) phi: f64,
     /// Newton stops when `|‖C(u) − P_i‖ − L_i| ≤ newton_tol_mm`.
-    pub newton_tol_mm: f64,
+    pub(crate) newton_tol_mm: f64,
 }
 
 /// One interpolated point.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Sample {
+pub(crate) struct Sample {
     /// Curve parameter.
-    pub u: f64,
+    pub(crate) u: f64,
     /// `C(u)`.
-    pub p: [f64; 3],
+    pub(crate) p: [f64; 3],
     /// Largest curvature of the curve over the step that ends here, 1/mm.
-    pub kappa: f64,
+    pub(crate) kappa: f64,
     /// Mean curvature over that step (turn of the tangent over the chord), 1/mm: what the
     /// feed rate of the written segment must respect.
-    pub mean_kappa: f64,
+    pub(crate) mean_kappa: f64,
     /// The step `L_i` asked for (0 for the first point and the shortened last step).
-    pub step_mm: f64,
+    pub(crate) step_mm: f64,
 }
 
 /// Steps walked, and the Newton error (eq. 28's speed fluctuation in mm).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct WalkStats {
+pub(crate) struct WalkStats {
     /// Steps taken.
-    pub steps: u64,
+    pub(crate) steps: u64,
     /// Sum of `|L_i − ‖P_{i+1} − P_i‖| / L_i` (eq. 28) over full steps.
-    pub fluctuation_sum: f64,
+    pub(crate) fluctuation_sum: f64,
 }
 
 /// Walks `curve` from start to end. Returns the points (first = `C(start)`, last = `C(end)`)
 /// or `None` if the walk does not converge (degenerate curve).
-pub fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample>> {
+pub(crate) fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<Sample>> {
     let (u_start, u_end) = (curve.start(), curve.end());
     if u_end.is_nan() || u_start.is_nan() || u_end <= u_start {
         return None;
@@ -74,22 +74,105 @@ pub fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<
         step_mm: 0.0,
     }];
     let end = curve.eval(u_end);
-    let (end_p, end_kappa) = (end.p, Some(end.curvature()));
-    let index = CurvatureIndex::new(curve);
-    let max_curvature =
-        |a: f64, b: f64, ends: [Option<f64>; 2]| index.max_with_ends(curve, a, b, ends);
+    let walker = Walker {
+        curve,
+        w,
+        index: CurvatureIndex::new(curve),
+        u_end,
+        end_p: end.p,
+        end_kappa: Some(end.curvature()),
+    };
     let mut u = u_start;
     let mut p = first.p;
     // Bounded: each accepted step advances u by at least a minimum amount.
     let max_points = 200_000usize;
     while out.len() < max_points {
         let e = curve.eval(u);
+        let (un, pn, k, step, d1_next) = walker.step(u, &p, &e)?;
+        if step > 0.0 {
+            let got = norm(&sub(&pn, &p));
+            stats.fluctuation_sum += ((step - got) / step).abs();
+        }
+        stats.steps += 1;
+        let t1 = d1_next.unwrap_or_else(|| curve.eval(un).d1);
+        out.push(Sample {
+            u: un,
+            p: pn,
+            kappa: k,
+            mean_kappa: mean_curvature(&e.d1, &t1, norm(&sub(&pn, &p))),
+            step_mm: step,
+        });
+        if un >= u_end {
+            return Some(out);
+        }
+        u = un;
+        p = pn;
+    }
+    None
+}
+
+/// Mean curvature of a stretch: the turn of the tangent from `t0` to `t1` over the chord
+/// length (0 where either is degenerate).
+fn mean_curvature(t0: &[f64; 3], t1: &[f64; 3], chord: f64) -> f64 {
+    let (n0, n1) = (norm(t0), norm(t1));
+    if n0 > 0.0 && n1 > 0.0 && chord > 0.0 {
+        crate::math::acos((dot(t0, t1) / (n0 * n1)).clamp(-1.0, 1.0)) / chord
+    } else {
+        0.0
+    }
+}
+
+/// A step of the walk: the parameter and point reached, the largest curvature over the step,
+/// the step `L_i` asked for (0: the end, reached by a shorter or longer last step) and the
+/// curve's derivative at the point (`None`: not evaluated there).
+type Step = (f64, [f64; 3], f64, f64, Option<[f64; 3]>);
+
+/// One curve being walked, with what every step reads: split from [`walk`] so choosing a step
+/// (try, shrink, lengthen by bisection, stretch to the end) reads apart from recording it.
+struct Walker<'c> {
+    curve: &'c Curve,
+    w: &'c Walk,
+    index: CurvatureIndex,
+    u_end: f64,
+    end_p: [f64; 3],
+    end_kappa: Option<f64>,
+}
+
+impl Walker<'_> {
+    /// Largest curvature on `[a, b]`, given the curvature at the ends where known.
+    fn max_curvature(&self, a: f64, b: f64, ends: [Option<f64>; 2]) -> f64 {
+        self.index.max_with_ends(self.curve, a, b, ends)
+    }
+
+    /// The next step from `u` (point `p`, curve `e` there); `None` if none converges.
+    fn step(&self, u: f64, p: &[f64; 3], e: &Eval) -> Option<Step> {
+        let w = self.w;
+        let (accepted, too_long) = self.shrink(u, p, e);
+        let accepted = self.lengthen(u, p, e, accepted, too_long);
+        let (mut un, mut pn, k, mut step, mut d1_next) = accepted?;
+        // Do not leave a sliver before the end: stretch this step to it instead (it is then
+        // the last, shorter-or-longer step to the end, not a full `L_i`, as the end step is).
+        if un < self.u_end
+            && norm(&sub(&self.end_p, &pn)) < w.min_step_mm
+            && (self.u_end - un) * norm(&e.d1) < 2.0 * w.min_step_mm
+        {
+            un = self.u_end;
+            pn = self.end_p;
+            step = 0.0;
+            d1_next = None;
+        }
+        Some((un, pn, k, step, d1_next))
+    }
+
+    /// The first step that fits, from the longest the curvature at `u` allows, shrunk to what
+    /// the curvature met on the way allows; and the shortest step tried that did not fit.
+    fn shrink(&self, u: f64, p: &[f64; 3], e: &Eval) -> (Option<Step>, Option<f64>) {
+        let (w, curve, u_end) = (self.w, self.curve, self.u_end);
         let kappa = e.curvature();
         // No longer than what is left of the curve (a closed loop ends near its start).
         let left = (u_end - u) * norm(&e.d1) * 1.05;
         let mut step = step_for(kappa, w).min(left).max(w.min_step_mm);
-        let remaining = norm(&sub(&end_p, &p));
-        let mut accepted = None;
+        let remaining = norm(&sub(&self.end_p, p));
         // The shortest step tried that did not fit.
         let mut too_long: Option<f64> = None;
         for _ in 0..40 {
@@ -99,26 +182,24 @@ pub fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<
                 // Try the end point as the next point: the turn and sagitta of the stretch are
                 // judged on its length along the curve, not on the chord, which is nothing at
                 // all when a closed loop comes back to its start.
-                let k = max_curvature(u, u_end, [Some(kappa), end_kappa]);
+                let k = self.max_curvature(u, u_end, [Some(kappa), self.end_kappa]);
                 let along = arc_length(curve, u, u_end);
                 if remaining >= 0.5 * along && fits(k, along, w) {
-                    accepted = Some((u_end, end_p, k, 0.0, None));
-                    break;
+                    return (Some((u_end, self.end_p, k, 0.0, None)), too_long);
                 }
             }
             let floor = step <= w.min_step_mm;
-            if let Some((un, at)) = newton(curve, u, &e, &p, step, w) {
+            if let Some((un, at)) = newton(curve, u, e, p, step, w) {
                 if un < u_end {
-                    let k = max_curvature(u, un, [Some(kappa), Some(at.curvature())]);
+                    let k = self.max_curvature(u, un, [Some(kappa), Some(at.curvature())]);
                     if floor || fits(k, step, w) {
-                        accepted = Some((un, at.p, k, step, Some(at.d1)));
-                        break;
+                        return (Some((un, at.p, k, step, Some(at.d1))), too_long);
                     }
                 }
             }
             too_long = Some(step);
             // Shrink to what the curvature met on the way allows (at least halving).
-            let k = max_curvature(
+            let k = self.max_curvature(
                 u,
                 (u + 2.0 * step / norm(&e.d1).max(1e-9)).min(u_end),
                 [Some(kappa), None],
@@ -130,9 +211,22 @@ pub fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<
                 .min(step_for(k, w).max(0.25 * step))
                 .max(w.min_step_mm);
         }
-        // The longest step that fits lies between the one accepted and the shortest that did
-        // not: a straight run up to a corner is then one step, not a series of ever shorter
-        // ones whose junctions the firmware would have to plan.
+        (None, too_long)
+    }
+
+    /// The longest step that fits lies between the one accepted and the shortest that did
+    /// not: a straight run up to a corner is then one step, not a series of ever shorter
+    /// ones whose junctions the firmware would have to plan.
+    fn lengthen(
+        &self,
+        u: f64,
+        p: &[f64; 3],
+        e: &Eval,
+        mut accepted: Option<Step>,
+        too_long: Option<f64>,
+    ) -> Option<Step> {
+        let (w, u_end) = (self.w, self.u_end);
+        let kappa = e.curvature();
         if let (Some((_, _, _, ok, Some(_))), Some(mut bad)) = (accepted, too_long) {
             let mut ok = ok;
             for _ in 0..BISECTIONS {
@@ -140,10 +234,10 @@ pub fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<
                     break;
                 }
                 let mid = 0.5 * (ok + bad);
-                let fitted = newton(curve, u, &e, &p, mid, w)
+                let fitted = newton(self.curve, u, e, p, mid, w)
                     .filter(|(un, _)| *un < u_end)
                     .map(|(un, at)| {
-                        let k = max_curvature(u, un, [Some(kappa), Some(at.curvature())]);
+                        let k = self.max_curvature(u, un, [Some(kappa), Some(at.curvature())]);
                         (un, at, k)
                     })
                     .filter(|(_, _, k)| fits(*k, mid, w));
@@ -156,47 +250,8 @@ pub fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Option<Vec<
                 }
             }
         }
-        let (mut un, mut pn, k, mut step, mut d1_next) = accepted?;
-        // Do not leave a sliver before the end: stretch this step to it instead (it is then
-        // the last, shorter-or-longer step to the end, not a full `L_i`, as the end step is).
-        if un < u_end
-            && norm(&sub(&end_p, &pn)) < w.min_step_mm
-            && (u_end - un) * norm(&e.d1) < 2.0 * w.min_step_mm
-        {
-            un = u_end;
-            pn = end_p;
-            step = 0.0;
-            d1_next = None;
-        }
-        if step > 0.0 {
-            let got = norm(&sub(&pn, &p));
-            stats.fluctuation_sum += ((step - got) / step).abs();
-        }
-        stats.steps += 1;
-        // Mean curvature of the stretch: the turn of the tangent over the chord length.
-        let t0 = e.d1;
-        let t1 = d1_next.unwrap_or_else(|| curve.eval(un).d1);
-        let (n0, n1) = (norm(&t0), norm(&t1));
-        let chord = norm(&sub(&pn, &p));
-        let mean_kappa = if n0 > 0.0 && n1 > 0.0 && chord > 0.0 {
-            crate::math::acos((dot(&t0, &t1) / (n0 * n1)).clamp(-1.0, 1.0)) / chord
-        } else {
-            0.0
-        };
-        out.push(Sample {
-            u: un,
-            p: pn,
-            kappa: k,
-            mean_kappa,
-            step_mm: step,
-        });
-        if un >= u_end {
-            return Some(out);
-        }
-        u = un;
-        p = pn;
+        accepted
     }
-    None
 }
 
 /// Length of the curve between parameters `a` and `b`, as a polyline through 16 points on it
@@ -237,7 +292,7 @@ fn fits(kappa: f64, step: f64, w: &Walk) -> bool {
 /// are computed once: a long step over many spans costs only table reads, and a partly
 /// covered span its samples inside the interval and the curvature at the interval's ends.
 #[derive(Debug, Clone)]
-pub struct CurvatureIndex {
+pub(crate) struct CurvatureIndex {
     /// Distinct knots.
     breaks: Vec<f64>,
     /// Curvature of span `i` (`breaks[i]..breaks[i+1]`) at `SPAN_SAMPLES` equally spaced
@@ -252,7 +307,7 @@ const SPAN_SAMPLES: usize = 6;
 
 impl CurvatureIndex {
     /// Samples every span of `curve`.
-    pub fn new(curve: &Curve) -> Self {
+    pub(crate) fn new(curve: &Curve) -> Self {
         let mut breaks: Vec<f64> = Vec::new();
         for &k in curve.knots() {
             if breaks.last().is_none_or(|&b| k > b) {
@@ -280,14 +335,21 @@ impl CurvatureIndex {
     }
 
     /// Largest curvature on `[a, b]`.
-    pub fn max(&self, curve: &Curve, a: f64, b: f64) -> f64 {
+    #[cfg(test)]
+    pub(crate) fn max(&self, curve: &Curve, a: f64, b: f64) -> f64 {
         self.max_with_ends(curve, a, b, [None, None])
     }
 
     /// [`Self::max`] given the curvature at `a` and/or `b` where the caller has already
     /// evaluated the curve there (the walk has, at its current point and at the Newton
     /// solution): the same figure without evaluating again.
-    pub fn max_with_ends(&self, curve: &Curve, a: f64, b: f64, ends: [Option<f64>; 2]) -> f64 {
+    pub(crate) fn max_with_ends(
+        &self,
+        curve: &Curve,
+        a: f64,
+        b: f64,
+        ends: [Option<f64>; 2],
+    ) -> f64 {
         // Spans: i such that breaks[i] < b and breaks[i+1] > a.
         let first = self.breaks.partition_point(|&k| k <= a).saturating_sub(1);
         let mut best = 0.0f64;
@@ -319,12 +381,6 @@ impl CurvatureIndex {
         }
         best
     }
-}
-
-/// Largest curvature on `[a, b]` (see [`CurvatureIndex`]; builds the index, so for one-off
-/// queries).
-pub fn max_curvature(curve: &Curve, a: f64, b: f64) -> f64 {
-    CurvatureIndex::new(curve).max(curve, a, b)
 }
 
 /// Eq. 27 predictor and Newton corrector: `u` past `u_i` with `‖C(u) − P_i‖ = L`; `e` is the

@@ -2,36 +2,37 @@
 //! lower than the original ran there and, if asked, no higher), and on a classic-jerk firmware
 //! the ramps that let the feed rise again without a stall at the junction.
 
-use super::smooth::{Settings, Smoothed};
 use crate::vec3::{lerp, norm, sub};
+use crate::vtg::smooth::{Settings, Smoothed};
+use crate::vtg::tuning::TUNING;
 
 /// The speed terms of one new segment.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StepSpeed {
+pub(crate) struct StepSpeed {
     /// The original's programmed feed there, mm/s.
-    pub programmed: f64,
+    pub(crate) programmed: f64,
     /// The speed eq. 29 allows for the segment's curvature, mm/s (infinite below `K_cr`).
-    pub limit: f64,
+    pub(crate) limit: f64,
     /// The original's planned speed over the stretch the segment replaces, mm/s: the feed is
     /// never lowered below it.
-    pub floor: f64,
+    pub(crate) floor: f64,
     /// The original's highest planned speed over that stretch, mm/s (infinite when unknown).
-    pub ceiling: f64,
+    pub(crate) ceiling: f64,
     /// The acceleration the firmware used there, mm/s² (0: unknown).
-    pub accel: f64,
+    pub(crate) accel: f64,
 }
 
 /// A rewritten path as it is written: points, filament and feed of each segment.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct Written {
+pub(crate) struct Written {
     /// Points after the start point.
-    pub points: Vec<[f64; 3]>,
+    pub(crate) points: Vec<[f64; 3]>,
     /// Filament pushed from the path start to each point, mm.
-    pub e: Vec<f64>,
+    pub(crate) e: Vec<f64>,
     /// Feed of the segment ending at each point, mm/s.
-    pub feed_mm_s: Vec<f64>,
+    pub(crate) feed_mm_s: Vec<f64>,
     /// Segments written with a lowered feed.
-    pub lowered: u64,
+    pub(crate) lowered: u64,
 }
 
 impl Smoothed {
@@ -42,7 +43,7 @@ impl Smoothed {
     /// energy). On a classic-jerk firmware rising feeds are ramped: such a planner counts a
     /// rise of the feed from one block to the next as jerk against the new block's full speed,
     /// so the segment where it rises is cut into pieces that each rise by a share of the jerk.
-    pub fn written(
+    pub(crate) fn written(
         &self,
         scale: Option<f64>,
         ceiling: bool,
@@ -79,28 +80,21 @@ impl Smoothed {
     }
 }
 
-/// Share of the jerk limit a ramp's feed may rise by from one piece to the next (the rest is
-/// left for the change of direction at the same junction).
-const RAMP_JERK_SHARE: f64 = 0.7;
-/// Shortest ramp piece, mm.
-const MIN_RAMP_PIECE_MM: f64 = 0.02;
-
 /// Splits segments where the written feed rises by more than a classic-jerk planner takes
 /// without slowing down.
 ///
-/// Such a planner (Marlin's and Prusa firmware's classic jerk, and the slicers' estimators
-/// that copy it) compares the *nominal* speeds of the two blocks at a junction: where the
-/// feed falls, the previous block's speed is scaled down to the junction speed first, but
-/// where it rises, the new block's full feed counts against the old one's, and a rise from
-/// 30 to 80 mm/s against a 7 mm/s jerk limit brings the junction down to 4 mm/s. Lowering the
-/// feed on a curve (eq. 29) would cost a near-stop wherever the feed rises again. So a segment
-/// whose feed rises by more than the limit is cut into collinear pieces whose feeds rise by
-/// `RAMP_JERK_SHARE` of it at a time, each as long as the machine needs to accelerate through
-/// it at `accel[i]` (segment `i`'s acceleration): the speed profile is the one it would have
-/// had anyway, and no junction is penalised. The pieces lie on the segment and share its
-/// filament by length.
+/// Such a planner (Marlin's and Prusa firmware's classic jerk, and the slicers' estimators that
+/// copy it) compares the *nominal* speeds of the two blocks at a junction: where the feed falls,
+/// the previous block's speed is scaled down to the junction speed first, but where it rises, the
+/// new block's full feed counts against the old one's, and a rise from 30 to 80 mm/s against a 7
+/// mm/s jerk limit brings the junction down to 4 mm/s. Lowering the feed on a curve (eq. 29) would
+/// cost a near-stop wherever the feed rises again. So a segment whose feed rises by more than the
+/// limit is cut into collinear pieces whose feeds rise by `Tuning::ramp_jerk_share` of it at a
+/// time, each as long as the machine needs to accelerate through it at `accel[i]` (segment `i`'s
+/// acceleration): the speed profile is the one it would have had anyway, and no junction is
+/// penalised. The pieces lie on the segment and share its filament by length.
 fn ramp_up(out: &mut Written, start: [f64; 3], start_feed: f64, jerk: f64, accel: &[f64]) {
-    let rise = RAMP_JERK_SHARE * jerk;
+    let rise = TUNING.ramp_jerk_share * jerk;
     if rise <= 0.0
         || accel.len() != out.points.len()
         || out.feed_mm_s.windows(2).all(|w| w[1] <= w[0] + jerk)
@@ -120,8 +114,8 @@ fn ramp_up(out: &mut Written, start: [f64; 3], start_feed: f64, jerk: f64, accel
         if i > 0 && target > now + jerk && len > 0.0 && a > 0.0 {
             loop {
                 let next = (now + rise).min(target);
-                let piece = ((next * next - now * now) / (2.0 * a)).max(MIN_RAMP_PIECE_MM);
-                if next >= target || done + piece >= len - MIN_RAMP_PIECE_MM {
+                let piece = ((next * next - now * now) / (2.0 * a)).max(TUNING.min_ramp_piece_mm);
+                if next >= target || done + piece >= len - TUNING.min_ramp_piece_mm {
                     break;
                 }
                 done += piece;

@@ -24,50 +24,52 @@
 //! largest the tolerance allows. Of the family's members that fit the legs, the one the
 //! look-ahead (as Klipper plans it: `stretch_time`) runs through fastest is kept.
 
-use super::deviation::both_ways;
-use super::hairpin::{cross_z, unit, Hairpin};
 use crate::vec3::{dot, norm, sub};
+use crate::vtg::deviation::both_ways;
+use crate::vtg::hairpin::{cross_z, unit, Hairpin};
+use crate::vtg::tuning::TUNING;
 
 /// What the firmware does at a corner: its limits there and the speeds either side.
 #[derive(Debug, Clone, Copy)]
-pub struct Firmware {
+pub(crate) struct Firmware {
     /// Acceleration of the moves, mm/s².
-    pub accel_mm_s2: f64,
+    pub(crate) accel_mm_s2: f64,
     /// Junction deviation equivalent to the square-corner velocity, mm.
-    pub junction_deviation_mm: f64,
+    pub(crate) junction_deviation_mm: f64,
     /// Programmed feed of the leg before and of the leg after, mm/s.
-    pub feed_mm_s: [f64; 2],
+    pub(crate) feed_mm_s: [f64; 2],
     /// Planned speed at the far end of each leg (the start of the one before, the end of the
     /// one after), mm/s.
-    pub ends_mm_s: [f64; 2],
+    pub(crate) ends_mm_s: [f64; 2],
 }
 
 /// The constraints of a polygon corner.
 #[derive(Debug, Clone, Copy)]
-pub struct Bounds {
+pub(crate) struct Bounds {
     /// Largest distance from the original both ways, mm.
-    pub tolerance_mm: f64,
+    pub(crate) tolerance_mm: f64,
     /// Largest turn of one vertex, rad.
-    pub max_turn_rad: f64,
+    pub(crate) max_turn_rad: f64,
     /// Shortest step, mm.
-    pub min_step_mm: f64,
+    pub(crate) min_step_mm: f64,
     /// How far along each leg from the corner the polygon may reach, mm.
-    pub room_mm: [f64; 2],
+    pub(crate) room_mm: [f64; 2],
 }
 
 /// A corner's polygon, and how the firmware runs it.
 #[derive(Debug, Clone)]
-pub struct Corner {
-    /// The polygon as a one-corner [`Hairpin`] (for [`super::hairpin::substitute`]).
-    pub pin: Hairpin,
+pub(crate) struct Corner {
+    /// The polygon as a one-corner [`Hairpin`] (for [`crate::vtg::hairpin::substitute`]).
+    pub(crate) pin: Hairpin,
     /// Measured largest distance from the original, both ways, mm.
-    pub deviation_mm: f64,
+    pub(crate) deviation_mm: f64,
     /// Slowest speed through the polygon, mm/s.
-    pub slowest_mm_s: f64,
+    pub(crate) slowest_mm_s: f64,
     /// Slowest speed through the sharp corner, mm/s (the same model).
-    pub sharp_mm_s: f64,
+    pub(crate) sharp_mm_s: f64,
     /// Time through the legs and the sharp corner, s.
-    pub sharp_time_s: f64,
+    #[cfg_attr(not(test), allow(dead_code))] // checked by the tests only
+    pub(crate) sharp_time_s: f64,
 }
 
 /// Shares of the largest turn tried at the apex.
@@ -76,14 +78,11 @@ const APEX_SHARES: [f64; 2] = [1.0, 0.85];
 const RAMP_DEG: [f64; 8] = [1.5, 2.5, 4.0, 6.0, 9.0, 13.0, 18.0, 24.0];
 /// Most vertices either side of the apex.
 const MAX_SIDE_VERTICES: usize = 12;
-/// Share of the tolerance the polygon is sized for (the rest: rounding of written coordinates
-/// and the sampling of the check).
-const TOLERANCE_SHARE: f64 = 0.97;
 /// Golden-section steps of the placement search.
 const PLACEMENT_STEPS: usize = 48;
 
 /// The polygon for corner `i` of `pts` that the firmware runs through fastest, if one fits.
-pub fn find(pts: &[[f64; 3]], i: usize, bounds: &Bounds, fw: &Firmware) -> Option<Corner> {
+pub(crate) fn find(pts: &[[f64; 3]], i: usize, bounds: &Bounds, fw: &Firmware) -> Option<Corner> {
     let (p0, v, p2) = (*pts.get(i.checked_sub(1)?)?, *pts.get(i)?, *pts.get(i + 1)?);
     if (p0[2] - v[2]).abs() > 1e-9 || (p2[2] - v[2]).abs() > 1e-9 {
         return None;
@@ -97,7 +96,7 @@ pub fn find(pts: &[[f64; 3]], i: usize, bounds: &Bounds, fw: &Firmware) -> Optio
     }
     let legs = [norm(&sub(&v, &p0)), norm(&sub(&p2, &v))];
     let sharp = stretch_time(&legs_frame(theta, legs, Vec::new()), fw);
-    let budget = TOLERANCE_SHARE * bounds.tolerance_mm;
+    let budget = TUNING.corner_tolerance_share * bounds.tolerance_mm;
     // Most corners have short legs: where the most compact member (the steepest ramp, the
     // fewest vertices) reaches past the room, so would every other.
     let steepest = RAMP_DEG[RAMP_DEG.len() - 1].to_radians();
@@ -161,6 +160,32 @@ pub fn find(pts: &[[f64; 3]], i: usize, bounds: &Bounds, fw: &Firmware) -> Optio
         sharp_mm_s: sharp.slowest_mm_s,
         sharp_time_s: sharp.time_s,
     })
+}
+
+/// The minimum of `f` on `[lo, hi]` by golden-section search in [`PLACEMENT_STEPS`] steps, and
+/// where it lies: the apex height at which a shape strays least from the corner.
+fn golden_min(mut lo: f64, mut hi: f64, f: impl Fn(f64) -> f64) -> (f64, f64) {
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    for _ in 0..PLACEMENT_STEPS {
+        if f1 <= f2 {
+            hi = x2;
+            (x2, f2) = (x1, f1);
+            x1 = hi - g * (hi - lo);
+            f1 = f(x1);
+        } else {
+            lo = x1;
+            (x1, f1) = (x2, f2);
+            x2 = lo + g * (hi - lo);
+            f2 = f(x2);
+        }
+    }
+    if f1 <= f2 {
+        (x1, f1)
+    } else {
+        (x2, f2)
+    }
 }
 
 /// One member of the family, placed and sized, in the corner's frame: the corner at the
@@ -237,24 +262,7 @@ impl Shape {
             return None;
         };
         let span = 2.0 * (mf + 1.0);
-        let (mut lo, mut hi) = (y_max - span, y_max - 1e-9 * span);
-        let g = 0.5 * (5f64.sqrt() - 1.0);
-        let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-        let (mut f1, mut f2) = (spread(x1), spread(x2));
-        for _ in 0..PLACEMENT_STEPS {
-            if f1 <= f2 {
-                hi = x2;
-                (x2, f2) = (x1, f1);
-                x1 = hi - g * (hi - lo);
-                f1 = spread(x1);
-            } else {
-                lo = x1;
-                (x1, f1) = (x2, f2);
-                x2 = lo + g * (hi - lo);
-                f2 = spread(x2);
-            }
-        }
-        let (y, unit_spread) = if f1 <= f2 { (x1, f1) } else { (x2, f2) };
+        let (y, unit_spread) = golden_min(y_max - span, y_max - 1e-9 * span, spread);
         if !(unit_spread.is_finite() && unit_spread > 0.0) {
             return None;
         }

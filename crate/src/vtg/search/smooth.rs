@@ -1,138 +1,101 @@
 //! One extrusion path through the VTG pipeline: blend its corners, fit (within tolerance), walk
 //! the curve with Algorithm 1, spread the path's filament over the new points, cap the feed
 //! where the curvature is above `K_cr`, and check the result against the original polyline.
-//! The feed each new segment is then written with is [`super::feed`]'s business.
+//! The feed each new segment is then written with is [`crate::vtg::feed`]'s business.
 //!
-//! The tolerance is shared: the corner blends ([`super::blend`]) may use `BLEND_SHARE` of it,
-//! the fit's residuals `FIT_SHARE` and the chords of the walk `CHORD_SHARE` (together a little
-//! more than all of it: they seldom peak at the same point). If the measured deviation still
-//! exceeds the tolerance, the blends are made smaller and the path tried again; a path that
-//! cannot be rounded within the tolerance is kept as it was.
+//! The tolerance is shared: the corner blends ([`crate::vtg::blend`]) may use `Tuning::blend_share`
+//! of it, the fit's residuals `Tuning::fit_share` and the chords of the walk `Tuning::chord_share`
+//! (together a little more than all of it: they seldom peak at the same point). If the measured
+//! deviation still exceeds the tolerance, the blends are made smaller and the path tried again; a
+//! path that cannot be rounded within the tolerance is kept as it was.
 
-use super::blend;
-use super::bspline::{arc_lengths, segment_at};
-use super::corner;
-use super::deviation::both_ways;
-use super::feed::StepSpeed;
-use super::fit::fit;
-use super::hairpin;
-use super::keyhole;
-use super::kinematics::KinematicLimits;
-use super::resample::{walk_curve, Walk, WalkStats};
 use crate::plan::Profile;
 use crate::vec3::{dot, norm, sub};
-
-/// Share of the tolerance the corner blends may use: most of it, since the fillet's radius sets
-/// the corner speed (a firmware planner lets a curve of radius `r` be run at `√(a r)`).
-///
-/// With the fit's and the chords' shares this adds up to more than the whole tolerance, on
-/// purpose: the three seldom peak at the same point (the fit's residuals are largest where a
-/// blend meets its legs, the blend's deviation at its apex), and the measured check after the
-/// walk catches the paths where they do, which are tried again with smaller blends. Measured
-/// against 0.8 on the 31 files by default: sharp corners fell further on 17 (less far on 6,
-/// none below the 40 %), energy further on 25, every output still within the
-/// tolerance, the 34 MB file no slower; and the K1C benchy's trade at `--allow-slower 1` rose
-/// from −33.9 % to −35.9 % of its sharp corners. (0.92 gained 0.2 points more on the K1C; the
-/// margin left to the fit is then a tenth of what it asks for.)
-const BLEND_SHARE: f64 = 0.9;
-/// Share of the tolerance the fit may use (the blended data are smooth: a small share does).
-const FIT_SHARE: f64 = 0.1;
-/// Share of the tolerance the walk's chords may use. In a fillet the turn per step binds first
-/// (a step turning by φ on radius `r` sags `r (1 − cos(φ/2))`, 0.03 r at 27°), so little is
-/// needed.
-const CHORD_SHARE: f64 = 0.09;
-/// Attempts, each with blends `RETRY_SCALE` the size of the previous one.
-const ATTEMPTS: usize = 4;
-/// Blend size of a retry relative to the attempt before.
-const RETRY_SCALE: f64 = 0.7;
-/// Shortest interpolation step on firmware that plans every segment (Klipper), mm (see
-/// [`Walk::min_step_mm`]).
-pub const MIN_STEP_MM: f64 = 0.03;
-/// Shortest interpolation step on Marlin and Prusa firmware, mm: they drop a block of fewer than
-/// `MIN_STEPS_PER_SEGMENT` (6) steps, or of at most `DROP_SEGMENTS` (5), and fold its distance
-/// into the next, which at 80–100 steps/mm is anything under 0.05–0.075 mm. Shorter steps
-/// would be merged by the firmware into segments that turn twice as much as written.
-pub const MARLIN_MIN_STEP_MM: f64 = 0.06;
-/// Longest gap between data points on straight runs, mm.
-const STRAIGHT_SPACING_MM: f64 = 3.0;
-/// Largest turn of one interpolation step, as a share of the critical angle.
-pub(crate) const STEP_TURN_SHARE: f64 = 0.9;
-/// Largest counter-turn where a keyhole leaves or rejoins the path, as a share of the critical
-/// angle (below the walk's share: the leg itself may bend a little there).
-const KINK_SHARE: f64 = 0.8;
+use crate::vtg::blend;
+use crate::vtg::bspline::{arc_lengths, segment_at};
+use crate::vtg::deviation::both_ways;
+use crate::vtg::feed::StepSpeed;
+use crate::vtg::fit::fit;
+use crate::vtg::hairpin;
+use crate::vtg::keyhole;
+use crate::vtg::kinematics::KinematicLimits;
+use crate::vtg::klipper;
+use crate::vtg::resample::{walk_curve, Sample, Walk, WalkStats};
+use crate::vtg::tuning::TUNING;
 
 /// Settings for [`smooth_path`].
 #[derive(Debug, Clone, Copy)]
-pub struct Settings {
+pub(crate) struct Settings {
     /// Tolerance, mm.
-    pub tolerance_mm: f64,
+    pub(crate) tolerance_mm: f64,
     /// Critical angle δθ, rad.
-    pub critical_rad: f64,
+    pub(crate) critical_rad: f64,
     /// Kinematic limits (eq. 29–30).
-    pub limits: KinematicLimits,
+    pub(crate) limits: KinematicLimits,
     /// Lower the feed where the curvature is above what the limits allow (eq. 29).
-    pub limit_feed: bool,
+    pub(crate) limit_feed: bool,
     /// The machine's X/Y acceleration limit (`M201`), mm/s²: the ceiling of `A_n`. Where the
     /// original's planned moves are known, `A_n` of a stretch is the acceleration the firmware
     /// used there (files change it per feature), within this.
-    pub max_normal_accel_mm_s2: f64,
+    pub(crate) max_normal_accel_mm_s2: f64,
     /// `f₁` when `J_n` follows `A_n` (`J_n = A_n f₁`, the default), Hz; `None` keeps
     /// `limits.normal_jerk_mm_s3` everywhere.
-    pub jerk_per_accel_hz: Option<f64>,
-    /// Shortest interpolation step, mm ([`MIN_STEP_MM`] or [`MARLIN_MIN_STEP_MM`]).
-    pub min_step_mm: f64,
+    pub(crate) jerk_per_accel_hz: Option<f64>,
+    /// Shortest interpolation step, mm (`Tuning::klipper_min_step_mm` or
+    /// `Tuning::marlin_min_step_mm`).
+    pub(crate) min_step_mm: f64,
     /// The per-axis jerk of a classic-jerk firmware, mm/s (`None` on junction-deviation and
     /// Klipper planners): rising feeds are then ramped, since such a planner counts a rise of
     /// the feed from one block to the next as jerk against the new block's full speed.
-    pub classic_jerk_mm_s: Option<f64>,
+    pub(crate) classic_jerk_mm_s: Option<f64>,
     /// The first scale of the eq. 29 speeds a rewrite is tried with (1: the speeds as they
     /// are); [`crate::vtg::vtg`] raises it where the dynamics model finds the rewrite at 1
     /// rings more than the original.
-    pub feed_cap_scale: f64,
-    /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`super::arcs`]).
-    pub arcs: bool,
+    pub(crate) feed_cap_scale: f64,
+    /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`crate::vtg::arcs`]).
+    pub(crate) arcs: bool,
     /// The slowest a rounded corner may be run, as a share of the firmware's speed through the
     /// sharp one: 1 rounds only the corners the machine runs round at least as fast (the free
     /// rewrite); below 1, the dearer variants of a path that
-    /// [`super::VtgOptions::allow_slower_pct`] may buy (0 rounds every corner it can).
-    pub min_speed_share: f64,
+    /// [`crate::vtg::VtgOptions::allow_slower_pct`] may buy (0 rounds every corner it can).
+    pub(crate) min_speed_share: f64,
     /// Turn single corners too tight to fillet round a [`keyhole`] loop where one fits.
-    pub keyholes: bool,
+    pub(crate) keyholes: bool,
     /// Which side of its corners a path may be rounded on ([`blend::Line`]).
-    pub line: blend::Line,
+    pub(crate) line: blend::Line,
     /// Klipper's square-corner velocity, mm/s, on a Klipper machine (`None` elsewhere): its
-    /// sharp corners are then turned as polygons placed for its look-ahead ([`corner`]).
-    pub klipper_scv_mm_s: Option<f64>,
+    /// sharp corners are then turned as polygons placed for its look-ahead ([`klipper`]).
+    pub(crate) klipper_scv_mm_s: Option<f64>,
 }
 
 /// A rewritten path: the new geometry, and what the feed of each new segment is made of.
 #[derive(Debug, Clone, Default)]
-pub struct Smoothed {
+pub(crate) struct Smoothed {
     /// New points after the start point (the last equals the original end).
-    pub points: Vec<[f64; 3]>,
+    pub(crate) points: Vec<[f64; 3]>,
     /// Filament pushed from the path start to each point, mm.
-    pub e: Vec<f64>,
+    pub(crate) e: Vec<f64>,
     /// The speed terms of the segment ending at each point.
-    pub steps: Vec<StepSpeed>,
+    pub(crate) steps: Vec<StepSpeed>,
     /// Segments whose curvature stays above `K_cr`.
-    pub above_k_cr: u64,
+    pub(crate) above_k_cr: u64,
     /// Measured largest distance to the original polyline, mm.
-    pub deviation_mm: f64,
+    pub(crate) deviation_mm: f64,
     /// Walk statistics (eq. 28).
-    pub stats: WalkStats,
+    pub(crate) stats: WalkStats,
     /// Corners turned round a keyhole loop.
-    pub keyholes: u64,
+    pub(crate) keyholes: u64,
 }
 
 /// A path to rewrite: its points, and what the original asks of each stretch.
 #[derive(Debug, Clone, Copy)]
-pub struct SmoothPath<'a> {
+pub(crate) struct SmoothPath<'a> {
     /// The polyline.
-    pub pts: &'a [[f64; 3]],
+    pub(crate) pts: &'a [[f64; 3]],
     /// Filament pushed from the path start to each point, mm (from 0).
-    pub e: &'a [f64],
+    pub(crate) e: &'a [f64],
     /// Feed of segment `i` (from `pts[i]` to `pts[i+1]`), mm/s.
-    pub feed: &'a [f64],
+    pub(crate) feed: &'a [f64],
     /// How the firmware's planner runs each original segment (empty when not known): the eq.
     /// 29 feed cap never asks for less than the speed the machine had at the same place on the
     /// original. At that speed the sharp corner is a step in velocity and the rounded one a
@@ -140,7 +103,7 @@ pub struct SmoothPath<'a> {
     /// with a high square-corner velocity, eq. 29's normal-jerk term would slow every corner
     /// down, and even at a classic-jerk corner the machine is back at speed within a few
     /// tenths of a millimetre on either side of the vertex).
-    pub planned: &'a [Profile],
+    pub(crate) planned: &'a [Profile],
 }
 
 impl<'a> SmoothPath<'a> {
@@ -179,7 +142,7 @@ impl<'a> SmoothPath<'a> {
 /// racing-line one, which the fit and walk do not always manage to follow in steps under δθ
 /// (it then stays sharp): where that happened, the path is also rounded on the inside line
 /// (with its hairpins and keyholes) and the one left with fewer sharp turns is kept.
-pub fn smooth_path(path: &SmoothPath<'_>, s: &Settings) -> Option<Smoothed> {
+pub(crate) fn smooth_path(path: &SmoothPath<'_>, s: &Settings) -> Option<Smoothed> {
     let corners = polygon_corners(path, s);
     if corners.is_empty() {
         return smooth_cut(path, s, &[]);
@@ -227,7 +190,7 @@ fn smooth_cut(path: &SmoothPath<'_>, s: &Settings, forced: &[usize]) -> Option<S
     let cos_critical = crate::math::cos(s.critical_rad);
     let left = |r: &Option<Smoothed>| {
         r.as_ref().map_or(usize::MAX, |r| {
-            super::rewrite::sharp_turns(path.pts.iter().take(1).chain(&r.points), cos_critical)
+            crate::vtg::rewrite::sharp_turns(path.pts.iter().take(1).chain(&r.points), cos_critical)
         })
     };
     let left_wide = left(&result);
@@ -253,105 +216,165 @@ fn smooth_on(path: &SmoothPath<'_>, s: &Settings, forced: &[usize]) -> (Option<S
     if pts.len() < 3 || !path.consistent() {
         return (None, false);
     }
-    let cos_critical = crate::math::cos(s.critical_rad);
-    let plan = |line| {
-        blend::plan(
-            pts,
-            BLEND_SHARE * s.tolerance_mm,
-            s.limits.critical_curvature(),
-            line,
-        )
-    };
-    let blends = plan(s.line);
-    let inside = (s.line != blend::Line::Inside).then(|| plan(blend::Line::Inside));
-    let mut rescued = false;
-    let n = pts.len();
-    // Each corner: sharp, and whether it can be rounded on its own.
-    let mut sharp = vec![false; n];
-    let mut alone = vec![true; n];
-    let mut degenerate = vec![false; n];
-    // Too tight to round within the tolerance (rather than not worth it).
-    let mut tight = vec![false; n];
-    for i in 1..n - 1 {
-        let a = sub(&pts[i], &pts[i - 1]);
-        let b = sub(&pts[i + 1], &pts[i]);
-        let (la, lb) = (norm(&a), norm(&b));
-        if la <= 0.0 || lb <= 0.0 {
-            degenerate[i] = true;
-            continue;
-        }
-        let cos = (dot(&a, &b) / (la * lb)).clamp(-1.0, 1.0);
-        if cos >= cos_critical {
-            continue;
-        }
-        sharp[i] = true;
-        tight[i] = !roundable(&blends[i], s);
-        rescued |= !tight[i] && inside.as_ref().is_some_and(|b| !roundable(&b[i], s));
-        alone[i] = !tight[i] && pays(blends[i].max_curvature, path.planned.get(i - 1), s);
+    let mut c = Corners::classify(path, s);
+    let arc = arc_lengths(pts);
+    let pins = c.pin(path, &arc, s);
+    let cuts = c.cuts(&pins, &arc, forced);
+    let rescued = c.rescued;
+    match smooth_pieces(path, s, &cuts, &c.sharp, &pins) {
+        Some((out, changed)) => ((changed || !forced.is_empty()).then_some(out), rescued),
+        None => (None, rescued),
     }
-    // Two sharp corners across a short leg, at least one of them too tight alone: a hairpin,
-    // rounded as one turn if it can be.
-    let mut pinned = vec![false; n];
-    let mut pins: Vec<hairpin::Hairpin> = Vec::new();
-    let mut i = 1;
-    while i + 2 < n {
-        if sharp[i] && sharp[i + 1] && !(alone[i] && alone[i + 1]) {
-            if let Some(pin) = find_hairpin(pts, i, BLEND_SHARE * s.tolerance_mm, s) {
-                pinned[i] = true;
-                pinned[i + 1] = true;
-                pins.push(pin);
-                i += 2;
+}
+
+/// What each point of a path is as a corner; kept in one place because the hairpin, keyhole
+/// and cut decisions all read (and the cuts clear) the same flags.
+struct Corners {
+    /// A turn above the critical angle.
+    sharp: Vec<bool>,
+    /// Can be rounded on its own, at no loss of speed.
+    alone: Vec<bool>,
+    /// A zero-length leg meets it.
+    degenerate: Vec<bool>,
+    /// Too tight to round within the tolerance (rather than not worth it).
+    tight: Vec<bool>,
+    /// Turned into a hairpin or keyhole.
+    pinned: Vec<bool>,
+    /// The racing line made a corner roundable that the inside fillet could not round.
+    rescued: bool,
+}
+
+impl Corners {
+    /// Each corner: sharp, and whether it can be rounded on its own.
+    fn classify(path: &SmoothPath<'_>, s: &Settings) -> Self {
+        let pts = path.pts;
+        let cos_critical = crate::math::cos(s.critical_rad);
+        let plan = |line| {
+            blend::plan(
+                pts,
+                TUNING.blend_share * s.tolerance_mm,
+                s.limits.critical_curvature(),
+                line,
+            )
+        };
+        let blends = plan(s.line);
+        let inside = (s.line != blend::Line::Inside).then(|| plan(blend::Line::Inside));
+        let n = pts.len();
+        let mut c = Corners {
+            sharp: vec![false; n],
+            alone: vec![true; n],
+            degenerate: vec![false; n],
+            tight: vec![false; n],
+            pinned: vec![false; n],
+            rescued: false,
+        };
+        for i in 1..n - 1 {
+            let a = sub(&pts[i], &pts[i - 1]);
+            let b = sub(&pts[i + 1], &pts[i]);
+            let (la, lb) = (norm(&a), norm(&b));
+            if la <= 0.0 || lb <= 0.0 {
+                c.degenerate[i] = true;
                 continue;
             }
+            let cos = (dot(&a, &b) / (la * lb)).clamp(-1.0, 1.0);
+            if cos >= cos_critical {
+                continue;
+            }
+            c.sharp[i] = true;
+            c.tight[i] = !roundable(&blends[i], s);
+            c.rescued |= !c.tight[i] && inside.as_ref().is_some_and(|b| !roundable(&b[i], s));
+            c.alone[i] = !c.tight[i] && pays(blends[i].max_curvature, path.planned.get(i - 1), s);
         }
-        i += 1;
+        c
     }
-    // Single corners too tight to round: a keyhole loop, where one fits between the neighbours
-    // and the machine runs round it at least as fast as through the corner.
-    let arc = arc_lengths(pts);
-    let loop_pays = |i: usize| pays(1.0 / min_hairpin_radius(s), path.planned.get(i - 1), s);
-    for i in 1..n - 1 {
-        if s.keyholes && tight[i] && !pinned[i] && loop_pays(i) {
-            if let Some(k) = find_keyhole(pts, &arc, i, &sharp, &pinned, &degenerate, s) {
-                pinned[i] = true;
-                pins.push(k);
+
+    /// The hairpins and keyholes of the path, in order: the corners that cannot be rounded
+    /// alone but can as one turn (two across a short leg) or round a loop (one too tight).
+    fn pin(&mut self, path: &SmoothPath<'_>, arc: &[f64], s: &Settings) -> Vec<hairpin::Hairpin> {
+        let pts = path.pts;
+        let n = pts.len();
+        // Two sharp corners across a short leg, at least one of them too tight alone: a
+        // hairpin, rounded as one turn if it can be.
+        let mut pins: Vec<hairpin::Hairpin> = Vec::new();
+        let mut i = 1;
+        while i + 2 < n {
+            if self.sharp[i] && self.sharp[i + 1] && !(self.alone[i] && self.alone[i + 1]) {
+                if let Some(pin) = find_hairpin(pts, i, TUNING.blend_share * s.tolerance_mm, s) {
+                    self.pinned[i] = true;
+                    self.pinned[i + 1] = true;
+                    pins.push(pin);
+                    i += 2;
+                    continue;
+                }
+            }
+            i += 1;
+        }
+        // Single corners too tight to round: a keyhole loop, where one fits between the
+        // neighbours and the machine runs round it at least as fast as through the corner.
+        let loop_pays = |i: usize| pays(1.0 / min_hairpin_radius(s), path.planned.get(i - 1), s);
+        for i in 1..n - 1 {
+            if s.keyholes && self.tight[i] && !self.pinned[i] && loop_pays(i) {
+                let found =
+                    find_keyhole(pts, arc, i, &self.sharp, &self.pinned, &self.degenerate, s);
+                if let Some(k) = found {
+                    self.pinned[i] = true;
+                    pins.push(k);
+                }
             }
         }
+        pins.sort_by_key(|p| p.at);
+        pins
     }
-    pins.sort_by_key(|p| p.at);
-    let mut cuts = vec![0usize];
-    for i in 1..n - 1 {
-        if degenerate[i] || (sharp[i] && !alone[i] && !pinned[i]) {
-            cuts.push(i);
-            sharp[i] = false;
+
+    /// The points the path is cut at (its ends included): corners kept sharp (no longer
+    /// counted as sharp), either side of a keyhole, and `forced`.
+    fn cuts(&mut self, pins: &[hairpin::Hairpin], arc: &[f64], forced: &[usize]) -> Vec<usize> {
+        let n = self.sharp.len();
+        let mut cuts = vec![0usize];
+        for i in 1..n - 1 {
+            if self.degenerate[i] || (self.sharp[i] && !self.alone[i] && !self.pinned[i]) {
+                cuts.push(i);
+                self.sharp[i] = false;
+            }
         }
+        // A keyhole is fitted on its own, between the original points either side of the
+        // stretch it replaces (on its straight legs): the rest of a long side need not be
+        // fitted again.
+        let spans: Vec<(f64, f64)> = pins.iter().map(|p| p.span(arc)).collect();
+        let free = |j: usize| {
+            j > 0
+                && j + 1 < n
+                && !self.sharp[j]
+                && !self.pinned[j]
+                && spans.iter().all(|&(u0, u1)| arc[j] <= u0 || arc[j] >= u1)
+        };
+        for (k, &(u0, u1)) in pins.iter().zip(&spans).filter(|(p, _)| p.corners == 1) {
+            let before = (0..k.at).rev().find(|&j| arc[j] <= u0);
+            let after = (k.at + 1..n).find(|&j| arc[j] >= u1);
+            cuts.extend(before.into_iter().chain(after).filter(|&j| free(j)));
+        }
+        cuts.extend(forced.iter().filter(|&&j| j < n));
+        cuts.push(n - 1);
+        cuts.sort_unstable();
+        cuts.dedup();
+        cuts
     }
-    // A keyhole is fitted on its own, between the original points either side of the stretch
-    // it replaces (on its straight legs): the rest of a long side need not be fitted again.
-    let spans: Vec<(f64, f64)> = pins.iter().map(|p| p.span(&arc)).collect();
-    let free = |j: usize| {
-        j > 0
-            && j + 1 < n
-            && !sharp[j]
-            && !pinned[j]
-            && spans.iter().all(|&(u0, u1)| arc[j] <= u0 || arc[j] >= u1)
-    };
-    for (k, &(u0, u1)) in pins.iter().zip(&spans).filter(|(p, _)| p.corners == 1) {
-        let before = (0..k.at).rev().find(|&j| arc[j] <= u0);
-        let after = (k.at + 1..n).find(|&j| arc[j] >= u1);
-        cuts.extend(before.into_iter().chain(after).filter(|&j| free(j)));
-    }
-    cuts.extend(forced.iter().filter(|&&j| j < n));
-    cuts.push(pts.len() - 1);
-    cuts.sort_unstable();
-    cuts.dedup();
+}
+
+/// Each piece between two `cuts` smoothed on its own (or kept) and joined; and whether any was
+/// rewritten. `None` when a cut falls outside the path.
+fn smooth_pieces(
+    path: &SmoothPath<'_>,
+    s: &Settings,
+    cuts: &[usize],
+    sharp: &[bool],
+    pins: &[hairpin::Hairpin],
+) -> Option<(Smoothed, bool)> {
     let mut out = Smoothed::default();
-    let mut changed = !forced.is_empty();
+    let mut changed = false;
     for w in cuts.windows(2) {
         let (a, b) = (w[0], w[1]);
-        let Some(piece) = path.piece(a, b) else {
-            return (None, rescued);
-        };
+        let piece = path.piece(a, b)?;
         let has_sharp = sharp.get(a + 1..b).is_some_and(|v| v.iter().any(|&x| x));
         let here: Vec<hairpin::Hairpin> = pins
             .iter()
@@ -376,41 +399,51 @@ fn smooth_on(path: &SmoothPath<'_>, s: &Settings, forced: &[usize]) -> (Option<S
         match done {
             Some(p) => {
                 changed = true;
-                out.points.extend(p.points);
-                out.e.extend(p.e);
-                out.steps.extend(p.steps);
-                out.above_k_cr += p.above_k_cr;
-                out.deviation_mm = out.deviation_mm.max(p.deviation_mm);
-                out.stats.steps += p.stats.steps;
-                out.stats.fluctuation_sum += p.stats.fluctuation_sum;
-                out.keyholes += p.keyholes;
+                out.append(p);
             }
-            None => {
-                out.points.extend(piece.pts.iter().skip(1).copied());
-                out.e.extend(piece.e.iter().skip(1).copied());
-                out.steps
-                    .extend(piece.feed.iter().enumerate().map(|(k, &f)| {
-                        let planned = piece.planned.get(k);
-                        StepSpeed {
-                            programmed: f,
-                            limit: f64::INFINITY,
-                            floor: 0.0,
-                            ceiling: planned.map_or(f64::INFINITY, |p| p.peak),
-                            accel: planned.map_or(0.0, |p| p.acceleration),
-                        }
-                    }));
-            }
+            None => out.keep(&piece),
         }
     }
-    (changed.then_some(out), rescued)
+    Some((out, changed))
+}
+
+impl Smoothed {
+    /// Appends a rewritten piece.
+    fn append(&mut self, p: Smoothed) {
+        self.points.extend(p.points);
+        self.e.extend(p.e);
+        self.steps.extend(p.steps);
+        self.above_k_cr += p.above_k_cr;
+        self.deviation_mm = self.deviation_mm.max(p.deviation_mm);
+        self.stats.steps += p.stats.steps;
+        self.stats.fluctuation_sum += p.stats.fluctuation_sum;
+        self.keyholes += p.keyholes;
+    }
+
+    /// Appends a piece kept as it was, its segments at their own feeds and planned peaks.
+    fn keep(&mut self, piece: &SmoothPath<'_>) {
+        self.points.extend(piece.pts.iter().skip(1).copied());
+        self.e.extend(piece.e.iter().skip(1).copied());
+        self.steps
+            .extend(piece.feed.iter().enumerate().map(|(k, &f)| {
+                let planned = piece.planned.get(k);
+                StepSpeed {
+                    programmed: f,
+                    limit: f64::INFINITY,
+                    floor: 0.0,
+                    ceiling: planned.map_or(f64::INFINITY, |p| p.peak),
+                    accel: planned.map_or(0.0, |p| p.acceleration),
+                }
+            }));
+    }
 }
 
 /// The sharp corners of `path` to turn as polygons placed for Klipper's look-ahead
-/// ([`corner`]): on a Klipper machine, where the original's planned speeds are known, a polygon
+/// ([`klipper`]): on a Klipper machine, where the original's planned speeds are known, a polygon
 /// fits within the tolerance and the legs' room (all of the leg where it ends the path, half
 /// where it is shared, less a shortest step), and the firmware runs it no slower than
 /// [`Settings::min_speed_share`] of its speed through the sharp corner.
-fn polygon_corners(path: &SmoothPath<'_>, s: &Settings) -> Vec<corner::Corner> {
+fn polygon_corners(path: &SmoothPath<'_>, s: &Settings) -> Vec<klipper::Corner> {
     let mut out = Vec::new();
     let Some(scv) = s.klipper_scv_mm_s else {
         return out;
@@ -425,13 +458,13 @@ fn polygon_corners(path: &SmoothPath<'_>, s: &Settings) -> Vec<corner::Corner> {
     // rings less than a polygon of the largest turns.
     let blends = blend::plan(
         pts,
-        BLEND_SHARE * s.tolerance_mm,
+        TUNING.blend_share * s.tolerance_mm,
         s.limits.critical_curvature(),
         s.line,
     );
     let room = |from: usize, to: usize, end: bool| {
         let l = norm(&sub(&pts[to], &pts[from]));
-        (if end { blend::LEG_SHARE } else { 0.5 } * l - s.min_step_mm).max(0.0)
+        (if end { TUNING.leg_share } else { 0.5 } * l - s.min_step_mm).max(0.0)
     };
     let free = Settings {
         min_speed_share: 1.0,
@@ -439,7 +472,7 @@ fn polygon_corners(path: &SmoothPath<'_>, s: &Settings) -> Vec<corner::Corner> {
     };
     for i in 1..n - 1 {
         let (u, w) = (sub(&pts[i], &pts[i - 1]), sub(&pts[i + 1], &pts[i]));
-        if !super::rewrite::is_sharp(&u, &w, cos_critical) {
+        if !crate::vtg::rewrite::is_sharp(&u, &w, cos_critical) {
             continue;
         }
         let (before, after) = (&path.planned[i - 1], &path.planned[i]);
@@ -450,19 +483,19 @@ fn polygon_corners(path: &SmoothPath<'_>, s: &Settings) -> Vec<corner::Corner> {
         if accel.is_nan() || accel <= 0.0 {
             continue;
         }
-        let bounds = corner::Bounds {
+        let bounds = klipper::Bounds {
             tolerance_mm: s.tolerance_mm - 0.001,
-            max_turn_rad: STEP_TURN_SHARE * s.critical_rad,
+            max_turn_rad: TUNING.step_turn_share * s.critical_rad,
             min_step_mm: s.min_step_mm,
             room_mm: [room(i - 1, i, i == 1), room(i, i + 1, i + 2 == n)],
         };
-        let fw = corner::Firmware {
+        let fw = klipper::Firmware {
             accel_mm_s2: accel,
             junction_deviation_mm: crate::plan::junction::klipper_junction_deviation(scv, accel),
             feed_mm_s: [path.feed[i - 1], path.feed[i]],
             ends_mm_s: [before.entry, after.exit],
         };
-        if let Some(c) = corner::find(pts, i, &bounds, &fw)
+        if let Some(c) = klipper::find(pts, i, &bounds, &fw)
             .filter(|c| c.slowest_mm_s >= s.min_speed_share * c.sharp_mm_s)
         {
             out.push(c);
@@ -474,7 +507,7 @@ fn polygon_corners(path: &SmoothPath<'_>, s: &Settings) -> Vec<corner::Corner> {
 /// Whether a corner's blend can be walked in steps of at least the minimum step, each turning
 /// less than the critical angle (a tighter blend would only trade one sharp turn for several).
 fn roundable(b: &blend::Blend, s: &Settings) -> bool {
-    b.extent_mm > 0.0 && b.max_curvature * s.min_step_mm <= STEP_TURN_SHARE * s.critical_rad
+    b.extent_mm > 0.0 && b.max_curvature * s.min_step_mm <= TUNING.step_turn_share * s.critical_rad
 }
 
 /// Whether rounding a corner on a curve of the largest curvature `curvature` (a fillet's, or a
@@ -502,7 +535,7 @@ impl Settings {
     /// Whether [`Settings::min_speed_share`] can change which corners are rounded: only where
     /// the firmware takes a sharp corner as a virtual arc that a fillet must keep up with (see
     /// `pays`); a classic-jerk planner's corners all pay already.
-    pub fn speed_share_matters(&self) -> bool {
+    pub(crate) fn speed_share_matters(&self) -> bool {
         self.classic_jerk_mm_s.is_none()
     }
 }
@@ -521,13 +554,12 @@ fn smooth_piece(
     let e0 = *path.e.first()?;
     let e: Vec<f64> = path.e.iter().map(|x| x - e0).collect();
     let from_zero = SmoothPath { e: &e, ..*path };
-    let mut share = BLEND_SHARE;
-    for _ in 0..ATTEMPTS {
+    for share in super::blend_shares() {
         let tol = share * s.tolerance_mm;
         let done = if pins.is_empty() {
             attempt(&from_zero, path.pts, s, tol)
         } else {
-            with_hairpins(&from_zero, s, tol, pins, share < BLEND_SHARE)
+            with_hairpins(&from_zero, s, tol, pins, share < TUNING.blend_share)
         };
         if let Some(mut r) = done {
             for x in &mut r.e {
@@ -535,14 +567,13 @@ fn smooth_piece(
             }
             return Some(r);
         }
-        share *= RETRY_SCALE;
     }
     None
 }
 
 /// [`hairpin::find`] at corners `i`, `i + 1` of `pts` within `blend_tol`, for an arc the walk
 /// can follow in steps of at least the minimum step each turning by less than its share of the
-/// critical angle (with 5 % to spare), reaching along each long leg [`blend::LEG_SHARE`] of it
+/// critical angle (with 5 % to spare), reaching along each long leg `Tuning::leg_share` of it
 /// where the leg ends the path and half that where another corner shares it.
 fn find_hairpin(
     pts: &[[f64; 3]],
@@ -554,7 +585,7 @@ fn find_hairpin(
     let room = |leg: usize, far_end: usize| {
         let l = norm(&sub(pts.get(leg + 1)?, pts.get(leg)?));
         let shared = far_end != 0 && far_end + 1 != n;
-        Some(blend::LEG_SHARE * l * if shared { 0.5 } else { 1.0 })
+        Some(TUNING.leg_share * l * if shared { 0.5 } else { 1.0 })
     };
     let min_radius = min_hairpin_radius(s);
     let rooms = [room(i.checked_sub(1)?, i - 1)?, room(i + 1, i + 2)?];
@@ -563,8 +594,8 @@ fn find_hairpin(
 
 /// [`keyhole::find`] at corner `i` of `pts` (arc lengths `arc`) within the blend share of the
 /// tolerance, on a loop of the hairpins' smallest radius, with counter-turns of at most
-/// `KINK_SHARE` of the critical angle. The loop may reach along the path up to
-/// [`blend::LEG_SHARE`] of the way to the path's ends and half the way to the nearest corner
+/// `Tuning::kink_share` of the critical angle. The loop may reach along the path up to
+/// `Tuning::leg_share` of the way to the path's ends and half the way to the nearest corner
 /// that is sharp, already replaced or degenerate (which the piece may be cut at).
 fn find_keyhole(
     pts: &[[f64; 3]],
@@ -579,7 +610,7 @@ fn find_keyhole(
     let stop = |k: usize| k == 0 || k + 1 == n || sharp[k] || pinned[k] || degenerate[k];
     let share = |k: usize| {
         if k == 0 || k + 1 == n {
-            blend::LEG_SHARE
+            TUNING.leg_share
         } else {
             0.5
         }
@@ -594,9 +625,9 @@ fn find_keyhole(
         pts,
         arc,
         i,
-        BLEND_SHARE * s.tolerance_mm,
+        TUNING.blend_share * s.tolerance_mm,
         min_hairpin_radius(s),
-        KINK_SHARE * s.critical_rad,
+        TUNING.kink_share * s.critical_rad,
         room,
     )
 }
@@ -604,7 +635,7 @@ fn find_keyhole(
 /// The smallest radius of a loop the walk can follow in steps of at least the minimum step,
 /// each turning by less than its share of the critical angle, with 5 % to spare.
 fn min_hairpin_radius(s: &Settings) -> f64 {
-    1.05 * s.min_step_mm / (STEP_TURN_SHARE * s.critical_rad)
+    1.05 * s.min_step_mm / (TUNING.step_turn_share * s.critical_rad)
 }
 
 /// [`attempt`] on `path` with its hairpins `pins` replaced by their arcs, checked against the
@@ -648,23 +679,87 @@ fn attempt(
     s: &Settings,
     blend_tol: f64,
 ) -> Option<Smoothed> {
-    let SmoothPath {
-        pts,
-        e,
-        feed,
-        planned,
-    } = *path;
+    let Walked {
+        samples: walked,
+        mut points,
+        deviation_mm: deviation,
+        stats,
+    } = walk_within(path, original, s, blend_tol)?;
+    let total_e = *path.e.last()?;
+    let mut out = Smoothed {
+        deviation_mm: deviation,
+        stats,
+        ..Smoothed::default()
+    };
+    let o = Original {
+        arc: arc_lengths(path.pts),
+        path,
+        s,
+    };
+    let k_cr = s.limits.critical_curvature();
+    let (e, feed) = (path.e, path.feed);
+    let mut seg = 0usize;
+    let mut u_prev = 0.0;
+    for x in walked.iter().skip(1) {
+        // The original segment this parameter (an arc length of the original) falls in.
+        while seg + 1 < feed.len() && o.arc.get(seg + 1).is_some_and(|&a| a <= x.u) {
+            seg += 1;
+        }
+        let (a0, a1) = (o.arc.get(seg).copied()?, o.arc.get(seg + 1).copied()?);
+        let t = if a1 > a0 {
+            ((x.u - a0) / (a1 - a0)).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let (e0, e1) = (e.get(seg).copied()?, e.get(seg + 1).copied()?);
+        let local = o.limits_at(seg);
+        let mut step = StepSpeed {
+            programmed: feed.get(seg).copied()?,
+            limit: f64::INFINITY,
+            floor: 0.0,
+            ceiling: o.top(u_prev, x.u),
+            accel: local.normal_accel_mm_s2,
+        };
+        if x.mean_kappa > k_cr {
+            out.above_k_cr += 1;
+            if s.limit_feed {
+                step.limit = local.feed_limit(x.mean_kappa);
+                step.floor = o.speed(u_prev).min(o.speed(x.u));
+            }
+        }
+        u_prev = x.u;
+        out.e.push(e0 + (e1 - e0) * t);
+        out.steps.push(step);
+    }
+    points.remove(0);
+    if let Some(last) = out.e.last_mut() {
+        *last = total_e;
+    }
+    out.points = points;
+    Some(out)
+}
+
+/// The blended, fitted and walked curve of `path` with its ends pinned to the original's,
+/// its points, their deviation from `original` and the walk's statistics; `None` when the
+/// fit or walk fails or the deviation exceeds the tolerance. Apart from [`attempt`] so the
+/// geometry (VTG eq. 18–28) reads apart from the feeds given to it.
+fn walk_within(
+    path: &SmoothPath<'_>,
+    original: &[[f64; 3]],
+    s: &Settings,
+    blend_tol: f64,
+) -> Option<Walked> {
+    let pts = path.pts;
     let tol = s.tolerance_mm;
     // Room for the 3-decimal rounding of written coordinates.
     let budget = tol - 0.001;
     let k_cr = s.limits.critical_curvature();
-    let arc = arc_lengths(pts);
     let blends = blend::plan(pts, blend_tol, k_cr, s.line);
-    let (data, params) = blend::samples(pts, &blends, STRAIGHT_SPACING_MM);
-    let f = fit(&data, &params, FIT_SHARE * tol)?;
+    let (data, params) = blend::samples(pts, &blends, TUNING.straight_spacing_mm);
+    let f = fit(&data, &params, TUNING.fit_share * tol)?;
     let w = Walk {
-        chord_tol_mm: CHORD_SHARE * tol,
-        max_turn_rad: STEP_TURN_SHARE * s.critical_rad,
+        chord_tol_mm: TUNING.chord_share * tol,
+        max_turn_rad: TUNING.step_turn_share * s.critical_rad,
         max_step_mm: 1e4,
         min_step_mm: s.min_step_mm,
         phi: 1.0,
@@ -685,79 +780,70 @@ fn attempt(
     if deviation.is_nan() || deviation > budget {
         return None;
     }
-    let total_e = *e.last()?;
-    let mut out = Smoothed {
+    Some(Walked {
+        samples: walked,
+        points,
         deviation_mm: deviation,
         stats,
-        ..Smoothed::default()
-    };
-    // The original segment at arc length `u`.
-    let segment = |u: f64| segment_at(&arc, u, feed.len());
-    // The original's planned speed at arc length `u`.
-    let original_speed = |u: f64| -> f64 {
-        let seg = segment(u);
-        planned.get(seg).map_or(0.0, |p| p.speed_at(u - arc[seg]))
-    };
-    // The original's highest planned speed between arc lengths `u0 ≤ u1`.
-    let original_top = |u0: f64, u1: f64| -> f64 {
-        (segment(u0)..=segment(u1))
+    })
+}
+
+/// What [`walk_within`] gives: the walk's samples, their points with the ends pinned, the
+/// measured deviation (mm) and the walk's statistics.
+struct Walked {
+    samples: Vec<Sample>,
+    points: Vec<[f64; 3]>,
+    deviation_mm: f64,
+    stats: WalkStats,
+}
+
+/// What the original asked at each arc length of a path: the planned speeds and the limits
+/// that bound the feed of the new points laid over it.
+struct Original<'p, 'a> {
+    /// Arc length at each original point.
+    arc: Vec<f64>,
+    path: &'p SmoothPath<'a>,
+    s: &'p Settings,
+}
+
+impl Original<'_, '_> {
+    /// The original segment at arc length `u`.
+    fn segment(&self, u: f64) -> usize {
+        segment_at(&self.arc, u, self.path.feed.len())
+    }
+
+    /// The original's planned speed at arc length `u`.
+    fn speed(&self, u: f64) -> f64 {
+        let seg = self.segment(u);
+        self.path
+            .planned
+            .get(seg)
+            .map_or(0.0, |p| p.speed_at(u - self.arc[seg]))
+    }
+
+    /// The original's highest planned speed between arc lengths `u0 ≤ u1`.
+    fn top(&self, u0: f64, u1: f64) -> f64 {
+        (self.segment(u0)..=self.segment(u1))
             .map(|k| {
-                planned.get(k).map_or(f64::INFINITY, |p| {
-                    p.max_speed_between(u0 - arc[k], u1 - arc[k])
+                self.path.planned.get(k).map_or(f64::INFINITY, |p| {
+                    p.max_speed_between(u0 - self.arc[k], u1 - self.arc[k])
                 })
             })
             .fold(0.0, f64::max)
-    };
-    // The limits of original segment `seg`: `A_n` the acceleration the firmware ran it with.
-    let limits_at = |seg: usize| -> KinematicLimits {
+    }
+
+    /// The limits of original segment `seg`: `A_n` the acceleration the firmware ran it with.
+    fn limits_at(&self, seg: usize) -> KinematicLimits {
+        let s = self.s;
         let mut l = s.limits;
-        if let Some(p) = planned.get(seg).filter(|p| p.acceleration > 0.0) {
+        if let Some(p) = self.path.planned.get(seg).filter(|p| p.acceleration > 0.0) {
             l.normal_accel_mm_s2 = p.acceleration.min(s.max_normal_accel_mm_s2);
             if let Some(f1) = s.jerk_per_accel_hz {
                 l.normal_jerk_mm_s3 = l.normal_accel_mm_s2 * f1;
             }
         }
         l
-    };
-    let mut seg = 0usize;
-    let mut u_prev = 0.0;
-    for x in walked.iter().skip(1) {
-        // The original segment this parameter (an arc length of the original) falls in.
-        while seg + 1 < feed.len() && arc.get(seg + 1).is_some_and(|&a| a <= x.u) {
-            seg += 1;
-        }
-        let (a0, a1) = (arc.get(seg).copied()?, arc.get(seg + 1).copied()?);
-        let t = if a1 > a0 {
-            ((x.u - a0) / (a1 - a0)).clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
-        let (e0, e1) = (e.get(seg).copied()?, e.get(seg + 1).copied()?);
-        let local = limits_at(seg);
-        let mut step = StepSpeed {
-            programmed: feed.get(seg).copied()?,
-            limit: f64::INFINITY,
-            floor: 0.0,
-            ceiling: original_top(u_prev, x.u),
-            accel: local.normal_accel_mm_s2,
-        };
-        if x.mean_kappa > k_cr {
-            out.above_k_cr += 1;
-            if s.limit_feed {
-                step.limit = local.feed_limit(x.mean_kappa);
-                step.floor = original_speed(u_prev).min(original_speed(x.u));
-            }
-        }
-        u_prev = x.u;
-        out.e.push(e0 + (e1 - e0) * t);
-        out.steps.push(step);
     }
-    points.remove(0);
-    if let Some(last) = out.e.last_mut() {
-        *last = total_e;
-    }
-    out.points = points;
-    Some(out)
 }
 
 #[cfg(test)]
@@ -785,7 +871,7 @@ mod tests {
             limit_feed: true,
             max_normal_accel_mm_s2: 1000.0,
             jerk_per_accel_hz: None,
-            min_step_mm: MIN_STEP_MM,
+            min_step_mm: TUNING.klipper_min_step_mm,
             classic_jerk_mm_s: None,
             feed_cap_scale: 1.0,
             arcs: false,
@@ -852,7 +938,7 @@ mod tests {
             assert_eq!(sharp_turns_from(pts[0], &r.points), 0);
             let tightest = all
                 .windows(3)
-                .filter_map(|w| super::super::arcs::circle_through(&w[0], &w[1], &w[2]))
+                .filter_map(|w| crate::vtg::arcs::circle_through(&w[0], &w[1], &w[2]))
                 .map(|(_, r)| r)
                 .fold(f64::INFINITY, f64::min);
             let outside = all.iter().map(|p| -p[1]).fold(0.0, f64::max);
@@ -877,7 +963,7 @@ mod tests {
         ];
         let mut e = vec![0.0];
         for w in pts.windows(2) {
-            let l = crate::vec3::norm(crate::vec3::sub(&w[1], &w[0]));
+            let l = crate::vec3::norm(&crate::vec3::sub(&w[1], &w[0]));
             e.push(e.last().unwrap() + 0.03 * l);
         }
         let feed = vec![20.0; pts.len() - 1];
@@ -922,7 +1008,7 @@ mod tests {
             planned: &[],
         };
         let s = Settings {
-            min_step_mm: MARLIN_MIN_STEP_MM,
+            min_step_mm: TUNING.marlin_min_step_mm,
             ..settings()
         };
         let r = smooth_path(&path, &s).expect("keyhole");
@@ -964,7 +1050,7 @@ mod tests {
             planned: &[],
         };
         let on = Settings {
-            min_step_mm: MARLIN_MIN_STEP_MM,
+            min_step_mm: TUNING.marlin_min_step_mm,
             ..settings()
         };
         let off = Settings {

@@ -12,41 +12,35 @@
 //!
 //! Arcs are off by default: not every firmware has them (Marlin's `ARC_SUPPORT`, Klipper's
 //! `[gcode_arcs]` section). The rewriter measures the path with its arcs against the original
-//! before it keeps them ([`super::deviation::both_ways`]), so the tolerance holds as before.
+//! before it keeps them ([`crate::vtg::deviation::both_ways`]), so the tolerance holds as before.
 
 use crate::gcode::number::rounded;
 use crate::machine::{Arc, Plane};
 use crate::vec3::{norm, sub};
+use crate::vtg::tuning::TUNING;
 
 /// Fewest steps an arc replaces: below that the file gains little.
-pub const MIN_SEGMENTS: usize = 3;
+pub(crate) const MIN_SEGMENTS: usize = 3;
 /// Most steps one arc replaces (bounds the search).
 const MAX_SEGMENTS: usize = 256;
 /// Largest sweep of one arc, rad (under a half turn, where `I`/`J` from a rounded start point
 /// still place the centre on the right side).
 const MAX_SWEEP: f64 = 0.95 * std::f64::consts::PI;
-/// Smallest radius, mm: the centre is written to 4 decimals and the end point to 3, and a
-/// firmware rejects an arc whose end is not on its circle to within a fraction of the radius.
-const MIN_RADIUS_MM: f64 = 0.2;
-/// Largest radius, mm: flatter runs are straight enough as lines.
-const MAX_RADIUS_MM: f64 = 500.0;
-/// Largest spread of the feed rates an arc joins (the arc takes the lowest).
-const FEED_SPREAD: f64 = 1.05;
 /// Largest relative mismatch between the start and end radius as written.
 const RADIUS_MISMATCH: f64 = 0.002;
 
 /// A circle an arc runs on.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ArcShape {
+pub(crate) struct ArcShape {
     /// Centre (X, Y), mm.
-    pub center: [f64; 2],
+    pub(crate) center: [f64; 2],
     /// Counter-clockwise (`G3`); clockwise is `G2`.
-    pub ccw: bool,
+    pub(crate) ccw: bool,
 }
 
 impl ArcShape {
     /// The machine's arc from `from` to `to` on this circle (the sweep the firmware takes).
-    pub fn resolve(&self, from: &[f64; 3], to: &[f64; 3]) -> Arc {
+    pub(crate) fn resolve(&self, from: &[f64; 3], to: &[f64; 3]) -> Arc {
         let c = self.center;
         let a0 = crate::math::atan2(from[1] - c[1], from[0] - c[0]);
         let mut a1 = crate::math::atan2(to[1] - c[1], to[0] - c[0]);
@@ -69,17 +63,17 @@ impl ArcShape {
 /// One written move: it ends at point `end` of the polyline (0 is the start point), straight or
 /// along an arc, at `feed` mm/s.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Piece {
+pub(crate) struct Piece {
     /// Index of its end point.
-    pub end: usize,
+    pub(crate) end: usize,
     /// The arc it runs along (`None`: a straight `G1`).
-    pub arc: Option<ArcShape>,
+    pub(crate) arc: Option<ArcShape>,
     /// Feed, mm/s.
-    pub feed: f64,
+    pub(crate) feed: f64,
 }
 
 /// The circle through three points in the XY plane: centre and radius.
-pub(super) fn circle_through(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Option<([f64; 2], f64)> {
+pub(crate) fn circle_through(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Option<([f64; 2], f64)> {
     let (bx, by) = (b[0] - a[0], b[1] - a[1]);
     let (cx, cy) = (c[0] - a[0], c[1] - a[1]);
     let d = 2.0 * (bx * cy - by * cx);
@@ -98,11 +92,11 @@ pub(super) fn circle_through(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Option
 /// and planar length at a feed (mm, mm, mm/s), and the largest turn one of its segments may
 /// make (rad): an arc the firmware would cut more coarsely than the walk cut the curve is not
 /// written (a tight fillet as two 40° chords would bring back the sharp corners).
-pub struct Firmware<'a> {
+pub(crate) struct Firmware<'a> {
     /// Segments of an arc.
-    pub segments: &'a dyn Fn(f64, f64, f64) -> usize,
+    pub(crate) segments: &'a dyn Fn(f64, f64, f64) -> usize,
     /// Largest turn at a segment's end, rad.
-    pub max_turn_rad: f64,
+    pub(crate) max_turn_rad: f64,
 }
 
 impl std::fmt::Debug for Firmware<'_> {
@@ -125,7 +119,7 @@ fn arc_over(
     let run = pts.get(i..=j)?;
     let (first, last) = (run.first()?, run.last()?);
     let (center, r) = circle_through(first, &run[run.len() / 2], last)?;
-    if !(MIN_RADIUS_MM..=MAX_RADIUS_MM).contains(&r) {
+    if !(TUNING.arc_min_radius_mm..=TUNING.arc_max_radius_mm).contains(&r) {
         return None;
     }
     if run.iter().any(|p| (p[2] - first[2]).abs() > 1e-9) {
@@ -135,7 +129,7 @@ fn arc_over(
     let (lo, hi) = speeds.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &f| {
         (lo.min(f), hi.max(f))
     });
-    if !(lo > 0.0 && hi <= lo * FEED_SPREAD) {
+    if !(lo > 0.0 && hi <= lo * TUNING.arc_feed_spread) {
         return None;
     }
     // Every point on the circle, every step turning the same way by less than a quarter turn.
@@ -187,7 +181,7 @@ fn arc_over(
 
 /// A polyline written as it is: one straight piece per segment, `feed[k]` on the one ending at
 /// point `k + 1`.
-pub fn lines(feed: &[f64]) -> Vec<Piece> {
+pub(crate) fn lines(feed: &[f64]) -> Vec<Piece> {
     feed.iter()
         .enumerate()
         .map(|(k, &feed)| Piece {
@@ -201,7 +195,12 @@ pub fn lines(feed: &[f64]) -> Vec<Piece> {
 /// The polyline `pts` (the start point first) as pieces: the longest runs that make arcs
 /// within `tol` (greedily, from the start), lines elsewhere. `feed[k]` is the feed of the segment
 /// ending at `pts[k + 1]`.
-pub fn pieces(pts: &[[f64; 3]], feed: &[f64], tol: f64, firmware: &Firmware<'_>) -> Vec<Piece> {
+pub(crate) fn pieces(
+    pts: &[[f64; 3]],
+    feed: &[f64],
+    tol: f64,
+    firmware: &Firmware<'_>,
+) -> Vec<Piece> {
     let n = pts.len().saturating_sub(1);
     let mut out = Vec::with_capacity(n);
     let mut i = 0;
@@ -240,7 +239,7 @@ pub fn pieces(pts: &[[f64; 3]], feed: &[f64], tol: f64, firmware: &Firmware<'_>)
 
 /// The pieces as a polyline for measuring: arcs sampled so no chord is more than `sagitta` from
 /// its arc.
-pub fn flatten(pts: &[[f64; 3]], pieces: &[Piece], sagitta: f64) -> Vec<[f64; 3]> {
+pub(crate) fn flatten(pts: &[[f64; 3]], pieces: &[Piece], sagitta: f64) -> Vec<[f64; 3]> {
     let mut out = Vec::with_capacity(pts.len());
     let Some(&first) = pts.first() else {
         return out;

@@ -15,21 +15,21 @@
 //! ways (ranked by the distances of the two polylines' points, then measured in full), is
 //! taken; the departure points are the nearest to the tip whose counter-turn stays
 //! within its limit. The loop is longer than the stretch it replaces; the stretch's filament is
-//! spread over it by length (see [`super::hairpin::substitute`]), so the tip gets the material
+//! spread over it by length (see [`crate::vtg::hairpin::substitute`]), so the tip gets the material
 //! it had, in the same place.
 
-use super::bspline::segment_at;
-use super::deviation::{both_ways, point_polyline};
-use super::hairpin::{arc_polygon, cross_z, unit, Hairpin};
-use crate::vec3::{angle, dot, lerp, norm, sub};
+use crate::vec3::angle;
+use crate::vec3::{dot, lerp, norm, sub};
+use crate::vtg::bspline::segment_at;
+use crate::vtg::deviation::{both_ways, point_polyline};
+use crate::vtg::hairpin::{arc_polygon, cross_z, unit, Hairpin};
+use crate::vtg::tuning::TUNING;
 
 /// Smallest turn a keyhole is tried at, rad (60°: below it a corner fillets within the
 /// tolerance, or the legs are too short for anything).
 const MIN_TURN_RAD: f64 = std::f64::consts::FRAC_PI_3;
 /// Largest turn, rad (170°: past it the legs are too close for a loop of any useful radius).
 const MAX_TURN_RAD: f64 = 170.0 * std::f64::consts::PI / 180.0;
-/// Turn of one side of the polygon that stands for the circle, rad (as for hairpins).
-const POLYGON_TURN_RAD: f64 = 15.0 * std::f64::consts::PI / 180.0;
 /// Centres tried along the bisector.
 const CENTRES: usize = 12;
 /// Spacing of the departure points tried along each leg, mm.
@@ -106,7 +106,7 @@ fn tangent_point(
 /// more than `room_mm[0]` before the corner and rejoining it no more than `room_mm[1]` after,
 /// with counter-turns of at most `max_kink_rad` where it leaves and rejoins. The stretch must
 /// lie in one plane of constant Z and turn by 60–170° in all.
-pub fn find(
+pub(crate) fn find(
     pts: &[[f64; 3]],
     arc: &[f64],
     i: usize,
@@ -139,64 +139,19 @@ pub fn find(
     if !(MIN_TURN_RAD..=MAX_TURN_RAD).contains(&turn) {
         return None;
     }
-    let side = cross_z(&a, &b).signum();
-    // Into the wedge, halfway between the legs.
-    let inward = unit(sub(&b, &a))?;
-    // The first departure point from the corner, `sign` -1 back along leg A, +1 on along leg
-    // B, whose counter-turn onto the tangent stays within the limit.
-    let depart = |centre: &[f64; 3], sign: f64, room: f64| -> Option<(f64, [f64; 3], [f64; 3])> {
-        let steps =
-            (room.min(MAX_DEPARTURE_RADII * radius_mm) / DEPARTURE_STEP_MM).floor() as usize;
-        (1..=steps).find_map(|k| {
-            let d = k as f64 * DEPARTURE_STEP_MM;
-            let (p, dir) = path.at(ui + sign * d)?;
-            let t = tangent_point(&p, centre, radius_mm, side, sign > 0.0)?;
-            let line = if sign < 0.0 { sub(&t, &p) } else { sub(&p, &t) };
-            (angle(dir, unit(line)?) <= max_kink_rad).then_some((d, p, t))
-        })
-    };
-    // A keyhole round the circle centred `c` from the corner, the original stretch it
-    // replaces, and how far their points are from each other's polyline (a lower bound of the
-    // deviation, close to it, and cheap: what the candidates are ranked by).
-    let candidate = |c: f64| -> Option<(f64, Hairpin, Vec<[f64; 3]>)> {
-        let centre = [v[0] + inward[0] * c, v[1] + inward[1] * c, z];
-        // The corner must be within reach of the loop, and the loop's far side of the corner.
-        if (norm(&sub(&v, &centre)) - radius_mm).abs() > tolerance_mm {
-            return None;
-        }
-        let (before, da, ta) = depart(&centre, -1.0, room_a)?;
-        let (after, db, tb) = depart(&centre, 1.0, room_b)?;
-        // Round the circle from `ta` to `tb` the way the corner turns.
-        let (ra, rb) = (sub(&ta, &centre), sub(&tb, &centre));
-        let mut span = side * crate::math::atan2(cross_z(&ra, &rb), dot(&ra, &rb));
-        if span < 0.0 {
-            span += 2.0 * std::f64::consts::PI;
-        }
-        if span > turn + 2.0 * max_kink_rad + 1e-9 {
-            return None;
-        }
-        let segments = (span / POLYGON_TURN_RAD).ceil().max(1.0) as usize;
-        let mut loop_pts = Vec::with_capacity(segments + 3);
-        loop_pts.push(da);
-        loop_pts.extend(arc_polygon(&centre, &ta, side * span, segments));
-        loop_pts.push(db);
-        let original = path.between(ui - before, ui + after)?;
-        let near = |a: &[[f64; 3]], b: &[[f64; 3]]| {
-            a.iter().map(|p| point_polyline(p, b)).fold(0.0, f64::max)
-        };
-        let apart = near(&loop_pts, &original).max(near(&original, &loop_pts));
-        (apart <= tolerance_mm).then_some((
-            apart,
-            Hairpin {
-                at: i,
-                corners: 1,
-                radius_mm,
-                arc: loop_pts,
-                before_mm: before,
-                after_mm: after,
-            },
-            original,
-        ))
+    let wedge = Wedge {
+        path,
+        i,
+        v,
+        ui,
+        room: [room_a, room_b],
+        turn,
+        side: cross_z(&a, &b).signum(),
+        // Into the wedge, halfway between the legs.
+        inward: unit(sub(&b, &a))?,
+        tolerance_mm,
+        radius_mm,
+        max_kink_rad,
     };
     // The corner is within the tolerance of the circle only for centres `c` from the corner
     // within `r ± tol`, and the circle bulges past leg A's line by `r − c sin(α/2)` (α the
@@ -210,7 +165,7 @@ pub fn find(
         return None;
     }
     let mut found: Vec<_> = (0..=CENTRES)
-        .filter_map(|k| candidate(lo + (hi - lo) * k as f64 / CENTRES as f64))
+        .filter_map(|k| wedge.candidate(lo + (hi - lo) * k as f64 / CENTRES as f64))
         .collect();
     found.sort_by(|x, y| x.0.total_cmp(&y.0));
     // The closest that the full measurement, both ways, keeps within the tolerance.
@@ -220,6 +175,90 @@ pub fn find(
             both_ways(&h.arc, original, tolerance_mm / 10.0, tolerance_mm) <= tolerance_mm
         })
         .map(|(_, h, _)| h)
+}
+
+/// A flat corner a keyhole is sought for, with what every candidate loop is measured against:
+/// split from [`find`] so the search over centres reads apart from building one loop.
+struct Wedge<'a> {
+    path: Measured<'a>,
+    /// The corner's index, its point and arc length.
+    i: usize,
+    v: [f64; 3],
+    ui: f64,
+    /// Room before and after the corner, mm.
+    room: [f64; 2],
+    /// The corner's turn, rad, and its sense about +Z.
+    turn: f64,
+    side: f64,
+    /// Into the wedge, halfway between the legs.
+    inward: [f64; 3],
+    tolerance_mm: f64,
+    radius_mm: f64,
+    max_kink_rad: f64,
+}
+
+impl Wedge<'_> {
+    /// The first departure point from the corner, `sign` -1 back along leg A, +1 on along leg
+    /// B, whose counter-turn onto the tangent of the circle centred `centre` stays within the
+    /// limit: its distance from the corner, the point and the tangent point.
+    fn depart(&self, centre: &[f64; 3], sign: f64, room: f64) -> Option<(f64, [f64; 3], [f64; 3])> {
+        let radius_mm = self.radius_mm;
+        let steps =
+            (room.min(MAX_DEPARTURE_RADII * radius_mm) / DEPARTURE_STEP_MM).floor() as usize;
+        (1..=steps).find_map(|k| {
+            let d = k as f64 * DEPARTURE_STEP_MM;
+            let (p, dir) = self.path.at(self.ui + sign * d)?;
+            let t = tangent_point(&p, centre, radius_mm, self.side, sign > 0.0)?;
+            let line = if sign < 0.0 { sub(&t, &p) } else { sub(&p, &t) };
+            (angle(dir, unit(line)?) <= self.max_kink_rad).then_some((d, p, t))
+        })
+    }
+
+    /// A keyhole round the circle centred `c` from the corner, the original stretch it
+    /// replaces, and how far their points are from each other's polyline (a lower bound of the
+    /// deviation, close to it, and cheap: what the candidates are ranked by).
+    fn candidate(&self, c: f64) -> Option<(f64, Hairpin, Vec<[f64; 3]>)> {
+        let (v, inward, side) = (self.v, self.inward, self.side);
+        let (tolerance_mm, radius_mm) = (self.tolerance_mm, self.radius_mm);
+        let centre = [v[0] + inward[0] * c, v[1] + inward[1] * c, v[2]];
+        // The corner must be within reach of the loop, and the loop's far side of the corner.
+        if (norm(&sub(&v, &centre)) - radius_mm).abs() > tolerance_mm {
+            return None;
+        }
+        let (before, da, ta) = self.depart(&centre, -1.0, self.room[0])?;
+        let (after, db, tb) = self.depart(&centre, 1.0, self.room[1])?;
+        // Round the circle from `ta` to `tb` the way the corner turns.
+        let (ra, rb) = (sub(&ta, &centre), sub(&tb, &centre));
+        let mut span = side * crate::math::atan2(cross_z(&ra, &rb), dot(&ra, &rb));
+        if span < 0.0 {
+            span += 2.0 * std::f64::consts::PI;
+        }
+        if span > self.turn + 2.0 * self.max_kink_rad + 1e-9 {
+            return None;
+        }
+        let segments = (span / TUNING.polygon_turn_rad).ceil().max(1.0) as usize;
+        let mut loop_pts = Vec::with_capacity(segments + 3);
+        loop_pts.push(da);
+        loop_pts.extend(arc_polygon(&centre, &ta, side * span, segments));
+        loop_pts.push(db);
+        let original = self.path.between(self.ui - before, self.ui + after)?;
+        let near = |a: &[[f64; 3]], b: &[[f64; 3]]| {
+            a.iter().map(|p| point_polyline(p, b)).fold(0.0, f64::max)
+        };
+        let apart = near(&loop_pts, &original).max(near(&original, &loop_pts));
+        (apart <= tolerance_mm).then_some((
+            apart,
+            Hairpin {
+                at: self.i,
+                corners: 1,
+                radius_mm,
+                arc: loop_pts,
+                before_mm: before,
+                after_mm: after,
+            },
+            original,
+        ))
+    }
 }
 
 #[cfg(test)]
@@ -277,7 +316,7 @@ mod tests {
         for w in h.arc[1..h.arc.len() - 1].windows(2) {
             assert!((norm(&sub(&w[1], &w[0])) - chord).abs() < 1e-9);
         }
-        assert!(chord <= r * POLYGON_TURN_RAD + 1e-9);
+        assert!(chord <= r * TUNING.polygon_turn_rad + 1e-9);
         let d = both_ways(&whole, &p, 1e-3, 0.0);
         assert!(d <= tol + 1e-3, "{d}");
         // The tip itself is passed within the tolerance.

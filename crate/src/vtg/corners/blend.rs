@@ -34,35 +34,33 @@
 //! still uses where the wider circle cannot be walked.
 
 use crate::vec3::{dot, norm, sub};
+use crate::vtg::tuning::TUNING;
 
 /// Samples per blend given to the fit (its ends included).
-pub const SAMPLES: usize = 9;
+pub(crate) const SAMPLES: usize = 9;
 /// Turns at or below this are treated as straight, rad (0.5°: nothing to round).
 const STRAIGHT_RAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
 /// Turns above this are not blended, rad (160°: the fillet's radius falls towards nothing and
 /// such reversals cannot be rounded within any useful tolerance anyway).
-pub const MAX_TURN_RAD: f64 = 160.0 * std::f64::consts::PI / 180.0;
-/// Share of a leg the blends at its two ends may use together (the rest stays straight, so the
-/// fit sees where one blend ends and the next begins).
-pub const LEG_SHARE: f64 = 0.9;
+pub(crate) const MAX_TURN_RAD: f64 = 160.0 * std::f64::consts::PI / 180.0;
 
 /// A corner transition at one vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Blend {
+pub(crate) struct Blend {
     /// Extent along each leg from the vertex, mm (0: the vertex is kept as it is).
-    pub extent_mm: f64,
+    pub(crate) extent_mm: f64,
     /// Turn of the path at the vertex, rad.
-    pub turn_rad: f64,
+    pub(crate) turn_rad: f64,
     /// Largest distance of the transition from the vertex, mm.
-    pub deviation_mm: f64,
+    pub(crate) deviation_mm: f64,
     /// Largest curvature of the transition, 1/mm.
-    pub max_curvature: f64,
+    pub(crate) max_curvature: f64,
     /// How far outside the legs the fillet's tangent lines run (the racing line), mm; 0: the
     /// fillet is tangent to the legs themselves.
-    pub offset_mm: f64,
+    pub(crate) offset_mm: f64,
     /// Length of leg beyond `extent_mm` over which the path eases out to the offset and back
     /// onto the leg, mm (0 without an offset).
-    pub ramp_mm: f64,
+    pub(crate) ramp_mm: f64,
 }
 
 impl Blend {
@@ -83,7 +81,7 @@ impl Blend {
 
 /// The shape constants of a fillet turning by `turn` (rad) for `L = 1`: the distance from the
 /// vertex to the fillet, and the curvature.
-pub fn shape(turn: f64) -> (f64, f64) {
+pub(crate) fn shape(turn: f64) -> (f64, f64) {
     let half = 0.5 * turn;
     let tan = crate::math::tan(half);
     let radius = 1.0 / tan;
@@ -123,17 +121,60 @@ fn fillet_point(v: &[f64; 3], a: &[f64; 3], b: &[f64; 3], turn: f64, l: f64, t: 
 /// curvature down to `enough_curvature` (1/mm; the curvature at which the machine's limits no
 /// longer slow it, `K_cr`): a gentle turn could be spread over metres within the tolerance, and
 /// would take the leg a sharp neighbour needs.
-pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64, line: Line) -> Vec<Blend> {
+pub(crate) fn plan(
+    pts: &[[f64; 3]],
+    tolerance_mm: f64,
+    enough_curvature: f64,
+    line: Line,
+) -> Vec<Blend> {
     let n = pts.len();
-    let mut out = vec![Blend::NONE; n];
     if n < 3 {
+        return vec![Blend::NONE; n];
+    }
+    let (mut out, through) = inside_fillets(pts, tolerance_mm, enough_curvature);
+    if line == Line::Inside {
         return out;
     }
+    // Then, corner by corner, the racing line where the path has room for it: up to the
+    // nearest vertex either way that is not straight (less what its own blend takes), or the
+    // path's end.
+    let along = crate::vtg::bspline::arc_lengths(pts);
+    for i in 1..n - 1 {
+        if out[i].extent_mm <= 0.0 || out[i].max_curvature <= enough_curvature {
+            continue;
+        }
+        let room = |other: usize| {
+            let used = if other == 0 || other == n - 1 {
+                0.0
+            } else {
+                out[other].reach()
+            };
+            TUNING.leg_share * (along[i] - along[other]).abs() - used
+        };
+        let back = (0..i).rev().find(|&k| !through[k]).unwrap_or(0);
+        let on = (i + 1..n).find(|&k| !through[k]).unwrap_or(n - 1);
+        let room = room(back).min(room(on));
+        if let Some(r) = racing(out[i], tolerance_mm, enough_curvature, room) {
+            out[i] = r;
+        }
+    }
+    out
+}
+
+/// [`plan`] on the inside line (at least three points): each corner's fillet with the legs
+/// shared between neighbours; and the vertices a ramp out to a racing line may run through
+/// (the path is straight there), which the racing lines are then fitted between.
+fn inside_fillets(
+    pts: &[[f64; 3]],
+    tolerance_mm: f64,
+    enough_curvature: f64,
+) -> (Vec<Blend>, Vec<bool>) {
+    let n = pts.len();
+    let mut out = vec![Blend::NONE; n];
     let lens: Vec<f64> = pts.windows(2).map(|w| norm(&sub(&w[1], &w[0]))).collect();
     // What each corner asks for.
     let mut want = vec![0.0f64; n];
     let mut shapes = vec![(0.0, 0.0); n];
-    // Vertices a ramp out to a racing line may run through: the path is straight there.
     let mut through = vec![false; n];
     for i in 1..n - 1 {
         let (la, lb) = (lens[i - 1], lens[i]);
@@ -162,7 +203,7 @@ pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64, line: Li
     // curvatures is as small as it can be: a blend's curvature is k(θ)/L, so in proportion to
     // k(θ), each at most what it asked for, and what one does not need goes to the other.
     let share = |leg: usize, me: usize, other: Option<usize>| -> f64 {
-        let room = LEG_SHARE * lens[leg];
+        let room = TUNING.leg_share * lens[leg];
         let Some(j) = other.filter(|&j| want[j] > 0.0) else {
             return room;
         };
@@ -187,49 +228,18 @@ pub fn plan(pts: &[[f64; 3]], tolerance_mm: f64, enough_curvature: f64, line: Li
         out[i].deviation_mm = c * l;
         out[i].max_curvature = k / l;
     }
-    if line == Line::Inside {
-        return out;
-    }
-    // Then, corner by corner, the racing line where the path has room for it: up to the
-    // nearest vertex either way that is not straight (less what its own blend takes), or the
-    // path's end.
-    let along = super::bspline::arc_lengths(pts);
-    for i in 1..n - 1 {
-        if out[i].extent_mm <= 0.0 || out[i].max_curvature <= enough_curvature {
-            continue;
-        }
-        let room = |other: usize| {
-            let used = if other == 0 || other == n - 1 {
-                0.0
-            } else {
-                out[other].reach()
-            };
-            LEG_SHARE * (along[i] - along[other]).abs() - used
-        };
-        let back = (0..i).rev().find(|&k| !through[k]).unwrap_or(0);
-        let on = (i + 1..n).find(|&k| !through[k]).unwrap_or(n - 1);
-        let room = room(back).min(room(on));
-        if let Some(r) = racing(out[i], tolerance_mm, enough_curvature, room) {
-            out[i] = r;
-        }
-    }
-    out
+    (out, through)
 }
 
 /// Which side of the vertex a blend may use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Line {
+pub(crate) enum Line {
     /// Fillets tangent to the legs: the path stays on or inside the corner.
     Inside,
     /// The racing line where there is room for it, else the inside fillet.
     Racing,
 }
 
-/// Shares of the tolerance tried as the racing line's offset, largest first.
-const OFFSET_SHARES: [f64; 3] = [1.0, 0.5, 0.25];
-/// Peak curvature of a ramp out to the racing line, as a share of the fillet's: low, since
-/// the ramp lies where the machine is still faster than on the fillet.
-const RAMP_CURVATURE_SHARE: f64 = 0.15;
 /// Peak of `|o''|` of the quintic ease `o(x) = 1 − (10x³ − 15x⁴ + 6x⁵)` on `0..1` (at
 /// `x = 1/2 ± √3/6`): `10/√3`.
 const EASE_PEAK: f64 = 5.773_502_691_896_258;
@@ -253,7 +263,7 @@ fn ease(x: f64) -> f64 {
 /// that, which on firmware that takes sharp corners fast (Klipper's square-corner velocity)
 /// makes rounding a corner cost no time where the inside fillet did. No radius beyond the
 /// `enough_curvature` one is asked for. The ramps are quintic eases whose peak curvature is
-/// [`RAMP_CURVATURE_SHARE`] of the fillet's.
+/// `Tuning::ramp_curvature_share` of the fillet's.
 fn racing(inside: Blend, tolerance_mm: f64, enough_curvature: f64, room: f64) -> Option<Blend> {
     let half = 0.5 * inside.turn_rad;
     let sec = 1.0 / crate::math::cos(half);
@@ -267,7 +277,7 @@ fn racing(inside: Blend, tolerance_mm: f64, enough_curvature: f64, room: f64) ->
         f64::INFINITY
     };
     let inside_radius = 1.0 / inside.max_curvature;
-    OFFSET_SHARES.iter().find_map(|&share| {
+    TUNING.racing_offset_shares.iter().find_map(|&share| {
         let radius = ((tolerance_mm + share * tolerance_mm * sec) / (sec - 1.0)).min(cap);
         let offset = ((sec - 1.0) * radius - tolerance_mm) / sec;
         let offset = offset.clamp(0.0, tolerance_mm);
@@ -275,7 +285,7 @@ fn racing(inside: Blend, tolerance_mm: f64, enough_curvature: f64, room: f64) ->
             return None;
         }
         let extent = (radius - offset) * tan;
-        let ramp = (EASE_PEAK * offset * radius / RAMP_CURVATURE_SHARE).sqrt();
+        let ramp = (EASE_PEAK * offset * radius / TUNING.ramp_curvature_share).sqrt();
         (extent > 0.0 && extent + ramp <= room).then_some(Blend {
             extent_mm: extent,
             turn_rad: inside.turn_rad,
@@ -292,50 +302,26 @@ fn racing(inside: Blend, tolerance_mm: f64, enough_curvature: f64, room: f64) ->
 /// stands for the original point at the same fraction of the stretch it replaces), so the
 /// filament pushed up to a point is read off the original. Straight stretches get points at
 /// most `spacing_mm` apart, denser near the blends so the knot spans grow gradually.
-pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64; 3]>, Vec<f64>) {
+pub(crate) fn samples(
+    pts: &[[f64; 3]],
+    blends: &[Blend],
+    spacing_mm: f64,
+) -> (Vec<[f64; 3]>, Vec<f64>) {
     let n = pts.len();
-    let mut data = Vec::with_capacity(n * (SAMPLES + 4));
-    let mut par = Vec::with_capacity(n * (SAMPLES + 4));
-    if n == 0 || blends.len() != n {
-        return (data, par);
-    }
-    let push = |p: [f64; 3], u: f64, data: &mut Vec<[f64; 3]>, par: &mut Vec<f64>| {
-        if par.last().is_none_or(|&last| u > last + 1e-9) {
-            data.push(p);
-            par.push(u);
-        }
+    let mut out = Sampled {
+        data: Vec::with_capacity(n * (SAMPLES + 4)),
+        par: Vec::with_capacity(n * (SAMPLES + 4)),
     };
-    push(pts[0], 0.0, &mut data, &mut par);
+    if n == 0 || blends.len() != n {
+        return (out.data, out.par);
+    }
+    out.push(pts[0], 0.0);
     // The ramps out to the racing lines: each runs from its blend's end along the straight
     // stretch, possibly past straight vertices (no turn, so no blend), so each leg looks for
     // the nearest blend either way through those.
-    let racers: Vec<Option<Racer>> = blends
-        .iter()
-        .enumerate()
-        .map(|(j, bl)| {
-            let o = (bl.offset_mm > 0.0 && bl.ramp_mm > 0.0)
-                .then(|| Outward::at(pts, j))
-                .flatten()?;
-            Some(Racer { blend: *bl, o })
-        })
-        .collect();
-    let along = super::bspline::arc_lengths(pts);
-    // The blend at vertex `i` itself, or `None` past a turn without one (a path end included).
-    let here = |i: usize| {
-        if i == 0 || i + 1 == n || blends[i].turn_rad != 0.0 {
-            Some((blends[i].extent_mm > 0.0).then_some(i))
-        } else {
-            None
-        }
-    };
-    let mut prev_blend = vec![None; n];
-    let mut next_blend = vec![None; n];
-    for i in 0..n {
-        prev_blend[i] = here(i).unwrap_or_else(|| prev_blend[i - 1]);
-    }
-    for i in (0..n).rev() {
-        next_blend[i] = here(i).unwrap_or_else(|| next_blend[i + 1]);
-    }
+    let racers = Racer::all(pts, blends);
+    let along = crate::vtg::bspline::arc_lengths(pts);
+    let (prev_blend, next_blend) = nearest_blends(blends);
     let mut ts = Vec::new();
     for i in 0..n - 1 {
         let (a, b) = (pts[i], pts[i + 1]);
@@ -383,44 +369,95 @@ pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64
             }
             ts.sort_by(f64::total_cmp);
             for &t in &ts {
-                push(at(t), arc + t, &mut data, &mut par);
+                out.push(at(t), arc + t);
             }
         }
         // The blend at the far end of the leg.
         let bl = &blends[i + 1];
         if i + 2 < n && bl.extent_mm > 0.0 {
-            let c = pts[i + 2];
-            let lc = norm(&sub(&c, &b));
-            let out_dir = [(c[0] - b[0]) / lc, (c[1] - b[1]) / lc, (c[2] - b[2]) / lc];
-            let l = bl.extent_mm;
-            // A racing line's fillet is tangent to the legs' offsets, which meet outside the
-            // vertex.
-            let (vertex, reach) = match racers[i + 1] {
-                Some(r) => {
-                    let half = 0.5 * bl.turn_rad;
-                    let away = bl.offset_mm / crate::math::cos(half);
-                    let w = r.o.bisector;
-                    (
-                        [b[0] + w[0] * away, b[1] + w[1] * away, b[2] + w[2] * away],
-                        l + bl.offset_mm * crate::math::tan(half),
-                    )
-                }
-                None => (b, l),
-            };
-            for k in 0..SAMPLES {
-                let u = k as f64 / (SAMPLES - 1) as f64;
-                push(
-                    fillet_point(&vertex, &dir, &out_dir, bl.turn_rad, reach, u),
-                    arc + len - l + 2.0 * l * u,
-                    &mut data,
-                    &mut par,
-                );
-            }
+            out.fillet(pts, i + 1, bl, racers[i + 1], &dir, arc + len);
         } else {
-            push(b, arc + len, &mut data, &mut par);
+            out.push(b, arc + len);
         }
     }
-    (data, par)
+    (out.data, out.par)
+}
+
+/// The blend nearest each vertex looking back and looking on, through straight vertices (a
+/// turn without a blend, the path's ends included, stops the search with `None`): where the
+/// racing-line ramps reaching into each leg come from.
+fn nearest_blends(blends: &[Blend]) -> (Vec<Option<usize>>, Vec<Option<usize>>) {
+    let n = blends.len();
+    // The blend at vertex `i` itself, or `None` past a turn without one (a path end included).
+    let here = |i: usize| {
+        if i == 0 || i + 1 == n || blends[i].turn_rad != 0.0 {
+            Some((blends[i].extent_mm > 0.0).then_some(i))
+        } else {
+            None
+        }
+    };
+    let mut prev_blend = vec![None; n];
+    let mut next_blend = vec![None; n];
+    for i in 0..n {
+        prev_blend[i] = here(i).unwrap_or_else(|| prev_blend[i - 1]);
+    }
+    for i in (0..n).rev() {
+        next_blend[i] = here(i).unwrap_or_else(|| next_blend[i + 1]);
+    }
+    (prev_blend, next_blend)
+}
+
+/// The fit's data points and their parameters, as [`samples`] builds them.
+struct Sampled {
+    data: Vec<[f64; 3]>,
+    par: Vec<f64>,
+}
+
+impl Sampled {
+    /// Adds point `p` at parameter `u`, unless `u` does not move on from the last one.
+    fn push(&mut self, p: [f64; 3], u: f64) {
+        if self.par.last().is_none_or(|&last| u > last + 1e-9) {
+            self.data.push(p);
+            self.par.push(u);
+        }
+    }
+
+    /// The points of blend `bl` at vertex `v` of `pts` (neither end), entered along `dir`,
+    /// `vertex_arc` the original's arc length at the vertex; on a racing line (`racer`) the
+    /// fillet is tangent to the legs' offsets, which meet outside the vertex.
+    fn fillet(
+        &mut self,
+        pts: &[[f64; 3]],
+        v: usize,
+        bl: &Blend,
+        racer: Option<Racer>,
+        dir: &[f64; 3],
+        vertex_arc: f64,
+    ) {
+        let (b, c) = (pts[v], pts[v + 1]);
+        let lc = norm(&sub(&c, &b));
+        let out_dir = [(c[0] - b[0]) / lc, (c[1] - b[1]) / lc, (c[2] - b[2]) / lc];
+        let l = bl.extent_mm;
+        let (vertex, reach) = match racer {
+            Some(r) => {
+                let half = 0.5 * bl.turn_rad;
+                let away = bl.offset_mm / crate::math::cos(half);
+                let w = r.o.bisector;
+                (
+                    [b[0] + w[0] * away, b[1] + w[1] * away, b[2] + w[2] * away],
+                    l + bl.offset_mm * crate::math::tan(half),
+                )
+            }
+            None => (b, l),
+        };
+        for k in 0..SAMPLES {
+            let u = k as f64 / (SAMPLES - 1) as f64;
+            self.push(
+                fillet_point(&vertex, dir, &out_dir, bl.turn_rad, reach, u),
+                vertex_arc - l + 2.0 * l * u,
+            );
+        }
+    }
 }
 
 /// A blend on a racing line, with its outward directions.
@@ -428,6 +465,23 @@ pub fn samples(pts: &[[f64; 3]], blends: &[Blend], spacing_mm: f64) -> (Vec<[f64
 struct Racer {
     blend: Blend,
     o: Outward,
+}
+
+impl Racer {
+    /// The racing-line blend at each vertex of `pts`, with its outward directions (`None`:
+    /// no ramp there).
+    fn all(pts: &[[f64; 3]], blends: &[Blend]) -> Vec<Option<Racer>> {
+        blends
+            .iter()
+            .enumerate()
+            .map(|(j, bl)| {
+                let o = (bl.offset_mm > 0.0 && bl.ramp_mm > 0.0)
+                    .then(|| Outward::at(pts, j))
+                    .flatten()?;
+                Some(Racer { blend: *bl, o })
+            })
+            .collect()
+    }
 }
 
 /// Samples across each ramp out to a racing line (its ends excluded).
@@ -447,7 +501,7 @@ struct Outward {
 impl Outward {
     /// At vertex `i` of `pts` (neither end), if it turns.
     fn at(pts: &[[f64; 3]], i: usize) -> Option<Outward> {
-        let unit = super::hairpin::unit;
+        let unit = crate::vtg::hairpin::unit;
         let a = unit(sub(pts.get(i)?, pts.get(i.checked_sub(1)?)?))?;
         let b = unit(sub(pts.get(i + 1)?, pts.get(i)?))?;
         let w = unit(sub(&a, &b))?;
@@ -540,7 +594,7 @@ mod tests {
         let (data, par) = samples(&wide, &b, 2.0);
         assert!(par.windows(2).all(|w| w[1] > w[0]));
         for p in &data {
-            let d = super::super::deviation::point_polyline(p, &wide);
+            let d = crate::vtg::deviation::point_polyline(p, &wide);
             assert!(d <= 0.05 + 1e-12, "{d}");
         }
         assert_eq!(data.first(), wide.first());
@@ -568,14 +622,14 @@ mod tests {
         assert!((racing.deviation_mm - eps).abs() < 1e-12);
         // The ramp's peak curvature is its share of the fillet's.
         let ramp_peak = EASE_PEAK * eps / (racing.ramp_mm * racing.ramp_mm);
-        assert!((ramp_peak * radius - RAMP_CURVATURE_SHARE).abs() < 1e-12);
+        assert!((ramp_peak * radius - TUNING.ramp_curvature_share).abs() < 1e-12);
         // The samples: within ε of the corner both ways, outside the first leg by ε where the
         // fillet starts, on the leg again beyond the ramp, and ε inside the vertex at the
         // fillet's middle.
         let blends = [Blend::NONE, racing, Blend::NONE];
         let (data, par) = samples(&pts, &blends, 2.0);
         assert!(par.windows(2).all(|w| w[1] > w[0]));
-        let d = super::super::deviation::both_ways(&data, &pts, 1e-3, 0.0);
+        let d = crate::vtg::deviation::both_ways(&data, &pts, 1e-3, 0.0);
         assert!((d - eps).abs() <= 0.5e-3 + 1e-9, "{d}");
         let near = |x: f64| {
             data.iter()
@@ -604,7 +658,7 @@ mod tests {
         // A leg of 1 mm leaves no room for the full ramp: a smaller offset, or none.
         let short = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 10.0, 0.0]];
         let b = plan(&short, eps, 0.0, Line::Racing)[1];
-        assert!(b.reach() <= LEG_SHARE * 1.0 + 1e-12, "{b:?}");
+        assert!(b.reach() <= TUNING.leg_share * 1.0 + 1e-12, "{b:?}");
         assert!(b.offset_mm < eps);
         // The same corner with its first leg cut by straight vertices has the room of the
         // whole leg, and samples that stay within ε.
@@ -621,7 +675,7 @@ mod tests {
         assert!(blends[..10].iter().all(|b| b.extent_mm == 0.0));
         let (data, par) = samples(&cut, &blends, 2.0);
         assert!(par.windows(2).all(|w| w[1] > w[0]));
-        let d = super::super::deviation::both_ways(&data, &cut, 1e-3, 0.0);
+        let d = crate::vtg::deviation::both_ways(&data, &cut, 1e-3, 0.0);
         assert!((d - eps).abs() <= 0.5e-3 + 1e-9, "{d}");
         // Ramp samples were placed on the legs it crosses.
         let on_ramp = data
@@ -650,7 +704,7 @@ mod tests {
         let (c, _) = shape(sharp.turn_rad);
         assert!((sharp.extent_mm - tol / c).abs() < 1e-12, "{sharp:?}");
         let leg = super::norm(&super::sub(&pts[3], &pts[2]));
-        assert!(b[2].extent_mm + sharp.extent_mm <= LEG_SHARE * leg + 1e-12);
+        assert!(b[2].extent_mm + sharp.extent_mm <= TUNING.leg_share * leg + 1e-12);
         assert!(b[2].extent_mm > 0.0);
     }
 }

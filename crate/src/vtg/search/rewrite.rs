@@ -11,16 +11,7 @@
 //! last `E` word exactly, so every later line stays valid; in relative mode the written amounts
 //! are differences of rounded running totals and add up to the original total.
 
-use super::arcs::{self, Piece};
-use super::block::{self, Frame};
-use super::budget::{self, Budget, Offer, Outcome};
-use super::deviation::both_ways;
-use super::feed::Written;
-use super::kinematics::KinematicLimits;
-use super::resample::WalkStats;
-use super::smooth::{smooth_path, Settings, SmoothPath, Smoothed};
-use super::source::{MoveSource, Sources};
-use super::VtgOptions;
+use super::Variant;
 use crate::energy::Accumulator;
 use crate::error::{Error, ErrorKind};
 use crate::gcode::{apply_edits, Edit};
@@ -28,46 +19,57 @@ use crate::machine::{ExtrusionMode, MoveKind};
 use crate::path::{PathMove, PrintPath};
 use crate::plan::{JunctionModel, Limits, Motion, Planner, Profile};
 use crate::vec3::{dot, norm, sub};
+use crate::vtg::arcs::{self, Piece};
+use crate::vtg::block::{self, Frame};
+use crate::vtg::budget::{self, Budget, Offer, Outcome};
+use crate::vtg::deviation::both_ways;
+use crate::vtg::feed::Written;
+use crate::vtg::kinematics::KinematicLimits;
+use crate::vtg::resample::WalkStats;
+use crate::vtg::smooth::{smooth_path, Settings, SmoothPath, Smoothed};
+use crate::vtg::source::{MoveSource, Sources};
+use crate::vtg::tuning::TUNING;
+use crate::vtg::VtgOptions;
 
 /// What the rewrite did.
 #[derive(Debug, Clone, Default)]
-pub struct Rewritten {
+pub(crate) struct Rewritten {
     /// The new file.
-    pub output: Vec<u8>,
+    pub(crate) output: Vec<u8>,
     /// Paths with a sharp corner (candidates).
-    pub candidate_paths: u64,
+    pub(crate) candidate_paths: u64,
     /// Of those, paths rewritten.
-    pub rewritten_paths: u64,
+    pub(crate) rewritten_paths: u64,
     /// Moves replaced.
-    pub replaced_moves: u64,
+    pub(crate) replaced_moves: u64,
     /// Moves written in their place.
-    pub written_moves: u64,
+    pub(crate) written_moves: u64,
     /// Segments whose feed was lowered (eq. 29).
-    pub lowered_segments: u64,
+    pub(crate) lowered_segments: u64,
     /// Segments whose curvature stays above `K_cr`.
-    pub above_k_cr_segments: u64,
+    pub(crate) above_k_cr_segments: u64,
     /// Largest measured distance of a rewritten path from its original, mm.
-    pub max_deviation_mm: f64,
+    pub(crate) max_deviation_mm: f64,
     /// Rewritten paths whose eq. 29 feed caps were raised so they cost no time.
-    pub raised_caps_paths: u64,
+    pub(crate) raised_caps_paths: u64,
     /// Rewritten paths written without the eq. 29 feed caps, which even raised would have made
     /// them slower than the original.
-    pub uncapped_paths: u64,
+    pub(crate) uncapped_paths: u64,
     /// Rewritten paths that plan slower or cost more motor energy than the original, paid for
     /// out of what the other rewrites saved or with the time the options allow (see
-    /// [`super::budget`]).
-    pub paid_paths: u64,
+    /// [`crate::vtg::budget`]).
+    pub(crate) paid_paths: u64,
     /// Paths kept as they were because even rounded without caps they plan slower or cost more
     /// motor energy, and the savings elsewhere could not pay for them.
-    pub kept_for_time: u64,
+    pub(crate) kept_for_time: u64,
     /// Algorithm 1 statistics.
-    pub walk: WalkStats,
+    pub(crate) walk: WalkStats,
     /// The first scale of the eq. 29 speeds each rewrite was tried with.
-    pub feed_cap_scale: f64,
+    pub(crate) feed_cap_scale: f64,
     /// Arcs (`G2`/`G3`) written.
-    pub arcs_written: u64,
+    pub(crate) arcs_written: u64,
     /// Corners turned round keyhole loops.
-    pub keyholes: u64,
+    pub(crate) keyholes: u64,
 }
 
 /// The eq. 30 limits for a file: `v_max` from the machine's X/Y feed limits (`M203`), `A_n` the
@@ -79,7 +81,7 @@ pub struct Rewritten {
 /// the quality of the print, and what junction-deviation and Klipper planners themselves hold
 /// the centripetal acceleration of a curve to (`M201` is often far above it: 9000 mm/s² in
 /// PrusaSlicer's MK3S profile, printing at 1250).
-pub fn limits_for(path: &PrintPath, options: &VtgOptions) -> KinematicLimits {
+pub(crate) fn limits_for(path: &PrintPath, options: &VtgOptions) -> KinematicLimits {
     let l = &path.print_limits;
     let pick = |a: f64, b: f64, default: f64| {
         let v = a.min(b);
@@ -108,7 +110,7 @@ pub fn limits_for(path: &PrintPath, options: &VtgOptions) -> KinematicLimits {
 }
 
 /// The machine's lowest natural frequency (see [`VtgOptions::normal_jerk_mm_s3`]), Hz.
-pub fn first_mode_hz(path: &PrintPath) -> f64 {
+pub(crate) fn first_mode_hz(path: &PrintPath) -> f64 {
     let name = crate::dynamics::parameters::preset_for_machine(&path.profile.name);
     let f1 = crate::dynamics::parameters::MachineDynamics::preset(name)
         .map_or(f64::NAN, |d| d.lowest_frequency_hz());
@@ -120,21 +122,9 @@ pub fn first_mode_hz(path: &PrintPath) -> f64 {
     }
 }
 
-/// The dearer variants offered for each path when time may be spent
-/// ([`super::VtgOptions::allow_slower_pct`]), as [`Settings::min_speed_share`]: the corners
-/// the machine runs round at 80 % or more of its speed through the sharp one, then every
-/// corner. A path's corners differ in what rounding them costs (on the K1C benchy a wall's
-/// short chamfers cost little, its right angles at 50 mm/s square-corner velocity much more),
-/// and one all-or-nothing variant makes the budget pay for a path's dear corners to buy its
-/// cheap ones. Measured on the K1C benchy at `--allow-slower 1` (blends at 0.8 of the
-/// tolerance, before `BLEND_SHARE` rose to 0.9): sharp corners −32.1 % with the all-corners
-/// variant alone, −33.9 % with this rung added, −34.0 % with four rungs (0.9, 0.7, 0.5, 0) at
-/// 1.6 times the run time of two.
-pub const DEARER_SPEED_SHARES: [f64; 2] = [0.8, 0.0];
-
 /// Every path's ways of being written, before the file-level choice ([`budget`]).
 #[derive(Debug, Default)]
-pub struct Offers {
+pub(crate) struct Offers {
     offers: Vec<Offer>,
     /// Time (s) and motor energy (J) the free rewrites save.
     saved: [f64; 2],
@@ -142,28 +132,9 @@ pub struct Offers {
     variant: Variant,
 }
 
-/// What a whole-file rewrite is tried with; [`super::vtg`] tries others where the dynamics
-/// model finds the first one ringing more than the original.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Variant {
-    /// The first scale of the eq. 29 speeds ([`Settings::feed_cap_scale`]).
-    pub feed_cap_scale: f64,
-    /// Turn corners too tight to fillet round keyhole loops ([`Settings::keyholes`]).
-    pub keyholes: bool,
-}
-
-impl Default for Variant {
-    fn default() -> Self {
-        Variant {
-            feed_cap_scale: 1.0,
-            keyholes: true,
-        }
-    }
-}
-
 /// Rewrites every eligible path of `input` in every way worth offering: the free rewrite, and
 /// the dearer ones (see [`budget`]); [`Offers::write`] then writes the file with the choice.
-pub fn offers(
+pub(crate) fn offers(
     input: &[u8],
     path: &PrintPath,
     all: &Sources,
@@ -183,37 +154,7 @@ pub fn offers(
     if !aligned {
         return Ok(out);
     }
-    let settings = Settings {
-        tolerance_mm: options.tolerance_mm,
-        critical_rad: options.critical_angle_deg.to_radians(),
-        limits: *limits,
-        limit_feed: options.limit_feed,
-        max_normal_accel_mm_s2: xy_acceleration(&path.print_limits)
-            .unwrap_or(limits.normal_accel_mm_s2),
-        jerk_per_accel_hz: options
-            .normal_jerk_mm_s3
-            .is_none()
-            .then(|| first_mode_hz(path)),
-        min_step_mm: if path.junction_model == JunctionModel::Klipper {
-            super::smooth::MIN_STEP_MM
-        } else {
-            super::smooth::MARLIN_MIN_STEP_MM
-        },
-        classic_jerk_mm_s: (path.junction_model == JunctionModel::ClassicJerk)
-            .then(|| xy_jerk(&path.print_limits)),
-        feed_cap_scale: variant.feed_cap_scale,
-        arcs: options.arcs,
-        min_speed_share: 1.0,
-        keyholes: variant.keyholes,
-        klipper_scv_mm_s: (path.junction_model == JunctionModel::Klipper)
-            .then(|| square_corner_velocity(&path.print_limits))
-            .flatten(),
-        line: if options.inside_corners {
-            super::blend::Line::Inside
-        } else {
-            super::blend::Line::Racing
-        },
-    };
+    let settings = file_settings(path, options, limits, variant);
     let energy = Accumulator::new(
         &options.analyze.energy.clone().unwrap_or_default(),
         &path.profile.name,
@@ -222,26 +163,21 @@ pub fn offers(
     // The candidates first (cheap), then the paths rewritten in parallel batches: each path is
     // independent, results are merged in file order (the same output on any number of
     // threads), and progress and cancellation are checked between batches.
-    let mut candidates: Vec<(usize, usize)> = Vec::new();
-    let mut i = 0usize;
-    while i < moves.len() {
-        let Some(j) = path_end(moves, sources, i) else {
-            i += 1;
-            continue;
-        };
-        let run = &moves[i..j];
-        if run.len() >= 2 && has_sharp_corner(run, cos_critical) {
-            candidates.push((i, j));
-        }
-        i = j;
-    }
+    let candidates = candidates(moves, sources, cos_critical);
     out.candidate_paths = candidates.len() as u64;
-    let dearer = DEARER_SPEED_SHARES.map(|min_speed_share| Settings {
-        min_speed_share,
-        ..settings
-    });
-    // Dearer variants only where they can differ from the free rewrite.
-    let buy_time = options.allow_slower_pct > 0.0 && settings.speed_share_matters();
+    let offering = Offering {
+        input,
+        path,
+        all,
+        energy: &energy,
+        settings,
+        dearer: TUNING.dearer_speed_shares.map(|min_speed_share| Settings {
+            min_speed_share,
+            ..settings
+        }),
+        // Dearer variants only where they can differ from the free rewrite.
+        buy_time: options.allow_slower_pct > 0.0 && settings.speed_share_matters(),
+    };
     let mut offers: Vec<Offer> = Vec::with_capacity(candidates.len());
     let mut saved = [0.0f64; 2];
     for (b, batch) in candidates.chunks(BATCH_PATHS).enumerate() {
@@ -251,38 +187,7 @@ pub fn offers(
         // One offer per path, added up here in file order: sums are then the same to the
         // last bit as a sequential run's (the wasm build's, which the CLI's JSON must equal).
         let parts = crate::parallel::map_chunks(batch, |chunk| {
-            chunk
-                .iter()
-                .map(|&(i, j)| {
-                    let machine = PlanContext {
-                        limits: all.limits_at(i),
-                        model: path.junction_model,
-                        energy: &energy,
-                        context: [
-                            i.checked_sub(1).map(|k| motion_of(&moves[k])),
-                            moves.get(j).map(motion_of),
-                        ],
-                    };
-                    let write = |s: &Settings| {
-                        rewrite_path(input, &moves[i..j], &sources[i..j], s, &machine)
-                    };
-                    let base = write(&settings).unwrap_or_default();
-                    let kept = base.iter().map(|o| o.corners_removed).max().unwrap_or(0);
-                    // With time to spend, the variants that round the corners the firmware
-                    // takes faster sharp, too: first those it takes nearly as fast round.
-                    let mut offer = Offer::default();
-                    base.into_iter().for_each(|o| offer.push(o));
-                    if buy_time {
-                        dearer
-                            .iter()
-                            .filter_map(write)
-                            .flatten()
-                            .filter(|o| o.corners_removed > kept)
-                            .for_each(|o| offer.push(o));
-                    }
-                    offer
-                })
-                .collect()
+            chunk.iter().map(|&(i, j)| offering.offer(i, j)).collect()
         });
         for offer in parts {
             if let Some(free) = &offer.free {
@@ -297,17 +202,130 @@ pub fn offers(
     Ok(out)
 }
 
+/// The settings every path of the file starts from: the options, the variant tried, and what
+/// the file's firmware and limits say (each path then takes the limits in force where it
+/// starts, [`PlanContext::settings`]).
+fn file_settings(
+    path: &PrintPath,
+    options: &VtgOptions,
+    limits: &KinematicLimits,
+    variant: Variant,
+) -> Settings {
+    Settings {
+        tolerance_mm: options.tolerance_mm,
+        critical_rad: options.critical_angle_deg.to_radians(),
+        limits: *limits,
+        limit_feed: options.limit_feed,
+        max_normal_accel_mm_s2: xy_acceleration(&path.print_limits)
+            .unwrap_or(limits.normal_accel_mm_s2),
+        jerk_per_accel_hz: options
+            .normal_jerk_mm_s3
+            .is_none()
+            .then(|| first_mode_hz(path)),
+        min_step_mm: if path.junction_model == JunctionModel::Klipper {
+            TUNING.klipper_min_step_mm
+        } else {
+            TUNING.marlin_min_step_mm
+        },
+        classic_jerk_mm_s: (path.junction_model == JunctionModel::ClassicJerk)
+            .then(|| xy_jerk(&path.print_limits)),
+        feed_cap_scale: variant.feed_cap_scale,
+        arcs: options.arcs,
+        min_speed_share: 1.0,
+        keyholes: variant.keyholes,
+        klipper_scv_mm_s: (path.junction_model == JunctionModel::Klipper)
+            .then(|| square_corner_velocity(&path.print_limits))
+            .flatten(),
+        line: if options.inside_corners {
+            crate::vtg::blend::Line::Inside
+        } else {
+            crate::vtg::blend::Line::Racing
+        },
+    }
+}
+
+/// The paths worth rewriting, as move ranges `i..j`: those with a sharp corner.
+fn candidates(
+    moves: &[PathMove],
+    sources: &[MoveSource],
+    cos_critical: f64,
+) -> Vec<(usize, usize)> {
+    let mut candidates: Vec<(usize, usize)> = Vec::new();
+    let mut i = 0usize;
+    while i < moves.len() {
+        let Some(j) = path_end(moves, sources, i) else {
+            i += 1;
+            continue;
+        };
+        let run = &moves[i..j];
+        if run.len() >= 2 && has_sharp_corner(run, cos_critical) {
+            candidates.push((i, j));
+        }
+        i = j;
+    }
+    candidates
+}
+
+/// What every path's offer is made with; one value shared by the parallel batches so each
+/// path's offer is one call.
+struct Offering<'a> {
+    input: &'a [u8],
+    path: &'a PrintPath,
+    all: &'a Sources,
+    energy: &'a Accumulator,
+    /// The free rewrite's settings.
+    settings: Settings,
+    /// The dearer variants' (`Tuning::dearer_speed_shares`).
+    dearer: [Settings; 2],
+    /// Whether time may be spent and the dearer variants can differ from the free one.
+    buy_time: bool,
+}
+
+impl Offering<'_> {
+    /// The ways of writing moves `i..j`: the free rewrite, and with time to spend the dearer
+    /// variants that round more corners.
+    fn offer(&self, i: usize, j: usize) -> Offer {
+        let (moves, sources) = (&self.path.moves, &self.all.moves[..]);
+        let machine = PlanContext {
+            limits: self.all.limits_at(i),
+            model: self.path.junction_model,
+            energy: self.energy,
+            context: [
+                i.checked_sub(1).map(|k| motion_of(&moves[k])),
+                moves.get(j).map(motion_of),
+            ],
+        };
+        let write =
+            |s: &Settings| rewrite_path(self.input, &moves[i..j], &sources[i..j], s, &machine);
+        let base = write(&self.settings).unwrap_or_default();
+        let kept = base.iter().map(|o| o.corners_removed).max().unwrap_or(0);
+        // With time to spend, the variants that round the corners the firmware takes faster
+        // sharp, too: first those it takes nearly as fast round.
+        let mut offer = Offer::default();
+        base.into_iter().for_each(|o| offer.push(o));
+        if self.buy_time {
+            self.dearer
+                .iter()
+                .filter_map(write)
+                .flatten()
+                .filter(|o| o.corners_removed > kept)
+                .for_each(|o| offer.push(o));
+        }
+        offer
+    }
+}
+
 impl Offers {
     /// Whether any path offers a rewrite that costs time or energy: otherwise what the budget
     /// allows changes nothing.
-    pub fn has_dearer(&self) -> bool {
+    pub(crate) fn has_dearer(&self) -> bool {
         self.offers.iter().any(|o| !o.dearer.is_empty())
     }
 
     /// The file with the free rewrites and the dearer ones bought with half of what the free
     /// ones saved plus `allowed_s` of time, energy weighed at the print's `mean_power_w` where
     /// time is allowed ([`budget::choose`]).
-    pub fn write(&self, input: &[u8], allowed_s: f64, mean_power_w: f64) -> Rewritten {
+    pub(crate) fn write(&self, input: &[u8], allowed_s: f64, mean_power_w: f64) -> Rewritten {
         let mut out = Rewritten {
             candidate_paths: self.candidate_paths,
             feed_cap_scale: self.variant.feed_cap_scale,
@@ -345,6 +363,18 @@ impl Offers {
 const BATCH_PATHS: usize = 4096;
 
 impl Rewritten {
+    /// The counts of a path written with its eq. 29 speeds at `scale`: raised above the
+    /// settings' first scale, or dropped (`None`).
+    fn at_scale(scale: Option<f64>, settings: &Settings) -> Self {
+        let mut part = Rewritten::default();
+        match scale {
+            None if settings.limit_feed => part.uncapped_paths += 1,
+            Some(k) if k > settings.feed_cap_scale => part.raised_caps_paths += 1,
+            _ => {}
+        }
+        part
+    }
+
     /// Adds the counts of a part of the file rewritten separately.
     fn add(&mut self, part: &Rewritten) {
         self.rewritten_paths += part.rewritten_paths;
@@ -396,7 +426,7 @@ fn has_sharp_corner(run: &[PathMove], cos_critical: f64) -> bool {
 
 /// Whether the turn from direction `a` to direction `b` (neither normalised) is above the
 /// critical angle (cosine `cos_critical`); a zero-length side turns nothing.
-pub(super) fn is_sharp(a: &[f64; 3], b: &[f64; 3], cos_critical: f64) -> bool {
+pub(crate) fn is_sharp(a: &[f64; 3], b: &[f64; 3], cos_critical: f64) -> bool {
     let (la, lb) = (norm(a), norm(b));
     la > 0.0 && lb > 0.0 && dot(a, b) / (la * lb) < cos_critical
 }
@@ -419,22 +449,6 @@ fn square_corner_velocity(limits: &Limits) -> Option<f64> {
 fn xy_jerk(limits: &Limits) -> f64 {
     limits.max_jerk[0].value.min(limits.max_jerk[1].value)
 }
-
-/// Share of the tolerance within which a run of new points must lie on a circle to be written
-/// as an arc (the path with its arcs is then measured against the original as a whole).
-const ARC_SHARE: f64 = 0.05;
-
-/// Scales of the eq. 29 speeds tried in turn (`None`: no caps), until a rewrite costs no time.
-const CAP_SCALES: [Option<f64>; 8] = [
-    Some(1.0),
-    Some(1.2),
-    Some(1.44),
-    Some(1.73),
-    Some(2.07),
-    Some(2.5),
-    Some(3.0),
-    None,
-];
 
 /// The firmware a path runs on: the limits in force where it starts, the junction model, and
 /// the motor energy model; and the moves just before and after the path, which are planned
@@ -537,9 +551,7 @@ impl PlanContext<'_> {
 /// square-corner velocity, gains nothing in time from rounding), the cheapest in energy is
 /// returned marked dearer, for [`budget::choose`] to take or leave, and after it the fastest if
 /// that is another: the lowered feeds that save motor energy cost time, and where time is what
-/// buys corners the fastest way buys more of them. On the K1C benchy at `--allow-slower 1`,
-/// offered both, the rewrite rounds −44.1 % of the sharp corners instead of −35.9 %, within the
-/// same 0.98 % of time, the energy still falling (−0.21 %).
+/// buys corners the fastest way buys more of them.
 fn rewrite_path(
     input: &[u8],
     run: &[PathMove],
@@ -548,84 +560,153 @@ fn rewrite_path(
     machine: &PlanContext<'_>,
 ) -> Option<Vec<Outcome>> {
     let settings = &machine.settings(file_settings);
-    let (first, first_src) = (run.first()?, src.first()?);
-    let xyz = |p: &crate::machine::Pos| [p[0], p[1], p[2]];
-    let mut pts = Vec::with_capacity(run.len() + 1);
-    pts.push(xyz(&first.from));
-    pts.extend(run.iter().map(|m| xyz(&m.to)));
-    // Filament from the path start at each vertex, in E words.
-    let mode = first_src.mode;
-    let mut e = Vec::with_capacity(pts.len());
-    e.push(0.0);
-    let mut sum = 0.0;
-    for s in src {
-        sum = match mode {
-            ExtrusionMode::Relative => sum + s.e_word,
-            ExtrusionMode::Absolute => s.e_word - first_src.e_before,
-        };
-        e.push(sum);
-    }
-    if sum.is_nan() || sum <= 0.0 || e.windows(2).any(|w| w[1] < w[0] - 1e-9) {
-        return None;
-    }
-    let feed: Vec<f64> = src
-        .iter()
-        .zip(run)
-        .map(|(s, m)| s.f_after.map_or(m.feed_mm_s, |f| f / 60.0))
-        .collect();
-    // How the planner ran each original move, when the path was planned.
-    let planned: Vec<Profile> = run
-        .iter()
-        .map_while(|m| m.timing.map(|t| t.profile))
-        .collect();
+    let o = Polyline::of(run, src)?;
+    let (pts, e, feed) = (&o.pts, &o.e, &o.feed);
     let path = SmoothPath {
-        pts: &pts,
-        e: &e,
-        feed: &feed,
-        planned: if planned.len() == run.len() {
-            &planned
+        pts,
+        e,
+        feed,
+        planned: if o.planned.len() == run.len() {
+            &o.planned
         } else {
             &[]
         },
     };
     let smoothed = smooth_path(&path, settings)?;
-    let (original_s, original_j) = machine.cost(pts[0], &pts[1..], &e[1..], &feed);
-    let cost = |w: &Written| machine.cost(pts[0], &w.points, &w.e, &w.feed_mm_s);
-    let added_by = |(s, j): (f64, f64)| [s - original_s, j - original_j];
-    let dearer = |a: &[f64; 2]| a[0] > original_s * 1e-9 || a[1] > original_j * 1e-9;
-    // The eq. 29 speeds as they are, then raised step by step, then no caps at all, each
-    // first as fast as the firmware will go elsewhere, then no faster than the original: the
-    // first that costs neither time nor energy, else the one that costs least energy.
-    let base = settings.feed_cap_scale;
-    let capped = CAP_SCALES.map(|k| k.map(|k| k * base));
-    let scales: &[Option<f64>] = if settings.limit_feed {
-        &capped
-    } else {
-        &[None]
+    let original = machine.cost(pts[0], &pts[1..], &e[1..], feed);
+    let costs = Costs { original };
+    let (cheapest, fastest) = cheapest_and_fastest(&smoothed, pts[0], settings, machine, costs);
+    let (scale, written, written_cost) = cheapest?;
+    let cos_critical = crate::math::cos(settings.critical_rad);
+    let draft = Draft {
+        sharp_before: sharp_turns(pts, cos_critical),
+        cos_critical,
+        input,
+        run,
+        src,
+        pts,
+        e,
+        smoothed: &smoothed,
+        settings,
+        machine,
     };
-    // (scale, the path as written, its time and energy)
-    let mut cheapest: Option<(Option<f64>, Written, (f64, f64))> = None;
-    // (scale, ceiling, its time and energy): written again at the end if it is another way.
-    let mut fastest: Option<(Option<f64>, bool, (f64, f64))> = None;
-    for (k, ceiling) in scales.iter().flat_map(|&k| [(k, false), (k, true)]) {
+    let added = costs.added_by(written_cost);
+    let mut out =
+        vec![draft.outcome(scale, &written, written_cost, added, costs.dearer(&added))?];
+    if let Some((k, ceiling, total)) = fastest.filter(|f| f.2 .0 < written_cost.0) {
         let w = smoothed.written(k, ceiling, pts[0], settings);
+        out.extend(draft.outcome(k, &w, total, costs.added_by(total), true));
+    }
+    Some(out)
+}
+
+/// An original path as the smoothing reads it: vertices (start point first), filament from
+/// the path start at each vertex in E words, feed per segment, and how the planner ran each
+/// move (as far as it was planned).
+struct Polyline {
+    pts: Vec<[f64; 3]>,
+    e: Vec<f64>,
+    feed: Vec<f64>,
+    planned: Vec<Profile>,
+}
+
+impl Polyline {
+    /// The path of `run`; `None` where its filament is not a positive, rising total.
+    fn of(run: &[PathMove], src: &[MoveSource]) -> Option<Self> {
+        let (first, first_src) = (run.first()?, src.first()?);
+        let xyz = |p: &crate::machine::Pos| [p[0], p[1], p[2]];
+        let mut pts = Vec::with_capacity(run.len() + 1);
+        pts.push(xyz(&first.from));
+        pts.extend(run.iter().map(|m| xyz(&m.to)));
+        // Filament from the path start at each vertex, in E words.
+        let mode = first_src.mode;
+        let mut e = Vec::with_capacity(pts.len());
+        e.push(0.0);
+        let mut sum = 0.0;
+        for s in src {
+            sum = match mode {
+                ExtrusionMode::Relative => sum + s.e_word,
+                ExtrusionMode::Absolute => s.e_word - first_src.e_before,
+            };
+            e.push(sum);
+        }
+        if sum.is_nan() || sum <= 0.0 || e.windows(2).any(|w| w[1] < w[0] - 1e-9) {
+            return None;
+        }
+        let feed: Vec<f64> = src
+            .iter()
+            .zip(run)
+            .map(|(s, m)| s.f_after.map_or(m.feed_mm_s, |f| f / 60.0))
+            .collect();
+        // How the planner ran each original move, when the path was planned.
+        let planned: Vec<Profile> = run
+            .iter()
+            .map_while(|m| m.timing.map(|t| t.profile))
+            .collect();
+        Some(Polyline {
+            pts,
+            e,
+            feed,
+            planned,
+        })
+    }
+}
+
+/// The original path's time (s) and motor energy (J), against which a writing's are weighed.
+#[derive(Clone, Copy)]
+struct Costs {
+    original: (f64, f64),
+}
+
+impl Costs {
+    /// Time and energy a writing costing `(s, j)` adds to the original's.
+    fn added_by(&self, (s, j): (f64, f64)) -> [f64; 2] {
+        [s - self.original.0, j - self.original.1]
+    }
+
+    /// Whether what a writing adds makes it dearer than the original.
+    fn dearer(&self, a: &[f64; 2]) -> bool {
+        a[0] > self.original.0 * 1e-9 || a[1] > self.original.1 * 1e-9
+    }
+}
+
+/// A writing of a smoothed path: the eq. 29 speeds' scale (`None`: no caps), and the path
+/// written with it (or whether it had a ceiling), with its time (s) and energy (J).
+type Writing<W> = (Option<f64>, W, (f64, f64));
+
+/// The eq. 29 speeds as they are, then raised step by step, then no caps at all, each first
+/// as fast as the firmware will go elsewhere, then no faster than the original: the first
+/// writing that costs neither time nor energy, else the one that costs least energy; and the
+/// fastest if that is not the first (to be written again at the end if it is another way).
+fn cheapest_and_fastest(
+    smoothed: &Smoothed,
+    start: [f64; 3],
+    settings: &Settings,
+    machine: &PlanContext<'_>,
+    costs: Costs,
+) -> (Option<Writing<Written>>, Option<Writing<bool>>) {
+    let cost = |w: &Written| machine.cost(start, &w.points, &w.e, &w.feed_mm_s);
+    let mut cheapest: Option<Writing<Written>> = None;
+    let mut fastest: Option<Writing<bool>> = None;
+    for (k, ceiling) in super::writings(settings) {
+        let w = smoothed.written(k, ceiling, start, settings);
         let total = cost(&w);
-        let a = added_by(total);
+        let a = costs.added_by(total);
         if a.iter().any(|x| x.is_nan()) {
             continue;
         }
         let better = cheapest.as_ref().is_none_or(|c| {
-            let b = added_by(c.2);
+            let b = costs.added_by(c.2);
             (a[1], a[0]) < (b[1], b[0])
         });
-        let stop = !dearer(&a);
+        let stop = !costs.dearer(&a);
         if stop {
             cheapest = Some((k, w, total));
             fastest = None;
             break;
         }
         let quicker = fastest.as_ref().is_none_or(|c| {
-            let b = added_by(c.2);
+            let b = costs.added_by(c.2);
             (a[0], a[1]) < (b[0], b[1])
         });
         if quicker {
@@ -635,27 +716,7 @@ fn rewrite_path(
             cheapest = Some((k, w, total));
         }
     }
-    let (scale, written, written_cost) = cheapest?;
-    let cos_critical = crate::math::cos(settings.critical_rad);
-    let draft = Draft {
-        sharp_before: sharp_turns(&pts, cos_critical),
-        cos_critical,
-        input,
-        run,
-        src,
-        pts: &pts,
-        e: &e,
-        smoothed: &smoothed,
-        settings,
-        machine,
-    };
-    let added = added_by(written_cost);
-    let mut out = vec![draft.outcome(scale, &written, written_cost, added, dearer(&added))?];
-    if let Some((k, ceiling, total)) = fastest.filter(|f| f.2 .0 < written_cost.0) {
-        let w = smoothed.written(k, ceiling, pts[0], settings);
-        out.extend(draft.outcome(k, &w, total, added_by(total), true));
-    }
-    Some(out)
+    (cheapest, fastest)
 }
 
 /// A path and its smoothed form, to be written one way or another.
@@ -701,29 +762,13 @@ impl Draft<'_> {
         let (first_src, last_src) = (src.first()?, src.last()?);
         let mode = first_src.mode;
         let sum = *e.last()?;
-        let base = settings.feed_cap_scale;
-        let mut part = Rewritten::default();
-        match scale {
-            None if settings.limit_feed => part.uncapped_paths += 1,
-            Some(k) if k > base => part.raised_caps_paths += 1,
-            _ => {}
-        }
+        let mut part = Rewritten::at_scale(scale, settings);
         let removed = sharp_before.saturating_sub(sharp_turns(
             std::iter::once(&pts[0]).chain(&written.points),
             cos_critical,
         ));
         let out = &mut part;
-        // Annotation lines between the original moves (`;WIDTH:`), each with the filament pushed
-        // where it stood.
-        let mut notes = Vec::new();
-        for (s, &at) in src.iter().zip(e).skip(1) {
-            if s.notes.lines > 0 {
-                notes.push((
-                    at,
-                    std::str::from_utf8(input.get(s.notes.from..s.notes.to)?).ok()?,
-                ));
-            }
-        }
+        let notes = notes(input, src, e)?;
         // Runs on a circle as arcs, if asked for and if the path with them still keeps the
         // tolerance both ways (measured on the arcs themselves).
         let all: Vec<[f64; 3]> = std::iter::once(pts[0])
@@ -761,25 +806,48 @@ impl Draft<'_> {
         out.max_deviation_mm = out.max_deviation_mm.max(deviation);
         out.walk.steps += smoothed.stats.steps;
         out.walk.fluctuation_sum += smoothed.stats.fluctuation_sum;
-        let mut edits = Vec::with_capacity(src.len());
-        edits.push(Edit {
-            line: first_src.line,
-            replacement: text.into_bytes(),
-        });
-        for s in src.iter().skip(1) {
-            edits.extend((s.line - s.notes.lines..=s.line).map(|line| Edit {
-                line,
-                replacement: Vec::new(),
-            }));
-        }
         Some(Outcome {
-            edits,
+            edits: edits(src, text),
             part,
             added,
             dearer,
             corners_removed: removed as u64,
         })
     }
+}
+
+/// Annotation lines between the original moves (`;WIDTH:`), each with the filament pushed
+/// where it stood (`e`, from the path start): the new block writes them back in place.
+fn notes<'i>(input: &'i [u8], src: &[MoveSource], e: &[f64]) -> Option<Vec<(f64, &'i str)>> {
+    let mut notes = Vec::new();
+    for (s, &at) in src.iter().zip(e).skip(1) {
+        if s.notes.lines > 0 {
+            notes.push((
+                at,
+                std::str::from_utf8(input.get(s.notes.from..s.notes.to)?).ok()?,
+            ));
+        }
+    }
+    Some(notes)
+}
+
+/// The edits replacing a path's first line with the new block `text` and deleting its other
+/// lines (with the annotations between them, which the block writes again).
+fn edits(src: &[MoveSource], text: String) -> Vec<Edit> {
+    let mut edits = Vec::with_capacity(src.len());
+    if let Some(first) = src.first() {
+        edits.push(Edit {
+            line: first.line,
+            replacement: text.into_bytes(),
+        });
+    }
+    for s in src.iter().skip(1) {
+        edits.extend((s.line - s.notes.lines..=s.line).map(|line| Edit {
+            line,
+            replacement: Vec::new(),
+        }));
+    }
+    edits
 }
 
 /// The written path `all` (start point first; `written` after it) with its runs on a circle as
@@ -805,10 +873,10 @@ fn with_arcs(
     };
     let firmware = arcs::Firmware {
         segments: &segments,
-        max_turn_rad: super::smooth::STEP_TURN_SHARE * settings.critical_rad,
+        max_turn_rad: TUNING.step_turn_share * settings.critical_rad,
     };
     let tol = settings.tolerance_mm;
-    let pieces = arcs::pieces(all, &written.feed_mm_s, ARC_SHARE * tol, &firmware);
+    let pieces = arcs::pieces(all, &written.feed_mm_s, TUNING.arc_share * tol, &firmware);
     if pieces.iter().all(|p| p.arc.is_none()) {
         return None;
     }
@@ -827,7 +895,7 @@ fn with_arcs(
 }
 
 /// Turns above the critical angle (cosine `cos_critical`) along the polyline through `pts`.
-pub(super) fn sharp_turns<'a>(
+pub(crate) fn sharp_turns<'a>(
     pts: impl IntoIterator<Item = &'a [f64; 3]>,
     cos_critical: f64,
 ) -> usize {

@@ -1,0 +1,80 @@
+//! The search for the rewrite, its ladders of variants in one table. Every rung is tried in
+//! the order listed; the first that passes (or the best, where noted) is kept.
+//!
+//! | level | rungs | enumerated by | tried in |
+//! |---|---|---|---|
+//! | file | eq. 29 speed scale 1 with keyholes, then `Tuning::quieter_scales` with and without keyholes; the quietest under the dynamics model is kept | [`quieter_variants`] | `vtg::with_simulated_deviation` |
+//! | file | the time allowance, cut by the excess for `Tuning::time_rounds` rounds, then none | — | `vtg::within_allowed_time` |
+//! | path | the free rewrite (corners rounded at no loss of speed), then `Tuning::dearer_speed_shares` where time may be spent | `rewrite::Offering` | [`rewrite::offers`] |
+//! | path | eq. 29 speeds at `Tuning::cap_scales`, each without then with a ceiling at the original's speed: the first that costs nothing, else the cheapest and the fastest | [`writings`] | `rewrite::cheapest_and_fastest` |
+//! | path | the racing line, then the inside line where that left more sharp turns | — | `smooth::smooth_cut` |
+//! | piece | blends at `Tuning::blend_share` of the tolerance, shrunk by `Tuning::retry_scale` for `Tuning::attempts` tries; keyholes dropped where none fits | [`blend_shares`] | `smooth::smooth_piece` |
+//!
+//! Each path goes through the stages with its corners chosen (`smooth`), is written its free
+//! way and its dearer ways (`rewrite`), and the file-level choice decides what to buy with the
+//! time allowed (`budget`).
+
+use super::tuning::TUNING;
+use smooth::Settings;
+
+pub(crate) mod budget;
+pub(crate) mod rewrite;
+pub(crate) mod smooth;
+
+/// What a whole-file rewrite is tried with; [`crate::vtg::vtg`] tries others where the dynamics
+/// model finds the first one ringing more than the original.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Variant {
+    /// The first scale of the eq. 29 speeds ([`Settings::feed_cap_scale`]).
+    pub(crate) feed_cap_scale: f64,
+    /// Turn corners too tight to fillet round keyhole loops ([`Settings::keyholes`]).
+    pub(crate) keyholes: bool,
+}
+
+impl Default for Variant {
+    fn default() -> Self {
+        Variant {
+            feed_cap_scale: 1.0,
+            keyholes: true,
+        }
+    }
+}
+
+/// The whole-file variants tried after the first (scale 1 with keyholes), in turn.
+pub(crate) fn quieter_variants() -> impl Iterator<Item = Variant> {
+    [true, false]
+        .into_iter()
+        .flat_map(|keyholes| {
+            TUNING.quieter_scales.map(|feed_cap_scale| Variant {
+                feed_cap_scale,
+                keyholes,
+            })
+        })
+        .skip(1)
+}
+
+/// The ways a smoothed path is written, in turn: the eq. 29 speeds at each of
+/// `Tuning::cap_scales` times the settings' first scale (`None`: no caps; only that without
+/// `limit_feed`), each first without a ceiling, then no faster than the original.
+pub(crate) fn writings(settings: &Settings) -> Vec<(Option<f64>, bool)> {
+    let base = settings.feed_cap_scale;
+    let capped = TUNING.cap_scales.map(|k| k.map(|k| k * base));
+    let scales: &[Option<f64>] = if settings.limit_feed {
+        &capped
+    } else {
+        &[None]
+    };
+    scales
+        .iter()
+        .flat_map(|&k| [(k, false), (k, true)])
+        .collect()
+}
+
+/// The shares of the tolerance a piece's blends are tried with, in turn: `Tuning::blend_share`,
+/// then each retry `Tuning::retry_scale` of the one before, `Tuning::attempts` in all.
+pub(crate) fn blend_shares() -> impl Iterator<Item = f64> {
+    std::iter::successors(Some(TUNING.blend_share), |share| {
+        Some(share * TUNING.retry_scale)
+    })
+    .take(TUNING.attempts)
+}
