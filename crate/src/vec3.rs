@@ -71,7 +71,7 @@ pub fn normalize(a: V3) -> Option<V3> {
 
 /// Angle between two vectors, radians, in `[0, π]`.
 ///
-/// Eq. 4 of the paper writes it as `arccos(a·b / |a||b|)`; `atan2(|a×b|, a·b)` is the same
+/// CIRP eq. 4 writes it as `arccos(a·b / |a||b|)`; `atan2(|a×b|, a·b)` is the same
 /// angle but keeps full precision near 0 and π, where the cone test must be exact.
 #[inline]
 pub fn angle(a: impl Borrow<V3>, b: impl Borrow<V3>) -> f64 {
@@ -96,7 +96,7 @@ pub fn is_finite(a: V3) -> bool {
     a.iter().all(|c| c.is_finite())
 }
 
-/// Rodrigues rotation of `v` about the unit axis `h` by `theta` radians (the matrix of eq. 6
+/// Rodrigues rotation of `v` about the unit axis `h` by `theta` radians (the matrix of CIRP eq. 6
 /// applied to `v`).
 pub fn rotate(v: V3, h: V3, theta: f64) -> V3 {
     let c = math::cos(theta);

@@ -61,7 +61,7 @@ pub struct Accounts {
     pub travel: FeatureSummary,
     /// Material named in the file's comments, if any.
     pub material: Option<Material>,
-    /// Toolpath metrics of the VTG paper (eq. 24–26, 31).
+    /// Toolpath metrics of the VTG paper (VTG eq. 24–26, 31).
     pub toolpath: MetricsAccumulator,
     moves_read: u64,
     /// The last point put into the bounds, while moves keep extruding.

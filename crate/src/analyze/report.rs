@@ -142,5 +142,5 @@ pub struct FeatureSummary {
 pub use crate::energy::Energy;
 pub use crate::machine::{FanEvent, TemperatureEvent};
 
-/// Toolpath metrics of the VTG paper (eq. 24–26, 31), see [`super::toolpath`].
+/// Toolpath metrics of the VTG paper (VTG eq. 24–26, 31), see [`super::toolpath`].
 pub type Toolpath = super::toolpath::ToolpathMetrics;

@@ -1,11 +1,11 @@
-//! Trajectory metrics of the VTG paper (eq. 24–26, 31): lengths, point counts, turning points
+//! Trajectory metrics of the VTG paper (VTG eq. 24–26, 31): lengths, point counts, turning points
 //! and chord error of the printed toolpath, per file and per layer.
 //!
 //! The paper speaks of "trajectory points" without saying which; a slicer's file makes it
 //! concrete. Here a *path* is a run of consecutive extruding moves within one feature (a travel,
 //! a retraction, a zero-length move or a feature change ends it); its points are the start of its
-//! first move and the end of every move. Turning angles (eq. 26) and chord errors (eq. 31) are
-//! taken at the interior points of paths only: the corner between a travel and a print is not a
+//! first move and the end of every move. Turning angles (VTG eq. 26) and chord errors (VTG eq. 31)
+//! are taken at the interior points of paths only: the corner between a travel and a print is not a
 //! trajectory corner. "Infill" is sparse and solid infill (the paper's Table 1 calls the majority
 //! region inside the walls infill). Arcs (`G2`/`G3`) count by their end points and by their
 //! length along the arc, and turn by their tangents at those points: an arc-fitted file meets
@@ -25,12 +25,12 @@ use crate::vec3::norm;
 /// Default critical angle δθ: turns above it are sharp corners (turning points), degrees.
 pub const DEFAULT_CRITICAL_ANGLE_DEG: f64 = 30.0;
 
-/// Toolpath metrics of a file or a layer (eq. 24–26, 31).
+/// Toolpath metrics of a file or a layer (VTG eq. 24–26, 31).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct ToolpathMetrics {
-    /// Printed path length `L_total`, mm (eq. 24).
+    /// Printed path length `L_total`, mm (VTG eq. 24).
     pub l_total_mm: f64,
-    /// Printed infill length `L_infill`, mm (eq. 25).
+    /// Printed infill length `L_infill`, mm (VTG eq. 25).
     pub l_infill_mm: f64,
     /// Trajectory points `n_total`.
     pub n_total: u64,
@@ -40,9 +40,9 @@ pub struct ToolpathMetrics {
     pub n_turning: u64,
     /// Interior points (where a turning angle is defined).
     pub n_corners: u64,
-    /// Mean turning angle ϑ over interior points, degrees (eq. 26).
+    /// Mean turning angle ϑ over interior points, degrees (VTG eq. 26).
     pub mean_turn_deg: f64,
-    /// Mean chord error `mean(e_c)` over interior points, mm (eq. 31).
+    /// Mean chord error `mean(e_c)` over interior points, mm (VTG eq. 31).
     pub mean_chord_error_mm: f64,
     /// Critical angle δθ used, degrees.
     pub critical_angle_deg: f64,
@@ -117,7 +117,7 @@ impl MetricsAccumulator {
         let chord = [to[0] - from[0], to[1] - from[1], to[2] - from[2]];
         let chord_len = norm(chord);
         // A line is its own direction at both ends; an arc leaves and arrives along its
-        // tangents, taken as long as its chord so eq. 31 sees a segment of the same size.
+        // tangents, taken as long as its chord so VTG eq. 31 sees a segment of the same size.
         let (start_seg, seg, len) = match arc {
             Some(a) => {
                 let rise = chord[a.plane.axes().2];
@@ -164,7 +164,8 @@ impl MetricsAccumulator {
         });
     }
 
-    /// Turning angle (eq. 26) and chord error (eq. 31) at the point between segments `a`, `b`.
+    /// Turning angle (VTG eq. 26) and chord error (VTG eq. 31) at the point between segments
+    /// `a`, `b`.
     #[inline]
     fn corner(&mut self, a: &[f64; 3], la: f64, b: &[f64; 3], lb: f64) {
         let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -220,9 +221,9 @@ fn same_point(a: &[f64; 3], b: &[f64]) -> bool {
     (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9 && (a[2] - b[2]).abs() < 1e-9
 }
 
-/// Eq. 31: `e_c = r − sqrt(r² − (|C_{i+1} − C_i|/2)²)` with `r` the radius of the circle through
-/// `C_i`, `C_{i+1}`, `C_{i+2}` (segments `a = C_{i+1} − C_i`, `b = C_{i+2} − C_{i+1}`). Written
-/// as `h²/(r + sqrt(r² − h²))` to avoid cancellation; collinear points give 0.
+/// VTG eq. 31: `e_c = r − sqrt(r² − (|C_{i+1} − C_i|/2)²)` with `r` the radius of the circle
+/// through `C_i`, `C_{i+1}`, `C_{i+2}` (segments `a = C_{i+1} − C_i`, `b = C_{i+2} − C_{i+1}`).
+/// Written as `h²/(r + sqrt(r² − h²))` to avoid cancellation; collinear points give 0.
 pub fn chord_error(a: &[f64; 3], la: f64, b: &[f64; 3], lb: f64) -> f64 {
     let c = [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
     let lc = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
@@ -298,7 +299,7 @@ mod tests {
 
     #[test]
     fn regular_polygon_chord_error_is_the_sagitta() {
-        // Points on a circle of radius 5: eq. 31 gives the sagitta of each chord.
+        // Points on a circle of radius 5: VTG eq. 31 gives the sagitta of each chord.
         let mut acc = MetricsAccumulator::new(30.0);
         let n = 36;
         let p = |i: usize| {

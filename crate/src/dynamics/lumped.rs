@@ -1,26 +1,26 @@
-//! The equivalent lumped-mass model of one axis drive (VTG paper, eq. 1–14).
+//! The equivalent lumped-mass model of one axis drive (VTG eq. 1–14).
 //!
 //! Generalised coordinates `q = [x1, x2, x3, x4, θM, θS]`: axial displacement of ball screws 1
-//! and 2, slave pedestal, working table (m), motor and screw angle (rad). Kinetic energy (eq. 11)
-//! `E_k = ½ Σ m_i ẋ_i² + ½ J_M θ̇M² + ½ J_S θ̇S²`; potential energy (eq. 12) and dissipation
-//! (eq. 13), read with these conventions:
+//! and 2, slave pedestal, working table (m), motor and screw angle (rad). Kinetic energy
+//! (VTG eq. 11) `E_k = ½ Σ m_i ẋ_i² + ½ J_M θ̇M² + ½ J_S θ̇S²`; potential energy (VTG eq. 12) and
+//! dissipation (VTG eq. 13), read with these conventions:
 //!
 //! - `E_p = ½ k_n x1² + ½ k_n x2² + ½ k_t (θS − θM)² + ½ k_mn (x3 − x_s − i_s θS)² + k_mw (x4 − x3)²`
 //!   with `x_s = (x1 + x2)/2`. The paper writes only screw 1's bearing term "for brevity" and
 //!   `(θM + θS)` for the twist (angles counted in opposite senses); here both screws are
 //!   supported alike and both angles turn the same way. `k_mw (x4 − x3)²` is two flexure hinges of
 //!   `½ k_mw` energy each.
-//! - `D = ½ C_mn ẋ3² + ½ (2 C_mw) ẋ4²`: one nut damper and two hinge dampers (eq. 13 without the
-//!   Rayleigh factor ½, which the paper leaves out).
+//! - `D = ½ C_mn ẋ3² + ½ (2 C_mw) ẋ4²`: one nut damper and two hinge dampers (VTG eq. 13 without
+//!   the Rayleigh factor ½, which the paper leaves out).
 //!
-//! Lagrange's equations (eq. 10) then give `M q̈ + C q̇ + K q = F` (eq. 14) with constant
+//! Lagrange's equations (VTG eq. 10) then give `M q̈ + C q̇ + K q = F` (VTG eq. 14) with constant
 //! diagonal `M`, `C = ∂²D/∂q̇²` and `K = ∂²E_p/∂q²`. `K` depends on the nut position through the
-//! screw's axial and torsional stiffness (eq. 5, 6, 8, 9).
+//! screw's axial and torsional stiffness (VTG eq. 5, 6, 8, 9).
 //!
 //! Two corrections to the paper's printed formulas, both dimensional: the screw's inertia about
-//! its axis is `J_sc = π ρ l_s r_s⁴ / 2` (½ m r², eq. 4 prints /4), and its torsional stiffness
-//! is `G J_p / l_n = G π r_s⁴ / (2 l_n)` in N·m/rad (eq. 6 prints `G π r_s² / (4 l_n)`, which
-//! is not a torsional stiffness). Eq. 3 adds `i_s² m_3` to the screw inertia; that is the
+//! its axis is `J_sc = π ρ l_s r_s⁴ / 2` (½ m r², VTG eq. 4 prints /4), and its torsional stiffness
+//! is `G J_p / l_n = G π r_s⁴ / (2 l_n)` in N·m/rad (VTG eq. 6 prints `G π r_s² / (4 l_n)`, which
+//! is not a torsional stiffness). VTG eq. 3 adds `i_s² m_3` to the screw inertia; that is the
 //! pedestal reflected onto the screw in a model without `x3`. Here `x3` is a coordinate of its
 //! own, so that term would count the pedestal twice and is left out.
 
@@ -49,20 +49,20 @@ pub mod dof {
     pub const THETA_S: usize = 5;
 }
 
-/// The coefficients of eq. 11–13 at one nut position.
+/// The coefficients of VTG eq. 11–13 at one nut position.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Coefficients {
-    /// Equivalent masses `m1..m4`, kg (eq. 1–2).
+    /// Equivalent masses `m1..m4`, kg (VTG eq. 1–2).
     pub m: [f64; 4],
     /// Motor inertia `J_M`, kg·m².
     pub j_m: f64,
-    /// Screw inertia `J_S`, kg·m² (eq. 3–4).
+    /// Screw inertia `J_S`, kg·m² (VTG eq. 3–4).
     pub j_s: f64,
-    /// Axial composite stiffness of screw and bearing `k_n` (eq. 5, 8), N/m.
+    /// Axial composite stiffness of screw and bearing `k_n` (VTG eq. 5, 8), N/m.
     pub k_n: f64,
-    /// Torsional composite stiffness of screw and coupling `k_t` (eq. 6, 9), N·m/rad.
+    /// Torsional composite stiffness of screw and coupling `k_t` (VTG eq. 6, 9), N·m/rad.
     pub k_t: f64,
-    /// Nut contact stiffness `k_mn` (eq. 7), N/m.
+    /// Nut contact stiffness `k_mn` (VTG eq. 7), N/m.
     pub k_mn: f64,
     /// One flexure hinge `k_mw`, N/m.
     pub k_mw: f64,
@@ -74,7 +74,7 @@ pub struct Coefficients {
     pub i_s: f64,
 }
 
-/// Mass, damping and stiffness matrices (eq. 14).
+/// Mass, damping and stiffness matrices (VTG eq. 14).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Matrices {
     /// `M`.
@@ -85,12 +85,12 @@ pub struct Matrices {
     pub k: Mat6,
 }
 
-/// Eq. 7: contact stiffness of a preloaded nut, `0.8 k_c (F_z / 0.1 C_a)^⅓`.
+/// VTG eq. 7: contact stiffness of a preloaded nut, `0.8 k_c (F_z / 0.1 C_a)^⅓`.
 pub fn nut_contact_stiffness(k_c: f64, preload: f64, dynamic_load_rating: f64) -> f64 {
     0.8 * k_c * libm::cbrt(preload / (0.1 * dynamic_load_rating))
 }
 
-/// Series combination of two springs (eq. 8, 9).
+/// Series combination of two springs (VTG eq. 8, 9).
 fn series(a: f64, b: f64) -> f64 {
     1.0 / (1.0 / a + 1.0 / b)
 }
@@ -114,17 +114,17 @@ pub fn ball_screw(d: &BallScrew, l_n: f64) -> Coefficients {
     let pi = core::f64::consts::PI;
     let r = d.screw_radius_m;
     let l_n = l_n.clamp(0.01 * d.screw_length_m, d.screw_length_m);
-    let m_sc = pi * d.density_kg_m3 * d.screw_length_m * r * r; // eq. 2
-    let m1 = m_sc + d.rotor_mass_kg + d.coupling_mass_kg; // eq. 1
-    let j_sc = pi * d.density_kg_m3 * d.screw_length_m * r.powi(4) / 2.0; // eq. 4 (½ m r²)
-    let k_sn = pi * r * r * d.youngs_modulus_pa / l_n; // eq. 5
-    let k_st = d.shear_modulus_pa * pi * r.powi(4) / (2.0 * l_n); // eq. 6 (G J_p / l)
+    let m_sc = pi * d.density_kg_m3 * d.screw_length_m * r * r; // VTG eq. 2
+    let m1 = m_sc + d.rotor_mass_kg + d.coupling_mass_kg; // VTG eq. 1
+    let j_sc = pi * d.density_kg_m3 * d.screw_length_m * r.powi(4) / 2.0; // VTG eq. 4 (½ m r²)
+    let k_sn = pi * r * r * d.youngs_modulus_pa / l_n; // VTG eq. 5
+    let k_st = d.shear_modulus_pa * pi * r.powi(4) / (2.0 * l_n); // VTG eq. 6 (G J_p / l)
     Coefficients {
         m: [m1, m1, d.pedestal_mass_kg, d.table_mass_kg],
         j_m: d.motor_inertia_kg_m2,
-        j_s: j_sc + d.coupling_inertia_kg_m2,           // eq. 3
-        k_n: series(d.bearing_stiffness_n_m, k_sn),     // eq. 8
-        k_t: series(d.coupling_stiffness_nm_rad, k_st), // eq. 9
+        j_s: j_sc + d.coupling_inertia_kg_m2,       // VTG eq. 3
+        k_n: series(d.bearing_stiffness_n_m, k_sn), // VTG eq. 8
+        k_t: series(d.coupling_stiffness_nm_rad, k_st), // VTG eq. 9
         k_mn: nut_contact_stiffness(
             d.nut_reference_stiffness_n_m,
             d.preload_n,
@@ -188,7 +188,7 @@ impl Drive {
 }
 
 impl Coefficients {
-    /// `M`, `C`, `K` of the mechanism alone (eq. 14); `K` is singular: the rigid-body motion of
+    /// `M`, `C`, `K` of the mechanism alone (VTG eq. 14); `K` is singular: the rigid-body motion of
     /// the axis (every part moving together) stores no energy.
     pub fn matrices(&self) -> Matrices {
         use dof::*;
@@ -283,7 +283,7 @@ mod tests {
         let near = p.x.coefficients(0.0);
         let far = p.x.coefficients(0.9);
         assert!(far.k_n < near.k_n && far.k_t < near.k_t);
-        // Eq. 7 with preload 5 % of C_a: 0.8 · 0.5^⅓ of the reference stiffness.
+        // VTG eq. 7 with preload 5 % of C_a: 0.8 · 0.5^⅓ of the reference stiffness.
         let k = nut_contact_stiffness(300e6, 500.0, 10e3);
         assert!((k - 0.8 * 300e6 * 0.5f64.powf(1.0 / 3.0)).abs() < 1.0);
     }

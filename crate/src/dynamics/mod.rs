@@ -1,13 +1,13 @@
-//! Machine dynamics: the lumped-mass model of an axis drive (VTG paper eq. 1–15), its response
+//! Machine dynamics: the lumped-mass model of an axis drive (VTG eq. 1–15), its response
 //! to the planned trajectory, trajectory deviation and acceleration spectra.
 //!
 //! The pipeline of [`vibration`]:
 //! 1. read the file's moves with the planner's timing ([`crate::path::extract`]);
-//! 2. build each axis's `M`, `C`, `K` ([`lumped`], eq. 1–14) from a physical parameter set
+//! 2. build each axis's `M`, `C`, `K` ([`lumped`], VTG eq. 1–14) from a physical parameter set
 //!    ([`parameters`]), close the position loop, and take its modes ([`modal`]);
 //! 3. sample the commanded X and Y motion every `T_s` ([`trajectory`]) and integrate the model
 //!    exactly ([`integrate`]: matrix exponential per nut-position bucket, [`axis`]);
-//! 4. trajectory deviation `dev = ‖C − C_p‖` (eq. 15) between commanded and simulated table
+//! 4. trajectory deviation `dev = ‖C − C_p‖` (VTG eq. 15) between commanded and simulated table
 //!    position, over the print and per layer; the table's acceleration, averaged to the
 //!    accelerometer rate `f_s`, and its Welch PSD ([`welch`]) with the top peaks.
 //!
@@ -81,7 +81,7 @@ impl Default for VibrationOptions {
     }
 }
 
-/// Trajectory deviation statistics (eq. 15), mm.
+/// Trajectory deviation statistics (VTG eq. 15), mm.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Deviation {
     /// Largest deviation.

@@ -5,8 +5,8 @@
 //!
 //! - [`BallScrew`]: the paper's drive. Servo motor → flexible coupling → ball screw held by a
 //!   fixed bearing → nut on the slave pedestal → flexure hinges → working table. Masses, inertias
-//!   and stiffnesses follow eq. 1–9; the screw's axial and torsional stiffness fall as the nut
-//!   moves away from the coupling (eq. 5–6).
+//!   and stiffnesses follow VTG eq. 1–9; the screw's axial and torsional stiffness fall as the nut
+//!   moves away from the coupling (VTG eq. 5–6).
 //! - [`Belt`]: the usual desktop printer. Stepper rotor (θM) → motor shaft (torsion) → GT2 pulley
 //!   (θS) → belt → carriage (x3) → toolhead or bed on its mount (x4); x1/x2 are the motor mount
 //!   and the idler moving on the frame. The belt plays the nut's part: its stiffness
@@ -62,7 +62,7 @@ impl ServoLoop {
     }
 }
 
-/// A ball-screw drive (VTG paper, eq. 1–9).
+/// A ball-screw drive (VTG eq. 1–9).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BallScrew {
@@ -78,11 +78,11 @@ pub struct BallScrew {
     pub youngs_modulus_pa: f64,
     /// Shear modulus `G`, Pa.
     pub shear_modulus_pa: f64,
-    /// Motor rotor mass `m_r` (eq. 1), kg.
+    /// Motor rotor mass `m_r` (VTG eq. 1), kg.
     pub rotor_mass_kg: f64,
-    /// Coupling mass `m_c` (eq. 1), kg.
+    /// Coupling mass `m_c` (VTG eq. 1), kg.
     pub coupling_mass_kg: f64,
-    /// Coupling inertia `J_c` (eq. 3), kg·m².
+    /// Coupling inertia `J_c` (VTG eq. 3), kg·m².
     pub coupling_inertia_kg_m2: f64,
     /// Motor rotor inertia `J_M`, kg·m².
     pub motor_inertia_kg_m2: f64,
@@ -90,21 +90,21 @@ pub struct BallScrew {
     pub pedestal_mass_kg: f64,
     /// Working table (what the axis carries) mass `m_4`, kg.
     pub table_mass_kg: f64,
-    /// Axial stiffness of the fixed bearing `k_zn` (eq. 8), N/m.
+    /// Axial stiffness of the fixed bearing `k_zn` (VTG eq. 8), N/m.
     pub bearing_stiffness_n_m: f64,
-    /// Torsional stiffness of the coupling `k_zt` (eq. 9), N·m/rad.
+    /// Torsional stiffness of the coupling `k_zt` (VTG eq. 9), N·m/rad.
     pub coupling_stiffness_nm_rad: f64,
-    /// Nut reference stiffness without preload `k_c` (eq. 7), N/m.
+    /// Nut reference stiffness without preload `k_c` (VTG eq. 7), N/m.
     pub nut_reference_stiffness_n_m: f64,
-    /// Nut preload `F_z` (eq. 7), N.
+    /// Nut preload `F_z` (VTG eq. 7), N.
     pub preload_n: f64,
-    /// Dynamic load rating `C_a` (eq. 7), N.
+    /// Dynamic load rating `C_a` (VTG eq. 7), N.
     pub dynamic_load_rating_n: f64,
     /// Axial stiffness of one flexure hinge between pedestal and table `k_mw`, N/m.
     pub hinge_stiffness_n_m: f64,
-    /// Damping coefficient of the nut `C_mn` (eq. 13), N·s/m.
+    /// Damping coefficient of the nut `C_mn` (VTG eq. 13), N·s/m.
     pub nut_damping_ns_m: f64,
-    /// Damping coefficient of one flexure hinge `C_mw` (eq. 13), N·s/m.
+    /// Damping coefficient of one flexure hinge `C_mw` (VTG eq. 13), N·s/m.
     pub hinge_damping_ns_m: f64,
     /// Distance from coupling to nut at axis position 0, m (`l_n = offset + position`).
     pub nut_offset_m: f64,

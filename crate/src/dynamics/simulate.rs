@@ -1,4 +1,4 @@
-//! Runs both axes over the sampled trajectory: trajectory deviation (eq. 15), per-layer
+//! Runs both axes over the sampled trajectory: trajectory deviation (VTG eq. 15), per-layer
 //! statistics and the table's acceleration signal.
 
 use super::axis::{Axis, State, TABLE, TABLE_VELOCITY};

@@ -1,5 +1,5 @@
 //! Calibrating the thesis model: ordinary least squares without intercept of measured energies
-//! on the terms `A`, `B`, `C`, `H`, as the thesis derives eq. 28 from its Table 3.
+//! on the terms `A`, `B`, `C`, `H`, as the thesis derives thesis eq. 28 from its Table 3.
 //!
 //! The fit uses a Householder QR factorisation of the (column-scaled) design matrix, never the
 //! normal equations, whose condition number is the square of the data's (the columns here

@@ -16,7 +16,7 @@
 //!   G. Wegner, *Kolloid-Z. u. Z. Polymere* 251 (1973) 980–990; commercial printing PLA is
 //!   mostly amorphous, taken here as 10 % crystalline;
 //! - PETG (glycol-modified PET) and ABS are amorphous: no latent heat;
-//! - cradle-to-gate emission factors (for eq. 17): PLA 0.5–2 kg CO₂e/kg depending on plant
+//! - cradle-to-gate emission factors (for VTG eq. 17): PLA 0.5–2 kg CO₂e/kg depending on plant
 //!   and generation (E. T. H. Vink et al., *Polym. Degrad. Stab.* 80 (2003) 403–419: about
 //!   1.8; NatureWorks' 2014 Ingeo eco-profile: about 0.6), 2.0 used, the conservative end as
 //!   suggested for this project; PET about 2.2 and ABS about 3.3 kg CO₂e/kg (PlasticsEurope
@@ -37,7 +37,7 @@ pub enum Material {
     Abs,
 }
 
-/// What `E_fuse` and the material part of eq. 17 need to know about a material.
+/// What `E_fuse` and the material part of VTG eq. 17 need to know about a material.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct MaterialProperties {

@@ -1,10 +1,10 @@
 //! Energy and carbon models: how much electricity a print takes and what it emits.
 //!
-//! The total follows the VTG paper (Wang et al., eq. 16–17):
+//! The total follows the VTG paper (Wang et al., VTG eq. 16–17):
 //! `E = E_servo + E_fuse + E_aux` and `m_CO₂ = f_e·E + f_m·m_material`, where
 //!
 //! - `E_servo`, the X/Y drives, is by default the thesis stepper model
-//!   ([`thesis`], Somade 2023, eq. 24–28, with the published regression coefficients or
+//!   ([`thesis`], Somade 2023, thesis eq. 24–28, with the published regression coefficients or
 //!   calibrated ones, see [`calibrate`]); for servo machines a physical model ([`servo`]) of
 //!   kinetic energy, friction, copper losses and standby draw;
 //! - `E_fuse` the heat that melts the filament ([`fuse`]);
@@ -67,10 +67,10 @@ pub enum ServoModel {
 
 /// Energy and carbon figures (see [`crate::energy`] for the models, their units and sources).
 ///
-/// `total_j = servo_j + fuse_j + aux_j` (VTG eq. 16); `co2_g` is eq. 17.
+/// `total_j = servo_j + fuse_j + aux_j` (VTG eq. 16); `co2_g` is VTG eq. 17.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct Energy {
-    /// X/Y stepper energy by the thesis model (eq. 28), J. Always computed.
+    /// X/Y stepper energy by the thesis model (thesis eq. 28), J. Always computed.
     pub thesis_j: f64,
     /// Energy of the X/Y drives, `E_servo`, J (equal to `thesis_j` with the thesis model).
     pub servo_j: f64,
@@ -183,7 +183,7 @@ pub struct Co2Report {
     pub material_g: f64,
 }
 
-/// `m_CO₂ = f_e·E + f_m·m` (eq. 17) in grams, from `energy_j` joules and `material_g` grams.
+/// `m_CO₂ = f_e·E + f_m·m` (VTG eq. 17) in grams, from `energy_j` joules and `material_g` grams.
 pub fn co2_g(energy_j: f64, material_g: f64, grid_kg_per_kwh: f64, material_kg_per_kg: f64) -> f64 {
     // kg/kWh × kWh = kg, × 1000 = g; kg/kg × g = g.
     grid_kg_per_kwh * energy_j / J_PER_KWH * 1000.0 + material_kg_per_kg * material_g

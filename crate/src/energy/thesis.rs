@@ -1,18 +1,18 @@
-//! The thesis stepper model (Somade 2023, eq. 20–28): energy of the X and Y stepper motors from
-//! the motion profile of every move.
+//! The thesis stepper model (Somade 2023, thesis eq. 20–28): energy of the X and Y stepper motors
+//! from the motion profile of every move.
 //!
 //! For a move of length `d` with displacement `δ`, axis `j` ∈ {X, Y} moves at the path speed
 //! times `s_j = |δ_j| / d` and accelerates at the path acceleration times `s_j` (a coordinated
 //! move: every axis follows the same trapezoid, scaled). With the move's profile (entry `v₀`,
 //! peak `v_m`, exit `v_f`, acceleration `a`, phase times `t_a`, `t_c`, `t_d`):
 //!
-//! - `A = Σ t_a·a_x·(v_x0 + v_xm)/2 + t_d·a_x·(v_xm + v_xf)/2` (eq. 24), where `a_x = s_x·a`,
-//!   `v_x0 = s_x·v₀`… so a move adds `s_x²·[t_a·a·(v₀+v_m)/2 + t_d·a·(v_m+v_f)/2]`. Unit:
-//!   (mm/s)² — time × acceleration × speed. (For an exact trapezoid this is
+//! - `A = Σ t_a·a_x·(v_x0 + v_xm)/2 + t_d·a_x·(v_xm + v_xf)/2` (thesis eq. 24), where
+//!   `a_x = s_x·a`, `v_x0 = s_x·v₀`… so a move adds `s_x²·[t_a·a·(v₀+v_m)/2 + t_d·a·(v_m+v_f)/2]`.
+//!   Unit: (mm/s)² — time × acceleration × speed. (For an exact trapezoid this is
 //!   `s_x²·(2v_m² − v₀² − v_f²)/2`, the change of "specific kinetic energy".)
-//! - `B`: the same for Y (eq. 25), (mm/s)².
-//! - `C = Σ_j t_c·v_jm` (eq. 26): distance both axes cover while coasting, mm.
-//! - `H = Σ_j t_h` (eq. 27): seconds during which an axis is energised but does not move.
+//! - `B`: the same for Y (thesis eq. 25), (mm/s)².
+//! - `C = Σ_j t_c·v_jm` (thesis eq. 26): distance both axes cover while coasting, mm.
+//! - `H = Σ_j t_h` (thesis eq. 27): seconds during which an axis is energised but does not move.
 //!
 //! Choices the thesis leaves open, made here:
 //! - An axis "does not move" in a move when `|δ_j| ≤` [`HOLD_EPS_MM`] (less than a microstep);
@@ -22,8 +22,8 @@
 //! - Dwells (`G4`) count as holding for both axes too: the drivers stay enabled and keep their
 //!   holding current. Waits for heaters are not timed by the planner and add nothing.
 //!
-//! `E = k_a·m_x·A + k_a·m_y·B + k_c·C + k_h·H` (eq. 28) in the thesis's unit, W·ms; the report
-//! gives joules (÷ 1000).
+//! `E = k_a·m_x·A + k_a·m_y·B + k_c·C + k_h·H` (thesis eq. 28) in the thesis's unit, W·ms; the
+//! report gives joules (÷ 1000).
 
 use serde::{Deserialize, Serialize};
 
@@ -33,7 +33,7 @@ use crate::plan::PlannedMove;
 /// Displacement below which an axis counts as holding during a move, mm.
 pub const HOLD_EPS_MM: f64 = 1e-6;
 
-/// The regression coefficients of eq. 28. Units make `E` come out in W·ms:
+/// The regression coefficients of thesis eq. 28. Units make `E` come out in W·ms:
 /// `k_a_mx`, `k_a_my` in W·ms per (mm/s)², `k_c` in W·ms per mm, `k_h` in W·ms per s (so
 /// `k_h` = 832.7 is 0.83 W of holding power per axis).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -102,7 +102,8 @@ pub fn move_terms_and_holds(pm: &PlannedMove) -> ([f64; 4], f64) {
     } else {
         (0.0, 0.0)
     };
-    // Path-level bracket of eq. 24/25; each axis scales it by s_j² (a_j = s_j a, v_j = s_j v).
+    // Path-level bracket of thesis eq. 24/25; each axis scales it by s_j²
+    // (a_j = s_j a, v_j = s_j v).
     let k = 0.5 * p.acceleration * (p.accel_s * (p.entry + p.peak) + p.decel_s * (p.peak + p.exit));
     let c = p.cruise_s * p.peak * (sx + sy);
     let holds = f64::from(u8::from(dx <= HOLD_EPS_MM)) + f64::from(u8::from(dy <= HOLD_EPS_MM));
@@ -118,15 +119,15 @@ pub fn dwell_terms(secs: f64) -> [f64; 4] {
 /// The sums `A`, `B`, `C`, `H` over a file, and the coefficients they are weighed with.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct ThesisReport {
-    /// `A`: X acceleration/deceleration term (eq. 24), (mm/s)².
+    /// `A`: X acceleration/deceleration term (thesis eq. 24), (mm/s)².
     pub a: f64,
-    /// `B`: Y acceleration/deceleration term (eq. 25), (mm/s)².
+    /// `B`: Y acceleration/deceleration term (thesis eq. 25), (mm/s)².
     pub b: f64,
-    /// `C`: coasting distance of X and Y (eq. 26), mm.
+    /// `C`: coasting distance of X and Y (thesis eq. 26), mm.
     pub c: f64,
-    /// `H`: holding time of X and Y (eq. 27), s.
+    /// `H`: holding time of X and Y (thesis eq. 27), s.
     pub h: f64,
-    /// Coefficients used (eq. 28).
+    /// Coefficients used (thesis eq. 28).
     pub coefficients: ThesisCoefficients,
     /// `E` in the thesis's unit, W·ms.
     pub e_wms: f64,

@@ -66,7 +66,7 @@ pub(crate) struct Costs {
     pub total_j: f64,
     pub length_mm: f64,
     pub filament_mm: f64,
-    /// VTG trajectory metrics (eq. 24–26, 31) of the new infill strokes alone: the paper's
+    /// VTG trajectory metrics (VTG eq. 24–26, 31) of the new infill strokes alone: the paper's
     /// Fig. 4–5 comparison of patterns by length and turning.
     pub infill: ToolpathMetrics,
 }

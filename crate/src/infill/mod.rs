@@ -5,7 +5,7 @@
 //! 2. `region`: per layer, where sparse infill may go (from the walls, holes included).
 //! 3. [`pattern`] + `link`: new infill with the original's spacing and extrusion per mm.
 //! 4. `emit`: G-code for it in the file's own habits; `cost`: every candidate costed with
-//!    the real planner and energy model (the thesis stepper model, eq. 24–28, and the whole
+//!    the real planner and energy model (the thesis stepper model, thesis eq. 24–28, and the whole
 //!    `total_j`), as `analyze` would cost the rewritten file.
 //! 5. `search`: angles × rotations × patterns (and per-layer hybrids); `write`: the output.
 
@@ -150,7 +150,7 @@ pub struct Candidate {
     pub angle_deg: f64,
     /// Part rotation about Z, degrees.
     pub rotation_deg: f64,
-    /// Thesis stepper energy of the whole file (eq. 28), J.
+    /// Thesis stepper energy of the whole file (thesis eq. 28), J.
     pub thesis_j: f64,
     /// Total energy of the whole file, J.
     pub total_j: f64,
@@ -160,11 +160,11 @@ pub struct Candidate {
     pub length_mm: f64,
     /// Filament, mm.
     pub filament_mm: f64,
-    /// Length of the new infill strokes, mm (`L_infill`, eq. 25; the paper's Fig. 4).
+    /// Length of the new infill strokes, mm (`L_infill`, VTG eq. 25; VTG Fig. 4).
     pub infill_length_mm: f64,
-    /// Turning points of the new infill (turns above 30°, eq. 26's δθ; Fig. 5).
+    /// Turning points of the new infill (turns above 30°, VTG eq. 26's δθ; Fig. 5).
     pub infill_turning_points: u64,
-    /// Mean turning angle of the new infill, degrees (eq. 26; Fig. 5).
+    /// Mean turning angle of the new infill, degrees (VTG eq. 26; Fig. 5).
     pub infill_mean_turn_deg: f64,
 }
 

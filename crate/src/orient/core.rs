@@ -1,5 +1,5 @@
 //! The hybrid smoothing of one continuous run (section 3.2): filter the tool vectors, correct
-//! them into the tolerance cone (eq. 4–7), and solve the rotary axes for the new vectors.
+//! them into the tolerance cone (CIRP eq. 4–7), and solve the rotary axes for the new vectors.
 
 use super::cone;
 use super::filter::{self, FilterKind, Window};
@@ -26,7 +26,7 @@ pub struct RunSettings {
 pub struct RunOutput {
     /// New samples (same positions; the first, where the run starts, is unchanged).
     pub samples: Vec<Sample>,
-    /// How many vectors eq. 7 put back on the cone's edge.
+    /// How many vectors CIRP eq. 7 put back on the cone's edge.
     pub corrected: usize,
 }
 

@@ -1,6 +1,6 @@
 //! Smoothing filters on a sequence of unit orientation vectors (section 3.2 of the paper).
 //!
-//! - Moving average, eq. 3: `T_S,m = (1/n) Σ_{i=0}^{n−1} b_{m−i}`, a backward-running (causal)
+//! - Moving average, CIRP eq. 3: `T_S,m = (1/n) Σ_{i=0}^{n−1} b_{m−i}`, a backward-running (causal)
 //!   window, component by component, then renormalised to a unit vector.
 //! - Median: the component-wise median of the window (the paper sorts the entries by size),
 //!   renormalised.
@@ -29,7 +29,7 @@ pub enum FilterKind {
     ZeroPhaseMovingAverage,
     /// Centred median.
     ZeroPhaseMedian,
-    /// Causal moving average, eq. 3 (lags behind the path).
+    /// Causal moving average, CIRP eq. 3 (lags behind the path).
     MovingAverage,
     /// Causal median.
     Median,

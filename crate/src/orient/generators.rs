@@ -1,5 +1,5 @@
-//! The paper's two test parts (section 3.1) as point-vector toolpaths: a quarter torus (eq. 1)
-//! and a square-shaped tube (eq. 2).
+//! The paper's two test parts (section 3.1) as point-vector toolpaths: a quarter torus (CIRP eq. 1)
+//! and a square-shaped tube (CIRP eq. 2).
 //!
 //! Each part is a tube surface `S(t, v)` around a guide curve (`t` along it, `v` the polar
 //! angle around it). Layers are generated at a constant inter-layer distance measured along the
@@ -40,7 +40,7 @@ impl Default for PartOptions {
     }
 }
 
-/// Eq. 1: guide curve `(R cos t − R, 0, R sin t)`, `t ∈ [0, π/2]`, tube radius `ρ`.
+/// CIRP eq. 1: guide curve `(R cos t − R, 0, R sin t)`, `t ∈ [0, π/2]`, tube radius `ρ`.
 pub fn torus_surface(t: f64, v: f64) -> V3 {
     const R: f64 = 50.0;
     const RHO: f64 = 15.0;
@@ -50,8 +50,9 @@ pub fn torus_surface(t: f64, v: f64) -> V3 {
     [R * ct - R + RHO * cv * ct, RHO * sv, R * st + RHO * cv * st]
 }
 
-/// Eq. 2: guide curve the Z axis, `ρ(t, v) = 15 (1 + t²/400) / (√(1 + sin 2v) + √(1 − sin 2v))`
-/// (a square whose half-side grows from 7.5 mm).
+/// CIRP eq. 2: guide curve the Z axis,
+/// `ρ(t, v) = 15 (1 + t²/400) / (√(1 + sin 2v) + √(1 − sin 2v))` (a square whose half-side grows
+/// from 7.5 mm).
 pub fn square_tube_surface(t: f64, v: f64) -> V3 {
     let s2 = math::sin(2.0 * v);
     let den = (1.0 + s2).max(0.0).sqrt() + (1.0 - s2).max(0.0).sqrt();
@@ -59,12 +60,12 @@ pub fn square_tube_surface(t: f64, v: f64) -> V3 {
     [rho * math::cos(v), rho * math::sin(v), t]
 }
 
-/// The quarter torus of eq. 1 (R = 50 mm, ρ = 15 mm).
+/// The quarter torus of CIRP eq. 1 (R = 50 mm, ρ = 15 mm).
 pub fn quarter_torus(options: &PartOptions) -> Vec<PointVector> {
     generate(&torus_surface, FRAC_PI_2, options)
 }
 
-/// The square-shaped tube of eq. 2, `options.height_mm` tall.
+/// The square-shaped tube of CIRP eq. 2, `options.height_mm` tall.
 pub fn square_tube(options: &PartOptions) -> Vec<PointVector> {
     generate(&square_tube_surface, options.height_mm, options)
 }

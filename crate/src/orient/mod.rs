@@ -4,9 +4,9 @@
 //! manufacturing" (CIRP CMS 2022, seed `002`): the tool vectors along each continuous path are
 //! smoothed with a median or moving-average filter (causal or zero-phase, section 3.2), and every
 //! smoothed vector that leaves the tolerance cone of opening `γ` around its original build
-//! direction is rotated back onto the cone's edge (eq. 4–7). The result is written back through
-//! a kinematic model ([`kinematics`]) as new rotary angles and the machine XYZ that keeps the
-//! tool tip on the same workpiece path.
+//! direction is rotated back onto the cone's edge (CIRP eq. 4–7). The result is written back
+//! through a kinematic model ([`kinematics`]) as new rotary angles and the machine XYZ that keeps
+//! the tool tip on the same workpiece path.
 //!
 //! ```
 //! use quietpath::orient::{smooth, SmoothOptions};
@@ -186,7 +186,7 @@ pub struct SmoothReport {
     pub points: usize,
     /// Continuous runs (paths) they form.
     pub runs: usize,
-    /// Points whose smoothed vector left the cone and was put back on its edge (eq. 7).
+    /// Points whose smoothed vector left the cone and was put back on its edge (CIRP eq. 7).
     pub corrected: usize,
     /// Lines (points) whose written values changed.
     pub changed: usize,

@@ -1,4 +1,4 @@
-//! Trajectory metrics of the VTG paper (eq. 24–26, 31) of a whole toolpath and of each of its
+//! Trajectory metrics of the VTG paper (VTG eq. 24–26, 31) of a whole toolpath and of each of its
 //! layers: the [`crate::analyze::toolpath`] accumulator run over the moves of a
 //! [`crate::path::PrintPath`] or streamed from G-code.
 

@@ -1,4 +1,4 @@
-//! Vibration-suppressed toolpath generation (VTG paper section 3, eq. 21–31, Algorithm 1).
+//! Vibration-suppressed toolpath generation (VTG paper section 3, VTG eq. 21–31, Algorithm 1).
 //!
 //! [`vtg`] reads a file, finds its extrusion paths (runs of consecutive printing moves of one
 //! feature) and rewrites each that turns by more than the critical angle δθ (VTG eq. 26).
@@ -63,9 +63,9 @@ pub struct VtgOptions {
     pub tolerance_mm: f64,
     /// Critical angle δθ: turns above it are sharp corners, degrees (default 30).
     pub critical_angle_deg: f64,
-    /// Interpolation period `T_s` of eq. 30, s (default 0.001: a 1 kHz firmware step planner).
+    /// Interpolation period `T_s` of VTG eq. 30, s (default 0.001: a 1 kHz firmware step planner).
     pub interpolation_period_s: f64,
-    /// Normal jerk limit `J_n` of eq. 29–30, mm/s³. By default the machine's own: `A_n · f₁`,
+    /// Normal jerk limit `J_n` of VTG eq. 29–30, mm/s³. By default the machine's own: `A_n · f₁`,
     /// with `f₁` the lowest natural frequency of its X and Y drives in the dynamics model
     /// ([`crate::dynamics`], the parameter set that goes with the machine preset). An
     /// acceleration that builds up over at least one period of the first mode leaves little
@@ -80,7 +80,7 @@ pub struct VtgOptions {
     /// Lower the feed rate where the curvature exceeds `K_cr` (default true).
     pub limit_feed: bool,
     /// Run the dynamics model ([`crate::dynamics`]) on both files for the deviation rows of
-    /// Table 2, and rewrite again with faster eq. 29 speeds if the rewrite rings more than the
+    /// Table 2, and rewrite again with faster VTG eq. 29 speeds if the rewrite rings more than the
     /// original (default true; it costs about as much as the rewrite itself, more when it
     /// rewrites again). See `with_simulated_deviation`.
     pub dynamics: bool,
@@ -278,9 +278,9 @@ fn within_allowed_time(
 /// Fills Table 2's deviation rows with the dynamics model, run on the original and on the
 /// rewritten file over printing moves (travels are not rewritten), and closes the loop on it.
 ///
-/// Eq. 29's speeds (`J_n = A_n f₁`) are meant to keep a rounded corner from exciting the frame more
-/// than the sharp one did, and on nearly every file they do. They are a rule of thumb, though: the
-/// ringing a corner leaves depends on how its timing falls against the modes, which no bound on
+/// VTG eq. 29's speeds (`J_n = A_n f₁`) are meant to keep a rounded corner from exciting the frame
+/// more than the sharp one did, and on nearly every file they do. They are a rule of thumb, though:
+/// the ringing a corner leaves depends on how its timing falls against the modes, which no bound on
 /// `a_n` and `j_n` sees, and not monotonically (figures in `docs/method/vtg-tuning-notes.md`). So
 /// when the simulated mean deviation does not fall, the file is rewritten again with the speeds
 /// starting at each of `Tuning::quieter_scales` in turn, and the rewrite with the lowest simulated

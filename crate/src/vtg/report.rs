@@ -74,13 +74,13 @@ pub struct DeviationComparison {
 pub struct Table2 {
     /// Simulated toolpath deviation (dynamics model); `null` until that model is run.
     pub deviation: Option<DeviationComparison>,
-    /// Total energy `E`, J (eq. 16).
+    /// Total energy `E`, J (VTG eq. 16).
     pub energy_j: Comparison,
     /// Servo (X/Y drive) energy, J.
     pub servo_energy_j: Comparison,
     /// Material, g.
     pub material_g: Comparison,
-    /// Carbon emission, g CO₂ (eq. 17).
+    /// Carbon emission, g CO₂ (VTG eq. 17).
     pub co2_g: Comparison,
     /// Print time, s.
     pub time_s: Comparison,
@@ -100,11 +100,11 @@ pub struct PathCounts {
     pub written_moves: u64,
     /// Written segments whose curvature is above `K_cr`.
     pub above_k_cr_segments: u64,
-    /// Of those, segments written with a lower feed rate (eq. 29).
+    /// Of those, segments written with a lower feed rate (VTG eq. 29).
     pub lowered_feed_segments: u64,
-    /// Rewritten paths whose eq. 29 speeds were raised (up to 3×) so they cost no time.
+    /// Rewritten paths whose VTG eq. 29 speeds were raised (up to 3×) so they cost no time.
     pub raised_caps: u64,
-    /// Rewritten paths written without the eq. 29 feed caps because even raised they would
+    /// Rewritten paths written without the VTG eq. 29 feed caps because even raised they would
     /// have made them slower than the original (the firmware's own cornering sets their
     /// speed).
     pub uncapped: u64,
@@ -115,9 +115,9 @@ pub struct PathCounts {
     pub paid_from_savings: u64,
     /// Paths like those that the savings could not pay for, kept as they were.
     pub kept_for_time: u64,
-    /// Mean speed fluctuation of the interpolation steps, percent (eq. 28).
+    /// Mean speed fluctuation of the interpolation steps, percent (VTG eq. 28).
     pub mean_speed_fluctuation_pct: f64,
-    /// The scale the eq. 29 speeds of every rewrite started from: 1, or higher where the
+    /// The scale the VTG eq. 29 speeds of every rewrite started from: 1, or higher where the
     /// dynamics model found that the rewrite at 1 left the machine ringing more than the
     /// original (see [`crate::vtg::VtgOptions::dynamics`]).
     pub feed_cap_scale: f64,
@@ -150,7 +150,7 @@ pub struct VtgReport {
     pub max_deviation_mm: f64,
     /// Critical angle δθ, degrees.
     pub critical_angle_deg: f64,
-    /// Critical curvature `K_cr` (eq. 30), 1/mm.
+    /// Critical curvature `K_cr` (VTG eq. 30), 1/mm.
     pub k_cr_per_mm: f64,
     /// The limits `K_cr` is built from.
     pub limits: KinematicLimits,

@@ -94,7 +94,7 @@ pub(crate) struct Tuning {
     /// Shortest ramp piece, mm: shorter ramps more smoothly, in more lines.
     pub(crate) min_ramp_piece_mm: f64,
     // The search.
-    /// Scales of the eq. 29 speeds tried in turn until a rewrite costs no time (`None`: no
+    /// Scales of the VTG eq. 29 speeds tried in turn until a rewrite costs no time (`None`: no
     /// caps): each step trades a little vibration suppression for speed.
     pub(crate) cap_scales: [Option<f64>; 8],
     /// The dearer variants offered for a path when time may be spent, as the slowest a rounded
@@ -114,7 +114,7 @@ pub(crate) struct Tuning {
     /// Each round cuts the allowance by this many times the excess measured: more meets the
     /// allowance in fewer rounds, spending less of it.
     pub(crate) time_margin: f64,
-    /// Scales of the eq. 29 speeds a whole file is rewritten with, in turn, where the dynamics
+    /// Scales of the VTG eq. 29 speeds a whole file is rewritten with, in turn, where the dynamics
     /// model finds it ringing more than the original (then the same without keyhole loops):
     /// more scales find a quieter rewrite more often, at one rewrite each.
     pub(crate) quieter_scales: [f64; 3],

@@ -2,14 +2,14 @@
 //!
 //! Fitting a B-spline by least squares straight to a polyline's corners lets the fit bend as
 //! tightly as its tolerance allows, wherever the residuals put the knots: the curvature peaks
-//! high, varies from step to step (and with it the eq. 29 feed caps), and the curve rings along
+//! high, varies from step to step (and with it the VTG eq. 29 feed caps), and the curve rings along
 //! the legs. So each corner is first replaced by a transition of known shape and size, and the
 //! fit is given points of the blended path: its curvature is then what the tolerance permits
 //! at best, and smooth.
 //!
 //! The transition is a circular fillet tangent to both legs. Of all curves that turn by `θ`
 //! and pass within `ε` of the vertex, the circle has the lowest peak curvature, and the peak
-//! curvature is what sets the corner speed (`v = √(A_n/κ)`, eq. 29): a curvature-continuous
+//! curvature is what sets the corner speed (`v = √(A_n/κ)`, VTG eq. 29): a curvature-continuous
 //! (G2) transition of the same deviation peaks higher (the symmetric five-point cubic B-spline
 //! corner of CNC smoothing by 1.7× at 90°), so the machine would have to slow down more. G2
 //! continuity buys little on G-code anyway: the firmware executes the written polyline, whose

@@ -3,10 +3,10 @@
 //!
 //! | level | rungs | enumerated by | tried in |
 //! |---|---|---|---|
-//! | file | eq. 29 speed scale 1 with keyholes, then `Tuning::quieter_scales` with and without keyholes; the quietest under the dynamics model is kept | [`quieter_variants`] | `vtg::with_simulated_deviation` |
+//! | file | VTG eq. 29 speed scale 1 with keyholes, then `Tuning::quieter_scales` with and without keyholes; the quietest under the dynamics model is kept | [`quieter_variants`] | `vtg::with_simulated_deviation` |
 //! | file | the time allowance, cut by the excess for `Tuning::time_rounds` rounds, then none | — | `vtg::within_allowed_time` |
 //! | path | the free rewrite (corners rounded at no loss of speed), then `Tuning::dearer_speed_shares` where time may be spent | `rewrite::Offering` | [`rewrite::offers`] |
-//! | path | eq. 29 speeds at `Tuning::cap_scales`, each without then with a ceiling at the original's speed: the first that costs nothing, else the cheapest and the fastest | [`writings`] | `rewrite::cheapest_and_fastest` |
+//! | path | VTG eq. 29 speeds at `Tuning::cap_scales`, each without then with a ceiling at the original's speed: the first that costs nothing, else the cheapest and the fastest | [`writings`] | `rewrite::cheapest_and_fastest` |
 //! | path | the racing line, then the inside line where that left more sharp turns | — | `smooth::smooth_cut` |
 //! | piece | blends at `Tuning::blend_share` of the tolerance, shrunk by `Tuning::retry_scale` for `Tuning::attempts` tries; keyholes dropped where none fits | [`blend_shares`] | `smooth::smooth_piece` |
 //!
@@ -25,7 +25,7 @@ pub(crate) mod smooth;
 /// model finds the first one ringing more than the original.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Variant {
-    /// The first scale of the eq. 29 speeds ([`Settings::feed_cap_scale`]).
+    /// The first scale of the VTG eq. 29 speeds ([`Settings::feed_cap_scale`]).
     pub(crate) feed_cap_scale: f64,
     /// Turn corners too tight to fillet round keyhole loops ([`Settings::keyholes`]).
     pub(crate) keyholes: bool,
@@ -53,7 +53,7 @@ pub(crate) fn quieter_variants() -> impl Iterator<Item = Variant> {
         .skip(1)
 }
 
-/// The ways a smoothed path is written, in turn: the eq. 29 speeds at each of
+/// The ways a smoothed path is written, in turn: the VTG eq. 29 speeds at each of
 /// `Tuning::cap_scales` times the settings' first scale (`None`: no caps; only that without
 /// `limit_feed`), each first without a ceiling, then no faster than the original.
 pub(crate) fn writings(settings: &Settings) -> Vec<(Option<f64>, bool)> {

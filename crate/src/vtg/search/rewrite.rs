@@ -44,15 +44,15 @@ pub(crate) struct Rewritten {
     pub(crate) replaced_moves: u64,
     /// Moves written in their place.
     pub(crate) written_moves: u64,
-    /// Segments whose feed was lowered (eq. 29).
+    /// Segments whose feed was lowered (VTG eq. 29).
     pub(crate) lowered_segments: u64,
     /// Segments whose curvature stays above `K_cr`.
     pub(crate) above_k_cr_segments: u64,
     /// Largest measured distance of a rewritten path from its original, mm.
     pub(crate) max_deviation_mm: f64,
-    /// Rewritten paths whose eq. 29 feed caps were raised so they cost no time.
+    /// Rewritten paths whose VTG eq. 29 feed caps were raised so they cost no time.
     pub(crate) raised_caps_paths: u64,
-    /// Rewritten paths written without the eq. 29 feed caps, which even raised would have made
+    /// Rewritten paths written without the VTG eq. 29 feed caps, which even raised would have made
     /// them slower than the original.
     pub(crate) uncapped_paths: u64,
     /// Rewritten paths that plan slower or cost more motor energy than the original, paid for
@@ -64,7 +64,7 @@ pub(crate) struct Rewritten {
     pub(crate) kept_for_time: u64,
     /// Algorithm 1 statistics.
     pub(crate) walk: WalkStats,
-    /// The first scale of the eq. 29 speeds each rewrite was tried with.
+    /// The first scale of the VTG eq. 29 speeds each rewrite was tried with.
     pub(crate) feed_cap_scale: f64,
     /// Arcs (`G2`/`G3`) written.
     pub(crate) arcs_written: u64,
@@ -72,7 +72,7 @@ pub(crate) struct Rewritten {
     pub(crate) keyholes: u64,
 }
 
-/// The eq. 30 limits for a file: `v_max` from the machine's X/Y feed limits (`M203`), `A_n` the
+/// The VTG eq. 30 limits for a file: `v_max` from the machine's X/Y feed limits (`M203`), `A_n` the
 /// printing acceleration (`M204 P`, Klipper's `ACCEL`) within the X/Y acceleration limits
 /// (`M201`), `T_s`, `R_n` and `δ` from the options, `J_n` from the options or else from `A_n`
 /// and the machine's first natural frequency (see [`VtgOptions::normal_jerk_mm_s3`]).
@@ -363,7 +363,7 @@ impl Offers {
 const BATCH_PATHS: usize = 4096;
 
 impl Rewritten {
-    /// The counts of a path written with its eq. 29 speeds at `scale`: raised above the
+    /// The counts of a path written with its VTG eq. 29 speeds at `scale`: raised above the
     /// settings' first scale, or dropped (`None`).
     fn at_scale(scale: Option<f64>, settings: &Settings) -> Self {
         let mut part = Rewritten::default();
@@ -544,7 +544,7 @@ impl PlanContext<'_> {
 ///
 /// A rewrite should cost neither time nor motor energy: the new path and the original are
 /// planned on their own with the firmware's limits and costed with the energy model, and where
-/// the new one is dearer its eq. 29 speeds are raised step by step (each step trading a little
+/// the new one is dearer its VTG eq. 29 speeds are raised step by step (each step trading a little
 /// of the vibration suppression for speed), then dropped (the firmware's own cornering then
 /// sets the speed). If every variant is still dearer (a machine whose planner takes sharp
 /// corners faster than a fillet within the tolerance allows, such as Klipper with a high
@@ -670,11 +670,11 @@ impl Costs {
     }
 }
 
-/// A writing of a smoothed path: the eq. 29 speeds' scale (`None`: no caps), and the path
+/// A writing of a smoothed path: the VTG eq. 29 speeds' scale (`None`: no caps), and the path
 /// written with it (or whether it had a ceiling), with its time (s) and energy (J).
 type Writing<W> = (Option<f64>, W, (f64, f64));
 
-/// The eq. 29 speeds as they are, then raised step by step, then no caps at all, each first
+/// The VTG eq. 29 speeds as they are, then raised step by step, then no caps at all, each first
 /// as fast as the firmware will go elsewhere, then no faster than the original: the first
 /// writing that costs neither time nor energy, else the one that costs least energy; and the
 /// fastest if that is not the first (to be written again at the end if it is another way).
@@ -737,7 +737,7 @@ struct Draft<'a> {
 }
 
 impl Draft<'_> {
-    /// The edits and counts of the path written as `written` (eq. 29 speeds at `scale`),
+    /// The edits and counts of the path written as `written` (VTG eq. 29 speeds at `scale`),
     /// costing `written_cost` (time s, motor energy J), `added` over the original's.
     fn outcome(
         &self,

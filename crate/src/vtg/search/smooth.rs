@@ -30,9 +30,9 @@ pub(crate) struct Settings {
     pub(crate) tolerance_mm: f64,
     /// Critical angle δθ, rad.
     pub(crate) critical_rad: f64,
-    /// Kinematic limits (eq. 29–30).
+    /// Kinematic limits (VTG eq. 29–30).
     pub(crate) limits: KinematicLimits,
-    /// Lower the feed where the curvature is above what the limits allow (eq. 29).
+    /// Lower the feed where the curvature is above what the limits allow (VTG eq. 29).
     pub(crate) limit_feed: bool,
     /// The machine's X/Y acceleration limit (`M201`), mm/s²: the ceiling of `A_n`. Where the
     /// original's planned moves are known, `A_n` of a stretch is the acceleration the firmware
@@ -48,7 +48,7 @@ pub(crate) struct Settings {
     /// Klipper planners): rising feeds are then ramped, since such a planner counts a rise of
     /// the feed from one block to the next as jerk against the new block's full speed.
     pub(crate) classic_jerk_mm_s: Option<f64>,
-    /// The first scale of the eq. 29 speeds a rewrite is tried with (1: the speeds as they
+    /// The first scale of the VTG eq. 29 speeds a rewrite is tried with (1: the speeds as they
     /// are); [`crate::vtg::vtg`] raises it where the dynamics model finds the rewrite at 1
     /// rings more than the original.
     pub(crate) feed_cap_scale: f64,
@@ -81,7 +81,7 @@ pub(crate) struct Smoothed {
     pub(crate) above_k_cr: u64,
     /// Measured largest distance to the original polyline, mm.
     pub(crate) deviation_mm: f64,
-    /// Walk statistics (eq. 28).
+    /// Walk statistics (VTG eq. 28).
     pub(crate) stats: WalkStats,
     /// Corners turned round a keyhole loop.
     pub(crate) keyholes: u64,
@@ -96,11 +96,11 @@ pub(crate) struct SmoothPath<'a> {
     pub(crate) e: &'a [f64],
     /// Feed of segment `i` (from `pts[i]` to `pts[i+1]`), mm/s.
     pub(crate) feed: &'a [f64],
-    /// How the firmware's planner runs each original segment (empty when not known): the eq.
-    /// 29 feed cap never asks for less than the speed the machine had at the same place on the
-    /// original. At that speed the sharp corner is a step in velocity and the rounded one a
+    /// How the firmware's planner runs each original segment (empty when not known): the
+    /// VTG eq. 29 feed cap never asks for less than the speed the machine had at the same place on
+    /// the original. At that speed the sharp corner is a step in velocity and the rounded one a
     /// finite acceleration, so capping below it would only cost time (on a Klipper machine
-    /// with a high square-corner velocity, eq. 29's normal-jerk term would slow every corner
+    /// with a high square-corner velocity, VTG eq. 29's normal-jerk term would slow every corner
     /// down, and even at a classic-jerk corner the machine is back at speed within a few
     /// tenths of a millimetre on either side of the vertex).
     pub(crate) planned: &'a [Profile],

@@ -1,8 +1,8 @@
-//! Cubic NURBS curves in 3-D (the VTG paper's eq. 21–22).
+//! Cubic NURBS curves in 3-D (VTG eq. 21–22).
 //!
-//! Most fits keep every weight 1, and eq. 21 reduces to a B-spline; [`Curve::rational`] takes
+//! Most fits keep every weight 1, and VTG eq. 21 reduces to a B-spline; [`Curve::rational`] takes
 //! weights where the fit finds they help ([`crate::vtg::fit`]). Basis functions follow Piegl &
-//! Tiller's A2.2 (the Cox–de Boor recursion of eq. 22), derivatives the derivative curves'
+//! Tiller's A2.2 (the Cox–de Boor recursion of VTG eq. 22), derivatives the derivative curves'
 //! control points (P&T eq. 3.8); a rational curve is evaluated in homogeneous coordinates and
 //! projected with the quotient rule (P&T eq. 4.8). The tests check both against A2.3.
 
@@ -128,7 +128,7 @@ impl Curve {
         }
     }
 
-    /// The rational curve (eq. 21) with these knots, control points and positive weights (one
+    /// The rational curve (VTG eq. 21) with these knots, control points and positive weights (one
     /// per control point; all 1 gives [`Curve::new`]'s curve).
     #[cfg(test)]
     pub(crate) fn rational(knots: Vec<f64>, ctrl: Vec<[f64; 3]>, weights: Vec<f64>) -> Self {

@@ -1,4 +1,4 @@
-//! How a smoothed path is written: the feed of each new segment (eq. 29's cap, scaled, no
+//! How a smoothed path is written: the feed of each new segment (VTG eq. 29's cap, scaled, no
 //! lower than the original ran there and, if asked, no higher), and on a classic-jerk firmware
 //! the ramps that let the feed rise again without a stall at the junction.
 
@@ -11,7 +11,7 @@ use crate::vtg::tuning::TUNING;
 pub(crate) struct StepSpeed {
     /// The original's programmed feed there, mm/s.
     pub(crate) programmed: f64,
-    /// The speed eq. 29 allows for the segment's curvature, mm/s (infinite below `K_cr`).
+    /// The speed VTG eq. 29 allows for the segment's curvature, mm/s (infinite below `K_cr`).
     pub(crate) limit: f64,
     /// The original's planned speed over the stretch the segment replaces, mm/s: the feed is
     /// never lowered below it.
@@ -36,7 +36,7 @@ pub(crate) struct Written {
 }
 
 impl Smoothed {
-    /// The path as written with the eq. 29 speeds scaled by `scale` (`None`: no caps, the
+    /// The path as written with the VTG eq. 29 speeds scaled by `scale` (`None`: no caps, the
     /// firmware's own cornering sets the speed), from `start` on; with `ceiling`, no faster
     /// than the original went over the same stretch either (rounded corners let the machine
     /// carry more speed into each leg, so it peaks higher on it: faster, but dearer in motor
@@ -87,9 +87,9 @@ impl Smoothed {
 /// copy it) compares the *nominal* speeds of the two blocks at a junction: where the feed falls,
 /// the previous block's speed is scaled down to the junction speed first, but where it rises, the
 /// new block's full feed counts against the old one's, and a rise from 30 to 80 mm/s against a 7
-/// mm/s jerk limit brings the junction down to 4 mm/s. Lowering the feed on a curve (eq. 29) would
-/// cost a near-stop wherever the feed rises again. So a segment whose feed rises by more than the
-/// limit is cut into collinear pieces whose feeds rise by `Tuning::ramp_jerk_share` of it at a
+/// mm/s jerk limit brings the junction down to 4 mm/s. Lowering the feed on a curve (VTG eq. 29)
+/// would cost a near-stop wherever the feed rises again. So a segment whose feed rises by more than
+/// the limit is cut into collinear pieces whose feeds rise by `Tuning::ramp_jerk_share` of it at a
 /// time, each as long as the machine needs to accelerate through it at `accel[i]` (segment `i`'s
 /// acceleration): the speed profile is the one it would have had anyway, and no junction is
 /// penalised. The pieces lie on the segment and share its filament by length.

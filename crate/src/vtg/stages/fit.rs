@@ -33,7 +33,8 @@ pub(crate) fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit>
     if u1 - u0 <= 1e-9 {
         return None;
     }
-    // A9.7 (eq. 9.68–9.69): n + 1 control points, interior knots averaging the parameters.
+    // A9.7 (NURBS Book eq. 9.68–9.69): n + 1 control points, interior knots averaging the
+    // parameters.
     let n = (((m + 1) as f64 / TUNING.points_per_span) as usize).clamp(DEGREE, m);
     let d = (m + 1) as f64 / (n - DEGREE + 1) as f64;
     let mut knots = vec![u0; DEGREE + 1];

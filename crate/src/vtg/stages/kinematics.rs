@@ -1,5 +1,5 @@
-//! The kinematic limits of the VTG paper: the critical curvature `K_cr` (eq. 30) and the feed
-//! rate that keeps `v`, `a_n` and `j_n` within eq. 29 on a stretch of curvature `κ`.
+//! The kinematic limits of the VTG paper: the critical curvature `K_cr` (VTG eq. 30) and the feed
+//! rate that keeps `v`, `a_n` and `j_n` within VTG eq. 29 on a stretch of curvature `κ`.
 //!
 //! Tangential acceleration and jerk (`a_t ≤ A_t`, `j_t ≤ J_t`) are the firmware planner's
 //! business: it accelerates every block within the machine's limits, so the rewriter only
@@ -7,7 +7,7 @@
 
 use serde::Serialize;
 
-/// The limits eq. 30 is built from.
+/// The limits VTG eq. 30 is built from.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct KinematicLimits {
     /// Highest feed rate `v_max`, mm/s.
@@ -25,7 +25,8 @@ pub struct KinematicLimits {
 }
 
 impl KinematicLimits {
-    /// Eq. 30: `K_cr = min(8δ/((v_max T_s)² + 4δ²), A_n/v_max², sqrt(J_n/v_max³), 1/R_n)`, 1/mm.
+    /// VTG eq. 30, in 1/mm:
+    /// `K_cr = min(8δ/((v_max T_s)² + 4δ²), A_n/v_max², sqrt(J_n/v_max³), 1/R_n)`.
     pub(crate) fn critical_curvature(&self) -> f64 {
         let v = self.v_max_mm_s;
         let d = self.chord_tolerance_mm;
@@ -41,7 +42,7 @@ impl KinematicLimits {
         }
     }
 
-    /// The highest feed rate (mm/s) at which a stretch of curvature `kappa` keeps eq. 30's
+    /// The highest feed rate (mm/s) at which a stretch of curvature `kappa` keeps VTG eq. 30's
     /// first three terms, i.e. the chord error of one interpolation period, `a_n = v²κ` and
     /// `j_n = v³κ²`, within their limits; `v_max` on straights.
     pub(crate) fn feed_limit(&self, kappa: f64) -> f64 {

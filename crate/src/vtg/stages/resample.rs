@@ -1,13 +1,13 @@
 //! Algorithm 1 of the VTG paper: walk the fitted curve with the second-order Taylor interpolator
-//! (eq. 27) and correct each step with Newton's method so consecutive points are exactly `L_i`
+//! (VTG eq. 27) and correct each step with Newton's method so consecutive points are exactly `L_i`
 //! apart.
 //!
 //! The paper leaves `L_i` open; here it is what a CAM interpolator would pick: the longest step
 //! whose chord stays within the chord tolerance of the curve (sagitta `L²κ/8 ≤ δ`) and turns by
 //! at most a fraction of the critical angle (`κ·L ≤ θ_step`, so a rounded corner is walked in
 //! several gentle turns instead of one sharp one), checked on the stretch the step covers and
-//! halved until it holds. Line 2 of Algorithm 1 has `⟨C', C'⟩` where eq. 27 has `⟨C', C''⟩`;
-//! eq. 27 is used. Line 5's `F` is the step error `‖C(u) − P_i‖ − L_i`, and the damping `φ` of
+//! halved until it holds. Line 2 of Algorithm 1 has `⟨C', C'⟩` where VTG eq. 27 has `⟨C', C''⟩`;
+//! VTG eq. 27 is used. Line 5's `F` is the step error `‖C(u) − P_i‖ − L_i`, and the damping `φ` of
 //! the paper scales the Newton step. Points are taken on the curve (`P_{i+1} = C(u_{i+1})`),
 //! which line 11 also gives once Newton has converged.
 
@@ -49,12 +49,12 @@ pub(crate) struct Sample {
     pub(crate) step_mm: f64,
 }
 
-/// Steps walked, and the Newton error (eq. 28's speed fluctuation in mm).
+/// Steps walked, and the Newton error (VTG eq. 28's speed fluctuation in mm).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct WalkStats {
     /// Steps taken.
     pub(crate) steps: u64,
-    /// Sum of `|L_i − ‖P_{i+1} − P_i‖| / L_i` (eq. 28) over full steps.
+    /// Sum of `|L_i − ‖P_{i+1} − P_i‖| / L_i` (VTG eq. 28) over full steps.
     pub(crate) fluctuation_sum: f64,
 }
 
@@ -383,7 +383,7 @@ impl CurvatureIndex {
     }
 }
 
-/// Eq. 27 predictor and Newton corrector: `u` past `u_i` with `‖C(u) − P_i‖ = L`; `e` is the
+/// VTG eq. 27 predictor and Newton corrector: `u` past `u_i` with `‖C(u) − P_i‖ = L`; `e` is the
 /// curve at `u_i`. Returns `u` and the curve there.
 fn newton(
     curve: &Curve,
@@ -397,7 +397,7 @@ fn newton(
     if s < 1e-12 {
         return None;
     }
-    // Eq. 27.
+    // VTG eq. 27.
     let mut u = ui + step / s - dot(&e.d1, &e.d2) * step * step / (2.0 * s.powi(4));
     if u.is_nan() || u <= ui {
         u = ui + step / s;
