@@ -1,8 +1,8 @@
 //! One way through a file: every pass that needs a file's moves (`analyze`, `path`, the infill
-//! program, VTG's move sources, the orientation smoother's motion lines) is a [`Fold`] over the
-//! [`Reader`].
+//! program, VTG's move sources, the orientation smoother's motion lines) is a `Fold` over the
+//! `Reader`.
 //!
-//! The reader owns what all of them must read the same way: set-up ([`prepare`]: options,
+//! The reader owns what all of them must read the same way: set-up (`prepare`: options,
 //! extrusion mode, prescan, machine profile, junction model and starting limits), the machine
 //! state, the limits the file's own commands set (`M201`–`M205`, `SET_VELOCITY_LIMIT`), the
 //! limits in force at the first extrusion, and the layer count. For each line it classifies the

@@ -2,7 +2,7 @@
 //! whether the line can be replaced safely, the extrusion mode its `E` word is read in, its
 //! `E` word and the modal feed rate word after it.
 //!
-//! A second fold over the [`Reader`], as `path::extract` is, so its moves line up one for one
+//! A second fold over the `Reader`, as `path::extract` is, so its moves line up one for one
 //! with the path's.
 
 use crate::error::Error;
