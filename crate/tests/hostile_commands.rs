@@ -146,3 +146,42 @@ G1 X10 Y10 E1 F1e-300\nG1 X0 Y10 E1 F1e300\nG1 X0 Y0 E1 Fnan\nG1 X1e15 Y0 E1\n\
 G1 X0 Y1e15 E1\nG2 X0 Y0 I1e12 J0 E1\nG3 X5 Y5 R0 E1\nG1 X20 Y20 E1e300\nG1 X0 Y0 E-1e300\n";
     run_all("absurd feeds and moves", data, &EVERY_JOB);
 }
+
+/// 20 000 arcs with centre offsets up to 1e9 mm and end points up to 1e6 mm (1.4 MB): what
+/// no printer runs must cost no more than a line (it cost 29 s to analyze and 118 s to rewrite
+/// when every arc was cut into the most segments an arc gets).
+fn absurd_arcs() -> Vec<u8> {
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let mut out = String::from("G21\nG90\nM83\nG1 X0 Y0 F3000\n");
+    for k in 0..20_000 {
+        let (x, y, i, j) = (next() * 1e6, next() * 1e6, next() * 1e9, next() * 1e9);
+        let g = 2 + k % 2;
+        out += &format!("G{g} X{x:.3} Y{y:.3} I{i:.3} J{j:.3} E0.1 F1200\n");
+    }
+    out.into_bytes()
+}
+
+#[test]
+fn arcs_larger_than_any_printer_cost_what_a_line_costs() {
+    let data = absurd_arcs();
+    let report = quietpath::analyze(&data, &Default::default()).unwrap();
+    let first = report.warnings.first().unwrap();
+    assert_eq!(first.line, 5, "the first absurd arc is named");
+    assert!(first.message.contains("larger than any printer"), "{}", first.message);
+    // The issue's bound, 2 s per megabyte, here in the test profile.
+    let jobs: [(&str, Check); 2] = [("analyze", checks::analyze), ("vtg", checks::vtg)];
+    for (job, check) in jobs {
+        let t = Instant::now();
+        check(&data);
+        let secs = t.elapsed().as_secs_f64();
+        let limit = 2.0 * data.len() as f64 / 1e6;
+        assert!(secs <= limit, "{job}: {secs:.2} s (limit {limit:.1} s)");
+    }
+    run_all("absurd arcs", &data, &EVERY_JOB);
+}

@@ -88,6 +88,10 @@ pub const DEFAULT_FEED_MM_S: f64 = 25.0;
 /// corruption, not geometry; the line is ignored with a warning so that no report or rewritten
 /// file ever carries absurd coordinates, and every sum over a file stays finite.
 pub const MAX_COORDINATE: f64 = 1e9;
+/// Largest arc a printer runs, radius or path length, mm (10 m: beyond any printer's bed, and
+/// ArcWelder's own largest radius, 9 999 mm). A longer one is garbage: it is read as a straight
+/// move to its end, with a warning, so that its cost cannot grow with its size.
+pub const MAX_ARC_MM: f64 = 10_000.0;
 /// Slowest feed rate used for timing, mm/s: a smaller (or vanishing) feed would make times
 /// infinite. Marlin's planner never goes below its `MINIMUM_PLANNER_SPEED` (0.05 mm/s) either.
 pub const MIN_FEED_MM_S: f64 = 1e-3;
@@ -704,6 +708,18 @@ impl Machine {
         let start = [self.logical[a0], self.logical[a1]];
         let end = [target[a0], target[a1]];
         match Arc::new(self.plane, start, end, spec, clockwise, turns) {
+            Ok((arc, _)) if arc.radius > MAX_ARC_MM || arc.planar_length() > MAX_ARC_MM => {
+                warnings.push(
+                    line_no,
+                    format!(
+                        "arc of radius {:.0} mm and length {:.0} mm is larger than any printer \
+                         (over {MAX_ARC_MM} mm); treated as a straight move",
+                        arc.radius,
+                        arc.planar_length()
+                    ),
+                );
+                None
+            }
             Ok((arc, mismatch)) => {
                 if mismatch {
                     warnings.push(line_no, "arc end point is not on the circle through its start; radius from the start point used");
@@ -856,6 +872,29 @@ mod tests {
                 }
             })
             .collect()
+    }
+
+    #[test]
+    fn an_arc_larger_than_any_printer_is_a_straight_move_with_a_warning() {
+        // Radius 1e8 mm: its 0.6 Gm of path would be cut into the most segments an arc gets.
+        let src =
+            "G1 X0 Y0 F600\nG2 X10 Y0 I5 J100000000 E1\nG2 X20 Y0 I5 J0 E1\nG3 X0 Y0 I0 J9000 P2";
+        let (_, ev, w) = run(src, MachineConfig::default());
+        // (The first line goes nowhere: the machine starts at 0, 0.)
+        let mv = moves(&ev);
+        assert!(matches!(mv[0].kind, MoveKind::Linear));
+        assert_eq!(mv[0].length_mm, 10.0);
+        // A bed-sized arc stays an arc; two turns of 9 m radius (113 m) do not.
+        assert!(matches!(mv[1].kind, MoveKind::Arc(_)));
+        assert!(matches!(mv[2].kind, MoveKind::Linear));
+        let (w, _) = w.into_parts();
+        let lines: Vec<u32> = w.iter().map(|w| w.line).collect();
+        assert_eq!(lines, [2, 4]);
+        assert!(
+            w[0].message.contains("larger than any printer"),
+            "{}",
+            w[0].message
+        );
     }
 
     #[test]
