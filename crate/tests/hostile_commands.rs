@@ -173,7 +173,11 @@ fn arcs_larger_than_any_printer_cost_what_a_line_costs() {
     let report = quietpath::analyze(&data, &Default::default()).unwrap();
     let first = report.warnings.first().unwrap();
     assert_eq!(first.line, 5, "the first absurd arc is named");
-    assert!(first.message.contains("larger than any printer"), "{}", first.message);
+    assert!(
+        first.message.contains("larger than any printer"),
+        "{}",
+        first.message
+    );
     // The bound, 2 s per megabyte, here in the test profile.
     let jobs: [(&str, Check); 2] = [("analyze", checks::analyze), ("vtg", checks::vtg)];
     for (job, check) in jobs {
