@@ -237,6 +237,10 @@ pub struct MachineConfig {
     pub retract_mm: f64,
     /// Firmware retraction speed before any `M207`, mm/s.
     pub retract_feed_mm_s: f64,
+    /// Read commands as Klipper does where it differs from Marlin: `G4` takes only `P`
+    /// (milliseconds; `G4 S2` is no dwell), and `M400` empties the look-ahead (the toolhead
+    /// stops there).
+    pub klipper: bool,
 }
 
 impl Default for MachineConfig {
@@ -245,6 +249,7 @@ impl Default for MachineConfig {
             extrusion: ExtrusionMode::Absolute,
             retract_mm: DEFAULT_RETRACT_MM,
             retract_feed_mm_s: DEFAULT_RETRACT_FEED_MM_S,
+            klipper: false,
         }
     }
 }
@@ -269,6 +274,7 @@ pub struct Machine {
     unretract_extra_mm: f64,
     unretract_feed_mm_s: f64,
     tool: u16,
+    klipper: bool,
 }
 
 impl Default for Machine {
@@ -296,6 +302,7 @@ impl Machine {
             unretract_extra_mm: 0.0,
             unretract_feed_mm_s: config.retract_feed_mm_s,
             tool: 0,
+            klipper: config.klipper,
         }
     }
 
@@ -410,7 +417,7 @@ impl Machine {
         let p = &line.params;
         match (code.number, code.sub) {
             (0..=3, None) => self.motion(line_no, code.number, line, warnings),
-            (4, None) => dwell(line_no, p, warnings),
+            (4, None) => dwell(line_no, p, self.klipper, warnings),
             (10, None) if !p.has(b'P') && !p.has(b'L') => self.firmware_retract(line_no, true),
             (11, None) => self.firmware_retract(line_no, false),
             (17, None) => {
@@ -512,6 +519,9 @@ impl Machine {
                 }
             }
             220 | 221 => self.set_override(line_no, number, p.get(b'S'), warnings),
+            // Klipper's M400 waits for the queue to drain: a dwell of no time, which stops the
+            // look-ahead as a heater wait does.
+            400 if self.klipper => return Some(Event::Dwell(0.0)),
             _ => {}
         }
         None
@@ -812,8 +822,8 @@ impl Machine {
 }
 
 /// A `G4` dwell: `S` seconds or `P` milliseconds; `None` for none or one out of range.
-fn dwell(line_no: u32, p: &Params, warnings: &mut Warnings) -> Option<Event> {
-    let secs = match (p.get(b'S'), p.get(b'P')) {
+fn dwell(line_no: u32, p: &Params, klipper: bool, warnings: &mut Warnings) -> Option<Event> {
+    let secs = match (p.get(b'S').filter(|_| !klipper), p.get(b'P')) {
         (Some(s), _) => s,
         (None, Some(ms)) => ms / 1000.0,
         _ => 0.0,
@@ -895,6 +905,30 @@ mod tests {
             "{}",
             w[0].message
         );
+    }
+
+    #[test]
+    fn klipper_dwells_only_on_p_and_stops_at_m400() {
+        let src = "G4 S2\nG4 P500\nM400";
+        let dwells = |klipper| {
+            let config = MachineConfig {
+                klipper,
+                ..MachineConfig::default()
+            };
+            let (_, ev, _) = run(src, config);
+            ev.iter()
+                .map(|e| match e {
+                    Event::Dwell(s) => *s,
+                    _ => f64::NAN,
+                })
+                .collect::<Vec<f64>>()
+        };
+        assert_eq!(
+            dwells(false),
+            [2.0, 0.5],
+            "Marlin: S seconds, P ms, M400 no event"
+        );
+        assert_eq!(dwells(true), [0.5, 0.0], "Klipper: no S, P ms, M400 a stop");
     }
 
     #[test]

@@ -128,6 +128,7 @@ impl Setup {
             extrusion: self.mode,
             retract_mm: self.retract.0.unwrap_or(default.retract_mm),
             retract_feed_mm_s: self.retract.1.unwrap_or(default.retract_feed_mm_s),
+            klipper: self.model == JunctionModel::Klipper,
         })
     }
 }
