@@ -131,6 +131,32 @@ impl Limits {
         candidate && self.apply_limit_command(line, units)
     }
 
+    /// Applies a limit command as Klipper reads it; returns whether the line was one. Klipper
+    /// has no `M201`, `M203`, `M205` (its config sets those limits: the lines change nothing);
+    /// its `M204` sets the toolhead's acceleration from `S`, or from the lower of `P` and `T`
+    /// when both are given (`P` alone is ignored, as Klipper's `cmd_M204` does).
+    #[inline]
+    pub fn apply_klipper_command(&mut self, line: &Line<'_>) -> bool {
+        match line.command {
+            crate::gcode::Command::Code(code) if code.is(b'M', 204) => {
+                let p = &line.params;
+                let positive = |v: Option<f64>| v.filter(|v| *v > 0.0);
+                let accel = positive(p.get(b'S'))
+                    .or_else(|| Some(positive(p.get(b'P'))?.min(positive(p.get(b'T'))?)));
+                set(&mut self.acceleration, accel, LimitSource::Command);
+                set(&mut self.travel_acceleration, accel, LimitSource::Command);
+                true
+            }
+            crate::gcode::Command::Extended(name)
+                if name.eq_ignore_ascii_case(b"SET_VELOCITY_LIMIT") =>
+            {
+                self.apply_set_velocity_limit(line);
+                true
+            }
+            _ => false,
+        }
+    }
+
     fn apply_limit_command(&mut self, line: &Line<'_>, units: FeedUnits) -> bool {
         if let Some(code) = line.code() {
             if code.letter != b'M' || code.sub.is_some() {
@@ -299,6 +325,35 @@ mod tests {
         l.apply_command(&line, FeedUnits::PerMinute);
         assert_eq!(l.accel_to_decel.value, 0.0);
         assert_eq!(l.minimum_cruise_ratio.value, 0.3);
+    }
+
+    #[test]
+    fn klipper_takes_m204_s_or_the_lower_of_p_and_t_and_no_m201_m203_m205() {
+        let read = |src: &str| {
+            let mut l = voron();
+            let line = crate::gcode::parse_line(src.as_bytes()).expect(src);
+            let taken = l.apply_klipper_command(&line);
+            (taken, l)
+        };
+        let (taken, l) = read("M204 S4000 P1000 T500");
+        assert!(taken);
+        assert_eq!(
+            (l.acceleration.value, l.travel_acceleration.value),
+            (4000.0, 4000.0)
+        );
+        let (_, l) = read("M204 P1000 T1500");
+        assert_eq!(
+            (l.acceleration.value, l.travel_acceleration.value),
+            (1000.0, 1000.0)
+        );
+        let (taken, l) = read("M204 P1000");
+        assert!(taken);
+        assert_eq!(l, voron(), "P alone is ignored");
+        for src in ["M201 X100", "M203 X10", "M205 X1"] {
+            assert_eq!(read(src), (false, voron()), "{src}");
+        }
+        let (_, l) = read("SET_VELOCITY_LIMIT ACCEL=7000");
+        assert_eq!(l.acceleration.value, 7000.0);
     }
 
     #[test]

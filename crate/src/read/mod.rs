@@ -119,6 +119,8 @@ impl Reader {
             layers,
         } = self;
         let units = setup.units;
+        // Klipper reads its limit commands its own way (see `Limits::apply_klipper_command`).
+        let klipper = setup.model == crate::plan::JunctionModel::Klipper;
         gcode::for_each_line(
             input,
             setup.strictness,
@@ -138,7 +140,12 @@ impl Reader {
                         None => fold.comment(comment),
                     }
                 }
-                if limits.apply_command(line, units) {
+                let limit_command = if klipper {
+                    limits.apply_klipper_command(line)
+                } else {
+                    limits.apply_command(line, units)
+                };
+                if limit_command {
                     fold.limits(limits, machine);
                     return Ok(());
                 }
