@@ -195,9 +195,6 @@ pub mod plan;
 pub mod progress;
 pub mod read;
 pub mod vec3;
-// The rewriter keeps its points in slices and hands them to `vec3` by reference, which the
-// helpers take as well as values (`impl Borrow<V3>`).
-#[allow(clippy::needless_borrows_for_generic_args)]
 pub mod vtg;
 
 #[cfg(target_arch = "wasm32")]

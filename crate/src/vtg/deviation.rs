@@ -14,20 +14,20 @@ use crate::vec3::{dot, lerp, norm, sub};
 pub(crate) fn point_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
     let ab = sub(b, a);
     let ap = sub(p, a);
-    let l2 = dot(&ab, &ab);
+    let l2 = dot(ab, ab);
     let t = if l2 > 0.0 {
-        (dot(&ap, &ab) / l2).clamp(0.0, 1.0)
+        (dot(ap, ab) / l2).clamp(0.0, 1.0)
     } else {
         0.0
     };
-    norm(&sub(p, &lerp(a, b, t)))
+    norm(sub(p, lerp(a, b, t)))
 }
 
 /// Distance from `p` to the polyline `poly`.
 pub(crate) fn point_polyline(p: &[f64; 3], poly: &[[f64; 3]]) -> f64 {
     match poly {
         [] => f64::INFINITY,
-        [a] => norm(&sub(p, a)),
+        [a] => norm(sub(p, a)),
         _ => poly
             .windows(2)
             .map(|w| point_segment(p, &w[0], &w[1]))
@@ -41,10 +41,10 @@ fn samples(poly: &[[f64; 3]], step: f64, mut each: impl FnMut(&[f64; 3])) {
         each(p);
     }
     for w in poly.windows(2) {
-        let len = norm(&sub(&w[1], &w[0]));
+        let len = norm(sub(w[1], w[0]));
         let k = ((len / step).ceil() as usize).clamp(1, 100_000);
         for i in 1..=k {
-            each(&lerp(&w[0], &w[1], i as f64 / k as f64));
+            each(&lerp(w[0], w[1], i as f64 / k as f64));
         }
     }
 }
@@ -69,7 +69,7 @@ pub(crate) fn polyline_deviation(
     if segs == 0 {
         return match (out.is_empty(), orig.first()) {
             (true, _) => 0.0,
-            (false, Some(o)) => out.iter().map(|p| norm(&sub(p, o))).fold(0.0, f64::max),
+            (false, Some(o)) => out.iter().map(|p| norm(sub(p, o))).fold(0.0, f64::max),
             (false, None) => f64::INFINITY,
         };
     }
@@ -153,7 +153,7 @@ impl Original<'_> {
     /// `accept − d` mm cannot exceed `accept`: the walk strides there and steps `step` mm only
     /// where the segment comes close to the limit.
     fn walk(&self, q: &[f64; 3], p: &[f64; 3], jq: usize, step: f64, accept: f64) -> f64 {
-        let len = norm(&sub(p, q));
+        let len = norm(sub(p, q));
         let mut m = 0.0f64;
         let mut t = 0.0f64;
         let mut c = jq;
@@ -198,7 +198,7 @@ impl Grid {
         for (a, b) in segs {
             let i = g.segs.len() as u32;
             g.segs.push((a, b));
-            let len = norm(&sub(&b, &a));
+            let len = norm(sub(b, a));
             let k = ((len / (0.5 * cell)).ceil() as usize).clamp(1, 1_000_000);
             let mut last = None;
             for j in 0..=k {

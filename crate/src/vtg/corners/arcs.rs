@@ -159,7 +159,7 @@ fn arc_over(
     if sweep > MAX_SWEEP
         || run
             .iter()
-            .any(|p| (norm(&sub(p, &[center[0], center[1], p[2]])) - r).abs() > tol)
+            .any(|p| (norm(sub(p, [center[0], center[1], p[2]])) - r).abs() > tol)
     {
         return None;
     }

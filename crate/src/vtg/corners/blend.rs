@@ -95,7 +95,7 @@ fn fillet_point(v: &[f64; 3], a: &[f64; 3], b: &[f64; 3], turn: f64, l: f64, t: 
     let r = l / crate::math::tan(half);
     // The centre lies on the inner bisector, r / cos(θ/2) from the vertex.
     let m = sub(b, a);
-    let lm = norm(&m);
+    let lm = norm(m);
     let reach = r / crate::math::cos(half) / lm;
     let c = [
         v[0] + m[0] * reach,
@@ -105,7 +105,7 @@ fn fillet_point(v: &[f64; 3], a: &[f64; 3], b: &[f64; 3], turn: f64, l: f64, t: 
     // Unit vectors from the centre to the two tangent points, and the slerp between them.
     let t1 = [v[0] - a[0] * l, v[1] - a[1] * l, v[2] - a[2] * l];
     let t2 = [v[0] + b[0] * l, v[1] + b[1] * l, v[2] + b[2] * l];
-    let (u1, u2) = (sub(&t1, &c), sub(&t2, &c));
+    let (u1, u2) = (sub(t1, c), sub(t2, c));
     let sin = crate::math::sin;
     let s = sin(turn);
     let (w1, w2) = (sin((1.0 - t) * turn) / s, sin(t * turn) / s);
@@ -171,7 +171,7 @@ fn inside_fillets(
 ) -> (Vec<Blend>, Vec<bool>) {
     let n = pts.len();
     let mut out = vec![Blend::NONE; n];
-    let lens: Vec<f64> = pts.windows(2).map(|w| norm(&sub(&w[1], &w[0]))).collect();
+    let lens: Vec<f64> = pts.windows(2).map(|w| norm(sub(w[1], w[0]))).collect();
     // What each corner asks for.
     let mut want = vec![0.0f64; n];
     let mut shapes = vec![(0.0, 0.0); n];
@@ -181,9 +181,9 @@ fn inside_fillets(
         if la <= 0.0 || lb <= 0.0 {
             continue;
         }
-        let a = sub(&pts[i], &pts[i - 1]);
-        let b = sub(&pts[i + 1], &pts[i]);
-        let turn = crate::math::acos((dot(&a, &b) / (la * lb)).clamp(-1.0, 1.0));
+        let a = sub(pts[i], pts[i - 1]);
+        let b = sub(pts[i + 1], pts[i]);
+        let turn = crate::math::acos((dot(a, b) / (la * lb)).clamp(-1.0, 1.0));
         through[i] = turn <= STRAIGHT_RAD;
         if turn <= STRAIGHT_RAD || turn > MAX_TURN_RAD {
             continue;
@@ -326,7 +326,7 @@ pub(crate) fn samples(
     for i in 0..n - 1 {
         let (a, b) = (pts[i], pts[i + 1]);
         let arc = along[i]; // arc length of the original at pts[i]
-        let len = norm(&sub(&b, &a));
+        let len = norm(sub(b, a));
         let dir = if len > 0.0 {
             [
                 (b[0] - a[0]) / len,
@@ -435,7 +435,7 @@ impl Sampled {
         vertex_arc: f64,
     ) {
         let (b, c) = (pts[v], pts[v + 1]);
-        let lc = norm(&sub(&c, &b));
+        let lc = norm(sub(c, b));
         let out_dir = [(c[0] - b[0]) / lc, (c[1] - b[1]) / lc, (c[2] - b[2]) / lc];
         let l = bl.extent_mm;
         let (vertex, reach) = match racer {
@@ -504,9 +504,9 @@ impl Outward {
         let unit = crate::vtg::hairpin::unit;
         let a = unit(sub(pts.get(i)?, pts.get(i.checked_sub(1)?)?))?;
         let b = unit(sub(pts.get(i + 1)?, pts.get(i)?))?;
-        let w = unit(sub(&a, &b))?;
+        let w = unit(sub(a, b))?;
         let square = |d: &[f64; 3]| {
-            let along = dot(&w, d);
+            let along = dot(w, d);
             unit([
                 w[0] - d[0] * along,
                 w[1] - d[1] * along,
@@ -560,14 +560,14 @@ mod tests {
         let half_pi = std::f64::consts::FRAC_PI_2;
         let p0 = fillet_point(&[0.0; 3], &a, &b, half_pi, 2.0, 0.0);
         let p1 = fillet_point(&[0.0; 3], &a, &b, half_pi, 2.0, 1.0);
-        assert!(norm(&sub(&p0, &[-2.0, 0.0, 0.0])) < 1e-12, "{p0:?}");
-        assert!(norm(&sub(&p1, &[0.0, 2.0, 0.0])) < 1e-12, "{p1:?}");
+        assert!(norm(sub(p0, [-2.0, 0.0, 0.0])) < 1e-12, "{p0:?}");
+        assert!(norm(sub(p1, [0.0, 2.0, 0.0])) < 1e-12, "{p1:?}");
         for i in 0..=8 {
             let p = fillet_point(&[0.0; 3], &a, &b, half_pi, 2.0, i as f64 / 8.0);
-            assert!((norm(&sub(&p, &[-2.0, 2.0, 0.0])) - 2.0).abs() < 1e-12);
+            assert!((norm(sub(p, [-2.0, 2.0, 0.0])) - 2.0).abs() < 1e-12);
         }
         let mid = fillet_point(&[0.0; 3], &a, &b, half_pi, 2.0, 0.5);
-        assert!((norm(&mid) - 2.0 * c).abs() < 1e-12);
+        assert!((norm(mid) - 2.0 * c).abs() < 1e-12);
     }
 
     #[test]
@@ -648,7 +648,7 @@ mod tests {
             .filter(|(_, &u)| u <= beyond)
             .all(|(p, _)| p[1] == 0.0));
         let (mid, _) = near(10.0);
-        assert!((norm(&sub(&mid, &pts[1])) - eps).abs() < 1e-9, "{mid:?}");
+        assert!((norm(sub(mid, pts[1])) - eps).abs() < 1e-9, "{mid:?}");
         assert!(mid[0] < 10.0 && mid[1] > 0.0);
     }
 
@@ -703,7 +703,7 @@ mod tests {
         assert!(sharp.turn_rad.to_degrees() > 110.0);
         let (c, _) = shape(sharp.turn_rad);
         assert!((sharp.extent_mm - tol / c).abs() < 1e-12, "{sharp:?}");
-        let leg = super::norm(&super::sub(&pts[3], &pts[2]));
+        let leg = super::norm(super::sub(pts[3], pts[2]));
         assert!(b[2].extent_mm + sharp.extent_mm <= TUNING.leg_share * leg + 1e-12);
         assert!(b[2].extent_mm > 0.0);
     }

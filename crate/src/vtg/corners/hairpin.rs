@@ -66,7 +66,7 @@ impl Hairpin {
 /// `v / |v|`, or `None` for a tiny vector. (Divides: `crate::vec3::normalize` multiplies by
 /// the reciprocal, which rounds differently and would move the arcs in the last bit.)
 pub(crate) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
-    let l = norm(&v);
+    let l = norm(v);
     (l > 1e-12).then(|| [v[0] / l, v[1] / l, v[2] / l])
 }
 
@@ -118,10 +118,10 @@ pub(crate) fn find(
     if [p0, v2, p3].iter().any(|p| (p[2] - z).abs() > 1e-9) {
         return None;
     }
-    let a = unit(sub(&v1, &p0))?;
-    let b = unit(sub(&p3, &v2))?;
-    let connector = sub(&v2, &v1);
-    let c_len = norm(&connector);
+    let a = unit(sub(v1, p0))?;
+    let b = unit(sub(p3, v2))?;
+    let connector = sub(v2, v1);
+    let c_len = norm(connector);
     if !(c_len > 0.0 && c_len <= TUNING.hairpin_max_connector_mm) {
         return None;
     }
@@ -133,16 +133,16 @@ pub(crate) fn find(
         [-a[1] * side, a[0] * side, 0.0],
         [-b[1] * side, b[0] * side, 0.0],
     );
-    let m = sub(&na, &nb);
-    let m2 = dot(&m, &m);
+    let m = sub(na, nb);
+    let m2 = dot(m, m);
     if m2 < 1e-12 {
         return None;
     }
-    let k = dot(&na, &v1) - dot(&nb, &v2);
-    let s0 = (k - dot(&m, &v1)) / m2;
+    let k = dot(na, v1) - dot(nb, v2);
+    let s0 = (k - dot(m, v1)) / m2;
     let ml = m2.sqrt();
     // The original around the hairpin, and the same stretch with the arc in place.
-    let (la, lb) = (norm(&sub(&v1, &p0)), norm(&sub(&p3, &v2)));
+    let (la, lb) = (norm(sub(v1, p0)), norm(sub(p3, v2)));
     let (room_a, room_b) = (room_mm[0].min(la), room_mm[1].min(lb));
     let pa = [v1[0] - a[0] * room_a, v1[1] - a[1] * room_a, z];
     let pb = [v2[0] + b[0] * room_b, v2[1] + b[1] * room_b, z];
@@ -235,14 +235,14 @@ impl UTurn {
         let [pa, _, _, pb] = self.original;
         let (tolerance_mm, segments) = (self.tolerance_mm, self.segments);
         let centre = [c0[0] + along[0] * t, c0[1] + along[1] * t, z];
-        let r = dot(&na, &sub(&centre, &v1));
+        let r = dot(na, sub(centre, v1));
         if !(r >= self.min_radius_mm && r.is_finite()) {
             return None;
         }
         let ta = [centre[0] - na[0] * r, centre[1] - na[1] * r, z];
         let tb = [centre[0] - nb[0] * r, centre[1] - nb[1] * r, z];
-        let before = dot(&a, &sub(&v1, &ta));
-        let after = dot(&b, &sub(&tb, &v2));
+        let before = dot(a, sub(v1, ta));
+        let after = dot(b, sub(tb, v2));
         if before > self.room[0] || after > self.room[1] {
             return None;
         }
@@ -387,7 +387,7 @@ impl Substituted {
             match (on_arc, speed_at(at[j]), speed_at(at[j + 1])) {
                 (true, Some(v0), Some(v1)) => {
                     let v = v0.min(v1);
-                    let len = norm(&sub(&out.pts[j + 1], &out.pts[j]));
+                    let len = norm(sub(out.pts[j + 1], out.pts[j]));
                     out.planned
                         .push(crate::plan::Profile::new(len, v, v, v, p.acceleration));
                 }
@@ -432,7 +432,7 @@ mod tests {
         assert!(d <= 0.08 + 1e-3, "{d}");
         let centre = [first[0], 0.225, 0.2];
         for q in &h.arc {
-            assert!((norm(&sub(q, &centre)) - 0.225).abs() < 1e-9);
+            assert!((norm(sub(q, centre)) - 0.225).abs() < 1e-9);
         }
     }
 

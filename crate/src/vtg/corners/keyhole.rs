@@ -87,7 +87,7 @@ fn tangent_point(
     leaving: bool,
 ) -> Option<[f64; 3]> {
     let v = sub(d, centre);
-    let dist = norm(&v);
+    let dist = norm(v);
     if dist <= r * 1.001 {
         return None;
     }
@@ -133,8 +133,8 @@ pub(crate) fn find(
         return None;
     }
     // The legs' directions, read over the probe length.
-    let a = unit(sub(&v, &path.at(ui - room_a.min(PROBE_MM))?.0))?;
-    let b = unit(sub(&path.at(ui + room_b.min(PROBE_MM))?.0, &v))?;
+    let a = unit(sub(v, path.at(ui - room_a.min(PROBE_MM))?.0))?;
+    let b = unit(sub(path.at(ui + room_b.min(PROBE_MM))?.0, v))?;
     let turn = angle(a, b);
     if !(MIN_TURN_RAD..=MAX_TURN_RAD).contains(&turn) {
         return None;
@@ -148,7 +148,7 @@ pub(crate) fn find(
         turn,
         side: cross_z(&a, &b).signum(),
         // Into the wedge, halfway between the legs.
-        inward: unit(sub(&b, &a))?,
+        inward: unit(sub(b, a))?,
         tolerance_mm,
         radius_mm,
         max_kink_rad,
@@ -209,7 +209,7 @@ impl Wedge<'_> {
             let d = k as f64 * DEPARTURE_STEP_MM;
             let (p, dir) = self.path.at(self.ui + sign * d)?;
             let t = tangent_point(&p, centre, radius_mm, self.side, sign > 0.0)?;
-            let line = if sign < 0.0 { sub(&t, &p) } else { sub(&p, &t) };
+            let line = if sign < 0.0 { sub(t, p) } else { sub(p, t) };
             (angle(dir, unit(line)?) <= self.max_kink_rad).then_some((d, p, t))
         })
     }
@@ -222,14 +222,14 @@ impl Wedge<'_> {
         let (tolerance_mm, radius_mm) = (self.tolerance_mm, self.radius_mm);
         let centre = [v[0] + inward[0] * c, v[1] + inward[1] * c, v[2]];
         // The corner must be within reach of the loop, and the loop's far side of the corner.
-        if (norm(&sub(&v, &centre)) - radius_mm).abs() > tolerance_mm {
+        if (norm(sub(v, centre)) - radius_mm).abs() > tolerance_mm {
             return None;
         }
         let (before, da, ta) = self.depart(&centre, -1.0, self.room[0])?;
         let (after, db, tb) = self.depart(&centre, 1.0, self.room[1])?;
         // Round the circle from `ta` to `tb` the way the corner turns.
-        let (ra, rb) = (sub(&ta, &centre), sub(&tb, &centre));
-        let mut span = side * crate::math::atan2(cross_z(&ra, &rb), dot(&ra, &rb));
+        let (ra, rb) = (sub(ta, centre), sub(tb, centre));
+        let mut span = side * crate::math::atan2(cross_z(&ra, &rb), dot(ra, rb));
         if span < 0.0 {
             span += 2.0 * std::f64::consts::PI;
         }
@@ -286,8 +286,8 @@ mod tests {
 
     fn turn_at(p: &[[f64; 3]], k: usize) -> f64 {
         angle(
-            unit(sub(&p[k], &p[k - 1])).unwrap(),
-            unit(sub(&p[k + 1], &p[k])).unwrap(),
+            unit(sub(p[k], p[k - 1])).unwrap(),
+            unit(sub(p[k + 1], p[k])).unwrap(),
         )
     }
 
@@ -312,9 +312,9 @@ mod tests {
             assert!(t <= kink + 1e-9, "turn {} at {k}", t.to_degrees());
         }
         // The loop's sides are equal chords of the circle of radius `r`.
-        let chord = norm(&sub(&h.arc[2], &h.arc[1]));
+        let chord = norm(sub(h.arc[2], h.arc[1]));
         for w in h.arc[1..h.arc.len() - 1].windows(2) {
-            assert!((norm(&sub(&w[1], &w[0])) - chord).abs() < 1e-9);
+            assert!((norm(sub(w[1], w[0])) - chord).abs() < 1e-9);
         }
         assert!(chord <= r * TUNING.polygon_turn_rad + 1e-9);
         let d = both_ways(&whole, &p, 1e-3, 0.0);

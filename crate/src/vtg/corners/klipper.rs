@@ -87,14 +87,14 @@ pub(crate) fn find(pts: &[[f64; 3]], i: usize, bounds: &Bounds, fw: &Firmware) -
     if (p0[2] - v[2]).abs() > 1e-9 || (p2[2] - v[2]).abs() > 1e-9 {
         return None;
     }
-    let a = unit(sub(&v, &p0))?;
-    let b = unit(sub(&p2, &v))?;
+    let a = unit(sub(v, p0))?;
+    let b = unit(sub(p2, v))?;
     let side = cross_z(&a, &b).signum();
-    let theta = crate::math::atan2(cross_z(&a, &b).abs(), dot(&a, &b));
+    let theta = crate::math::atan2(cross_z(&a, &b).abs(), dot(a, b));
     if !(theta > bounds.max_turn_rad && theta < 170f64.to_radians()) {
         return None;
     }
-    let legs = [norm(&sub(&v, &p0)), norm(&sub(&p2, &v))];
+    let legs = [norm(sub(v, p0)), norm(sub(p2, v))];
     let sharp = stretch_time(&legs_frame(theta, legs, Vec::new()), fw);
     let budget = TUNING.corner_tolerance_share * bounds.tolerance_mm;
     // Most corners have short legs: where the most compact member (the steepest ramp, the
@@ -151,8 +151,8 @@ pub(crate) fn find(pts: &[[f64; 3]], i: usize, bounds: &Bounds, fw: &Firmware) -
             at: i,
             corners: 1,
             radius_mm: shape.d / shape.t0,
-            before_mm: dot(&a, &sub(&v, &first)),
-            after_mm: dot(&b, &sub(&last, &v)),
+            before_mm: dot(a, sub(v, first)),
+            after_mm: dot(b, sub(last, v)),
             arc,
         },
         deviation_mm: deviation,
@@ -467,18 +467,18 @@ mod tests {
         let mut total = 0.0;
         let mut apex = (0.0f64, 0.0);
         for w in all.windows(3) {
-            let (u, v) = (sub(&w[1], &w[0]), sub(&w[2], &w[1]));
-            let turn = crate::math::atan2(cross_z(&u, &v), dot(&u, &v));
+            let (u, v) = (sub(w[1], w[0]), sub(w[2], w[1]));
+            let turn = crate::math::atan2(cross_z(&u, &v), dot(u, v));
             assert!(turn.abs() <= b.max_turn_rad + 1e-9, "{}", turn.to_degrees());
             total += turn;
             if turn > apex.0 {
-                apex = (turn, norm(&u).min(norm(&v)));
+                apex = (turn, norm(u).min(norm(v)));
             }
         }
         assert!((total - std::f64::consts::FRAC_PI_2).abs() < 1e-9);
         assert!(all
             .windows(2)
-            .all(|w| norm(&sub(&w[1], &w[0])) >= b.min_step_mm));
+            .all(|w| norm(sub(w[1], w[0])) >= b.min_step_mm));
         assert!((c.pin.before_mm - c.pin.after_mm).abs() < 1e-9);
         assert!(c.pin.before_mm > 0.0 && c.pin.before_mm <= b.room_mm[0]);
         assert!(poly[0][1].abs() < 1e-12 && (poly[poly.len() - 1][0] - 20.0).abs() < 1e-12);

@@ -269,14 +269,14 @@ impl Corners {
             rescued: false,
         };
         for i in 1..n - 1 {
-            let a = sub(&pts[i], &pts[i - 1]);
-            let b = sub(&pts[i + 1], &pts[i]);
-            let (la, lb) = (norm(&a), norm(&b));
+            let a = sub(pts[i], pts[i - 1]);
+            let b = sub(pts[i + 1], pts[i]);
+            let (la, lb) = (norm(a), norm(b));
             if la <= 0.0 || lb <= 0.0 {
                 c.degenerate[i] = true;
                 continue;
             }
-            let cos = (dot(&a, &b) / (la * lb)).clamp(-1.0, 1.0);
+            let cos = (dot(a, b) / (la * lb)).clamp(-1.0, 1.0);
             if cos >= cos_critical {
                 continue;
             }
@@ -463,7 +463,7 @@ fn polygon_corners(path: &SmoothPath<'_>, s: &Settings) -> Vec<klipper::Corner> 
         s.line,
     );
     let room = |from: usize, to: usize, end: bool| {
-        let l = norm(&sub(&pts[to], &pts[from]));
+        let l = norm(sub(pts[to], pts[from]));
         (if end { TUNING.leg_share } else { 0.5 } * l - s.min_step_mm).max(0.0)
     };
     let free = Settings {
@@ -471,7 +471,7 @@ fn polygon_corners(path: &SmoothPath<'_>, s: &Settings) -> Vec<klipper::Corner> 
         ..*s
     };
     for i in 1..n - 1 {
-        let (u, w) = (sub(&pts[i], &pts[i - 1]), sub(&pts[i + 1], &pts[i]));
+        let (u, w) = (sub(pts[i], pts[i - 1]), sub(pts[i + 1], pts[i]));
         if !crate::vtg::rewrite::is_sharp(&u, &w, cos_critical) {
             continue;
         }
@@ -583,7 +583,7 @@ fn find_hairpin(
 ) -> Option<hairpin::Hairpin> {
     let n = pts.len();
     let room = |leg: usize, far_end: usize| {
-        let l = norm(&sub(pts.get(leg + 1)?, pts.get(leg)?));
+        let l = norm(sub(pts.get(leg + 1)?, pts.get(leg)?));
         let shared = far_end != 0 && far_end + 1 != n;
         Some(TUNING.leg_share * l * if shared { 0.5 } else { 1.0 })
     };
@@ -963,7 +963,7 @@ mod tests {
         ];
         let mut e = vec![0.0];
         for w in pts.windows(2) {
-            let l = crate::vec3::norm(&crate::vec3::sub(&w[1], &w[0]));
+            let l = crate::vec3::norm(crate::vec3::sub(w[1], w[0]));
             e.push(e.last().unwrap() + 0.03 * l);
         }
         let feed = vec![20.0; pts.len() - 1];

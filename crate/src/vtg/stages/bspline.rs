@@ -78,12 +78,12 @@ pub(crate) struct Eval {
 impl Eval {
     /// Curvature `|C' × C''| / |C'|³`.
     pub(crate) fn curvature(&self) -> f64 {
-        let c = cross(&self.d1, &self.d2);
-        let s = norm(&self.d1);
+        let c = cross(self.d1, self.d2);
+        let s = norm(self.d1);
         if s < 1e-12 {
             return 0.0;
         }
-        norm(&c) / (s * s * s)
+        norm(c) / (s * s * s)
     }
 }
 
@@ -289,7 +289,7 @@ pub(crate) fn arc_lengths(pts: &[[f64; 3]]) -> Vec<f64> {
     let mut s = 0.0;
     arc.push(s);
     for w in pts.windows(2) {
-        s += norm(&sub(&w[1], &w[0]));
+        s += norm(sub(w[1], w[0]));
         arc.push(s);
     }
     arc
@@ -498,7 +498,7 @@ mod tests {
         for i in 0..=100 {
             let u = i as f64 / 100.0;
             let e = c.eval(u);
-            assert!((norm(&e.p) - r).abs() < 1e-12, "{u}: {:?}", e.p);
+            assert!((norm(e.p) - r).abs() < 1e-12, "{u}: {:?}", e.p);
             assert!(
                 (e.curvature() - 1.0 / r).abs() < 1e-9,
                 "{u}: {}",

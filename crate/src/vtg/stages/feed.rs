@@ -109,7 +109,7 @@ fn ramp_up(out: &mut Written, start: [f64; 3], start_feed: f64, jerk: f64, accel
     // `e` of the first point is the filament up to it from the piece's start.
     let segments = out.points.iter().zip(&out.e).zip(&out.feed_mm_s).zip(accel);
     for (i, (((&to, &e_to), &target), &a)) in segments.enumerate() {
-        let len = norm(&sub(&to, &from));
+        let len = norm(sub(to, from));
         let mut done = 0.0;
         if i > 0 && target > now + jerk && len > 0.0 && a > 0.0 {
             loop {
@@ -120,7 +120,7 @@ fn ramp_up(out: &mut Written, start: [f64; 3], start_feed: f64, jerk: f64, accel
                 }
                 done += piece;
                 let t = done / len;
-                points.push(lerp(&from, &to, t));
+                points.push(lerp(from, to, t));
                 e.push(e_from + (e_to - e_from) * t);
                 feeds.push(next);
                 now = next;

@@ -57,7 +57,7 @@ pub(crate) fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit>
         // points is caught as well. In parameter order, so each evaluation finds its span
         // where the last one was.
         let mut check = |q: &[f64; 3], u: f64| {
-            let r = norm(&sub(&curve.eval(u).p, q));
+            let r = norm(sub(curve.eval(u).p, q));
             worst = worst.max(r);
             if r > tol_mm {
                 let s = find_span(&knots, last, u);
@@ -342,7 +342,7 @@ mod tests {
         // The curve passes inside the corner, not through it, about where the blend does
         // (0.04 mm from the vertex), never further than blend and fit allow.
         let c = f.curve.eval(10.0).p;
-        let off = norm(&sub(&c, &[10.0, 0.0, 0.2]));
+        let off = norm(sub(c, [10.0, 0.0, 0.2]));
         assert!(off > 0.03 && off <= 0.05, "{off}");
     }
 }

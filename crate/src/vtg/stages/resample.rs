@@ -90,7 +90,7 @@ pub(crate) fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Opti
         let e = curve.eval(u);
         let (un, pn, k, step, d1_next) = walker.step(u, &p, &e)?;
         if step > 0.0 {
-            let got = norm(&sub(&pn, &p));
+            let got = norm(sub(pn, p));
             stats.fluctuation_sum += ((step - got) / step).abs();
         }
         stats.steps += 1;
@@ -99,7 +99,7 @@ pub(crate) fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Opti
             u: un,
             p: pn,
             kappa: k,
-            mean_kappa: mean_curvature(&e.d1, &t1, norm(&sub(&pn, &p))),
+            mean_kappa: mean_curvature(&e.d1, &t1, norm(sub(pn, p))),
             step_mm: step,
         });
         if un >= u_end {
@@ -153,8 +153,8 @@ impl Walker<'_> {
         // Do not leave a sliver before the end: stretch this step to it instead (it is then
         // the last, shorter-or-longer step to the end, not a full `L_i`, as the end step is).
         if un < self.u_end
-            && norm(&sub(&self.end_p, &pn)) < w.min_step_mm
-            && (self.u_end - un) * norm(&e.d1) < 2.0 * w.min_step_mm
+            && norm(sub(self.end_p, pn)) < w.min_step_mm
+            && (self.u_end - un) * norm(e.d1) < 2.0 * w.min_step_mm
         {
             un = self.u_end;
             pn = self.end_p;
@@ -170,15 +170,15 @@ impl Walker<'_> {
         let (w, curve, u_end) = (self.w, self.curve, self.u_end);
         let kappa = e.curvature();
         // No longer than what is left of the curve (a closed loop ends near its start).
-        let left = (u_end - u) * norm(&e.d1) * 1.05;
+        let left = (u_end - u) * norm(e.d1) * 1.05;
         let mut step = step_for(kappa, w).min(left).max(w.min_step_mm);
-        let remaining = norm(&sub(&self.end_p, p));
+        let remaining = norm(sub(self.end_p, p));
         // The shortest step tried that did not fit.
         let mut too_long: Option<f64> = None;
         for _ in 0..40 {
             // The end is near along the curve, not just in space (a closed loop ends where it
             // started).
-            if remaining <= step && (u_end - u) * norm(&e.d1) <= 1.5 * step + 1e-9 {
+            if remaining <= step && (u_end - u) * norm(e.d1) <= 1.5 * step + 1e-9 {
                 // Try the end point as the next point: the turn and sagitta of the stretch are
                 // judged on its length along the curve, not on the chord, which is nothing at
                 // all when a closed loop comes back to its start.
@@ -201,7 +201,7 @@ impl Walker<'_> {
             // Shrink to what the curvature met on the way allows (at least halving).
             let k = self.max_curvature(
                 u,
-                (u + 2.0 * step / norm(&e.d1).max(1e-9)).min(u_end),
+                (u + 2.0 * step / norm(e.d1).max(1e-9)).min(u_end),
                 [Some(kappa), None],
             );
             if floor {
@@ -261,7 +261,7 @@ fn arc_length(curve: &Curve, a: f64, b: f64) -> f64 {
     let mut sum = 0.0;
     for i in 1..=16 {
         let p = curve.eval(a + (b - a) * i as f64 / 16.0).p;
-        sum += norm(&sub(&p, &prev));
+        sum += norm(sub(p, prev));
         prev = p;
     }
     sum
@@ -393,19 +393,19 @@ fn newton(
     step: f64,
     w: &Walk,
 ) -> Option<(f64, Eval)> {
-    let s = norm(&e.d1);
+    let s = norm(e.d1);
     if s < 1e-12 {
         return None;
     }
     // VTG eq. 27.
-    let mut u = ui + step / s - dot(&e.d1, &e.d2) * step * step / (2.0 * s.powi(4));
+    let mut u = ui + step / s - dot(e.d1, e.d2) * step * step / (2.0 * s.powi(4));
     if u.is_nan() || u <= ui {
         u = ui + step / s;
     }
     for _ in 0..30 {
         let c = curve.eval(u);
-        let v = sub(&c.p, pi);
-        let dist = norm(&v);
+        let v = sub(c.p, pi);
+        let dist = norm(v);
         let f = dist - step;
         if f.abs() <= w.newton_tol_mm {
             return Some((u, c));
@@ -413,7 +413,7 @@ fn newton(
         if dist < 1e-12 {
             return None;
         }
-        let fp = dot(&v, &c.d1) / dist;
+        let fp = dot(v, c.d1) / dist;
         if fp.is_nan() || fp <= 1e-12 {
             return None;
         }
@@ -457,7 +457,7 @@ mod tests {
         let s = walk_curve(&f.curve, &w, &mut st).unwrap();
         assert!(s.len() >= 5, "{}", s.len());
         for pair in s.windows(2) {
-            let got = norm(&sub(&pair[1].p, &pair[0].p));
+            let got = norm(sub(pair[1].p, pair[0].p));
             if pair[1].step_mm > 0.0 {
                 assert!((got - pair[1].step_mm).abs() <= 1e-7);
             }
@@ -484,7 +484,7 @@ mod tests {
                 let mut pts: Vec<[f64; 3]> = Vec::new();
                 for (x, y) in raw {
                     let p = [x, y, 0.2];
-                    if pts.last().is_none_or(|q: &[f64; 3]| norm(&sub(&p, q)) > 0.5) {
+                    if pts.last().is_none_or(|q: &[f64; 3]| norm(sub(p, q)) > 0.5) {
                         pts.push(p);
                     }
                 }
@@ -504,13 +504,13 @@ mod tests {
                 let index = CurvatureIndex::new(&f.curve);
                 for x in &s {
                     let on = f.curve.eval(x.u).p;
-                    prop_assert!(norm(&sub(&on, &x.p)) < 1e-12);
+                    prop_assert!(norm(sub(on, x.p)) < 1e-12);
                 }
                 for pair in s.windows(2) {
                     let (a, b) = (&pair[0], &pair[1]);
                     prop_assert!(b.u > a.u);
                     if b.step_mm > 0.0 {
-                        let got = norm(&sub(&b.p, &a.p));
+                        let got = norm(sub(b.p, a.p));
                         prop_assert!((got - b.step_mm).abs() <= 1e-7, "{} vs {}", got, b.step_mm);
                         if b.step_mm > w.min_step_mm {
                             // Accepted by the test, not forced by the step floor.
