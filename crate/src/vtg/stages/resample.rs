@@ -335,7 +335,7 @@ impl CurvatureIndex {
     }
 
     /// Largest curvature on `[a, b]`.
-    #[cfg(test)]
+    #[cfg(all(test, not(target_arch = "wasm32")))]
     pub(crate) fn max(&self, curve: &Curve, a: f64, b: f64) -> f64 {
         self.max_with_ends(curve, a, b, [None, None])
     }
