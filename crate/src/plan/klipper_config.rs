@@ -148,6 +148,11 @@ impl KlipperConfig {
                     section = "";
                 } else {
                     section = name;
+                    if name == "gcode_arcs" {
+                        // Klipper's resolution when the section is there without the key (a
+                        // `resolution` read later replaces it).
+                        self.arc_resolution.get_or_insert(1.0);
+                    }
                 }
                 continue;
             }
@@ -163,10 +168,6 @@ impl KlipperConfig {
                 value: value.trim(),
             };
             self.set(&entry).map_err(|reason| error(number, reason))?;
-        }
-        if text.lines().any(|l| l.trim() == "[gcode_arcs]") && self.arc_resolution.is_none() {
-            // Klipper's default resolution when the section is there without the key.
-            self.arc_resolution = Some(1.0);
         }
         Ok(())
     }
@@ -389,6 +390,18 @@ resolution: 0.1
         assert_eq!(c.filament_diameter, Some(1.75));
         assert_eq!(c.arc_resolution, Some(0.1));
         assert_eq!(c.retract_length, None);
+        let bare = KlipperConfig::parse_text("[gcode_arcs]\n[printer]\nmax_accel: 1\n").unwrap();
+        assert_eq!(
+            bare.arc_resolution,
+            Some(1.0),
+            "Klipper's default resolution"
+        );
+        assert_eq!(
+            KlipperConfig::parse_text("[printer]\n")
+                .unwrap()
+                .arc_resolution,
+            None
+        );
     }
 
     #[test]

@@ -120,7 +120,7 @@ impl Reader {
         } = self;
         let units = setup.units;
         // Klipper reads its limit commands its own way (see `Limits::apply_klipper_command`).
-        let klipper = setup.model == crate::plan::JunctionModel::Klipper;
+        let klipper = setup.klipper();
         gcode::for_each_line(
             input,
             setup.strictness,

@@ -120,6 +120,11 @@ pub(crate) struct Setup {
 }
 
 impl Setup {
+    /// Whether the file runs on Klipper, which reads some commands its own way.
+    pub fn klipper(&self) -> bool {
+        self.model == JunctionModel::Klipper
+    }
+
     /// The machine a pass starts with: the file's extrusion mode, everything else at its
     /// power-on state.
     pub fn machine(&self) -> Machine {
@@ -128,7 +133,7 @@ impl Setup {
             extrusion: self.mode,
             retract_mm: self.retract.0.unwrap_or(default.retract_mm),
             retract_feed_mm_s: self.retract.1.unwrap_or(default.retract_feed_mm_s),
-            klipper: self.model == JunctionModel::Klipper,
+            klipper: self.klipper(),
         })
     }
 }
