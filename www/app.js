@@ -319,7 +319,9 @@ function showJobResult(job, result, outBytes, target) {
   els.resultPanel.hidden = false;
   els.resultJob.textContent = `· ${JOB_NAMES[job]}${target === 'output' ? ' of the optimized output' : ''}`;
   els.resultLine.textContent = resultLine(job, result);
-  if (outBytes) {
+  // An infill search that kept the original hands back the input: nothing better to download.
+  const keptOriginal = job === 'infill' && result.best?.pattern === 'original';
+  if (outBytes && !keptOriginal) {
     output = { job, bytes: outBytes };
     fileToken++;
     layerCache.clear();
@@ -351,6 +353,7 @@ function resultLine(job, r) {
       return `Tolerance ${n(r.tolerance_mm)} mm, largest deviation from the original path ${n(r.max_deviation_mm, 4)} mm; energy ${pct(r.after?.energy?.total_j, r.before?.energy?.total_j)}, time ${pct(r.after?.time_s, r.before?.time_s)}${isNum(r.paths?.arcs_written) && r.paths.arcs_written > 0 ? `; ${r.paths.arcs_written} arcs` : ''}.`;
     case 'infill': {
       const b = r.best ?? {};
+      if (b.pattern === 'original') return `No candidate beats your file: it is kept as it was (${r.candidates?.length ?? '—'} candidates). ${b.message ?? ''}`;
       return `Best: ${b.pattern ?? '—'} at ${n(b.angle_deg, 1)}°${isNum(b.rotation_deg) ? ` (rotation ${n(b.rotation_deg, 1)}°)` : ''} of ${Array.isArray(r.candidates) ? r.candidates.length : '—'} candidates; energy ${pct(r.after?.energy?.total_j, r.before?.energy?.total_j)}.`;
     }
     case 'smooth':

@@ -7,7 +7,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use quietpath::error::ErrorKind;
-use quietpath::infill::{infill, infill_with_progress, InfillOptions, Pattern};
+use quietpath::infill::{
+    infill, infill_with_progress, Choice, InfillOptions, InfillReport, Objective, Pattern,
+};
+use quietpath::Report;
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -203,6 +206,8 @@ fn pattern_length_and_turning_match_the_written_file() {
             angles_deg: vec![0.0],
             rotations_deg: vec![0.0],
             patterns: vec![pattern],
+            // Written even where dearer than the original: the test reads the strokes back.
+            force_candidate: true,
             ..Default::default()
         };
         let r = infill(&input, &options).unwrap();
@@ -258,4 +263,102 @@ fn pattern_length_and_turning_match_the_written_file() {
         "{seen:?}"
     );
     assert!(turn(Pattern::ArchimedeanChords).2 < 30.0, "{seen:?}");
+}
+
+/// The objective's value of a report, as the search scores it (weighted: relative to `base`).
+fn objective_of(o: &InfillOptions, r: &Report, base: &Report) -> f64 {
+    let rel = |a: f64, b: f64| if b > 0.0 { a / b } else { a };
+    match o.objective {
+        Objective::Energy => r.energy.total_j,
+        Objective::Time => r.time_s,
+        Objective::Length => r.distance_mm,
+        Objective::Weighted => {
+            o.weights.energy * rel(r.energy.total_j, base.energy.total_j)
+                + o.weights.time * rel(r.time_s, base.time_s)
+                + o.weights.length * rel(r.distance_mm, base.distance_mm)
+        }
+    }
+}
+
+/// The rule every optimiser keeps: the file handed back, analysed afresh, costs no more than
+/// the input on the objective; when the original is kept it is the input byte for byte.
+fn assert_never_dearer(input: &[u8], o: &InfillOptions, r: &InfillReport, what: &str) {
+    let before = quietpath::analyze(input, &o.analyze).unwrap();
+    let after = quietpath::analyze(&r.output, &o.analyze).unwrap();
+    let (b, a) = (
+        objective_of(o, &before, &before),
+        objective_of(o, &after, &before),
+    );
+    assert!(a <= b, "{what}: output {a} > input {b} ({:?})", r.best);
+    if r.best.pattern == Choice::Original {
+        assert!(
+            r.output == input,
+            "{what}: original kept but the output differs"
+        );
+        assert!(
+            r.best.message.is_some(),
+            "{what}: original kept without a message"
+        );
+    } else {
+        assert!(
+            a < b,
+            "{what}: a candidate written that does not beat the original"
+        );
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::test_runner::Config { cases: 16, ..Default::default() })]
+
+    /// Random candidate sets and objectives on a plain part: whichever wins, never dearer.
+    #[test]
+    fn never_hands_back_a_dearer_file(
+        patterns in proptest::sample::subsequence(Pattern::ALL.to_vec(), 1..3),
+        angles in proptest::collection::vec(0.0f64..180.0, 1..3),
+        objective in proptest::sample::select(vec![
+            Objective::Energy, Objective::Time, Objective::Length, Objective::Weighted,
+        ]),
+        file in proptest::sample::select(vec!["rect_infill_0.gcode", "rect_infill_45.gcode"]),
+    ) {
+        let input = std::fs::read(data(file)).unwrap();
+        let o = InfillOptions { patterns, angles_deg: angles, objective, ..Default::default() };
+        let r = infill(&input, &o).unwrap();
+        assert_never_dearer(&input, &o, &r, file);
+    }
+}
+
+/// Every sliced fixture with sparse infill: the search over the thesis's patterns at three
+/// angles never writes a dearer file.
+#[test]
+fn no_fixture_gets_a_dearer_file() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/gcode");
+    let o = InfillOptions {
+        angles_deg: vec![0.0, 45.0, 90.0],
+        ..Default::default()
+    };
+    let mut tested = 0;
+    let mut entries: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    entries.sort();
+    for path in entries {
+        let input = std::fs::read(&path).unwrap();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        match infill(&input, &o) {
+            Ok(r) => {
+                assert_never_dearer(&input, &o, &r, &name);
+                tested += 1;
+            }
+            // Vases and walls-only parts: nothing to regenerate is an error, not a file.
+            Err(e) => assert!(
+                matches!(e.kind, ErrorKind::InvalidOption { .. }),
+                "{name}: {e}"
+            ),
+        }
+    }
+    assert!(
+        tested >= 8,
+        "only {tested} fixtures had infill to regenerate"
+    );
 }

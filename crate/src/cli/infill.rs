@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use quietpath::infill::{
-    infill_with_progress, InfillOptions, InfillReport, Objective, Pattern, Weights,
+    infill_with_progress, Choice, InfillOptions, InfillReport, Objective, Pattern, Weights,
 };
 
 use super::output::{write_atomically, write_json, ProgressBar};
@@ -49,6 +49,10 @@ pub struct Args {
     /// Allow the output to replace the input file.
     #[arg(long)]
     pub force: bool,
+    /// Write the best candidate even when it does not beat the original on the objective
+    /// (by default the original is written unchanged and the report says why).
+    #[arg(long)]
+    pub force_candidate: bool,
     /// Print the report as JSON (an array with several files).
     #[arg(long)]
     pub json: bool,
@@ -125,6 +129,7 @@ fn options(args: &Args) -> Result<InfillOptions, String> {
         },
         per_layer: args.per_layer,
         spacing_mm: args.spacing,
+        force_candidate: args.force_candidate,
     })
 }
 
@@ -142,18 +147,25 @@ fn print(
         "  measured: spacing {:.3} mm, clearance {:.3} mm, {:.5} mm filament/mm, {} layers ({} blocks) regenerated",
         m.spacing_mm, m.clearance_mm, m.e_per_mm, m.layers_regenerated, m.blocks
     )?;
-    writeln!(
-        out,
-        "  best: {} at {}°, part turned {}°{}",
-        r.best.pattern.name(),
-        r.best.angle_deg,
-        r.best.rotation_deg,
-        if r.best.layers.is_some() {
-            " (per-layer hybrid)"
-        } else {
-            ""
-        }
-    )?;
+    if r.best.pattern == Choice::Original {
+        writeln!(out, "  best: the original (written unchanged)")?;
+    } else {
+        writeln!(
+            out,
+            "  best: {} at {}°, part turned {}°{}",
+            r.best.pattern.name(),
+            r.best.angle_deg,
+            r.best.rotation_deg,
+            if r.best.layers.is_some() {
+                " (per-layer hybrid)"
+            } else {
+                ""
+            }
+        )?;
+    }
+    if let Some(m) = &r.best.message {
+        writeln!(out, "  note: {m}")?;
+    }
     writeln!(
         out,
         "  {:<12} {:>12} {:>12} {:>10} {:>12}",
@@ -175,8 +187,9 @@ fn print(
     sorted.sort_by(|x, y| x.total_j.total_cmp(&y.total_j));
     writeln!(
         out,
-        "  {} candidates in {secs:.2} s; cheapest:",
-        r.candidates.len()
+        "  {} candidates ({} with the geometry of an earlier one, not costed again) in {secs:.2} s; cheapest:",
+        r.candidates.len(),
+        r.candidates_skipped
     )?;
     for c in sorted.iter().take(8) {
         writeln!(

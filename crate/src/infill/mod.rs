@@ -86,6 +86,9 @@ pub struct InfillOptions {
     pub per_layer: bool,
     /// Rectilinear-equivalent line spacing, mm (default: measured from the file).
     pub spacing_mm: Option<f64>,
+    /// Write the best candidate even when it does not beat the original on the objective
+    /// (default false: the original is kept and the report says so).
+    pub force_candidate: bool,
 }
 
 impl Default for InfillOptions {
@@ -99,6 +102,7 @@ impl Default for InfillOptions {
             weights: Weights::default(),
             per_layer: false,
             spacing_mm: None,
+            force_candidate: false,
         }
     }
 }
@@ -179,11 +183,34 @@ pub struct LayerChoice {
     pub angle_deg: f64,
 }
 
+/// What was written: a regenerated pattern, or the original file kept as it was.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Choice {
+    /// No candidate beat the original on the objective (as `analyze` costs both files): the
+    /// output is the input, byte for byte.
+    Original,
+    /// The regenerated pattern.
+    #[serde(untagged)]
+    Pattern(Pattern),
+}
+
+impl Choice {
+    /// The snake_case name (`original` or the pattern's).
+    pub fn name(self) -> &'static str {
+        match self {
+            Choice::Original => "original",
+            Choice::Pattern(p) => p.name(),
+        }
+    }
+}
+
 /// The chosen result.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Best {
-    /// Pattern (the most used one for a per-layer result).
-    pub pattern: Pattern,
+    /// Pattern (the most used one for a per-layer result), or `original` when the input is
+    /// kept.
+    pub pattern: Choice,
     /// Infill angle, degrees.
     pub angle_deg: f64,
     /// Part rotation, degrees.
@@ -202,6 +229,9 @@ pub struct Best {
     pub saving_pct: f64,
     /// Per-layer choices when `per_layer` was asked and beat the single best.
     pub layers: Option<Vec<LayerChoice>>,
+    /// Why the original was kept, or that a worse candidate was forced; `None` when the
+    /// written candidate beats the original.
+    pub message: Option<String>,
 }
 
 /// What the method measured from the file.
@@ -236,6 +266,9 @@ pub struct InfillReport {
     pub best: Best,
     /// Every candidate costed, in search order.
     pub candidates: Vec<Candidate>,
+    /// Candidates not costed because their geometry is the same as an earlier one's (a
+    /// concentric pattern at another angle, a rotation that gives the same strokes).
+    pub candidates_skipped: usize,
     /// What was measured from the file.
     pub measured: Measured,
     /// Rotations skipped (the part would not fit on the bed), degrees.

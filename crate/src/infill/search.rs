@@ -15,8 +15,8 @@ use super::program::{self, Program};
 use super::region::{self, LayerRegion};
 use super::spacing::Line;
 use super::{
-    link, pattern, write, Best, Candidate, InfillOptions, InfillReport, Measured, Objective,
-    Pattern,
+    link, pattern, write, Best, Candidate, Choice, InfillOptions, InfillReport, Measured,
+    Objective, Pattern,
 };
 use crate::analyze::{analyze, Report};
 use crate::error::{Error, ErrorKind};
@@ -415,6 +415,11 @@ fn angle_key(beta: f64) -> i64 {
 }
 
 /// [`infill`] with a progress callback (fraction of candidates costed; `false` cancels).
+///
+/// The original file is the reference every candidate must beat: the best candidate is
+/// written, analysed as `analyze` would, and kept only if it costs less than the input on the
+/// objective; otherwise the input is returned unchanged with `best.pattern = original` and a
+/// message (unless [`InfillOptions::force_candidate`]).
 pub fn infill_with_progress(
     input: &[u8],
     options: &InfillOptions,
@@ -422,26 +427,96 @@ pub fn infill_with_progress(
 ) -> Result<InfillReport, Error> {
     let prep = prepare(input, options)?;
     let base_costs = replay(&prep.prog, &[], None, &prep.base);
+    let (rotations, rotations_skipped) = rotations_of(&prep, options)?;
+    let searched = search(&prep, options, &rotations, &base_costs, progress)?;
+    let Some((best_score, bi)) = searched.best else {
+        return Err(invalid("no candidate"));
+    };
+    let chosen = searched.candidates[bi].clone();
+    let rotation = rotations
+        .iter()
+        .find(|(d, _)| *d == chosen.rotation_deg)
+        .and_then(|(_, r)| *r);
+    let written = write_chosen(
+        &prep,
+        options,
+        &chosen,
+        rotation.as_ref(),
+        best_score,
+        &base_costs,
+    );
+    let after = analyze(&written.output, &options.analyze)?;
+    progress(1.0);
+    let mut best = best_of(
+        &chosen,
+        &written.costs,
+        prep.before.energy.total_j,
+        written.layers,
+    );
+    let verdict = Verdict::of(options, &prep.before, &after);
+    let (output, after) = if verdict.beats || options.force_candidate {
+        best.message =
+            (!verdict.beats).then(|| verdict.describe(&best, "written anyway (force_candidate)"));
+        measured_as_written(&mut best, &prep.before, &after);
+        (written.output, after)
+    } else {
+        best = original_kept(
+            &prep.before,
+            verdict.describe(
+                &best,
+                "the original is kept (force_candidate writes it anyway)",
+            ),
+        );
+        (input.to_vec(), prep.before.clone())
+    };
+    let measured = measured(&prep);
+    Ok(InfillReport {
+        before: prep.before,
+        after,
+        best,
+        candidates: searched.candidates,
+        candidates_skipped: searched.skipped,
+        measured,
+        rotations_skipped,
+        output,
+    })
+}
+
+/// The rotations that keep the part on the bed, and those that do not.
+#[allow(clippy::type_complexity)]
+fn rotations_of(
+    prep: &Prepared<'_>,
+    options: &InfillOptions,
+) -> Result<(Vec<(f64, Option<Rotation>)>, Vec<f64>), Error> {
     let mut rotations = Vec::new();
-    let mut rotations_skipped = Vec::new();
+    let mut skipped = Vec::new();
     for &deg in &options.rotations_deg {
         match prep.rotation(deg) {
             Some(r) => rotations.push((deg, r)),
-            None => rotations_skipped.push(deg),
+            None => skipped.push(deg),
         }
     }
     if rotations.is_empty() {
         return Err(invalid("no rotation keeps the part on the bed"));
     }
-    let Searched { candidates, best } = search(&prep, options, &rotations, &base_costs, progress)?;
-    let Some((best_score, bi)) = best else {
-        return Err(invalid("no candidate"));
-    };
-    let chosen = candidates[bi].clone();
-    let rotation = rotations
-        .iter()
-        .find(|(d, _)| *d == chosen.rotation_deg)
-        .and_then(|(_, r)| *r);
+    Ok((rotations, skipped))
+}
+
+/// The chosen candidate (or its per-layer hybrid, when asked and cheaper) as G-code.
+struct Written {
+    output: Vec<u8>,
+    costs: Costs,
+    layers: Option<Vec<super::LayerChoice>>,
+}
+
+fn write_chosen(
+    prep: &Prepared<'_>,
+    options: &InfillOptions,
+    chosen: &Candidate,
+    rotation: Option<&Rotation>,
+    best_score: f64,
+    base_costs: &Costs,
+) -> Written {
     let beta = chosen.angle_deg - chosen.rotation_deg;
     let mut plans: Vec<Vec<Path>> = prep
         .work
@@ -449,7 +524,7 @@ pub fn infill_with_progress(
         .map(|w| prep.plan_layer(w, chosen.pattern, beta))
         .collect();
     let mut layers = None;
-    let mut result = Costs {
+    let mut costs = Costs {
         time_s: chosen.time_s,
         thesis_j: chosen.thesis_j,
         total_j: chosen.total_j,
@@ -458,33 +533,114 @@ pub fn infill_with_progress(
         infill: Default::default(),
     };
     if options.per_layer {
-        if let Some((hybrid, choices, costs)) =
-            super::hybrid::per_layer(&prep, options, &chosen, rotation.as_ref())
+        if let Some((hybrid, choices, hybrid_costs)) =
+            super::hybrid::per_layer(prep, options, chosen, rotation)
         {
-            if score(options.objective, &options.weights, &costs, &base_costs) < best_score {
+            if score(
+                options.objective,
+                &options.weights,
+                &hybrid_costs,
+                base_costs,
+            ) < best_score
+            {
                 plans = hybrid;
                 layers = Some(choices);
-                result = costs;
+                costs = hybrid_costs;
             }
         }
     }
     let refs: Vec<&Vec<Path>> = plans.iter().collect();
-    let (texts, _) = prep.candidate(&refs, rotation.as_ref());
-    let edits = write::edits(prep.input, &prep.prog, &texts, rotation.as_ref());
-    let output = crate::gcode::apply_edits(prep.input, &edits);
-    let after = analyze(&output, &options.analyze)?;
-    progress(1.0);
-    let best = best_of(&chosen, &result, prep.before.energy.total_j, layers);
-    let measured = measured(&prep);
-    Ok(InfillReport {
-        before: prep.before,
-        after,
-        best,
-        candidates,
-        measured,
-        rotations_skipped,
-        output,
-    })
+    let (texts, _) = prep.candidate(&refs, rotation);
+    let edits = write::edits(prep.input, &prep.prog, &texts, rotation);
+    Written {
+        output: crate::gcode::apply_edits(prep.input, &edits),
+        costs,
+        layers,
+    }
+}
+
+/// Whether the written file beats the original on the objective, both as `analyze` costs
+/// them: the rule that no file handed back is dearer than the one given.
+struct Verdict {
+    objective: Objective,
+    beats: bool,
+    /// The written file's score over the original's, minus one (`0.012`: 1.2 % dearer).
+    change: f64,
+}
+
+impl Verdict {
+    fn of(options: &InfillOptions, before: &Report, after: &Report) -> Self {
+        let b = report_costs(before);
+        let a = report_costs(after);
+        let sb = score(options.objective, &options.weights, &b, &b);
+        let sa = score(options.objective, &options.weights, &a, &b);
+        Self {
+            objective: options.objective,
+            beats: sa < sb,
+            change: if sb > 0.0 { sa / sb - 1.0 } else { 0.0 },
+        }
+    }
+
+    fn describe(&self, best: &Best, outcome: &str) -> String {
+        let objective = match self.objective {
+            Objective::Energy => "energy",
+            Objective::Time => "time",
+            Objective::Length => "toolpath length",
+            Objective::Weighted => "the weighted objective",
+        };
+        format!(
+            "no candidate beats the original on {objective}: the best, {} at {}° (part turned {}°), \
+             is {:+.2} % against the original; {outcome}",
+            best.pattern.name(),
+            best.angle_deg,
+            best.rotation_deg,
+            100.0 * self.change
+        )
+    }
+}
+
+/// `best`'s numbers as `analyze` gives them for the written file (the search's replay of a
+/// candidate can differ from it in the last few tenths of a percent).
+fn measured_as_written(best: &mut Best, before: &Report, after: &Report) {
+    best.thesis_j = after.energy.thesis_j;
+    best.total_j = after.energy.total_j;
+    best.time_s = after.time_s;
+    best.length_mm = after.distance_mm;
+    best.saving_j = before.energy.total_j - after.energy.total_j;
+    best.saving_pct = if before.energy.total_j > 0.0 {
+        100.0 * best.saving_j / before.energy.total_j
+    } else {
+        0.0
+    };
+}
+
+/// A report's numbers in the form candidates are scored in.
+fn report_costs(r: &Report) -> Costs {
+    Costs {
+        time_s: r.time_s,
+        thesis_j: r.energy.thesis_j,
+        total_j: r.energy.total_j,
+        length_mm: r.distance_mm,
+        filament_mm: r.filament_mm,
+        infill: Default::default(),
+    }
+}
+
+/// The report's best when the original is kept: its own numbers, no saving.
+fn original_kept(before: &Report, message: String) -> Best {
+    Best {
+        pattern: Choice::Original,
+        angle_deg: 0.0,
+        rotation_deg: 0.0,
+        thesis_j: before.energy.thesis_j,
+        total_j: before.energy.total_j,
+        time_s: before.time_s,
+        length_mm: before.distance_mm,
+        saving_j: 0.0,
+        saving_pct: 0.0,
+        layers: None,
+        message: Some(message),
+    }
 }
 
 /// Every (pattern, angle, rotation) costed.
@@ -492,6 +648,50 @@ struct Searched {
     candidates: Vec<Candidate>,
     /// Score and index of the best candidate.
     best: Option<(f64, usize)>,
+    /// Candidates whose geometry repeated an earlier one's: listed with its costs, not replayed.
+    skipped: usize,
+}
+
+/// One pattern's generated strokes, each set once: angles that give the same strokes (any
+/// angle for concentric loops; symmetric patterns) share one entry and one costing per
+/// rotation.
+#[derive(Default)]
+struct Geometries {
+    /// Strokes of each distinct geometry.
+    plans: Vec<Vec<Vec<Path>>>,
+    /// Geometry index of each part-frame angle key.
+    by_key: HashMap<i64, usize>,
+    /// Costs of (geometry, rotation index) already replayed.
+    costed: HashMap<(usize, usize), Costs>,
+}
+
+impl Geometries {
+    /// The geometry index of `pattern` at part-frame angle `beta`, generating it if new.
+    fn index(&mut self, prep: &Prepared<'_>, pattern: Pattern, beta: f64) -> usize {
+        // Concentric loops do not depend on the angle.
+        let key = if pattern == Pattern::Concentric {
+            0
+        } else {
+            angle_key(beta)
+        };
+        if let Some(&i) = self.by_key.get(&key) {
+            return i;
+        }
+        let plans: Vec<Vec<Path>> = prep
+            .work
+            .iter()
+            .map(|w| prep.plan_layer(w, pattern, beta))
+            .collect();
+        let i = match self.plans.iter().position(|p| *p == plans) {
+            Some(i) => i,
+            None => {
+                self.plans.push(plans);
+                self.plans.len() - 1
+            }
+        };
+        self.by_key.insert(key, i);
+        i
+    }
 }
 
 /// Every (pattern, angle, rotation) costed, and the score and index of the best.
@@ -504,53 +704,59 @@ fn search(
 ) -> Result<Searched, Error> {
     let total = options.patterns.len() * options.angles_deg.len() * rotations.len();
     let mut done = 0usize;
-    let mut candidates: Vec<Candidate> = Vec::with_capacity(total);
-    let mut best: Option<(f64, usize)> = None;
+    let mut out = Searched {
+        candidates: Vec::with_capacity(total),
+        best: None,
+        skipped: 0,
+    };
     for &pattern in &options.patterns {
-        let mut cache: HashMap<i64, Vec<Vec<Path>>> = HashMap::new();
+        let mut geometries = Geometries::default();
         for &angle in &options.angles_deg {
-            for (rot_deg, rotation) in rotations {
+            for (ri, (rot_deg, rotation)) in rotations.iter().enumerate() {
                 if !progress(done as f64 / total as f64) {
                     return Err(Error::new(0, 0, ErrorKind::Cancelled));
                 }
                 done += 1;
-                let beta = angle - rot_deg;
-                // Concentric loops do not depend on the angle.
-                let key = if pattern == Pattern::Concentric {
-                    0
-                } else {
-                    angle_key(beta)
+                let g = geometries.index(prep, pattern, angle - rot_deg);
+                let c = match geometries.costed.get(&(g, ri)) {
+                    Some(c) => {
+                        out.skipped += 1;
+                        *c
+                    }
+                    None => {
+                        let refs: Vec<&Vec<Path>> = geometries.plans[g].iter().collect();
+                        let (_, motions) = prep.candidate(&refs, rotation.as_ref());
+                        let c = replay(&prep.prog, &motions, rotation.as_ref(), &prep.base);
+                        geometries.costed.insert((g, ri), c);
+                        c
+                    }
                 };
-                let plans = cache.entry(key).or_insert_with(|| {
-                    prep.work
-                        .iter()
-                        .map(|w| prep.plan_layer(w, pattern, beta))
-                        .collect()
-                });
-                let refs: Vec<&Vec<Path>> = plans.iter().collect();
-                let (_, motions) = prep.candidate(&refs, rotation.as_ref());
-                let c = replay(&prep.prog, &motions, rotation.as_ref(), &prep.base);
                 let s = score(options.objective, &options.weights, &c, base_costs);
-                if best.is_none_or(|(b, _)| s < b) {
-                    best = Some((s, candidates.len()));
+                if out.best.is_none_or(|(b, _)| s < b) {
+                    out.best = Some((s, out.candidates.len()));
                 }
-                candidates.push(Candidate {
-                    pattern,
-                    angle_deg: angle,
-                    rotation_deg: *rot_deg,
-                    thesis_j: c.thesis_j,
-                    total_j: c.total_j,
-                    time_s: c.time_s,
-                    length_mm: c.length_mm,
-                    filament_mm: c.filament_mm,
-                    infill_length_mm: c.infill.l_total_mm,
-                    infill_turning_points: c.infill.n_turning,
-                    infill_mean_turn_deg: c.infill.mean_turn_deg,
-                });
+                out.candidates
+                    .push(candidate_of(pattern, angle, *rot_deg, &c));
             }
         }
     }
-    Ok(Searched { candidates, best })
+    Ok(out)
+}
+
+fn candidate_of(pattern: Pattern, angle_deg: f64, rotation_deg: f64, c: &Costs) -> Candidate {
+    Candidate {
+        pattern,
+        angle_deg,
+        rotation_deg,
+        thesis_j: c.thesis_j,
+        total_j: c.total_j,
+        time_s: c.time_s,
+        length_mm: c.length_mm,
+        filament_mm: c.filament_mm,
+        infill_length_mm: c.infill.l_total_mm,
+        infill_turning_points: c.infill.n_turning,
+        infill_mean_turn_deg: c.infill.mean_turn_deg,
+    }
 }
 
 /// The report's best candidate: `chosen` with the costs `result` it was written with.
@@ -561,7 +767,7 @@ fn best_of(
     layers: Option<Vec<super::LayerChoice>>,
 ) -> Best {
     Best {
-        pattern: chosen.pattern,
+        pattern: Choice::Pattern(chosen.pattern),
         angle_deg: chosen.angle_deg,
         rotation_deg: chosen.rotation_deg,
         thesis_j: result.thesis_j,
@@ -575,6 +781,7 @@ fn best_of(
             0.0
         },
         layers,
+        message: None,
     }
 }
 

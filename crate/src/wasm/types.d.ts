@@ -338,6 +338,8 @@ export interface InfillOptions {
   /** Choose pattern and angle per layer (the thesis's hybrid). */
   per_layer?: boolean;
   spacing_mm?: number | null;
+  /** Write the best candidate even when it does not beat the original (default false: the original is kept). */
+  force_candidate?: boolean;
 }
 export interface InfillCandidate {
   pattern: InfillPattern;
@@ -359,7 +361,8 @@ export interface InfillReport {
   before: Report;
   after: Report;
   best: {
-    pattern: InfillPattern;
+    /** The regenerated pattern, or `original` when no candidate beat the input (the output is then the input). */
+    pattern: InfillPattern | 'original';
     angle_deg: number;
     rotation_deg: number;
     thesis_j: number;
@@ -369,8 +372,12 @@ export interface InfillReport {
     saving_j: number;
     saving_pct: number;
     layers: { layer: number; pattern: InfillPattern; angle_deg: number; [key: string]: unknown }[] | null;
+    /** Why the original was kept (or that a dearer candidate was forced); null when the output beats the input. */
+    message: string | null;
   };
   candidates: InfillCandidate[];
+  /** Candidates with the geometry of an earlier one (concentric at another angle): listed with its costs, not costed again. */
+  candidates_skipped: number;
   measured: {
     spacing_mm: number;
     clearance_mm: number;
