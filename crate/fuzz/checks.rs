@@ -308,6 +308,19 @@ pub fn infill(data: &[u8]) {
     use quietpath::infill::{infill as run, InfillOptions};
     if let Ok(r) = run(data, &InfillOptions::default()) {
         check_rewritten(data, &r.output, "infill");
+        // Never a dearer file (the default objective is energy); a kept original is the input.
+        assert!(
+            r.after.energy.total_j <= r.before.energy.total_j,
+            "infill: {} J written for {} J",
+            r.after.energy.total_j,
+            r.before.energy.total_j
+        );
+        if r.best.pattern == quietpath::infill::Choice::Original {
+            assert!(
+                r.output == data,
+                "infill: original kept but the output differs"
+            );
+        }
     }
 }
 
