@@ -36,7 +36,7 @@ pub mod source;
 mod stages;
 mod tuning;
 
-use corners::{arcs, blend, hairpin, keyhole, klipper};
+use corners::{arcs, blend, hairpin};
 use search::{budget, rewrite, smooth};
 use stages::{bspline, feed, fit, kinematics, resample};
 
@@ -287,10 +287,10 @@ fn within_allowed_time(
 /// mean deviation is kept: every variant still passes the no-dearer check path by path, so time and
 /// energy fall as before.
 ///
-/// Keyhole loops ([`keyhole`]) are the other thing the model can object to: the machine no
-/// longer stops at the tip of a wedge, but it swings round a loop of a tenth of a millimetre
-/// or so in radius, and on some files that rang more than the stop did. If no scale brings the
-/// mean below the original's with them, the scales are tried again without keyholes.
+/// Keyhole loops ([`corners::keyhole`]) are the other thing the model can object to: the
+/// machine no longer stops at the tip of a wedge, but it swings round a loop of a tenth of a
+/// millimetre or so in radius, and on some files that rang more than the stop did. If no scale
+/// brings the mean below the original's with them, the scales are tried again without keyholes.
 ///
 /// `None` rows when the model cannot run (a print too long to simulate, for instance): the
 /// rest of the report stands without them.

@@ -7,13 +7,16 @@
 //! | file | the time allowance, cut by the excess for `Tuning::time_rounds` rounds, then none | — | `vtg::within_allowed_time` |
 //! | path | the free rewrite (corners rounded at no loss of speed), then `Tuning::dearer_speed_shares` where time may be spent | `rewrite::Offering` | [`rewrite::offers`] |
 //! | path | VTG eq. 29 speeds at `Tuning::cap_scales`, each without then with a ceiling at the original's speed: the first that costs nothing, else the cheapest and the fastest | [`writings`] | `rewrite::cheapest_and_fastest` |
+//! | path | the corners written as they are (Klipper polygons), asked first of the whole path | [`WRITTEN_KINDS`] | `smooth::smooth_path` |
 //! | path | the racing line, then the inside line where that left more sharp turns | — | `smooth::smooth_cut` |
-//! | piece | blends at `Tuning::blend_share` of the tolerance, shrunk by `Tuning::retry_scale` for `Tuning::attempts` tries; keyholes dropped where none fits | [`blend_shares`] | `smooth::smooth_piece` |
+//! | line | each sharp corner's fillet (`blend::Fillets`), then the corners fitted with the path: hairpins, then keyholes; the replacements taken in the order of their corners | [`FITTED_KINDS`] | `smooth::smooth_on` |
+//! | piece | blends at `Tuning::blend_share` of the tolerance, shrunk by `Tuning::retry_scale` for `Tuning::attempts` tries (each kind asked for its replacement again: `CornerKind::again`); keyholes dropped where none fits | [`blend_shares`] | `smooth::smooth_piece` |
 //!
-//! Each path goes through the stages with its corners chosen (`smooth`), is written its free
-//! way and its dearer ways (`rewrite`), and the file-level choice decides what to buy with the
-//! time allowed (`budget`).
+//! Each path goes through the stages with its corners chosen (`smooth`, asking the kinds of
+//! `corners` through `CornerKind`), is written its free way and its dearer ways (`rewrite`),
+//! and the file-level choice decides what to buy with the time allowed (`budget`).
 
+use super::corners::{hairpin, keyhole, klipper, CornerKind};
 use super::tuning::TUNING;
 use smooth::Settings;
 
@@ -78,3 +81,12 @@ pub(crate) fn blend_shares() -> impl Iterator<Item = f64> {
     })
     .take(TUNING.attempts)
 }
+
+/// The corner kinds whose replacements are written as they are, asked first, of the whole
+/// path, about each sharp corner its own fillet does not round at no loss of speed.
+pub(crate) const WRITTEN_KINDS: [&dyn CornerKind; 1] = [&klipper::Polygons];
+
+/// The corner kinds whose replacements are blended and fitted with the path, asked in turn
+/// on each line tried, after each corner's fillet: two corners across a short leg before
+/// single corners.
+pub(crate) const FITTED_KINDS: [&dyn CornerKind; 2] = [&hairpin::Hairpins, &keyhole::Keyholes];
