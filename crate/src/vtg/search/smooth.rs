@@ -146,7 +146,7 @@ impl<'a> SmoothPath<'a> {
 pub(crate) fn smooth_path(path: &SmoothPath<'_>, s: &Settings) -> Option<Smoothed> {
     let written = written_as_they_are(path, s);
     if written.is_empty() {
-        return smooth_cut(path, s, &[]);
+        return super::smooth_cut(path, s, &[]);
     }
     let pins: Vec<Hairpin> = written.iter().map(|t| t.pin.clone()).collect();
     let mut sub = hairpin::substitute(path.pts, path.e, path.feed, path.planned, &pins);
@@ -174,40 +174,11 @@ pub(crate) fn smooth_path(path: &SmoothPath<'_>, s: &Settings) -> Option<Smoothe
         feed: &sub.feed,
         planned: &sub.planned,
     };
-    let mut out = smooth_cut(&replaced, s, &cuts)?;
+    let mut out = super::smooth_cut(&replaced, s, &cuts)?;
     for t in &written {
         out.deviation_mm = out.deviation_mm.max(t.deviation_mm);
     }
     Some(out)
-}
-
-/// [`smooth_path`] without the corners written as they are, the path also cut at the points `forced` (whose
-/// pieces are kept as they are unless they have a sharp corner).
-fn smooth_cut(path: &SmoothPath<'_>, s: &Settings, forced: &[usize]) -> Option<Smoothed> {
-    let (result, rescued) = smooth_on(path, s, forced);
-    if !rescued {
-        return result;
-    }
-    let cos_critical = crate::math::cos(s.critical_rad);
-    let left = |r: &Option<Smoothed>| {
-        r.as_ref().map_or(usize::MAX, |r| {
-            crate::vtg::rewrite::sharp_turns(path.pts.iter().take(1).chain(&r.points), cos_critical)
-        })
-    };
-    let left_wide = left(&result);
-    if left_wide == 0 {
-        return result;
-    }
-    let inside_line = Settings {
-        line: blend::Line::Inside,
-        ..*s
-    };
-    let (inside, _) = smooth_on(path, &inside_line, forced);
-    if left(&inside) < left_wide {
-        inside
-    } else {
-        result
-    }
 }
 
 /// A replacement the search took: the kind that proposed it (asked again on retries), its
@@ -246,7 +217,11 @@ fn written_as_they_are(path: &SmoothPath<'_>, s: &Settings) -> Vec<Taken> {
 /// [`smooth_path`] on the line `s` asks for, with the kinds fitted with the path
 /// ([`super::FITTED_KINDS`]); and whether the racing line made a corner roundable that the
 /// inside fillet could not round.
-fn smooth_on(path: &SmoothPath<'_>, s: &Settings, forced: &[usize]) -> (Option<Smoothed>, bool) {
+pub(super) fn smooth_on(
+    path: &SmoothPath<'_>,
+    s: &Settings,
+    forced: &[usize],
+) -> (Option<Smoothed>, bool) {
     let pts = path.pts;
     if pts.len() < 3 || !path.consistent() {
         return (None, false);
@@ -451,7 +426,7 @@ fn smooth_pieces(
                 keyholes: false,
                 ..*s
             };
-            done = smooth_cut(&piece, &plain, &[]);
+            done = super::smooth_cut(&piece, &plain, &[]);
         }
         match done {
             Some(p) => {
