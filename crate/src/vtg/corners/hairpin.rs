@@ -296,14 +296,8 @@ impl CornerKind for Hairpins {
         })
     }
 
-    fn again(
-        &self,
-        pts: &[[f64; 3]],
-        pin: &Hairpin,
-        blend_tol_mm: f64,
-        s: &Settings,
-    ) -> Option<Hairpin> {
-        within(pts, pin.at, blend_tol_mm, s)
+    fn again(&self, pts: &[[f64; 3]], pin: &Hairpin, tol: f64, s: &Settings) -> Option<Hairpin> {
+        within(pts, pin.at, tol, s)
     }
 }
 
