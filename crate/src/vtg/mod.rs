@@ -36,12 +36,11 @@ pub mod source;
 mod stages;
 mod tuning;
 
-use corners::{arcs, blend, hairpin, keyhole, klipper};
+use corners::{arcs, blend, hairpin};
 use search::{budget, rewrite, smooth};
 use stages::{bspline, feed, fit, kinematics, resample};
 
 use serde::{Deserialize, Serialize};
-use tuning::TUNING;
 
 use crate::analyze::{AnalyzeOptions, Report};
 use crate::error::{Error, ErrorKind};
@@ -195,7 +194,7 @@ pub fn vtg_with_progress(
         if !progress(0.8) {
             return Err(cancelled());
         }
-        let (rewritten, measured) = within_allowed_time(input, &offers, options, &before)?;
+        let (rewritten, measured) = search::within_allowed_time(input, &offers, options, &before)?;
         // The output's metrics streamed, not from a kept move list: rounding corners can
         // multiply the moves tenfold.
         let metrics = || {
@@ -239,42 +238,6 @@ pub fn vtg_with_progress(
     Ok(report)
 }
 
-/// The rewrite written from `offers` with the time `allow_slower_pct` allows, measured on the
-/// whole file, and the analysis it was measured with (`None`: no time allowed, or no path that
-/// could spend it, not analysed).
-/// The choice counts the time each path adds as planned with its neighbours only; across the
-/// file the firmware's look-ahead adds a little more, so where the whole file comes out slower
-/// than allowed the allowance is cut by the excess and the choice made again (at most
-/// `Tuning::time_rounds` times, then without any allowance).
-fn within_allowed_time(
-    input: &[u8],
-    offers: &rewrite::Offers,
-    options: &VtgOptions,
-    before: &Report,
-) -> Result<(rewrite::Rewritten, Option<Report>), Error> {
-    // Nothing to buy (every Marlin file of the corpus): the choice is the free rewrites'.
-    let allowed = if offers.has_dearer() {
-        options.allow_slower_pct / 100.0 * before.time_s
-    } else {
-        0.0
-    };
-    let mut allowed_s = allowed;
-    let mean_power_w = before.energy.total_j / before.time_s;
-    for _ in 0..TUNING.time_rounds {
-        if allowed_s <= 0.0 {
-            break;
-        }
-        let rewritten = offers.write(input, allowed_s, mean_power_w);
-        let after = crate::analyze::analyze(&rewritten.output, &options.analyze)?;
-        let added = after.time_s - before.time_s;
-        if added <= allowed {
-            return Ok((rewritten, Some(after)));
-        }
-        allowed_s -= TUNING.time_margin * (added - allowed);
-    }
-    Ok((offers.write(input, 0.0, mean_power_w), None))
-}
-
 /// Fills Table 2's deviation rows with the dynamics model, run on the original and on the
 /// rewritten file over printing moves (travels are not rewritten), and closes the loop on it.
 ///
@@ -287,10 +250,10 @@ fn within_allowed_time(
 /// mean deviation is kept: every variant still passes the no-dearer check path by path, so time and
 /// energy fall as before.
 ///
-/// Keyhole loops ([`keyhole`]) are the other thing the model can object to: the machine no
-/// longer stops at the tip of a wedge, but it swings round a loop of a tenth of a millimetre
-/// or so in radius, and on some files that rang more than the stop did. If no scale brings the
-/// mean below the original's with them, the scales are tried again without keyholes.
+/// Keyhole loops ([`corners::keyhole`]) are the other thing the model can object to: the
+/// machine no longer stops at the tip of a wedge, but it swings round a loop of a tenth of a
+/// millimetre or so in radius, and on some files that rang more than the stop did. If no scale
+/// brings the mean below the original's with them, the scales are tried again without keyholes.
 ///
 /// `None` rows when the model cannot run (a print too long to simulate, for instance): the
 /// rest of the report stands without them.

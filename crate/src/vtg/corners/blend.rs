@@ -33,7 +33,9 @@
 //! is then the whole story only for the inside line ([`Line::Inside`]), which the pipeline
 //! still uses where the wider circle cannot be walked.
 
+use super::{CornerKind, Cost, Proposal, Replacement, Site};
 use crate::vec3::{dot, norm, sub};
+use crate::vtg::smooth::Settings;
 use crate::vtg::tuning::TUNING;
 
 /// Samples per blend given to the fit (its ends included).
@@ -76,6 +78,32 @@ impl Blend {
     /// Length of each leg the blend takes: the fillet's extent and the ramp beyond it.
     fn reach(&self) -> f64 {
         self.extent_mm + self.ramp_mm
+    }
+
+    /// Whether the blend can be walked in steps of at least the minimum step, each turning
+    /// less than the critical angle (a tighter blend would only trade one sharp turn for
+    /// several).
+    pub(crate) fn roundable(&self, s: &Settings) -> bool {
+        self.extent_mm > 0.0
+            && self.max_curvature * s.min_step_mm <= TUNING.step_turn_share * s.critical_rad
+    }
+}
+
+/// The corner kind of the blends `plan` laid out for a path: each corner's own fillet (or
+/// racing line), where it can be walked; it costs its peak curvature.
+pub(crate) struct Fillets<'a>(pub(crate) &'a [Blend]);
+
+impl CornerKind for Fillets<'_> {
+    fn asks_about(&self, site: &Site<'_>, i: usize) -> bool {
+        site.marks.sharp[i]
+    }
+
+    fn propose(&self, site: &Site<'_>, i: usize) -> Option<Proposal> {
+        let b = self.0.get(i).filter(|b| b.roundable(site.settings))?;
+        Some(Proposal {
+            replacement: Replacement::Fillet,
+            cost: Cost::Curvature(b.max_curvature),
+        })
     }
 }
 

@@ -16,9 +16,11 @@
 //! a fine polygon of the arc, which the rest of the pipeline blends, fits and walks like any
 //! other path.
 
+use super::{CornerKind, Cost, Proposal, Replacement, Site};
 use crate::vec3::{cross, dot, norm, sub};
 use crate::vtg::bspline::{arc_lengths, segment_at};
 use crate::vtg::deviation::{both_ways, point_polyline};
+use crate::vtg::smooth::Settings;
 use crate::vtg::tuning::TUNING;
 
 /// Smallest combined turn of a hairpin, rad (90°: below it the corners are separate turns).
@@ -34,7 +36,7 @@ pub(crate) struct Hairpin {
     /// Index of the first of the corners it replaces.
     pub(crate) at: usize,
     /// How many corners it replaces: 2 for a hairpin (the second is the next point), 1 for a
-    /// [`crate::vtg::keyhole`].
+    /// [`crate::vtg::corners::keyhole`].
     pub(crate) corners: usize,
     /// Radius, mm.
     pub(crate) radius_mm: f64,
@@ -270,6 +272,55 @@ impl UTurn {
             after_mm: after,
         })
     }
+}
+
+/// The corner kind of two sharp corners across a short leg that are not both rounded alone:
+/// one arc for the two, taken wherever it fits (its cost is not weighed).
+pub(crate) struct Hairpins;
+
+impl CornerKind for Hairpins {
+    fn asks_about(&self, site: &Site<'_>, i: usize) -> bool {
+        let m = site.marks;
+        i + 2 < m.sharp.len()
+            && !m.pinned[i]
+            && m.sharp[i]
+            && m.sharp[i + 1]
+            && !(m.alone[i] && m.alone[i + 1])
+    }
+
+    fn propose(&self, site: &Site<'_>, i: usize) -> Option<Proposal> {
+        let pin = within(site.path.pts, i, site.blend_tol_mm, site.settings)?;
+        Some(Proposal {
+            replacement: Replacement::Fitted(pin),
+            cost: Cost::Unweighed,
+        })
+    }
+
+    fn again(&self, pts: &[[f64; 3]], pin: &Hairpin, tol: f64, s: &Settings) -> Option<Hairpin> {
+        within(pts, pin.at, tol, s)
+    }
+}
+
+/// [`find`] at corners `i`, `i + 1` of `pts` within `blend_tol`, for an arc the walk can follow
+/// in steps of at least the minimum step each turning by less than its share of the critical
+/// angle (with 5 % to spare), reaching along each long leg `Tuning::leg_share` of it where the
+/// leg ends the path and half that where another corner shares it.
+fn within(pts: &[[f64; 3]], i: usize, blend_tol: f64, s: &Settings) -> Option<Hairpin> {
+    let n = pts.len();
+    let room = |leg: usize, far_end: usize| {
+        let l = norm(sub(pts.get(leg + 1)?, pts.get(leg)?));
+        let shared = far_end != 0 && far_end + 1 != n;
+        Some(TUNING.leg_share * l * if shared { 0.5 } else { 1.0 })
+    };
+    let min_radius = min_radius(s);
+    let rooms = [room(i.checked_sub(1)?, i - 1)?, room(i + 1, i + 2)?];
+    find(pts, i, blend_tol, min_radius, rooms)
+}
+
+/// The smallest radius of a loop the walk can follow in steps of at least the minimum step,
+/// each turning by less than its share of the critical angle, with 5 % to spare.
+pub(crate) fn min_radius(s: &Settings) -> f64 {
+    1.05 * s.min_step_mm / (TUNING.step_turn_share * s.critical_rad)
 }
 
 /// A path with its hairpins replaced by their arcs: points, filament at each, and the feed and

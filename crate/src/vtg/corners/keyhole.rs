@@ -18,11 +18,13 @@
 //! spread over it by length (see [`crate::vtg::hairpin::substitute`]), so the tip gets the material
 //! it had, in the same place.
 
+use super::{CornerKind, Cost, Proposal, Replacement, Site};
 use crate::vec3::angle;
 use crate::vec3::{dot, lerp, norm, sub};
 use crate::vtg::bspline::segment_at;
 use crate::vtg::deviation::{both_ways, point_polyline};
-use crate::vtg::hairpin::{arc_polygon, cross_z, unit, Hairpin};
+use crate::vtg::hairpin::{arc_polygon, cross_z, min_radius, unit, Hairpin};
+use crate::vtg::smooth::Settings;
 use crate::vtg::tuning::TUNING;
 
 /// Smallest turn a keyhole is tried at, rad (60°: below it a corner fillets within the
@@ -175,6 +177,61 @@ pub(crate) fn find(
             both_ways(&h.arc, original, tolerance_mm / 10.0, tolerance_mm) <= tolerance_mm
         })
         .map(|(_, h, _)| h)
+}
+
+/// The corner kind of a single corner too tight to fillet, where keyholes are on: a loop round
+/// it, of the smallest radius the walk follows, so its cost (the loop's curvature) is known
+/// before it is sought.
+pub(crate) struct Keyholes;
+
+impl CornerKind for Keyholes {
+    fn asks_about(&self, site: &Site<'_>, i: usize) -> bool {
+        site.settings.keyholes && site.marks.tight[i] && !site.marks.pinned[i]
+    }
+
+    fn known_cost(&self, s: &Settings) -> Option<Cost> {
+        Some(Cost::Curvature(1.0 / min_radius(s)))
+    }
+
+    fn propose(&self, site: &Site<'_>, i: usize) -> Option<Proposal> {
+        Some(Proposal {
+            replacement: Replacement::Fitted(within(site, i)?),
+            cost: self.known_cost(site.settings)?,
+        })
+    }
+}
+
+/// [`find`] at corner `i` of `site` within its blend share of the tolerance, on a loop of the
+/// hairpins' smallest radius, with counter-turns of at most `Tuning::kink_share` of the
+/// critical angle. The loop may reach along the path up to `Tuning::leg_share` of the way to
+/// the path's ends and half the way to the nearest corner that is sharp, already replaced or
+/// degenerate (which the piece may be cut at).
+fn within(site: &Site<'_>, i: usize) -> Option<Hairpin> {
+    let (pts, arc, m, s) = (site.path.pts, site.arc, site.marks, site.settings);
+    let n = pts.len();
+    let stop = |k: usize| k == 0 || k + 1 == n || m.sharp[k] || m.pinned[k] || m.degenerate[k];
+    let share = |k: usize| {
+        if k == 0 || k + 1 == n {
+            TUNING.leg_share
+        } else {
+            0.5
+        }
+    };
+    let back = (0..i).rev().find(|&k| stop(k))?;
+    let on = (i + 1..n).find(|&k| stop(k))?;
+    let room = [
+        share(back) * (arc[i] - arc[back]),
+        share(on) * (arc[on] - arc[i]),
+    ];
+    find(
+        pts,
+        arc,
+        i,
+        site.blend_tol_mm,
+        min_radius(s),
+        TUNING.kink_share * s.critical_rad,
+        room,
+    )
 }
 
 /// A flat corner a keyhole is sought for, with what every candidate loop is measured against:

@@ -24,9 +24,11 @@
 //! largest the tolerance allows. Of the family's members that fit the legs, the one the
 //! look-ahead (as Klipper plans it: `stretch_time`) runs through fastest is kept.
 
+use super::{CornerKind, Cost, Proposal, Replacement, Site};
 use crate::vec3::{dot, norm, sub};
 use crate::vtg::deviation::both_ways;
 use crate::vtg::hairpin::{cross_z, unit, Hairpin};
+use crate::vtg::smooth::{Settings, SmoothPath};
 use crate::vtg::tuning::TUNING;
 
 /// What the firmware does at a corner: its limits there and the speeds either side.
@@ -160,6 +162,59 @@ pub(crate) fn find(pts: &[[f64; 3]], i: usize, bounds: &Bounds, fw: &Firmware) -
         sharp_mm_s: sharp.slowest_mm_s,
         sharp_time_s: sharp.time_s,
     })
+}
+
+/// The corner kind of a sharp corner on a Klipper machine whose own fillet does not round it
+/// at no loss of speed (the fitted curve rings less than a polygon of the largest turns): the
+/// polygon the firmware runs through fastest, written as it is, within the tolerance and the
+/// legs' room (all of the leg where it ends the path, half where it is shared, less a shortest
+/// step). It costs its slowest planned speed against the sharp corner's.
+pub(crate) struct Polygons;
+
+impl CornerKind for Polygons {
+    fn applies(&self, path: &SmoothPath<'_>, s: &Settings) -> bool {
+        s.klipper_scv_mm_s.is_some() && !path.planned.is_empty()
+    }
+
+    fn asks_about(&self, site: &Site<'_>, i: usize) -> bool {
+        site.marks.sharp[i] && !site.marks.alone[i]
+    }
+
+    fn propose(&self, site: &Site<'_>, i: usize) -> Option<Proposal> {
+        let (path, s) = (site.path, site.settings);
+        let scv = s.klipper_scv_mm_s?;
+        let pts = path.pts;
+        let n = pts.len();
+        let (before, after) = (path.planned.get(i - 1)?, path.planned.get(i)?);
+        let accel = before.acceleration.min(after.acceleration);
+        if accel.is_nan() || accel <= 0.0 {
+            return None;
+        }
+        let room = |from: usize, to: usize, end: bool| {
+            let l = norm(sub(pts[to], pts[from]));
+            (if end { TUNING.leg_share } else { 0.5 } * l - s.min_step_mm).max(0.0)
+        };
+        let bounds = Bounds {
+            tolerance_mm: s.tolerance_mm - 0.001,
+            max_turn_rad: TUNING.step_turn_share * s.critical_rad,
+            min_step_mm: s.min_step_mm,
+            room_mm: [room(i - 1, i, i == 1), room(i, i + 1, i + 2 == n)],
+        };
+        let fw = Firmware {
+            accel_mm_s2: accel,
+            junction_deviation_mm: crate::plan::junction::klipper_junction_deviation(scv, accel),
+            feed_mm_s: [path.feed[i - 1], path.feed[i]],
+            ends_mm_s: [before.entry, after.exit],
+        };
+        let c = find(pts, i, &bounds, &fw)?;
+        Some(Proposal {
+            replacement: Replacement::Written(c.pin, c.deviation_mm),
+            cost: Cost::Planned {
+                slowest_mm_s: c.slowest_mm_s,
+                sharp_mm_s: c.sharp_mm_s,
+            },
+        })
+    }
 }
 
 /// The minimum of `f` on `[lo, hi]` by golden-section search in [`PLACEMENT_STEPS`] steps, and

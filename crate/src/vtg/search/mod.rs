@@ -4,18 +4,24 @@
 //! | level | rungs | enumerated by | tried in |
 //! |---|---|---|---|
 //! | file | VTG eq. 29 speed scale 1 with keyholes, then `Tuning::quieter_scales` with and without keyholes; the quietest under the dynamics model is kept | [`quieter_variants`] | `vtg::with_simulated_deviation` |
-//! | file | the time allowance, cut by the excess for `Tuning::time_rounds` rounds, then none | — | `vtg::within_allowed_time` |
+//! | file | the time allowance, cut by the excess for `Tuning::time_rounds` rounds, then none | — | [`within_allowed_time`] |
 //! | path | the free rewrite (corners rounded at no loss of speed), then `Tuning::dearer_speed_shares` where time may be spent | `rewrite::Offering` | [`rewrite::offers`] |
 //! | path | VTG eq. 29 speeds at `Tuning::cap_scales`, each without then with a ceiling at the original's speed: the first that costs nothing, else the cheapest and the fastest | [`writings`] | `rewrite::cheapest_and_fastest` |
-//! | path | the racing line, then the inside line where that left more sharp turns | — | `smooth::smooth_cut` |
-//! | piece | blends at `Tuning::blend_share` of the tolerance, shrunk by `Tuning::retry_scale` for `Tuning::attempts` tries; keyholes dropped where none fits | [`blend_shares`] | `smooth::smooth_piece` |
+//! | path | the corners written as they are (Klipper polygons), asked first of the whole path | [`WRITTEN_KINDS`] | `smooth::smooth_path` |
+//! | path | the racing line, then the inside line where that left more sharp turns | — | [`smooth_cut`] |
+//! | line | each sharp corner's fillet (`blend::Fillets`), then the corners fitted with the path: hairpins, then keyholes; the replacements taken in the order of their corners | [`FITTED_KINDS`] | `smooth::smooth_on` |
+//! | piece | blends at `Tuning::blend_share` of the tolerance, shrunk by `Tuning::retry_scale` for `Tuning::attempts` tries (each kind asked for its replacement again: `CornerKind::again`); keyholes dropped where none fits | [`blend_shares`] | `smooth::smooth_piece` |
 //!
-//! Each path goes through the stages with its corners chosen (`smooth`), is written its free
-//! way and its dearer ways (`rewrite`), and the file-level choice decides what to buy with the
-//! time allowed (`budget`).
+//! Each path goes through the stages with its corners chosen (`smooth`, asking the kinds of
+//! `corners` through `CornerKind`), is written its free way and its dearer ways (`rewrite`),
+//! and the file-level choice decides what to buy with the time allowed (`budget`).
 
+use super::corners::{hairpin, keyhole, klipper, CornerKind};
 use super::tuning::TUNING;
-use smooth::Settings;
+use super::VtgOptions;
+use crate::analyze::Report;
+use crate::error::Error;
+use smooth::{Settings, SmoothPath, Smoothed};
 
 pub(crate) mod budget;
 pub(crate) mod rewrite;
@@ -77,4 +83,85 @@ pub(crate) fn blend_shares() -> impl Iterator<Item = f64> {
         Some(share * TUNING.retry_scale)
     })
     .take(TUNING.attempts)
+}
+
+/// The corner kinds whose replacements are written as they are, asked first, of the whole
+/// path, about each sharp corner its own fillet does not round at no loss of speed.
+pub(crate) const WRITTEN_KINDS: [&dyn CornerKind; 1] = [&klipper::Polygons];
+
+/// The corner kinds whose replacements are blended and fitted with the path, asked in turn
+/// on each line tried, after each corner's fillet: two corners across a short leg before
+/// single corners.
+pub(crate) const FITTED_KINDS: [&dyn CornerKind; 2] = [&hairpin::Hairpins, &keyhole::Keyholes];
+
+/// [`smooth::smooth_path`] without the corners written as they are, the path also cut at the
+/// points `forced` (whose pieces are kept as they are unless they have a sharp corner): on the
+/// settings' line, then, where the racing line rounded a corner the inside fillet could not
+/// and sharp turns were left, on the inside line too; the one left with fewer sharp turns is
+/// kept.
+pub(crate) fn smooth_cut(
+    path: &SmoothPath<'_>,
+    s: &Settings,
+    forced: &[usize],
+) -> Option<Smoothed> {
+    let (result, rescued) = smooth::smooth_on(path, s, forced);
+    if !rescued {
+        return result;
+    }
+    let cos_critical = crate::math::cos(s.critical_rad);
+    let left = |r: &Option<Smoothed>| {
+        r.as_ref().map_or(usize::MAX, |r| {
+            rewrite::sharp_turns(path.pts.iter().take(1).chain(&r.points), cos_critical)
+        })
+    };
+    let left_wide = left(&result);
+    if left_wide == 0 {
+        return result;
+    }
+    let inside_line = Settings {
+        line: super::blend::Line::Inside,
+        ..*s
+    };
+    let (inside, _) = smooth::smooth_on(path, &inside_line, forced);
+    if left(&inside) < left_wide {
+        inside
+    } else {
+        result
+    }
+}
+
+/// The rewrite written from `offers` with the time `allow_slower_pct` allows, measured on the
+/// whole file, and the analysis it was measured with (`None`: no time allowed, or no path that
+/// could spend it, not analysed).
+/// The choice counts the time each path adds as planned with its neighbours only; across the
+/// file the firmware's look-ahead adds a little more, so where the whole file comes out slower
+/// than allowed the allowance is cut by the excess and the choice made again (at most
+/// `Tuning::time_rounds` times, then without any allowance).
+pub(crate) fn within_allowed_time(
+    input: &[u8],
+    offers: &rewrite::Offers,
+    options: &VtgOptions,
+    before: &Report,
+) -> Result<(rewrite::Rewritten, Option<Report>), Error> {
+    // Nothing to buy (every Marlin file of the corpus): the choice is the free rewrites'.
+    let allowed = if offers.has_dearer() {
+        options.allow_slower_pct / 100.0 * before.time_s
+    } else {
+        0.0
+    };
+    let mut allowed_s = allowed;
+    let mean_power_w = before.energy.total_j / before.time_s;
+    for _ in 0..TUNING.time_rounds {
+        if allowed_s <= 0.0 {
+            break;
+        }
+        let rewritten = offers.write(input, allowed_s, mean_power_w);
+        let after = crate::analyze::analyze(&rewritten.output, &options.analyze)?;
+        let added = after.time_s - before.time_s;
+        if added <= allowed {
+            return Ok((rewritten, Some(after)));
+        }
+        allowed_s -= TUNING.time_margin * (added - allowed);
+    }
+    Ok((offers.write(input, 0.0, mean_power_w), None))
 }

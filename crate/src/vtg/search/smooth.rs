@@ -13,13 +13,12 @@ use crate::plan::Profile;
 use crate::vec3::{dot, norm, sub};
 use crate::vtg::blend;
 use crate::vtg::bspline::{arc_lengths, segment_at};
+use crate::vtg::corners::{CornerKind, Cost, Marks, Replacement, Site};
 use crate::vtg::deviation::both_ways;
 use crate::vtg::feed::StepSpeed;
 use crate::vtg::fit::fit;
-use crate::vtg::hairpin;
-use crate::vtg::keyhole;
+use crate::vtg::hairpin::{self, Hairpin};
 use crate::vtg::kinematics::KinematicLimits;
-use crate::vtg::klipper;
 use crate::vtg::resample::{walk_curve, Sample, Walk, WalkStats};
 use crate::vtg::tuning::TUNING;
 
@@ -59,12 +58,14 @@ pub(crate) struct Settings {
     /// rewrite); below 1, the dearer variants of a path that
     /// [`crate::vtg::VtgOptions::allow_slower_pct`] may buy (0 rounds every corner it can).
     pub(crate) min_speed_share: f64,
-    /// Turn single corners too tight to fillet round a [`keyhole`] loop where one fits.
+    /// Turn single corners too tight to fillet round a [`crate::vtg::corners::keyhole`] loop
+    /// where one fits.
     pub(crate) keyholes: bool,
     /// Which side of its corners a path may be rounded on ([`blend::Line`]).
     pub(crate) line: blend::Line,
     /// Klipper's square-corner velocity, mm/s, on a Klipper machine (`None` elsewhere): its
-    /// sharp corners are then turned as polygons placed for its look-ahead ([`klipper`]).
+    /// sharp corners are then turned as polygons placed for its look-ahead
+    /// ([`crate::vtg::corners::klipper`]).
     pub(crate) klipper_scv_mm_s: Option<f64>,
 }
 
@@ -143,11 +144,11 @@ impl<'a> SmoothPath<'a> {
 /// (it then stays sharp): where that happened, the path is also rounded on the inside line
 /// (with its hairpins and keyholes) and the one left with fewer sharp turns is kept.
 pub(crate) fn smooth_path(path: &SmoothPath<'_>, s: &Settings) -> Option<Smoothed> {
-    let corners = polygon_corners(path, s);
-    if corners.is_empty() {
-        return smooth_cut(path, s, &[]);
+    let written = written_as_they_are(path, s);
+    if written.is_empty() {
+        return super::smooth_cut(path, s, &[]);
     }
-    let pins: Vec<hairpin::Hairpin> = corners.iter().map(|c| c.pin.clone()).collect();
+    let pins: Vec<Hairpin> = written.iter().map(|t| t.pin.clone()).collect();
     let mut sub = hairpin::substitute(path.pts, path.e, path.feed, path.planned, &pins);
     // A polygon's sides are run as the firmware will: no ceiling below the legs' own peak
     // (the substitute's profiles are the original's speeds near the corner).
@@ -173,162 +174,191 @@ pub(crate) fn smooth_path(path: &SmoothPath<'_>, s: &Settings) -> Option<Smoothe
         feed: &sub.feed,
         planned: &sub.planned,
     };
-    let mut out = smooth_cut(&replaced, s, &cuts)?;
-    for c in &corners {
-        out.deviation_mm = out.deviation_mm.max(c.deviation_mm);
+    let mut out = super::smooth_cut(&replaced, s, &cuts)?;
+    for t in &written {
+        out.deviation_mm = out.deviation_mm.max(t.deviation_mm);
     }
     Some(out)
 }
 
-/// [`smooth_path`] without polygon corners, the path also cut at the points `forced` (whose
-/// pieces are kept as they are unless they have a sharp corner).
-fn smooth_cut(path: &SmoothPath<'_>, s: &Settings, forced: &[usize]) -> Option<Smoothed> {
-    let (result, rescued) = smooth_on(path, s, forced);
-    if !rescued {
-        return result;
-    }
-    let cos_critical = crate::math::cos(s.critical_rad);
-    let left = |r: &Option<Smoothed>| {
-        r.as_ref().map_or(usize::MAX, |r| {
-            crate::vtg::rewrite::sharp_turns(path.pts.iter().take(1).chain(&r.points), cos_critical)
-        })
-    };
-    let left_wide = left(&result);
-    if left_wide == 0 {
-        return result;
-    }
-    let inside_line = Settings {
-        line: blend::Line::Inside,
-        ..*s
-    };
-    let (inside, _) = smooth_on(path, &inside_line, forced);
-    if left(&inside) < left_wide {
-        inside
-    } else {
-        result
-    }
+/// A replacement the search took: the kind that proposed it (asked again on retries), its
+/// points, and their measured deviation where they are written as they are (mm; 0 where they
+/// are fitted with the path, whose deviation the walk measures).
+#[derive(Clone)]
+struct Taken {
+    kind: &'static dyn CornerKind,
+    pin: Hairpin,
+    deviation_mm: f64,
 }
 
-/// [`smooth_path`] on the line `s` asks for; and whether the racing line made a corner
-/// roundable that the inside fillet could not round.
-fn smooth_on(path: &SmoothPath<'_>, s: &Settings, forced: &[usize]) -> (Option<Smoothed>, bool) {
+/// The corners of `path` replaced by the kinds whose replacements are written as they are
+/// ([`super::WRITTEN_KINDS`]), asked about each sharp corner that its own fillet does not
+/// round at no loss of speed.
+fn written_as_they_are(path: &SmoothPath<'_>, s: &Settings) -> Vec<Taken> {
+    let kinds: Vec<&'static dyn CornerKind> = super::WRITTEN_KINDS
+        .into_iter()
+        .filter(|k| k.applies(path, s))
+        .collect();
+    if kinds.is_empty() || path.pts.len() < 3 || !path.consistent() {
+        return Vec::new();
+    }
+    // Corners a fillet already rounds at no loss of speed keep the fillet: the fitted curve
+    // rings less than a polygon of the largest turns.
+    let free = Settings {
+        min_speed_share: 1.0,
+        ..*s
+    };
+    let arc = arc_lengths(path.pts);
+    let blends = blends_on(path.pts, s, s.line);
+    let mut marks = Marks::classify(path, &arc, &free, &blend::Fillets(&blends));
+    ask(&kinds, path, &arc, s, &mut marks)
+}
+
+/// [`smooth_path`] on the line `s` asks for, with the kinds fitted with the path
+/// ([`super::FITTED_KINDS`]); and whether the racing line made a corner roundable that the
+/// inside fillet could not round.
+pub(super) fn smooth_on(
+    path: &SmoothPath<'_>,
+    s: &Settings,
+    forced: &[usize],
+) -> (Option<Smoothed>, bool) {
     let pts = path.pts;
     if pts.len() < 3 || !path.consistent() {
         return (None, false);
     }
-    let mut c = Corners::classify(path, s);
     let arc = arc_lengths(pts);
-    let pins = c.pin(path, &arc, s);
-    let cuts = c.cuts(&pins, &arc, forced);
-    let rescued = c.rescued;
-    match smooth_pieces(path, s, &cuts, &c.sharp, &pins) {
+    let blends = blends_on(pts, s, s.line);
+    let mut marks = Marks::classify(path, &arc, s, &blend::Fillets(&blends));
+    let rescued = rescued(pts, s, &marks);
+    let pins = ask(&super::FITTED_KINDS, path, &arc, s, &mut marks);
+    let cuts = marks.cuts(&pins, &arc, forced);
+    match smooth_pieces(path, s, &cuts, &marks.sharp, &pins) {
         Some((out, changed)) => ((changed || !forced.is_empty()).then_some(out), rescued),
         None => (None, rescued),
     }
 }
 
-/// What each point of a path is as a corner; kept in one place because the hairpin, keyhole
-/// and cut decisions all read (and the cuts clear) the same flags.
-struct Corners {
-    /// A turn above the critical angle.
-    sharp: Vec<bool>,
-    /// Can be rounded on its own, at no loss of speed.
-    alone: Vec<bool>,
-    /// A zero-length leg meets it.
-    degenerate: Vec<bool>,
-    /// Too tight to round within the tolerance (rather than not worth it).
-    tight: Vec<bool>,
-    /// Turned into a hairpin or keyhole.
-    pinned: Vec<bool>,
-    /// The racing line made a corner roundable that the inside fillet could not round.
-    rescued: bool,
+/// The blends of every corner of `pts` within the blend share of the tolerance, on `line`.
+fn blends_on(pts: &[[f64; 3]], s: &Settings, line: blend::Line) -> Vec<blend::Blend> {
+    blend::plan(
+        pts,
+        TUNING.blend_share * s.tolerance_mm,
+        s.limits.critical_curvature(),
+        line,
+    )
 }
 
-impl Corners {
-    /// Each corner: sharp, and whether it can be rounded on its own.
-    fn classify(path: &SmoothPath<'_>, s: &Settings) -> Self {
+/// Whether the racing line made a sharp corner of `pts` roundable that the inside fillet could
+/// not round (never on the inside line itself).
+fn rescued(pts: &[[f64; 3]], s: &Settings, marks: &Marks) -> bool {
+    if s.line == blend::Line::Inside {
+        return false;
+    }
+    let inside = blends_on(pts, s, blend::Line::Inside);
+    (1..pts.len() - 1).any(|i| marks.sharp[i] && !marks.tight[i] && !inside[i].roundable(s))
+}
+
+/// Asks each of `kinds` in turn about every corner of `path` it asks about, and takes the
+/// proposals the search [`accepts`]; the corners they replace are marked as replaced. The
+/// replacements taken, in the order of their corners.
+fn ask(
+    kinds: &[&'static dyn CornerKind],
+    path: &SmoothPath<'_>,
+    arc: &[f64],
+    s: &Settings,
+    marks: &mut Marks,
+) -> Vec<Taken> {
+    let n = path.pts.len();
+    let blend_tol_mm = TUNING.blend_share * s.tolerance_mm;
+    let mut taken: Vec<Taken> = Vec::new();
+    for &kind in kinds {
+        let known = kind.known_cost(s);
+        for i in 1..n - 1 {
+            let before = path.planned.get(i - 1);
+            let site = Site {
+                path,
+                arc,
+                settings: s,
+                marks,
+                blend_tol_mm,
+            };
+            if !kind.asks_about(&site, i) || known.is_some_and(|c| !accepts(&c, before, s)) {
+                continue;
+            }
+            let proposal = kind
+                .propose(&site, i)
+                .filter(|p| accepts(&p.cost, before, s));
+            let (pin, deviation_mm) = match proposal.map(|p| p.replacement) {
+                Some(Replacement::Fitted(pin)) => (pin, 0.0),
+                Some(Replacement::Written(pin, d)) => (pin, d),
+                Some(Replacement::Fillet) | None => continue,
+            };
+            for k in i..i + pin.corners {
+                if let Some(m) = marks.pinned.get_mut(k) {
+                    *m = true;
+                }
+            }
+            taken.push(Taken {
+                kind,
+                pin,
+                deviation_mm,
+            });
+        }
+    }
+    taken.sort_by_key(|t| t.pin.at);
+    taken
+}
+
+impl Marks {
+    /// Each corner of `path` (arc lengths `arc`): sharp, and whether `fillets` round it alone.
+    fn classify(
+        path: &SmoothPath<'_>,
+        arc: &[f64],
+        s: &Settings,
+        fillets: &blend::Fillets,
+    ) -> Self {
         let pts = path.pts;
         let cos_critical = crate::math::cos(s.critical_rad);
-        let plan = |line| {
-            blend::plan(
-                pts,
-                TUNING.blend_share * s.tolerance_mm,
-                s.limits.critical_curvature(),
-                line,
-            )
-        };
-        let blends = plan(s.line);
-        let inside = (s.line != blend::Line::Inside).then(|| plan(blend::Line::Inside));
         let n = pts.len();
-        let mut c = Corners {
+        let mut m = Marks {
             sharp: vec![false; n],
             alone: vec![true; n],
             degenerate: vec![false; n],
             tight: vec![false; n],
             pinned: vec![false; n],
-            rescued: false,
         };
         for i in 1..n - 1 {
             let a = sub(pts[i], pts[i - 1]);
             let b = sub(pts[i + 1], pts[i]);
             let (la, lb) = (norm(a), norm(b));
             if la <= 0.0 || lb <= 0.0 {
-                c.degenerate[i] = true;
+                m.degenerate[i] = true;
                 continue;
             }
             let cos = (dot(a, b) / (la * lb)).clamp(-1.0, 1.0);
-            if cos >= cos_critical {
+            m.sharp[i] = cos < cos_critical;
+        }
+        for i in 1..n - 1 {
+            let site = Site {
+                path,
+                arc,
+                settings: s,
+                marks: &m,
+                blend_tol_mm: TUNING.blend_share * s.tolerance_mm,
+            };
+            if !fillets.asks_about(&site, i) {
                 continue;
             }
-            c.sharp[i] = true;
-            c.tight[i] = !roundable(&blends[i], s);
-            c.rescued |= !c.tight[i] && inside.as_ref().is_some_and(|b| !roundable(&b[i], s));
-            c.alone[i] = !c.tight[i] && pays(blends[i].max_curvature, path.planned.get(i - 1), s);
+            let fillet = fillets.propose(&site, i);
+            m.tight[i] = fillet.is_none();
+            m.alone[i] = fillet.is_some_and(|p| accepts(&p.cost, path.planned.get(i - 1), s));
         }
-        c
-    }
-
-    /// The hairpins and keyholes of the path, in order: the corners that cannot be rounded
-    /// alone but can as one turn (two across a short leg) or round a loop (one too tight).
-    fn pin(&mut self, path: &SmoothPath<'_>, arc: &[f64], s: &Settings) -> Vec<hairpin::Hairpin> {
-        let pts = path.pts;
-        let n = pts.len();
-        // Two sharp corners across a short leg, at least one of them too tight alone: a
-        // hairpin, rounded as one turn if it can be.
-        let mut pins: Vec<hairpin::Hairpin> = Vec::new();
-        let mut i = 1;
-        while i + 2 < n {
-            if self.sharp[i] && self.sharp[i + 1] && !(self.alone[i] && self.alone[i + 1]) {
-                if let Some(pin) = find_hairpin(pts, i, TUNING.blend_share * s.tolerance_mm, s) {
-                    self.pinned[i] = true;
-                    self.pinned[i + 1] = true;
-                    pins.push(pin);
-                    i += 2;
-                    continue;
-                }
-            }
-            i += 1;
-        }
-        // Single corners too tight to round: a keyhole loop, where one fits between the
-        // neighbours and the machine runs round it at least as fast as through the corner.
-        let loop_pays = |i: usize| pays(1.0 / min_hairpin_radius(s), path.planned.get(i - 1), s);
-        for i in 1..n - 1 {
-            if s.keyholes && self.tight[i] && !self.pinned[i] && loop_pays(i) {
-                let found =
-                    find_keyhole(pts, arc, i, &self.sharp, &self.pinned, &self.degenerate, s);
-                if let Some(k) = found {
-                    self.pinned[i] = true;
-                    pins.push(k);
-                }
-            }
-        }
-        pins.sort_by_key(|p| p.at);
-        pins
+        m
     }
 
     /// The points the path is cut at (its ends included): corners kept sharp (no longer
     /// counted as sharp), either side of a keyhole, and `forced`.
-    fn cuts(&mut self, pins: &[hairpin::Hairpin], arc: &[f64], forced: &[usize]) -> Vec<usize> {
+    fn cuts(&mut self, pins: &[Taken], arc: &[f64], forced: &[usize]) -> Vec<usize> {
         let n = self.sharp.len();
         let mut cuts = vec![0usize];
         for i in 1..n - 1 {
@@ -340,7 +370,7 @@ impl Corners {
         // A keyhole is fitted on its own, between the original points either side of the
         // stretch it replaces (on its straight legs): the rest of a long side need not be
         // fitted again.
-        let spans: Vec<(f64, f64)> = pins.iter().map(|p| p.span(arc)).collect();
+        let spans: Vec<(f64, f64)> = pins.iter().map(|t| t.pin.span(arc)).collect();
         let free = |j: usize| {
             j > 0
                 && j + 1 < n
@@ -348,9 +378,10 @@ impl Corners {
                 && !self.pinned[j]
                 && spans.iter().all(|&(u0, u1)| arc[j] <= u0 || arc[j] >= u1)
         };
-        for (k, &(u0, u1)) in pins.iter().zip(&spans).filter(|(p, _)| p.corners == 1) {
-            let before = (0..k.at).rev().find(|&j| arc[j] <= u0);
-            let after = (k.at + 1..n).find(|&j| arc[j] >= u1);
+        for (t, &(u0, u1)) in pins.iter().zip(&spans).filter(|(t, _)| t.pin.corners == 1) {
+            let at = t.pin.at;
+            let before = (0..at).rev().find(|&j| arc[j] <= u0);
+            let after = (at + 1..n).find(|&j| arc[j] >= u1);
             cuts.extend(before.into_iter().chain(after).filter(|&j| free(j)));
         }
         cuts.extend(forced.iter().filter(|&&j| j < n));
@@ -368,7 +399,7 @@ fn smooth_pieces(
     s: &Settings,
     cuts: &[usize],
     sharp: &[bool],
-    pins: &[hairpin::Hairpin],
+    pins: &[Taken],
 ) -> Option<(Smoothed, bool)> {
     let mut out = Smoothed::default();
     let mut changed = false;
@@ -376,15 +407,16 @@ fn smooth_pieces(
         let (a, b) = (w[0], w[1]);
         let piece = path.piece(a, b)?;
         let has_sharp = sharp.get(a + 1..b).is_some_and(|v| v.iter().any(|&x| x));
-        let here: Vec<hairpin::Hairpin> = pins
+        let here: Vec<Taken> = pins
             .iter()
-            .filter(|p| p.at > a && p.at < b)
-            .map(|p| hairpin::Hairpin {
-                at: p.at - a,
-                ..p.clone()
+            .filter(|t| t.pin.at > a && t.pin.at < b)
+            .map(|t| {
+                let mut t = t.clone();
+                t.pin.at -= a;
+                t
             })
             .collect();
-        let keyholes = here.iter().filter(|p| p.corners == 1).count() as u64;
+        let keyholes = here.iter().filter(|t| t.pin.corners == 1).count() as u64;
         let mut done =
             smooth_piece(&piece, s, has_sharp, &here).map(|p| Smoothed { keyholes, ..p });
         if done.is_none() && keyholes > 0 {
@@ -394,7 +426,7 @@ fn smooth_pieces(
                 keyholes: false,
                 ..*s
             };
-            done = smooth_cut(&piece, &plain, &[]);
+            done = super::smooth_cut(&piece, &plain, &[]);
         }
         match done {
             Some(p) => {
@@ -438,78 +470,6 @@ impl Smoothed {
     }
 }
 
-/// The sharp corners of `path` to turn as polygons placed for Klipper's look-ahead
-/// ([`klipper`]): on a Klipper machine, where the original's planned speeds are known, a polygon
-/// fits within the tolerance and the legs' room (all of the leg where it ends the path, half
-/// where it is shared, less a shortest step), and the firmware runs it no slower than
-/// [`Settings::min_speed_share`] of its speed through the sharp corner.
-fn polygon_corners(path: &SmoothPath<'_>, s: &Settings) -> Vec<klipper::Corner> {
-    let mut out = Vec::new();
-    let Some(scv) = s.klipper_scv_mm_s else {
-        return out;
-    };
-    let pts = path.pts;
-    let n = pts.len();
-    if n < 3 || path.planned.is_empty() || !path.consistent() {
-        return out;
-    }
-    let cos_critical = crate::math::cos(s.critical_rad);
-    // Corners a fillet already rounds at no loss of speed keep the fillet: the fitted curve
-    // rings less than a polygon of the largest turns.
-    let blends = blend::plan(
-        pts,
-        TUNING.blend_share * s.tolerance_mm,
-        s.limits.critical_curvature(),
-        s.line,
-    );
-    let room = |from: usize, to: usize, end: bool| {
-        let l = norm(sub(pts[to], pts[from]));
-        (if end { TUNING.leg_share } else { 0.5 } * l - s.min_step_mm).max(0.0)
-    };
-    let free = Settings {
-        min_speed_share: 1.0,
-        ..*s
-    };
-    for i in 1..n - 1 {
-        let (u, w) = (sub(pts[i], pts[i - 1]), sub(pts[i + 1], pts[i]));
-        if !crate::vtg::rewrite::is_sharp(&u, &w, cos_critical) {
-            continue;
-        }
-        let (before, after) = (&path.planned[i - 1], &path.planned[i]);
-        if roundable(&blends[i], s) && pays(blends[i].max_curvature, Some(before), &free) {
-            continue;
-        }
-        let accel = before.acceleration.min(after.acceleration);
-        if accel.is_nan() || accel <= 0.0 {
-            continue;
-        }
-        let bounds = klipper::Bounds {
-            tolerance_mm: s.tolerance_mm - 0.001,
-            max_turn_rad: TUNING.step_turn_share * s.critical_rad,
-            min_step_mm: s.min_step_mm,
-            room_mm: [room(i - 1, i, i == 1), room(i, i + 1, i + 2 == n)],
-        };
-        let fw = klipper::Firmware {
-            accel_mm_s2: accel,
-            junction_deviation_mm: crate::plan::junction::klipper_junction_deviation(scv, accel),
-            feed_mm_s: [path.feed[i - 1], path.feed[i]],
-            ends_mm_s: [before.entry, after.exit],
-        };
-        if let Some(c) = klipper::find(pts, i, &bounds, &fw)
-            .filter(|c| c.slowest_mm_s >= s.min_speed_share * c.sharp_mm_s)
-        {
-            out.push(c);
-        }
-    }
-    out
-}
-
-/// Whether a corner's blend can be walked in steps of at least the minimum step, each turning
-/// less than the critical angle (a tighter blend would only trade one sharp turn for several).
-fn roundable(b: &blend::Blend, s: &Settings) -> bool {
-    b.extent_mm > 0.0 && b.max_curvature * s.min_step_mm <= TUNING.step_turn_share * s.critical_rad
-}
-
 /// Whether rounding a corner on a curve of the largest curvature `curvature` (a fillet's, or a
 /// keyhole's loop) leaves the machine at least as fast through it, given how the
 /// firmware ran the original move `before` that ends at the corner (unknown: assume it does).
@@ -531,6 +491,19 @@ fn pays(curvature: f64, before: Option<&Profile>, s: &Settings) -> bool {
     on_fillet >= s.min_speed_share * p.exit
 }
 
+/// Whether the search takes a replacement costing `cost` at a corner the firmware reached on
+/// the original move `before` (see [`crate::vtg::corners::Cost`]).
+fn accepts(cost: &Cost, before: Option<&Profile>, s: &Settings) -> bool {
+    match *cost {
+        Cost::Curvature(k) => pays(k, before, s),
+        Cost::Planned {
+            slowest_mm_s,
+            sharp_mm_s,
+        } => slowest_mm_s >= s.min_speed_share * sharp_mm_s,
+        Cost::Unweighed => true,
+    }
+}
+
 impl Settings {
     /// Whether [`Settings::min_speed_share`] can change which corners are rounded: only where
     /// the firmware takes a sharp corner as a virtual arc that a fillet must keep up with (see
@@ -546,7 +519,7 @@ fn smooth_piece(
     path: &SmoothPath<'_>,
     s: &Settings,
     has_sharp: bool,
-    pins: &[hairpin::Hairpin],
+    pins: &[Taken],
 ) -> Option<Smoothed> {
     if path.pts.len() < 3 || !has_sharp {
         return None;
@@ -571,97 +544,25 @@ fn smooth_piece(
     None
 }
 
-/// [`hairpin::find`] at corners `i`, `i + 1` of `pts` within `blend_tol`, for an arc the walk
-/// can follow in steps of at least the minimum step each turning by less than its share of the
-/// critical angle (with 5 % to spare), reaching along each long leg `Tuning::leg_share` of it
-/// where the leg ends the path and half that where another corner shares it.
-fn find_hairpin(
-    pts: &[[f64; 3]],
-    i: usize,
-    blend_tol: f64,
-    s: &Settings,
-) -> Option<hairpin::Hairpin> {
-    let n = pts.len();
-    let room = |leg: usize, far_end: usize| {
-        let l = norm(sub(pts.get(leg + 1)?, pts.get(leg)?));
-        let shared = far_end != 0 && far_end + 1 != n;
-        Some(TUNING.leg_share * l * if shared { 0.5 } else { 1.0 })
-    };
-    let min_radius = min_hairpin_radius(s);
-    let rooms = [room(i.checked_sub(1)?, i - 1)?, room(i + 1, i + 2)?];
-    hairpin::find(pts, i, blend_tol, min_radius, rooms)
-}
-
-/// [`keyhole::find`] at corner `i` of `pts` (arc lengths `arc`) within the blend share of the
-/// tolerance, on a loop of the hairpins' smallest radius, with counter-turns of at most
-/// `Tuning::kink_share` of the critical angle. The loop may reach along the path up to
-/// `Tuning::leg_share` of the way to the path's ends and half the way to the nearest corner
-/// that is sharp, already replaced or degenerate (which the piece may be cut at).
-fn find_keyhole(
-    pts: &[[f64; 3]],
-    arc: &[f64],
-    i: usize,
-    sharp: &[bool],
-    pinned: &[bool],
-    degenerate: &[bool],
-    s: &Settings,
-) -> Option<hairpin::Hairpin> {
-    let n = pts.len();
-    let stop = |k: usize| k == 0 || k + 1 == n || sharp[k] || pinned[k] || degenerate[k];
-    let share = |k: usize| {
-        if k == 0 || k + 1 == n {
-            TUNING.leg_share
-        } else {
-            0.5
-        }
-    };
-    let back = (0..i).rev().find(|&k| stop(k))?;
-    let on = (i + 1..n).find(|&k| stop(k))?;
-    let room = [
-        share(back) * (arc[i] - arc[back]),
-        share(on) * (arc[on] - arc[i]),
-    ];
-    keyhole::find(
-        pts,
-        arc,
-        i,
-        TUNING.blend_share * s.tolerance_mm,
-        min_hairpin_radius(s),
-        TUNING.kink_share * s.critical_rad,
-        room,
-    )
-}
-
-/// The smallest radius of a loop the walk can follow in steps of at least the minimum step,
-/// each turning by less than its share of the critical angle, with 5 % to spare.
-fn min_hairpin_radius(s: &Settings) -> f64 {
-    1.05 * s.min_step_mm / (TUNING.step_turn_share * s.critical_rad)
-}
-
-/// [`attempt`] on `path` with its hairpins `pins` replaced by their arcs, checked against the
-/// original; with `again`, the arcs are found anew within the smaller `blend_tol`.
+/// [`attempt`] on `path` with its replacements `pins` spliced in, checked against the
+/// original; with `again`, each kind is asked for its replacement again within the smaller
+/// `blend_tol` ([`CornerKind::again`]: hairpins are found anew, keyholes kept).
 fn with_hairpins(
     path: &SmoothPath<'_>,
     s: &Settings,
     blend_tol: f64,
-    pins: &[hairpin::Hairpin],
+    pins: &[Taken],
     again: bool,
 ) -> Option<Smoothed> {
     let pts = path.pts;
-    let found: Vec<hairpin::Hairpin>;
-    let pins = if again {
-        found = pins
-            .iter()
-            .map(|p| match p.corners {
-                2 => find_hairpin(pts, p.at, blend_tol, s),
-                _ => Some(p.clone()),
-            })
-            .collect::<Option<_>>()?;
-        &found
+    let pins: Vec<Hairpin> = if again {
+        pins.iter()
+            .map(|t| t.kind.again(pts, &t.pin, blend_tol, s))
+            .collect::<Option<_>>()?
     } else {
-        pins
+        pins.iter().map(|t| t.pin.clone()).collect()
     };
-    let sub = hairpin::substitute(pts, path.e, path.feed, path.planned, pins);
+    let sub = hairpin::substitute(pts, path.e, path.feed, path.planned, &pins);
     let replaced = SmoothPath {
         pts: &sub.pts,
         e: &sub.e,
