@@ -32,6 +32,12 @@ const ALLOWED: &[(&str, &[&str])] = &[
         &["gcode", "machine", "plan", "read", "energy", "analyze"],
     ),
     (
+        "estimate",
+        &[
+            "gcode", "machine", "plan", "read", "energy", "analyze", "path",
+        ],
+    ),
+    (
         "dynamics",
         &[
             "gcode", "machine", "plan", "read", "energy", "analyze", "path",
@@ -53,6 +59,13 @@ const ALLOWED: &[(&str, &[&str])] = &[
         "orient",
         &[
             "gcode", "machine", "plan", "read", "energy", "analyze", "path",
+        ],
+    ),
+    (
+        "optimize",
+        &[
+            "gcode", "machine", "plan", "read", "energy", "analyze", "path", "estimate",
+            "dynamics", "vtg", "infill",
         ],
     ),
 ];

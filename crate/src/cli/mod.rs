@@ -3,8 +3,10 @@
 
 mod bench;
 mod calibrate;
+mod estimate;
 mod infill;
 mod klipper;
+mod optimize;
 mod output;
 mod smooth;
 mod table;
@@ -76,6 +78,11 @@ enum Cmd {
     Vibration(vibration::Args),
     /// Rewrite a file as a vibration-suppressed toolpath (VTG).
     Vtg(vtg::Args),
+    /// The recommended pipeline in one pass (infill when asked, VTG, arcs where the firmware
+    /// runs them, true time estimates); `--in-place` as a slicer's post-processing script.
+    Optimize(optimize::Args),
+    /// Rewrite the time comments and M73 progress lines from quietpath's planner.
+    Estimate(estimate::Args),
     /// Regenerate sparse infill, searching pattern, infill angle and part orientation.
     Infill(infill::Args),
     /// Smooth the tool orientation of a multi-axis toolpath within a tolerance cone.
@@ -154,6 +161,21 @@ enum ExtrusionArg {
 }
 
 impl AnalyzeArgs {
+    /// Whether any analyze option was given on the command line.
+    fn any(&self) -> bool {
+        self.strict
+            || self.filament_diameter.is_some()
+            || self.density.is_some()
+            || self.extrusion.is_some()
+            || self.machine.is_some()
+            || self.machine_file.is_some()
+            || self.junction.is_some()
+            || self.arc_segment.is_some()
+            || self.energy.is_some()
+            || self.klipper_config.is_some()
+            || self.klipper_version.is_some()
+    }
+
     fn options(&self) -> Result<AnalyzeOptions, String> {
         let machine_profile = match &self.machine_file {
             Some(path) => {
@@ -276,6 +298,8 @@ fn run(cli: Cli) -> Result<(), String> {
         Cmd::Vibration(args) => vibration::run(args),
         Cmd::Vtg(args) => vtg::run(args),
         Cmd::Infill(args) => infill::run(args),
+        Cmd::Optimize(args) => optimize::run(args),
+        Cmd::Estimate(args) => estimate::run(args),
         Cmd::Smooth(args) => smooth::run(args),
         Cmd::Bench { file, runs, json } => {
             let input = read(&file)?;

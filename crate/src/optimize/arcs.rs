@@ -1,0 +1,81 @@
+//! Whether the firmware runs arcs, for VTG's `G2`/`G3` output.
+
+use serde::{Deserialize, Serialize};
+
+use crate::analyze::{AnalyzeOptions, Report};
+use crate::plan::JunctionModel;
+
+/// Arcs in the output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ArcsMode {
+    /// Where the firmware runs them: a file that already has arcs; Marlin (its default
+    /// configuration enables `ARC_SUPPORT`, and Prusa's firmware has them), RepRapFirmware and
+    /// Smoothieware; Klipper only with `[gcode_arcs]` in the printer config given (Klipper
+    /// lacks them unless configured).
+    #[default]
+    Auto,
+    /// Always.
+    On,
+    /// Never.
+    Off,
+}
+
+impl ArcsMode {
+    /// The decision for `input` (analysed as `report`).
+    pub fn resolve(self, input: &[u8], report: &Report, options: &AnalyzeOptions) -> bool {
+        match self {
+            ArcsMode::On => true,
+            ArcsMode::Off => false,
+            ArcsMode::Auto => {
+                has_arcs(input)
+                    || match &options.klipper_config {
+                        Some(c) => c.arc_resolution.is_some(),
+                        None => {
+                            report.machine.junction_model != JunctionModel::Klipper
+                                && arc_capable_flavor(report.file.flavor.as_deref())
+                        }
+                    }
+            }
+        }
+    }
+}
+
+/// A flavour whose firmware runs `G2`/`G3` in its default build.
+fn arc_capable_flavor(flavor: Option<&str>) -> bool {
+    let Some(f) = flavor else { return false };
+    let f = f.to_ascii_lowercase();
+    ["marlin", "reprap", "rrf", "smoothie", "prusa"]
+        .iter()
+        .any(|k| f.contains(k))
+}
+
+/// The file already has arc moves: its slicer (or ArcWelder) was set up for a firmware that
+/// runs them.
+fn has_arcs(input: &[u8]) -> bool {
+    input.split(|&b| b == b'\n').any(|l| {
+        let l = l.trim_ascii_start();
+        (l.starts_with(b"G2") || l.starts_with(b"G3"))
+            && l.get(2).is_none_or(|c| !c.is_ascii_digit())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arcs_in_the_file() {
+        assert!(has_arcs(b"G1 X1\nG2 X1 Y1 I1 J0\n"));
+        assert!(has_arcs(b"G3"));
+        assert!(!has_arcs(b"G1 X1\nG28\nG29\n"));
+    }
+
+    #[test]
+    fn flavours() {
+        assert!(arc_capable_flavor(Some("marlin2")));
+        assert!(arc_capable_flavor(Some("RepRapFirmware")));
+        assert!(!arc_capable_flavor(Some("klipper")));
+        assert!(!arc_capable_flavor(None));
+    }
+}

@@ -1,0 +1,160 @@
+//! The recommended pipeline in one pass: infill search when asked, VTG, arcs where the
+//! firmware runs them, and true time estimates in the file handed back.
+//!
+//! Each stage works on the previous stage's file and is kept only if it makes the file no
+//! dearer in time and energy, as `analyze` costs both (the project's rule: a user never gets a
+//! worse file back); a stage that cannot improve the file says why and passes it on unchanged.
+//! The time comments and `M73` lines are then rewritten from the planner's clock
+//! ([`crate::estimate`]), so printers show the time of the toolpath they run.
+
+mod arcs;
+mod stages;
+
+use serde::{Deserialize, Serialize};
+
+use crate::analyze::{analyze, AnalyzeOptions, Report};
+use crate::error::Error;
+use crate::estimate::{rewrite_estimates, EstimateReport};
+use crate::infill::InfillOptions;
+use crate::progress::Progress;
+use crate::vtg::VtgOptions;
+pub use arcs::ArcsMode;
+use stages::Stage;
+
+/// Options of [`optimize`]. Every field is optional in JSON.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OptimizeOptions {
+    /// How the file is read and the machine it runs on; every stage uses these.
+    pub analyze: AnalyzeOptions,
+    /// Run the infill search first with these options (default: off). Its `analyze` is
+    /// replaced by the one above.
+    pub infill: Option<InfillOptions>,
+    /// Run VTG (default true).
+    pub vtg: bool,
+    /// VTG's options (default: VTG's, with no added print time allowed: `allow_slower_pct`
+    /// 0, so the pipeline never trades time for corners). Its `analyze` and `arcs` are
+    /// replaced by this pipeline's.
+    pub vtg_options: VtgOptions,
+    /// Arcs in VTG's output: `auto` (default) writes them where the firmware runs them.
+    pub arcs: ArcsMode,
+    /// Rewrite the time comments and `M73` lines (default true).
+    pub estimates: bool,
+}
+
+impl Default for OptimizeOptions {
+    fn default() -> Self {
+        Self {
+            analyze: AnalyzeOptions::default(),
+            infill: None,
+            vtg: true,
+            vtg_options: VtgOptions {
+                allow_slower_pct: 0.0,
+                ..VtgOptions::default()
+            },
+            arcs: ArcsMode::Auto,
+            estimates: true,
+        }
+    }
+}
+
+/// One stage's outcome.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StageReport {
+    /// `infill`, `vtg` or `estimates`.
+    pub stage: String,
+    /// Whether the stage's file was kept.
+    pub applied: bool,
+    /// What it did, or why its file was not kept.
+    pub message: String,
+    /// Print time before and after the stage, s.
+    pub time_s: [f64; 2],
+    /// Total energy before and after the stage, J.
+    pub energy_j: [f64; 2],
+    /// Lines before and after the stage.
+    pub lines: [u64; 2],
+}
+
+/// Result of [`optimize`].
+#[derive(Debug, Clone, Serialize)]
+pub struct OptimizeReport {
+    /// `analyze` of the input.
+    pub before: Report,
+    /// `analyze` of the output.
+    pub after: Report,
+    /// Each stage in order.
+    pub stages: Vec<StageReport>,
+    /// The estimates written, when asked.
+    pub estimates: Option<EstimateReport>,
+    /// The optimised file.
+    #[serde(skip)]
+    pub output: Vec<u8>,
+}
+
+/// [`optimize_with_progress`] without progress.
+pub fn optimize(input: &[u8], options: &OptimizeOptions) -> Result<OptimizeReport, Error> {
+    optimize_with_progress(input, options, &mut |_| true)
+}
+
+/// Runs the pipeline on `input`; `progress` gets the fraction done (`false` cancels).
+pub fn optimize_with_progress(
+    input: &[u8],
+    options: &OptimizeOptions,
+    progress: Progress<'_>,
+) -> Result<OptimizeReport, Error> {
+    let before = analyze(input, &options.analyze)?;
+    let mut current = Stage::start(input.to_vec(), before.clone());
+    let mut stages = Vec::new();
+    let spans = stages::spans(options);
+    let mut span = spans.iter();
+    if let Some(infill) = &options.infill {
+        let (a, b) = span.next().copied().unwrap_or((0.0, 1.0));
+        let mut p = |f: f64| progress(a + (b - a) * f);
+        stages.push(current.infill(infill, &options.analyze, &mut p)?);
+    }
+    if options.vtg {
+        let (a, b) = span.next().copied().unwrap_or((0.0, 1.0));
+        let mut p = |f: f64| progress(a + (b - a) * f);
+        let arcs = options.arcs.resolve(input, &before, &options.analyze);
+        stages.push(current.vtg(&options.vtg_options, arcs, &options.analyze, &mut p)?);
+    }
+    let mut estimates = None;
+    if options.estimates {
+        let (report, stage) = current.estimates(&stages, &options.analyze)?;
+        estimates = Some(report);
+        stages.push(stage);
+    }
+    progress(1.0);
+    let (output, after) = current.finish();
+    Ok(OptimizeReport {
+        before,
+        after,
+        stages,
+        estimates,
+        output,
+    })
+}
+
+/// The header notes that say what quietpath changed in a file.
+fn notes(stages: &[StageReport]) -> Vec<String> {
+    stages
+        .iter()
+        .map(|s| {
+            format!(
+                "{}: {}{}",
+                s.stage,
+                if s.applied { "" } else { "not applied: " },
+                s.message
+            )
+        })
+        .collect()
+}
+
+/// The estimates stage's own input: the notes of the stages before it.
+pub(crate) fn estimate_file(
+    file: &[u8],
+    stages: &[StageReport],
+    analyze: &AnalyzeOptions,
+) -> Result<crate::estimate::Estimated, Error> {
+    rewrite_estimates(file, analyze, &notes(stages))
+}
