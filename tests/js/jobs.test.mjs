@@ -121,6 +121,18 @@ test('infill: wasm report and output equal the CLI (angles 0/45/90, two patterns
   assert.ok(Math.abs(after.filament_mm / report.before.filament_mm - 1) < 0.1);
 });
 
+test('optimize: wasm report and output equal the CLI (VTG without dynamics, estimates)', () => {
+  const out = path.join(tmp, 'optimize.gcode');
+  const fromCli = runCli(['optimize', DEMO, '-o', out, '--no-dynamics', '--json']);
+  const { report, output } = reportOf(qp.optimize(fs.readFileSync(DEMO), { vtg_options: { dynamics: false } }));
+  assert.deepEqual(report, fromCli);
+  assert.ok(Buffer.from(output).equals(fs.readFileSync(out)), 'optimised file differs from the CLI output');
+  assert.deepEqual(report.stages.map((s) => s.stage), ['vtg', 'estimates']);
+  // Never dearer than the input, and the file's own estimate is the planner's.
+  assert.ok(report.after.time_s <= report.before.time_s && report.after.energy.total_j <= report.before.energy.total_j);
+  assert.equal(qp.analyze(output).time_s, report.after.time_s);
+});
+
 test('Session jobs use the session analyze options unless the job names its own', () => {
   const bytes = fs.readFileSync(DEMO);
   const s = new qp.Session(bytes, { machine: 'vtg-ldam-servo' });

@@ -43,6 +43,9 @@ pub struct Args {
     /// VTG's largest distance from the original path, mm.
     #[arg(long, value_name = "MM")]
     pub tolerance: Option<f64>,
+    /// Print time VTG may add to round corners that cost time, percent (default 0).
+    #[arg(long, value_name = "PCT")]
+    pub allow_slower: Option<f64>,
     /// Arcs in the output: auto (where the firmware runs them), on or off.
     #[arg(long, value_enum)]
     pub arcs: Option<ArcsArg>,
@@ -87,6 +90,9 @@ fn options(args: &Args) -> Result<OptimizeOptions, String> {
     o.estimates &= !args.no_estimates;
     if let Some(t) = args.tolerance {
         o.vtg_options.tolerance_mm = t;
+    }
+    if let Some(p) = args.allow_slower {
+        o.allow_slower_pct = p;
     }
     if args.no_dynamics {
         o.vtg_options.dynamics = false;

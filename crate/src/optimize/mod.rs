@@ -32,10 +32,12 @@ pub struct OptimizeOptions {
     pub infill: Option<InfillOptions>,
     /// Run VTG (default true).
     pub vtg: bool,
-    /// VTG's options (default: VTG's, with no added print time allowed: `allow_slower_pct`
-    /// 0, so the pipeline never trades time for corners). Its `analyze` and `arcs` are
+    /// VTG's options (default: VTG's). Its `analyze`, `arcs` and `allow_slower_pct` are
     /// replaced by this pipeline's.
     pub vtg_options: VtgOptions,
+    /// Print time VTG may add to round corners, percent (default 0: the pipeline never
+    /// trades time for corners; every stage must also leave the file no slower).
+    pub allow_slower_pct: f64,
     /// Arcs in VTG's output: `auto` (default) writes them where the firmware runs them.
     pub arcs: ArcsMode,
     /// Rewrite the time comments and `M73` lines (default true).
@@ -48,10 +50,8 @@ impl Default for OptimizeOptions {
             analyze: AnalyzeOptions::default(),
             infill: None,
             vtg: true,
-            vtg_options: VtgOptions {
-                allow_slower_pct: 0.0,
-                ..VtgOptions::default()
-            },
+            vtg_options: VtgOptions::default(),
+            allow_slower_pct: 0.0,
             arcs: ArcsMode::Auto,
             estimates: true,
         }
@@ -116,7 +116,13 @@ pub fn optimize_with_progress(
         let (a, b) = span.next().copied().unwrap_or((0.0, 1.0));
         let mut p = |f: f64| progress(a + (b - a) * f);
         let arcs = options.arcs.resolve(input, &before, &options.analyze);
-        stages.push(current.vtg(&options.vtg_options, arcs, &options.analyze, &mut p)?);
+        let vtg = VtgOptions {
+            analyze: options.analyze.clone(),
+            arcs,
+            allow_slower_pct: options.allow_slower_pct,
+            ..options.vtg_options.clone()
+        };
+        stages.push(current.vtg(&vtg, &mut p)?);
     }
     let mut estimates = None;
     if options.estimates {

@@ -102,19 +102,8 @@ impl Stage {
     }
 
     /// VTG on the file so far.
-    pub fn vtg(
-        &mut self,
-        options: &VtgOptions,
-        arcs: bool,
-        analyze: &AnalyzeOptions,
-        progress: Progress<'_>,
-    ) -> Result<StageReport, Error> {
-        let o = VtgOptions {
-            analyze: analyze.clone(),
-            arcs,
-            ..options.clone()
-        };
-        let r = vtg_with_progress(&self.file, &o, progress)?;
+    pub fn vtg(&mut self, o: &VtgOptions, progress: Progress<'_>) -> Result<StageReport, Error> {
+        let r = vtg_with_progress(&self.file, o, progress)?;
         let turns = |rep: &Report| rep.toolpath.n_turning;
         let done = format!(
             "sharp corners {} → {} ({:+.1} %), largest deviation {:.3} mm of {} mm{}",
@@ -123,7 +112,7 @@ impl Stage {
             pct(turns(&r.after) as f64, turns(&self.report) as f64),
             r.max_deviation_mm,
             r.tolerance_mm,
-            if arcs { ", arcs written" } else { "" }
+            if o.arcs { ", arcs written" } else { "" }
         );
         Ok(self.offer("vtg", r.output, r.after, done))
     }

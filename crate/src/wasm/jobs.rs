@@ -9,6 +9,7 @@ use super::{input_bytes, js_error, options, progress_fn, to_js, JsProgress, Sess
 use crate::analyze::AnalyzeOptions;
 use crate::dynamics::{vibration_with_progress, VibrationOptions};
 use crate::infill::{infill_with_progress, InfillOptions};
+use crate::optimize::{optimize_with_progress, OptimizeOptions};
 use crate::orient::{smooth_with_progress, SmoothOptions};
 use crate::vtg::{vtg_with_progress, VtgOptions};
 
@@ -30,6 +31,10 @@ extern "C" {
     #[wasm_bindgen(typescript_type = "VibrationOptions")]
     #[derive(Debug)]
     pub type JsVibrationOptions;
+    /// `OptimizeOptions` in TypeScript.
+    #[wasm_bindgen(typescript_type = "OptimizeOptions")]
+    #[derive(Debug)]
+    pub type JsOptimizeOptions;
 }
 
 /// The report as JS, with the rewritten file as `output`.
@@ -71,6 +76,15 @@ fn run_vtg(bytes: &[u8], o: &VtgOptions, p: Option<JsProgress>) -> Result<JsValu
 
 fn run_infill(bytes: &[u8], o: &InfillOptions, p: Option<JsProgress>) -> Result<JsValue, JsValue> {
     let r = infill_with_progress(bytes, o, &mut progress_fn(p)).map_err(|e| js_error(&e))?;
+    with_output(&r, &r.output)
+}
+
+fn run_optimize(
+    bytes: &[u8],
+    o: &OptimizeOptions,
+    p: Option<JsProgress>,
+) -> Result<JsValue, JsValue> {
+    let r = optimize_with_progress(bytes, o, &mut progress_fn(p)).map_err(|e| js_error(&e))?;
     with_output(&r, &r.output)
 }
 
@@ -128,6 +142,22 @@ pub fn infill(
         |o: &mut InfillOptions, a| o.analyze = a,
     )?;
     run_infill(&input_bytes(&input)?, &o, on_progress)
+}
+
+/// The recommended pipeline: infill when asked, VTG, arcs where the firmware runs them, true
+/// time estimates (`quietpath optimize --json`, plus `output`).
+#[wasm_bindgen(unchecked_return_type = "OptimizeResult")]
+pub fn optimize(
+    #[wasm_bindgen(unchecked_param_type = "string | Uint8Array | ArrayBuffer")] input: JsValue,
+    options_value: Option<JsOptimizeOptions>,
+    on_progress: Option<JsProgress>,
+) -> Result<JsValue, JsValue> {
+    let o = job_options(
+        options_value.as_deref(),
+        None,
+        |o: &mut OptimizeOptions, a| o.analyze = a,
+    )?;
+    run_optimize(&input_bytes(&input)?, &o, on_progress)
 }
 
 /// Tool-orientation smoothing of a multi-axis file (`quietpath smooth --json`, plus `output`).
@@ -191,6 +221,21 @@ impl Session {
             |o: &mut InfillOptions, a| o.analyze = a,
         )?;
         run_infill(self.input_ref(), &o, on_progress)
+    }
+
+    /// `optimize` of the session's file.
+    #[wasm_bindgen(unchecked_return_type = "OptimizeResult")]
+    pub fn optimize(
+        &self,
+        options_value: Option<JsOptimizeOptions>,
+        on_progress: Option<JsProgress>,
+    ) -> Result<JsValue, JsValue> {
+        let o = job_options(
+            options_value.as_deref(),
+            Some(self),
+            |o: &mut OptimizeOptions, a| o.analyze = a,
+        )?;
+        run_optimize(self.input_ref(), &o, on_progress)
     }
 
     /// `smooth` of the session's file.

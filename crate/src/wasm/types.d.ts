@@ -479,3 +479,47 @@ export interface VtgReport {
 }
 /** vtg() result: the report plus the rewritten file. */
 export interface VtgResult extends VtgReport { output: Uint8Array }
+
+// ── optimize (`quietpath optimize --json`) ──
+export interface OptimizeOptions {
+  analyze?: AnalyzeOptions;
+  /** Run the infill search first with these options (default: off); its `analyze` is replaced by this one's. */
+  infill?: InfillOptions | null;
+  /** Run VTG (default true). */
+  vtg?: boolean;
+  /** VTG's options (default: VTG's); `analyze`, `arcs` and `allow_slower_pct` are replaced by the pipeline's. */
+  vtg_options?: VtgOptions;
+  /** Print time VTG may add to round corners, percent (default 0: never slower). */
+  allow_slower_pct?: number;
+  /** Arcs in the output: where the firmware runs them (default), always, never. */
+  arcs?: 'auto' | 'on' | 'off';
+  /** Rewrite the time comments and M73 lines (default true). */
+  estimates?: boolean;
+}
+/** One stage of the pipeline. */
+export interface OptimizeStage {
+  stage: 'infill' | 'vtg' | 'estimates';
+  /** Whether its file was kept (no dearer in time and energy). */
+  applied: boolean;
+  /** What it did, or why its file was not kept. */
+  message: string;
+  /** Before and after the stage. */
+  time_s: [number, number];
+  energy_j: [number, number];
+  lines: [number, number];
+}
+/** What the estimates stage wrote (`quietpath estimate --json`). */
+export interface EstimateReport {
+  time_s: number;
+  progress_lines: number;
+  time_comments: number;
+  header_lines: number;
+}
+export interface OptimizeReport {
+  before: Report;
+  after: Report;
+  stages: OptimizeStage[];
+  estimates: EstimateReport | null;
+}
+/** optimize() result: the report plus the optimised file. */
+export interface OptimizeResult extends OptimizeReport { output: Uint8Array }

@@ -1,0 +1,354 @@
+//! `optimize` and `estimate` the way slicers run them: as a post-processing script on the
+//! slicer's temporary file, with true estimates checked against the planner at each place,
+//! the untouched blocks byte for byte, and a failing or interrupted run leaving the file as it
+//! was.
+#![cfg(not(target_arch = "wasm32"))]
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use quietpath::path::extract;
+use quietpath::AnalyzeOptions;
+
+fn corpus(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/corpus")
+        .join(name)
+}
+
+/// A fresh folder with a copy of a corpus file in it.
+fn scratch_copy(tag: &str, name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("quietpath-optimize-{}-{tag}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let to = dir.join(name);
+    std::fs::copy(corpus(name), &to).unwrap();
+    to
+}
+
+fn cli(args: &[&str], envs: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_quietpath"));
+    c.args(args);
+    for (k, v) in envs {
+        c.env(k, v);
+    }
+    c.output().unwrap()
+}
+
+/// The lines from the first that starts with `begin` to the next that starts with `end`.
+fn block<'a>(text: &'a str, begin: &str, end: &str) -> Vec<&'a str> {
+    let mut out = Vec::new();
+    let mut inside = false;
+    for l in text.lines() {
+        inside |= l.starts_with(begin);
+        if inside {
+            out.push(l);
+            if l.starts_with(end) && out.len() > 1 {
+                break;
+            }
+        }
+    }
+    out
+}
+
+/// The planner's clock of `file`, independently of the estimates code: elapsed time at each
+/// line (the start of the first move on or after it) and the total.
+fn clock(file: &[u8]) -> (impl Fn(u32) -> f64, f64) {
+    let p = extract(file, &AnalyzeOptions::default(), true).unwrap();
+    let total = p.time_s;
+    let starts: Vec<(u32, f64)> = p
+        .moves
+        .iter()
+        .filter_map(|m| m.timing.map(|t| (m.line, t.start_s)))
+        .collect();
+    let at = move |line: u32| {
+        starts
+            .iter()
+            .find(|(l, _)| *l >= line)
+            .map_or(total, |&(_, t)| t)
+    };
+    (at, total)
+}
+
+/// Every M73 and time comment of `text` within 1 % of the planner's clock of the file (M73
+/// percents to the whole percent, minutes to the rounding minute); the last `M73 R` is 0.
+fn assert_estimates_true(text: &str) -> usize {
+    let (at, total) = clock(text.as_bytes());
+    let mut checked = 0;
+    let mut last_r = None;
+    for (i, l) in text.lines().enumerate() {
+        let t = at(i as u32 + 1);
+        if let Some(words) = l.strip_prefix("M73 ") {
+            for w in words.split_whitespace() {
+                let v: f64 = w[1..].parse().unwrap();
+                match &w[..1] {
+                    "P" | "Q" => assert!(
+                        (v - 100.0 * t / total).abs() <= 1.0 + 1e-9,
+                        "{l} at {t} of {total}"
+                    ),
+                    "R" | "S" => {
+                        assert!(
+                            (v - (total - t) / 60.0).abs() <= 0.5 + 0.01 * total / 60.0,
+                            "{l} at {t} of {total}"
+                        );
+                        last_r = Some(v);
+                    }
+                    _ => {}
+                }
+            }
+            checked += 1;
+        } else if let Some(v) = l.strip_prefix(";TIME_ELAPSED:") {
+            let v: f64 = v.parse().unwrap();
+            assert!((v - t).abs() <= 0.01 * total, "{l} vs {t}");
+            checked += 1;
+        } else if let Some(v) = l.strip_prefix(";TIME:") {
+            let v: f64 = v.parse().unwrap();
+            assert!((v - total).abs() <= 0.01 * total, "{l} vs {total}");
+            checked += 1;
+        } else if l.starts_with("; estimated printing time (normal mode) = ") {
+            let d = l.rsplit("= ").next().unwrap();
+            let secs: f64 = d
+                .split_whitespace()
+                .map(|p| {
+                    let (n, unit) = p.split_at(p.len() - 1);
+                    let n: f64 = n.parse().unwrap();
+                    n * match unit {
+                        "d" => 86_400.0,
+                        "h" => 3_600.0,
+                        "m" => 60.0,
+                        _ => 1.0,
+                    }
+                })
+                .sum();
+            assert!((secs - total).abs() <= 0.01 * total, "{l} vs {total}");
+            checked += 1;
+        }
+    }
+    if let Some(r) = last_r {
+        assert_eq!(r, 0.0, "the last M73 R");
+    }
+    checked
+}
+
+/// PrusaSlicer runs `script <temporary file>` with the final name in `SLIC3R_PP_OUTPUT_NAME`;
+/// the file is rewritten, its thumbnail and config blocks untouched, its estimates true.
+#[test]
+fn in_place_as_prusaslicer_runs_it() {
+    let name = "prusaslicer-2.6.1_benchy_marlin2.gcode";
+    let file = scratch_copy("prusa", name);
+    let before = std::fs::read_to_string(&file).unwrap();
+    let out = cli(
+        &["optimize", "--in-place", file.to_str().unwrap()],
+        &[("SLIC3R_PP_OUTPUT_NAME", "/home/user/benchy.gcode")],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("/home/user/benchy.gcode"));
+    let after = std::fs::read_to_string(&file).unwrap();
+    assert_ne!(before, after);
+    for (b, e) in [
+        ("; thumbnail begin", "; thumbnail end"),
+        ("; prusaslicer_config = begin", "; prusaslicer_config = end"),
+    ] {
+        let kept = block(&before, b, e);
+        assert!(kept.len() > 2, "no {b} block");
+        assert_eq!(kept, block(&after, b, e), "{b} block changed");
+    }
+    assert_eq!(
+        before.lines().next(),
+        after.lines().next(),
+        "the first line identifies the slicer"
+    );
+    assert!(assert_estimates_true(&after) > 100);
+    // The benchy gets no slower and no dearer, and loses most of its sharp corners.
+    let a = quietpath::analyze(after.as_bytes(), &AnalyzeOptions::default()).unwrap();
+    let b = quietpath::analyze(before.as_bytes(), &AnalyzeOptions::default()).unwrap();
+    assert!(a.time_s <= b.time_s && a.energy.total_j <= b.energy.total_j);
+    let sharp = a.toolpath.n_turning as f64 / b.toolpath.n_turning as f64 - 1.0;
+    assert!(sharp <= -0.6, "sharp corners {:+.1} %", 100.0 * sharp);
+}
+
+/// SuperSlicer (PrusaSlicer's time comment, Klipper) and Cura (`;TIME:`, `;TIME_ELAPSED:`):
+/// `estimate --in-place` writes true estimates and touches nothing else.
+#[test]
+fn estimate_in_place_on_other_slicers_files() {
+    for (name, least) in [
+        ("superslicer-2.3.56_klipper_arcwelder.gcode", 1),
+        ("cura-4.10.0_multi-object.gcode", 10),
+        (
+            "crealityprint-5_k1c_benchy_klipper_exclude-object.gcode",
+            100,
+        ),
+    ] {
+        let file = scratch_copy("estimate", name);
+        let before = std::fs::read(&file).unwrap();
+        let out = cli(&["estimate", "--in-place", file.to_str().unwrap()], &[]);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let after = std::fs::read(&file).unwrap();
+        let text = String::from_utf8_lossy(&after);
+        assert!(assert_estimates_true(&text) >= least, "{name}");
+        // Every other line as it was: drop the rewritten ones and the header from both.
+        let plain = |t: &str| -> Vec<String> {
+            t.lines()
+                .filter(|l| {
+                    !(l.starts_with("M73 ")
+                        || l.starts_with(";TIME")
+                        || l.starts_with("; estimated")
+                        || l.starts_with("; quietpath "))
+                })
+                .map(str::to_string)
+                .collect()
+        };
+        assert_eq!(
+            plain(&String::from_utf8_lossy(&before)),
+            plain(&text),
+            "{name}"
+        );
+        // Our planner's time of the output is that of the input.
+        let o = AnalyzeOptions::default();
+        let (tb, ta) = (
+            quietpath::analyze(&before, &o).unwrap().time_s,
+            quietpath::analyze(&after, &o).unwrap().time_s,
+        );
+        assert_eq!(tb, ta, "{name}");
+    }
+}
+
+/// A run that fails (a malformed line under `--strict`) leaves the file byte-identical and
+/// exits non-zero with a message naming the line.
+#[test]
+fn a_failing_run_leaves_the_file_as_it_was() {
+    let file = scratch_copy("fail", "cura-4.10.0_multi-object.gcode");
+    let mut bytes = std::fs::read(&file).unwrap();
+    bytes.extend_from_slice(b"G1 X1..5 Y2\n");
+    std::fs::write(&file, &bytes).unwrap();
+    let out = cli(
+        &["optimize", "--in-place", "--strict", file.to_str().unwrap()],
+        &[],
+    );
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("error:") && err.contains(':'), "{err}");
+    assert_eq!(std::fs::read(&file).unwrap(), bytes);
+}
+
+/// Killed at any moment, an in-place run leaves either the input or the whole output, never
+/// a part of it (the write goes to a temporary file that is renamed when complete).
+#[test]
+fn an_interrupted_run_leaves_the_input_or_the_whole_output() {
+    let name = "prusaslicer-2.7.4_screw_arcfit.gcode";
+    let reference = scratch_copy("ref", name);
+    let ok = cli(
+        &[
+            "optimize",
+            "--in-place",
+            "--no-dynamics",
+            reference.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let complete = std::fs::read(&reference).unwrap();
+    let original = std::fs::read(corpus(name)).unwrap();
+    for (k, delay_ms) in [5u64, 50, 200, 400, 800, 1600].into_iter().enumerate() {
+        let file = scratch_copy(&format!("kill{k}"), name);
+        let mut child = Command::new(env!("CARGO_BIN_EXE_quietpath"))
+            .args(["optimize", "--in-place", "--no-dynamics"])
+            .arg(&file)
+            .stdout(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(delay_ms));
+        let _ = child.kill();
+        let _ = child.wait();
+        let now = std::fs::read(&file).unwrap();
+        assert!(
+            now == original || now == complete,
+            "killed after {delay_ms} ms: a partial file"
+        );
+    }
+}
+
+/// Several files at once into a folder: each written, a bad one reported, exit status non-zero.
+#[test]
+fn a_batch_writes_every_good_file_and_fails_for_the_bad_one() {
+    let good = scratch_copy("batch", "cura-4.10.0_multi-object.gcode");
+    let bad = good.with_file_name("not-gcode.gcode");
+    std::fs::write(&bad, [0u8, 159, 146, 150, 255].repeat(100)).unwrap();
+    let dir = good.with_file_name("out");
+    let out = cli(
+        &[
+            "optimize",
+            "--out-dir",
+            dir.to_str().unwrap(),
+            "--no-dynamics",
+            "--strict",
+            good.to_str().unwrap(),
+            bad.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("1 of 2 files failed"));
+    assert!(dir.join("cura-4.10.0_multi-object.gcode").exists());
+    assert!(!dir.join("not-gcode.gcode").exists());
+}
+
+/// Options from a TOML file, with the JSON API's names; a flag wins over the file.
+#[test]
+fn options_from_a_config_file() {
+    let file = scratch_copy("config", "cura-4.10.0_multi-object.gcode");
+    let config = file.with_file_name("quietpath.toml");
+    std::fs::write(
+        &config,
+        "arcs = \"off\"\n[vtg_options]\ntolerance_mm = 0.05\ndynamics = false\n",
+    )
+    .unwrap();
+    let out_path = file.with_file_name("out.gcode");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "optimize",
+            file.to_str().unwrap(),
+            "-o",
+            out_path.to_str().unwrap(),
+            "--json",
+        ];
+        args.extend_from_slice(&["--config", config.to_str().unwrap()]);
+        args.extend_from_slice(extra);
+        let out = cli(&args, &[]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let vtg = |v: &serde_json::Value| v["stages"][0]["message"].as_str().unwrap().to_string();
+    assert!(vtg(&run(&[])).contains("of 0.05 mm"), "{}", vtg(&run(&[])));
+    assert!(vtg(&run(&["--tolerance", "0.08"])).contains("of 0.08 mm"));
+    std::fs::write(&config, "tolerance = 1\n").unwrap();
+    let out = cli(
+        &[
+            "optimize",
+            file.to_str().unwrap(),
+            "-o",
+            out_path.to_str().unwrap(),
+            "--config",
+            config.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("quietpath.toml"));
+}
