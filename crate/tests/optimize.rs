@@ -352,3 +352,48 @@ fn options_from_a_config_file() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("quietpath.toml"));
 }
+
+/// The Cura post-processing script shipped in `integrations/cura`, run by Python the way Cura
+/// runs it (a list of layer chunks in, a list out) with a stand-in for Cura's `Script` base:
+/// the chunks come back optimised, and unchanged when the executable fails.
+#[test]
+fn the_cura_script_calls_the_cli() {
+    let dir = std::env::temp_dir().join(format!("quietpath-cura-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("Script.py"),
+        "class Script:\n    settings = {}\n    def getSettingValueByKey(self, k):\n        return self.settings.get(k)\n",
+    )
+    .unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../integrations/cura");
+    let program = r#"
+import sys
+sys.path[:0] = [sys.argv[1], sys.argv[2]]
+from QuietpathOptimize import QuietpathOptimize
+text = open(sys.argv[3], encoding="utf-8", newline="").read()
+chunks = [c for c in text.split(";LAYER:")]
+chunks = [chunks[0]] + [";LAYER:" + c for c in chunks[1:]]
+s = QuietpathOptimize()
+s.settings = {"executable": sys.argv[4], "extra_args": "--no-dynamics"}
+out = s.execute(chunks)
+assert len(out) == 1 and "; quietpath " in out[0], "not optimised"
+s.settings = {"executable": "/nonexistent/quietpath"}
+assert s.execute(chunks) == chunks, "a failure must hand the chunks back"
+print("ok")
+"#;
+    let out = Command::new("python3")
+        .arg("-c")
+        .arg(program)
+        .arg(&dir)
+        .arg(&script)
+        .arg(corpus("cura-4.10.0_multi-object.gcode"))
+        .arg(env!("CARGO_BIN_EXE_quietpath"))
+        .output()
+        .expect("python3 is needed to test the Cura script (apt install python3)");
+    assert!(
+        out.status.success() && String::from_utf8_lossy(&out.stdout).contains("ok"),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
