@@ -16,8 +16,8 @@ const ROOT_HELPERS: &[&str] = &["error", "math", "parallel", "progress", "vec3"]
 
 /// Lowest layer first: each module and the modules (besides [`ROOT_HELPERS`]) it may use.
 ///
-/// gcode → machine → plan → energy → read → analyze → path → dynamics / vtg / infill / orient →
-/// cli / wasm. `read` sits above `energy` because its options carry the energy settings every
+/// gcode → machine → plan → energy → read → analyze → path → estimate → dynamics / vtg / infill /
+/// orient → optimize → cli / wasm. `read` sits above `energy` because its options carry the energy settings every
 /// job passes on. `vtg` may use `dynamics` (its deviation rows); the four top library modules
 /// use nothing else of each other.
 const ALLOWED: &[(&str, &[&str])] = &[
@@ -46,13 +46,13 @@ const ALLOWED: &[(&str, &[&str])] = &[
     (
         "vtg",
         &[
-            "gcode", "machine", "plan", "read", "energy", "analyze", "path", "dynamics",
+            "gcode", "machine", "plan", "read", "energy", "analyze", "path", "dynamics", "estimate",
         ],
     ),
     (
         "infill",
         &[
-            "gcode", "machine", "plan", "read", "energy", "analyze", "path",
+            "gcode", "machine", "plan", "read", "energy", "analyze", "path", "estimate",
         ],
     ),
     (

@@ -397,3 +397,37 @@ print("ok")
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// Every rewriting command leaves true estimates behind: `vtg` on a PrusaSlicer file (its
+/// `; estimated printing time` line) and `infill` on a sliced fixture (its `M73` lines).
+#[test]
+fn vtg_and_infill_rewrite_the_estimates_they_change() {
+    let dir = std::env::temp_dir().join(format!("quietpath-rewriters-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures/gcode/prusaslicer-2.5.0_cube_marlin2_defaults.gcode");
+    for (cmd, input, least) in [
+        ("vtg", corpus("prusaslicer-2.7.4_screw_arcfit.gcode"), 1),
+        ("infill", fixture, 100),
+    ] {
+        let out = dir.join(format!("{cmd}.gcode"));
+        let mut args = vec![cmd, input.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        if cmd == "vtg" {
+            args.push("--no-dynamics");
+        } else {
+            args.extend(["--angles", "0,90", "--patterns", "rectilinear"]);
+        }
+        let run = cli(&args, &[]);
+        assert!(
+            run.status.success(),
+            "{cmd}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let text = std::fs::read_to_string(&out).unwrap();
+        assert!(
+            text.contains(&format!("; quietpath {cmd}:")),
+            "{cmd}: no header"
+        );
+        assert!(assert_estimates_true(&text) >= least, "{cmd}");
+    }
+}

@@ -53,6 +53,9 @@ pub struct Args {
     /// (by default the original is written unchanged and the report says why).
     #[arg(long)]
     pub force_candidate: bool,
+    /// Leave the file's time comments and M73 lines as the slicer wrote them.
+    #[arg(long)]
+    pub no_estimates: bool,
     /// Print the report as JSON (an array with several files).
     #[arg(long)]
     pub json: bool,
@@ -130,6 +133,7 @@ fn options(args: &Args) -> Result<InfillOptions, String> {
         per_layer: args.per_layer,
         spacing_mm: args.spacing,
         force_candidate: args.force_candidate,
+        estimates: !args.no_estimates,
     })
 }
 

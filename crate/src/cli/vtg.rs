@@ -42,6 +42,9 @@ pub struct Args {
     /// line, which eases out by up to the tolerance before a corner for a wider circle.
     #[arg(long)]
     pub inside_corners: bool,
+    /// Leave the file's time comments and M73 lines as the slicer wrote them.
+    #[arg(long)]
+    pub no_estimates: bool,
     /// Overwrite the input file if OUT names it.
     #[arg(long)]
     pub force: bool,
@@ -64,6 +67,7 @@ pub fn run(args: Args) -> Result<(), String> {
         arcs: args.arcs,
         allow_slower_pct: args.allow_slower,
         inside_corners: args.inside_corners,
+        estimates: !args.no_estimates,
         ..VtgOptions::default()
     };
     let mut bar = output::ProgressBar::for_input(input.len());

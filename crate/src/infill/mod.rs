@@ -89,6 +89,9 @@ pub struct InfillOptions {
     /// Write the best candidate even when it does not beat the original on the objective
     /// (default false: the original is kept and the report says so).
     pub force_candidate: bool,
+    /// Rewrite the file's time comments and `M73` lines from the planner when a candidate is
+    /// written (default true; see [`crate::estimate`]).
+    pub estimates: bool,
 }
 
 impl Default for InfillOptions {
@@ -103,6 +106,7 @@ impl Default for InfillOptions {
             per_layer: false,
             spacing_mm: None,
             force_candidate: false,
+            estimates: true,
         }
     }
 }

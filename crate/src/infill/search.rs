@@ -458,7 +458,7 @@ pub fn infill_with_progress(
         best.message =
             (!verdict.beats).then(|| verdict.describe(&best, "written anyway (force_candidate)"));
         measured_as_written(&mut best, &prep.before, &after);
-        (written.output, after)
+        with_estimates(options, &best, written.output, after)?
     } else {
         best = original_kept(
             &prep.before,
@@ -557,6 +557,26 @@ fn write_chosen(
         costs,
         layers,
     }
+}
+
+/// The written file with true time estimates (when asked and the file has any), and its
+/// analysis.
+fn with_estimates(
+    options: &InfillOptions,
+    best: &Best,
+    output: Vec<u8>,
+    after: Report,
+) -> Result<(Vec<u8>, Report), Error> {
+    if !options.estimates {
+        return Ok((output, after));
+    }
+    let note = format!(
+        "infill: {} at {}° (part turned {}°)",
+        best.pattern.name(),
+        best.angle_deg,
+        best.rotation_deg
+    );
+    Ok(crate::estimate::refresh(&output, &options.analyze, &note)?.unwrap_or((output, after)))
 }
 
 /// Whether the written file beats the original on the objective, both as `analyze` costs

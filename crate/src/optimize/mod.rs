@@ -120,6 +120,8 @@ pub fn optimize_with_progress(
             analyze: options.analyze.clone(),
             arcs,
             allow_slower_pct: options.allow_slower_pct,
+            // The pipeline writes the estimates once, at its end.
+            estimates: false,
             ..options.vtg_options.clone()
         };
         stages.push(current.vtg(&vtg, &mut p)?);

@@ -85,6 +85,7 @@ impl Stage {
     ) -> Result<StageReport, Error> {
         let o = InfillOptions {
             analyze: analyze.clone(),
+            estimates: false,
             ..options.clone()
         };
         let r = infill_with_progress(&self.file, &o, progress)?;

@@ -104,6 +104,9 @@ pub struct VtgOptions {
     /// near a corner, as the inside fillet moves it inward at the corner; this keeps every
     /// new point on or inside the corner's legs.
     pub inside_corners: bool,
+    /// Rewrite the file's time comments and `M73` lines from the planner when the toolpath
+    /// changed (default true; see [`crate::estimate`]).
+    pub estimates: bool,
 }
 
 /// The print time the rewrite may add by default, percent: the bar. More rounds more
@@ -125,6 +128,7 @@ impl Default for VtgOptions {
             arcs: false,
             allow_slower_pct: DEFAULT_ALLOW_SLOWER_PCT,
             inside_corners: false,
+            estimates: true,
         }
     }
 }
@@ -233,6 +237,15 @@ pub fn vtg_with_progress(
         report = with_simulated_deviation(input, report, options, &mut |variant, before, f| {
             attempt(variant, before, &mut |g| progress(f + 0.05 * g))
         })?;
+    }
+    if options.estimates && report.output != input {
+        let note = format!("vtg: corners rounded within {} mm", options.tolerance_mm);
+        if let Some((output, after)) =
+            crate::estimate::refresh(&report.output, &options.analyze, &note)?
+        {
+            report.output = output;
+            report.after = after;
+        }
     }
     progress(1.0);
     Ok(report)

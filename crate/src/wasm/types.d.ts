@@ -340,6 +340,8 @@ export interface InfillOptions {
   spacing_mm?: number | null;
   /** Write the best candidate even when it does not beat the original (default false: the original is kept). */
   force_candidate?: boolean;
+  /** Rewrite the file's time comments and M73 lines from the planner when a candidate is written (default true). */
+  estimates?: boolean;
 }
 export interface InfillCandidate {
   pattern: InfillPattern;
@@ -415,6 +417,8 @@ export interface VtgOptions {
   allow_slower_pct?: number;
   /** Round corners only on the inside, with fillets tangent to the legs (default false: the racing line, easing out by up to the tolerance before a corner for a circle 2.4× wider at 90°). */
   inside_corners?: boolean;
+  /** Rewrite the file's time comments and M73 lines from the planner when the toolpath changed (default true). */
+  estimates?: boolean;
 }
 /** before, after and the relative change in percent. */
 export interface Comparison { before: number; after: number; change_pct: number }
