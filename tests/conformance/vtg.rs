@@ -22,8 +22,11 @@ use std::path::PathBuf;
 use quietpath_conformance::{corpus, corpus_dir, fixtures_dir};
 
 /// Lines that are not `G0`–`G3` moves, in order.
+/// The lines that are not moves, without the header quietpath writes when it rewrites the
+/// file's time estimates (`; quietpath …`).
 fn non_motion_lines(bytes: &[u8]) -> Vec<Vec<u8>> {
     Lines::new(bytes)
+        .filter(|l| !l.text.starts_with(quietpath::estimate::HEADER_PREFIX.as_bytes()))
         .filter(|l| {
             parse_line(l.text).map_or(true, |p| {
                 !p.code()
