@@ -65,7 +65,7 @@ const els = {
 
 const DEMO_URL = 'demo/demo.gcode';
 const MAX_WARNINGS_SHOWN = 500;
-const JOB_NAMES = { vtg: 'VTG', infill: 'infill search', smooth: 'orientation smoothing', vibration: 'vibration analysis' };
+const JOB_NAMES = { optimize: 'optimize', vtg: 'VTG', infill: 'infill search', smooth: 'orientation smoothing', vibration: 'vibration analysis' };
 const LAYER_CACHE = 32;
 
 // Fields rendered by dedicated views; everything else goes to "More".
@@ -253,6 +253,13 @@ function jobOptions(form) {
       options[input.name] = raw;
     }
   }
+  // OptimizeOptions (types.d.ts): VTG's tolerance inside vtg_options, the infill search as
+  // an options object (its defaults).
+  if (form.dataset.job === 'optimize') {
+    if (isNum(options.tolerance_mm)) options.vtg_options = { tolerance_mm: options.tolerance_mm };
+    delete options.tolerance_mm;
+    if (options.infill === true) options.infill = {};
+  }
   // SmoothOptions.window is { points } or { millimetres } (types.d.ts).
   if (form.dataset.job === 'smooth') {
     if (isNum(options.window_mm)) options.window = { millimetres: options.window_mm };
@@ -356,6 +363,8 @@ function resultLine(job, r) {
       if (b.pattern === 'original') return `No candidate beats your file: it is kept as it was (${r.candidates?.length ?? '—'} candidates). ${b.message ?? ''}`;
       return `Best: ${b.pattern ?? '—'} at ${n(b.angle_deg, 1)}°${isNum(b.rotation_deg) ? ` (rotation ${n(b.rotation_deg, 1)}°)` : ''} of ${Array.isArray(r.candidates) ? r.candidates.length : '—'} candidates; energy ${pct(r.after?.energy?.total_j, r.before?.energy?.total_j)}.`;
     }
+    case 'optimize':
+      return (r.stages ?? []).map((s) => `${s.stage}: ${s.applied ? '' : 'not applied, '}${s.message}.`).join(' ');
     case 'smooth':
       return `${formatCount(r.points)} points, ${formatCount(r.corrected)} corrected; the smoothed orientation stays within ${n(r.max_angle_to_original_deg, 2)}° of the original.`;
     case 'vibration': {

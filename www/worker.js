@@ -60,7 +60,7 @@ import init, * as qp from './pkg/quietpath.js';
 const PROGRESS_STEP = 0.01;
 const PROGRESS_INTERVAL_MS = 50;
 const EXCERPT_MAX = 200;
-const JOBS = ['analyze', 'vtg', 'infill', 'smooth', 'vibration'];
+const JOBS = ['analyze', 'optimize', 'vtg', 'infill', 'smooth', 'vibration'];
 
 // Which jobs this build offers: a Session method or a free function.
 function capabilities() {

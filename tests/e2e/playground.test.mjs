@@ -438,6 +438,7 @@ for (const [job, file] of [
   // also run on the optimized output of the one before.
   ['smooth', MULTIAXIS],
   ['vtg', BENCHY],
+  ['optimize', BENCHY],
   ['infill', BENCHY],
   ['vibration', BENCHY],
 ]) {
