@@ -171,6 +171,53 @@ fn in_place_as_prusaslicer_runs_it() {
     assert!(sharp <= -0.6, "sharp corners {:+.1} %", 100.0 * sharp);
 }
 
+/// SuperSlicer runs post-processing scripts as PrusaSlicer does; its file drives Klipper and
+/// already has arcs (ArcWelder), so `arcs = auto` writes them.
+#[test]
+fn in_place_as_superslicer_runs_it() {
+    let file = scratch_copy("superslicer", "superslicer-2.3.56_klipper_arcwelder.gcode");
+    let before = std::fs::read_to_string(&file).unwrap();
+    let out = cli(
+        &["optimize", "--in-place", "--json", file.to_str().unwrap()],
+        &[("SLIC3R_PP_OUTPUT_NAME", "/home/user/part.gcode")],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let after = std::fs::read_to_string(&file).unwrap();
+    let kept = block(&before, "; thumbnail begin", "; thumbnail end");
+    assert!(kept.len() > 2, "no thumbnail");
+    assert_eq!(kept, block(&after, "; thumbnail begin", "; thumbnail end"));
+    // SuperSlicer 2.3 ends with its settings as `; key = value` lines, no begin/end markers.
+    let tail = |t: &str| {
+        t.lines()
+            .rev()
+            .take(300)
+            .map(str::to_string)
+            .collect::<Vec<_>>()
+    };
+    assert!(
+        tail(&before).iter().all(|l| l.starts_with("; ")),
+        "not the settings"
+    );
+    assert_eq!(tail(&before), tail(&after), "the settings block changed");
+    assert!(assert_estimates_true(&after) >= 1);
+    let (b, a) = (&report["before"], &report["after"]);
+    assert!(a["time_s"].as_f64() <= b["time_s"].as_f64());
+    assert!(a["energy"]["total_j"].as_f64() <= b["energy"]["total_j"].as_f64());
+    let vtg = &report["stages"][0];
+    assert_eq!(vtg["stage"], "vtg");
+    if vtg["applied"] == true {
+        assert!(
+            vtg["message"].as_str().unwrap().contains("arcs written"),
+            "{vtg}"
+        );
+    }
+}
+
 /// SuperSlicer (PrusaSlicer's time comment, Klipper) and Cura (`;TIME:`, `;TIME_ELAPSED:`):
 /// `estimate --in-place` writes true estimates and touches nothing else.
 #[test]

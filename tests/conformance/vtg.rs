@@ -26,7 +26,10 @@ use quietpath_conformance::{corpus, corpus_dir, fixtures_dir};
 /// file's time estimates (`; quietpath …`).
 fn non_motion_lines(bytes: &[u8]) -> Vec<Vec<u8>> {
     Lines::new(bytes)
-        .filter(|l| !l.text.starts_with(quietpath::estimate::HEADER_PREFIX.as_bytes()))
+        .filter(|l| {
+            !l.text
+                .starts_with(quietpath::estimate::HEADER_PREFIX.as_bytes())
+        })
         .filter(|l| {
             parse_line(l.text).map_or(true, |p| {
                 !p.code()

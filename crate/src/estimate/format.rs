@@ -121,6 +121,14 @@ fn comment(text: &str, at: &At) -> Option<String> {
             at.remaining_s().round() as u64
         ));
     }
+    if let Some(prefix) = simplify3d_build_time(text) {
+        let minutes = (at.total_s / 60.0).round() as u64;
+        return Some(format!(
+            "{prefix}{} hours {} minutes",
+            minutes / 60,
+            minutes % 60
+        ));
+    }
     if text.starts_with("; --- print time: ") && text.ends_with("s ---") {
         return Some(format!(
             "; --- print time: {}s ---",
@@ -128,6 +136,23 @@ fn comment(text: &str, at: &At) -> Option<String> {
         ));
     }
     None
+}
+
+/// Simplify3D's `;   Build Time: 1 hours 2 minutes` (`Build time` before version 5): the text
+/// up to the time, if the line is one.
+fn simplify3d_build_time(text: &str) -> Option<&str> {
+    let body = text.strip_prefix(';')?.trim_start();
+    let label = body.get(..11)?;
+    if !label.eq_ignore_ascii_case("build time:") || !body.ends_with("minutes") {
+        return None;
+    }
+    let cut = text.len() - body.len() + 11;
+    let prefix = &text[..cut];
+    Some(if text[cut..].starts_with(' ') {
+        &text[..cut + 1]
+    } else {
+        prefix
+    })
 }
 
 /// PrusaSlicer's `1d 2h 3m 4s` form, leading zero units left out.
@@ -198,6 +223,14 @@ mod tests {
         assert_eq!(
             line("; --- print time: 806s ---").as_deref(),
             Some("; --- print time: 2400s ---")
+        );
+        assert_eq!(
+            line(";   Build Time: 0 hours 3 minutes").as_deref(),
+            Some(";   Build Time: 0 hours 40 minutes")
+        );
+        assert_eq!(
+            line(";   Build time: 2 hours 6 minutes").as_deref(),
+            Some(";   Build time: 0 hours 40 minutes")
         );
         // A setting that holds such text, and a placeholder, are not estimates.
         assert_eq!(

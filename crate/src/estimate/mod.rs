@@ -5,9 +5,9 @@
 //! those still hold the slicer's numbers for the old toolpath; [`rewrite_estimates`] puts in
 //! the time the planner gives the file it is handed, at the same places: `M73 P R` / `Q S`,
 //! PrusaSlicer's (and its forks') `; estimated printing time` lines, Cura's `;TIME:` and
-//! `;TIME_ELAPSED:`, ideaMaker's and Kiri:Moto's. Every other line is copied byte for byte, so
-//! the planner's time of the output is that of the input: the estimates are true of the file
-//! they are written into.
+//! `;TIME_ELAPSED:`, Simplify3D's build time, ideaMaker's and Kiri:Moto's. Every other line is
+//! copied byte for byte, so the planner's time of the output is that of the input: the
+//! estimates are true of the file they are written into.
 
 mod clock;
 mod format;
