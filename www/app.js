@@ -328,6 +328,17 @@ function showJobResult(job, result, outBytes, target) {
   els.resultLine.textContent = resultLine(job, result);
   // An infill search that kept the original hands back the input: nothing better to download.
   const keptOriginal = job === 'infill' && result.best?.pattern === 'original';
+  if (keptOriginal && output) {
+    // The download and the after view would otherwise offer an earlier job's file as this one's.
+    output = null;
+    fileToken++;
+    layerCache.clear();
+    delete vibrationRuns.output;
+    els.downloadGcode.disabled = true;
+    if (els.viewMode.value !== 'before') els.viewMode.value = 'before';
+    viewer.set('mode', els.viewMode.value);
+    refreshLayers();
+  }
   if (outBytes && !keptOriginal) {
     output = { job, bytes: outBytes };
     fileToken++;
