@@ -68,6 +68,10 @@ impl Fold for Tally<'_> {
     fn event(&mut self, _: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
         let to_timing = &mut self.to_timing;
         match event {
+            Event::Move(m) if at.untimed_homing(m) => {
+                self.acc.totals.homing_count += 1;
+                to_timing(TimeMsg::Flush);
+            }
             Event::Move(m) => to_timing(self.acc.read_move(m, at.layers)),
             &Event::Dwell(secs) => to_timing(self.acc.dwell(secs, at.layers)),
             &Event::Temperature {
@@ -139,7 +143,7 @@ fn report(
         toolpath,
         ..
     } = acc;
-    let Timing { planner, book, .. } = timing;
+    let (time_s, Timing { book, .. }) = (timing.planner.elapsed_s(), timing);
     let TimeBook {
         energy: energy_acc,
         temperatures,
@@ -159,7 +163,6 @@ fn report(
     if travel.moves > 0 {
         features.push(travel);
     }
-    let time_s = planner.elapsed_s();
     let energy = energy_acc.finish(time_s, material_g, &temperatures, &fans);
     share_aux_energy(energy.aux_j, time_s, &mut features, &mut layer_list);
     let (warnings, warnings_dropped) = setup.warnings.into_parts();
@@ -174,6 +177,7 @@ fn report(
         },
         time_s,
         dwell_s: totals.dwell_s,
+        homing_count: totals.homing_count,
         time_model: "planner".into(),
         machine: MachineInfo {
             profile: setup.profile.name,
