@@ -684,7 +684,9 @@ impl Machine {
             return None;
         }
         if let MoveKind::Arc(a) = &kind {
-            if a.planar_length() <= 1e-12 {
+            // Klipper still cuts a helix of no planar length into pieces along its rise.
+            let rise = d(a.plane.axes().2);
+            if a.planar_length() <= 1e-12 && !(self.klipper && rise != 0.0) {
                 kind = MoveKind::Linear;
             }
         }
@@ -732,10 +734,22 @@ impl Machine {
             );
             return None;
         }
-        let turns = p.get(b'P').map_or(1, |t| t.clamp(1.0, 1000.0) as u32);
+        // Klipper has no `P` (turns), and sweeps as `arc::klipper_sweep` says.
+        let turns = match p.get(b'P') {
+            Some(t) if !self.klipper => t.clamp(1.0, 1000.0) as u32,
+            _ => 1,
+        };
         let start = [self.logical[a0], self.logical[a1]];
         let end = [target[a0], target[a1]];
-        match Arc::new(self.plane, start, end, spec, clockwise, turns) {
+        let arc =
+            Arc::new(self.plane, start, end, spec, clockwise, turns).map(|(arc, bad)| match spec {
+                ArcSpec::Offsets(i, j) if self.klipper => {
+                    let sweep = arc::klipper_sweep(start, end, (i, j), clockwise);
+                    (Arc { sweep, ..arc }, bad)
+                }
+                _ => (arc, bad),
+            });
+        match arc {
             Ok((arc, _)) if arc.radius > MAX_ARC_MM || arc.planar_length() > MAX_ARC_MM => {
                 warnings.push(
                     line_no,

@@ -164,16 +164,18 @@ fn segment_count(n: f64) -> usize {
 
 /// Number of straight segments the firmware of a junction model cuts an arc into: Klipper's
 /// `[gcode_arcs]` makes pieces of `resolution` (the machine's `arc_segment_mm`, 1 mm unless
-/// set), `floor(length / resolution)` of them; Marlin 2 as in [`arc_segments`].
+/// set) along the helix (`rise`: along its axis), `floor(length / resolution)` of them;
+/// Marlin 2 as in [`arc_segments`], by the planar length.
 pub fn firmware_arc_segments(
     model: JunctionModel,
     radius: f64,
-    planar_length: f64,
+    (planar_length, rise): (f64, f64),
     feed_mm_s: f64,
     max_segment_mm: f64,
 ) -> usize {
     if model == JunctionModel::Klipper {
-        segment_count((planar_length / max_segment_mm.at_least(1e-3)).floor())
+        let length = planar_length.hypot(rise);
+        segment_count((length / max_segment_mm.at_least(1e-3)).floor())
     } else {
         arc_segments(radius, planar_length, feed_mm_s, max_segment_mm)
     }
@@ -293,7 +295,7 @@ impl Planner {
                 let n = firmware_arc_segments(
                     self.model,
                     arc.radius,
-                    arc.planar_length(),
+                    (arc.planar_length(), m.delta[h]),
                     m.feed_mm_s,
                     self.limits.arc_segment_mm.value,
                 );
@@ -301,7 +303,12 @@ impl Planner {
                 for k in 1..=n {
                     let t = k as f64 / n as f64;
                     let mut cur = [0.0f64; 4];
-                    let p = arc.offset_at(t);
+                    // Klipper ends the last piece on the target, which an end point a little
+                    // off the arc's circle (rounded in the file) does not lie on.
+                    let p = match self.model {
+                        JunctionModel::Klipper if k == n => [m.delta[p0], m.delta[p1]],
+                        _ => arc.offset_at(t),
+                    };
                     cur[p0] = p[0];
                     cur[p1] = p[1];
                     cur[h] = m.delta[h] * t;
