@@ -255,3 +255,24 @@ fn share_aux_energy(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn klipper_homing_is_counted_not_timed_and_marlin_times_it_as_a_move() {
+        let json = |r: &Report| serde_json::to_string(r).expect("json");
+        // SET_VELOCITY_LIMIT: the file drives Klipper.
+        let klipper = b"SET_VELOCITY_LIMIT ACCEL=3000\nG1 X50 F6000\nG28\nG1 X10\n";
+        let r = analyze(klipper, &AnalyzeOptions::default()).expect("analysis");
+        assert_eq!((r.homing_count, r.moves), (1, 2));
+        assert!(json(&r).contains("\"homing_count\":1"));
+        let marlin = b"G1 X50 F6000\nG28\nG1 X10\n";
+        let m = analyze(marlin, &AnalyzeOptions::default()).expect("analysis");
+        assert_eq!((m.homing_count, m.moves), (0, 3));
+        assert!(!json(&m).contains("homing_count"), "absent when none");
+        // Homing is a stop: the two moves on Klipper each run from rest to rest.
+        assert!(r.time_s < m.time_s, "{} {}", r.time_s, m.time_s);
+    }
+}
