@@ -836,7 +836,12 @@ fn klipper_cruise_v2(blocks: &[Block], legacy: bool, out: &mut Vec<f64>) -> Opti
                 if peaks == 2 {
                     lazy = Some(delayed_end.unwrap_or(i) + 1);
                 }
-                peak_v2 = sq(b.cruise).at_most((smoothed_v2 + reach_smoothed_v2) * 0.5);
+                // Older Klipper caps a chain's peak by the cruise of the block that sets
+                // it; current Klipper only each block's own cruise.
+                peak_v2 = (smoothed_v2 + reach_smoothed_v2) * 0.5;
+                if legacy {
+                    peak_v2 = peak_v2.at_most(sq(b.cruise));
+                }
             }
             let reach_v2 = sq(b.exit) + 2.0 * b.distance * b.acceleration;
             let cruise_v2 = ((sq(b.entry) + reach_v2) * 0.5)
