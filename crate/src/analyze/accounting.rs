@@ -32,6 +32,7 @@ pub struct Totals {
     pub lines: u64,
     pub bounds: Option<Bounds>,
     pub dwell_s: f64,
+    pub homing_count: u64,
 }
 
 /// An event waiting for its time.

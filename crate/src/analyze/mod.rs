@@ -68,6 +68,10 @@ impl Fold for Tally<'_> {
     fn event(&mut self, _: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
         let to_timing = &mut self.to_timing;
         match event {
+            Event::Move(m) if at.untimed_homing(m) => {
+                self.acc.totals.homing_count += 1;
+                to_timing(TimeMsg::Flush);
+            }
             Event::Move(m) => to_timing(self.acc.read_move(m, at.layers)),
             &Event::Dwell(secs) => to_timing(self.acc.dwell(secs, at.layers)),
             &Event::Temperature {
@@ -139,7 +143,7 @@ fn report(
         toolpath,
         ..
     } = acc;
-    let Timing { planner, book, .. } = timing;
+    let (time_s, Timing { book, .. }) = (timing.planner.elapsed_s(), timing);
     let TimeBook {
         energy: energy_acc,
         temperatures,
@@ -159,7 +163,6 @@ fn report(
     if travel.moves > 0 {
         features.push(travel);
     }
-    let time_s = planner.elapsed_s();
     let energy = energy_acc.finish(time_s, material_g, &temperatures, &fans);
     share_aux_energy(energy.aux_j, time_s, &mut features, &mut layer_list);
     let (warnings, warnings_dropped) = setup.warnings.into_parts();
@@ -174,6 +177,7 @@ fn report(
         },
         time_s,
         dwell_s: totals.dwell_s,
+        homing_count: totals.homing_count,
         time_model: "planner".into(),
         machine: MachineInfo {
             profile: setup.profile.name,
@@ -249,5 +253,26 @@ fn share_aux_energy(
         for l in layers {
             l.energy_j += share(l.time_s);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn klipper_homing_is_counted_not_timed_and_marlin_times_it_as_a_move() {
+        let json = |r: &Report| serde_json::to_string(r).expect("json");
+        // SET_VELOCITY_LIMIT: the file drives Klipper.
+        let klipper = b"SET_VELOCITY_LIMIT ACCEL=3000\nG1 X50 F6000\nG28\nG1 X10\n";
+        let r = analyze(klipper, &AnalyzeOptions::default()).expect("analysis");
+        assert_eq!((r.homing_count, r.moves), (1, 2));
+        assert!(json(&r).contains("\"homing_count\":1"));
+        let marlin = b"G1 X50 F6000\nG28\nG1 X10\n";
+        let m = analyze(marlin, &AnalyzeOptions::default()).expect("analysis");
+        assert_eq!((m.homing_count, m.moves), (0, 3));
+        assert!(!json(&m).contains("homing_count"), "absent when none");
+        // Homing is a stop: the two moves on Klipper each run from rest to rest.
+        assert!(r.time_s < m.time_s, "{} {}", r.time_s, m.time_s);
     }
 }

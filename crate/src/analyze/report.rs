@@ -20,6 +20,11 @@ pub struct Report {
     /// Time spent in dwells (`G4`), s: included in `time_s`. (PrusaSlicer's estimate leaves
     /// dwells out, so comparisons with it subtract this.)
     pub dwell_s: f64,
+    /// Homings (`G28`) on Klipper, left out of `time_s` and of the moves: how long homing
+    /// takes depends on the printer, and no file tells. Each stops the toolhead. Absent when
+    /// there are none (and on Marlin-style files, where `G28` is timed as a move to 0).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub homing_count: u64,
     /// How `time_s` was computed (`planner`: firmware look-ahead with the junction model below).
     pub time_model: String,
     /// The machine the file was planned for.
@@ -66,6 +71,10 @@ pub struct Report {
     pub warnings: Vec<Warning>,
     /// Warnings counted beyond the ones listed.
     pub warnings_dropped: u64,
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }
 
 /// Facts about the input file.

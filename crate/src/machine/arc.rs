@@ -178,6 +178,34 @@ impl Arc {
     }
 }
 
+/// The signed sweep Klipper's `[gcode_arcs]` gives an arc from `start` to `end` with centre
+/// offsets `(i, j)`, rad, computed in its order of operations: the angle between the start
+/// and end radii, wrapped to (0, 2π) counter-clockwise or (−2π, 0) clockwise, and a full turn
+/// only when that angle is exactly 0 and the end is the start. A closed arc whose centre does
+/// not round-trip exactly (`(x + i) − x ≠ i`) comes out as a sliver of an angle, not a turn:
+/// Creality Print's spiral lifts (`G3 Z… I… J…` back to the start) run on Klipper as a
+/// straight Z move, and so they are timed here.
+pub fn klipper_sweep(start: [f64; 2], end: [f64; 2], (i, j): (f64, f64), clockwise: bool) -> f64 {
+    let (r_p, r_q) = (-i, -j);
+    let (center_p, center_q) = (start[0] - r_p, start[1] - r_q);
+    let (rt_alpha, rt_beta) = (end[0] - center_p, end[1] - center_q);
+    let mut angle = atan2(
+        r_p * rt_beta - r_q * rt_alpha,
+        r_p * rt_alpha + r_q * rt_beta,
+    );
+    let tau = std::f64::consts::TAU;
+    if angle < 0.0 {
+        angle += tau;
+    }
+    if clockwise {
+        angle -= tau;
+    }
+    if angle == 0.0 && start == end {
+        angle = tau;
+    }
+    angle
+}
+
 /// Centre offsets of an `R`-form arc (the construction of RS274/NGC and grbl).
 fn radius_to_offsets(
     start: [f64; 2],

@@ -6,7 +6,8 @@
 //!   returns E to the `M82`/`M83` mode (Klipper's rule; Marlin's differs only if `G90` comes
 //!   after `M83`, which slicers do not write).
 //! - `G0` moves at the modal feed rate like `G1` (both firmwares, by default).
-//! - `G28` sets the homed axes (all, if none named) to 0; homing time is not modelled.
+//! - `G28` sets the homed axes (all, if none named) to 0, as a move there (Marlin-style files
+//!   time it as one; on Klipper it is untimed homing, see `read::At::untimed_homing`).
 //! - `G10`/`G11` without `P`/`L` are firmware retraction with the `M207`/`M208` lengths.
 //! - `M220` scales feed rates, `M221` scales extrusion.
 
@@ -102,6 +103,9 @@ pub const OVERRIDE_RANGE_PERCENT: std::ops::RangeInclusive<f64> = 1.0..=1000.0;
 /// Heater targets accepted, °C: from "off" (negative values are read as off by firmware too)
 /// to well above any hotend's maximum (high-temperature printers reach 500 °C).
 pub const TEMPERATURE_RANGE_C: std::ops::RangeInclusive<f64> = -273.15..=1500.0;
+/// Klipper's wait when `M84`/`M18` turns the motors off, s: `stepper_enable.py` dwells its
+/// `DISABLE_STALL_TIME` (0.1 s) before and after, so that no step overlaps the change.
+pub const KLIPPER_MOTORS_OFF_S: f64 = 0.2;
 /// Default firmware retraction length, mm (Marlin's `RETRACT_LENGTH`).
 pub const DEFAULT_RETRACT_MM: f64 = 3.0;
 /// Default firmware retraction speed, mm/s (Marlin's `RETRACT_FEEDRATE`).
@@ -238,8 +242,9 @@ pub struct MachineConfig {
     /// Firmware retraction speed before any `M207`, mm/s.
     pub retract_feed_mm_s: f64,
     /// Read commands as Klipper does where it differs from Marlin: `G4` takes only `P`
-    /// (milliseconds; `G4 S2` is no dwell), and `M400` empties the look-ahead (the toolhead
-    /// stops there).
+    /// (milliseconds; `G4 S2` is no dwell), every `G4` and `M400` empties the look-ahead
+    /// (the toolhead stops there), and `M84`/`M18` waits [`KLIPPER_MOTORS_OFF_S`] when a motor
+    /// was on.
     pub klipper: bool,
 }
 
@@ -275,6 +280,8 @@ pub struct Machine {
     unretract_feed_mm_s: f64,
     tool: u16,
     klipper: bool,
+    /// A move has run since the start or the last `M84` (its motors are on).
+    motors_on: bool,
 }
 
 impl Default for Machine {
@@ -303,6 +310,7 @@ impl Machine {
             unretract_feed_mm_s: config.retract_feed_mm_s,
             tool: 0,
             klipper: config.klipper,
+            motors_on: false,
         }
     }
 
@@ -396,7 +404,11 @@ impl Machine {
         warnings: &mut Warnings,
     ) -> Option<Event> {
         match code.letter {
-            b'G' => self.apply_g(line_no, code, line, warnings),
+            b'G' => {
+                let event = self.apply_g(line_no, code, line, warnings);
+                self.motors_on |= matches!(event, Some(Event::Move(_)));
+                event
+            }
             b'M' => self.apply_m(line_no, code.number, line, warnings),
             b'T' => {
                 self.tool = code.number;
@@ -522,6 +534,12 @@ impl Machine {
             // Klipper's M400 waits for the queue to drain: a dwell of no time, which stops the
             // look-ahead as a heater wait does.
             400 if self.klipper => return Some(Event::Dwell(0.0)),
+            // Klipper's M84/M18 stops the toolhead and, if a motor was on, waits
+            // KLIPPER_MOTORS_OFF_S around turning them off.
+            18 | 84 if self.klipper => {
+                let on = std::mem::take(&mut self.motors_on);
+                return Some(Event::Dwell(if on { KLIPPER_MOTORS_OFF_S } else { 0.0 }));
+            }
             _ => {}
         }
         None
@@ -666,7 +684,9 @@ impl Machine {
             return None;
         }
         if let MoveKind::Arc(a) = &kind {
-            if a.planar_length() <= 1e-12 {
+            // Klipper still cuts a helix of no planar length into pieces along its rise.
+            let rise = d(a.plane.axes().2);
+            if a.planar_length() <= 1e-12 && !(self.klipper && rise != 0.0) {
                 kind = MoveKind::Linear;
             }
         }
@@ -714,10 +734,22 @@ impl Machine {
             );
             return None;
         }
-        let turns = p.get(b'P').map_or(1, |t| t.clamp(1.0, 1000.0) as u32);
+        // Klipper has no `P` (turns), and sweeps as `arc::klipper_sweep` says.
+        let turns = match p.get(b'P') {
+            Some(t) if !self.klipper => t.clamp(1.0, 1000.0) as u32,
+            _ => 1,
+        };
         let start = [self.logical[a0], self.logical[a1]];
         let end = [target[a0], target[a1]];
-        match Arc::new(self.plane, start, end, spec, clockwise, turns) {
+        let arc =
+            Arc::new(self.plane, start, end, spec, clockwise, turns).map(|(arc, bad)| match spec {
+                ArcSpec::Offsets(i, j) if self.klipper => {
+                    let sweep = arc::klipper_sweep(start, end, (i, j), clockwise);
+                    (Arc { sweep, ..arc }, bad)
+                }
+                _ => (arc, bad),
+            });
+        match arc {
             Ok((arc, _)) if arc.radius > MAX_ARC_MM || arc.planar_length() > MAX_ARC_MM => {
                 warnings.push(
                     line_no,
@@ -821,7 +853,8 @@ impl Machine {
     }
 }
 
-/// A `G4` dwell: `S` seconds or `P` milliseconds; `None` for none or one out of range.
+/// A `G4` dwell: `S` seconds or `P` milliseconds (Klipper: only `P`, and a dwell of none is
+/// still a stop); `None` for none or one out of range.
 fn dwell(line_no: u32, p: &Params, klipper: bool, warnings: &mut Warnings) -> Option<Event> {
     let secs = match (p.get(b'S').filter(|_| !klipper), p.get(b'P')) {
         (Some(s), _) => s,
@@ -835,7 +868,9 @@ fn dwell(line_no: u32, p: &Params, klipper: bool, warnings: &mut Warnings) -> Op
         );
         return None;
     }
-    (secs > 0.0).then_some(Event::Dwell(secs))
+    // Klipper's G4 waits for the look-ahead to empty even when it dwells no time (`G4 S2`,
+    // `G4 P0`): the toolhead stops there.
+    (secs > 0.0 || klipper).then_some(Event::Dwell(secs))
 }
 
 /// Fan speed of `M106 S`, 0..=1: RepRapFirmware accepts 0..1 fractions; Marlin and Klipper
@@ -908,7 +943,7 @@ mod tests {
     }
 
     #[test]
-    fn klipper_dwells_only_on_p_and_stops_at_m400() {
+    fn klipper_dwells_only_on_p_and_stops_at_every_g4_and_m400() {
         let src = "G4 S2\nG4 P500\nM400";
         let dwells = |klipper| {
             let config = MachineConfig {
@@ -928,7 +963,11 @@ mod tests {
             [2.0, 0.5],
             "Marlin: S seconds, P ms, M400 no event"
         );
-        assert_eq!(dwells(true), [0.5, 0.0], "Klipper: no S, P ms, M400 a stop");
+        assert_eq!(
+            dwells(true),
+            [0.0, 0.5, 0.0],
+            "Klipper: S no dwell but a stop, P ms, M400 a stop"
+        );
     }
 
     #[test]

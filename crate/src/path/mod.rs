@@ -236,8 +236,14 @@ impl<S: MoveSink> Fold for Walk<'_, S> {
                     timing: None,
                 };
                 sink.moved(index, moved, at.layers, &self.features);
-                if let Some(planner) = planner {
-                    planner.push(&Motion::from(m), index as u64, &mut |pm| sink.timed(pm));
+                match planner {
+                    Some(planner) if at.untimed_homing(m) => {
+                        planner.flush(&mut |pm| sink.timed(pm))
+                    }
+                    Some(planner) => {
+                        planner.push(&Motion::from(m), index as u64, &mut |pm| sink.timed(pm));
+                    }
+                    None => {}
                 }
             }
             (&Event::Dwell(secs), Some(planner)) => {

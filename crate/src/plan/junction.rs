@@ -22,6 +22,10 @@ pub struct Segment {
     pub distance: f64,
     /// Acceleration, mm/s².
     pub acceleration: f64,
+    /// Klipper: the toolhead's junction deviation when the move was queued,
+    /// [`klipper_junction_deviation`] of the square-corner velocity and the toolhead's
+    /// `max_accel` then (not the move's own, lower acceleration), mm. Unused by other models.
+    pub klipper_jd: f64,
 }
 
 /// Jerk-limited "safe" speed of a move: the speed from which every axis can stop at once
@@ -127,16 +131,19 @@ pub fn junction_deviation(prev: &Segment, curr: &Segment, limits: &Limits) -> f6
 /// in filament speed a junction may ask of the extruder.
 pub const KLIPPER_INSTANT_CORNER_V: f64 = 1.0;
 
-/// Klipper's junction speed: the square-corner velocity as an equivalent junction deviation
-/// (`scv² (√2 − 1) / accel`), the centripetal limit of both moves, and the extruder's limit:
-/// where the filament per millimetre changes by Δr (a travel straight into a print, a change
-/// of line width), the junction is held to `instantaneous_corner_velocity / |Δr|`, so the
-/// filament speed steps by at most that much.
+/// Klipper's junction speed (`toolhead.py` `calc_junction`): the square-corner velocity as
+/// an equivalent junction deviation (`scv² (√2 − 1) / max_accel`, the toolhead's), times each
+/// move's own acceleration, so a move with a lower one (a Z hop) passes its corners slower;
+/// the centripetal limit of both moves; and the extruder's limit: where the filament per
+/// millimetre changes by Δr (a travel straight into a print, a change of line width), the
+/// junction is held to `instantaneous_corner_velocity / |Δr|`, so the filament speed steps by
+/// at most that much. Older Klipper (`max_accel_to_decel` in force: v0.12, Creality's K1
+/// firmware) stops at a full reversal and bounds a straight junction by the centripetal limit
+/// of an angle of 0.999999; current Klipper passes both at the cruise speeds.
 pub fn klipper(prev: &Segment, curr: &Segment, limits: &Limits) -> f64 {
     if is_e_only(prev) || is_e_only(curr) {
         return 0.0;
     }
-    let scv = limits.square_corner_velocity.value;
     let mut max_v2 = curr.cruise * curr.cruise;
     max_v2 = max_v2.at_most(prev.cruise * prev.cruise);
     let e_ratio = |s: &Segment| {
@@ -148,20 +155,28 @@ pub fn klipper(prev: &Segment, curr: &Segment, limits: &Limits) -> f64 {
     };
     let step = (e_ratio(curr) - e_ratio(prev)).abs();
     if step > 0.0 {
-        let v = KLIPPER_INSTANT_CORNER_V / step;
+        let icv = limits
+            .instantaneous_corner_velocity
+            .map_or(KLIPPER_INSTANT_CORNER_V, |l| l.value);
+        let v = icv / step;
         max_v2 = max_v2.at_most(v * v);
     }
-    let cos = cos_theta(prev, curr);
+    let mut cos = cos_theta(prev, curr);
+    if limits.accel_to_decel.value > 0.0 {
+        if cos > 0.999_999 {
+            return 0.0;
+        }
+        cos = cos.at_least(-0.999_999);
+    }
     let sin_d2 = (0.5 * (1.0 - cos)).at_least(0.0).sqrt();
     let cos_d2 = (0.5 * (1.0 + cos)).at_least(0.0).sqrt();
     let one_minus_sin = 1.0 - sin_d2;
     if one_minus_sin > 0.0 && cos_d2 > 0.0 {
         let r_jd = sin_d2 / one_minus_sin;
-        let jd = |accel: f64| klipper_junction_deviation(scv, accel);
         let quarter_tan = 0.25 * sin_d2 / cos_d2;
         max_v2 = max_v2
-            .at_most(r_jd * jd(curr.acceleration) * curr.acceleration)
-            .at_most(r_jd * jd(prev.acceleration) * prev.acceleration)
+            .at_most(r_jd * curr.klipper_jd * curr.acceleration)
+            .at_most(r_jd * prev.klipper_jd * prev.acceleration)
             .at_most(2.0 * curr.distance * curr.acceleration * quarter_tan)
             .at_most(2.0 * prev.distance * prev.acceleration * quarter_tan);
     }
@@ -193,6 +208,7 @@ mod tests {
             unit,
             distance,
             acceleration: accel,
+            klipper_jd: klipper_junction_deviation(5.0, accel),
         }
     }
 
@@ -246,6 +262,18 @@ mod tests {
             let v = klipper(&a, &b, &l);
             assert!((v - 5.0).abs() < 1e-9, "{accel}: {v}");
         }
+    }
+
+    #[test]
+    fn klipper_corners_of_a_slower_move_use_the_toolheads_junction_deviation() {
+        // A Z hop accelerating at 350 mm/s² on a 3000 mm/s² printer: the junction deviation
+        // stays the toolhead's, so the square corner runs at 5 √(350 / 3000) mm/s, not at 5.
+        let l = limits();
+        let a = seg([1.0, 0.0], 200.0, 3000.0, 50.0);
+        let mut hop = seg([0.0, 1.0], 200.0, 350.0, 50.0);
+        hop.klipper_jd = klipper_junction_deviation(5.0, 3000.0);
+        let v = klipper(&a, &hop, &l);
+        assert!((v - 5.0 * (350.0f64 / 3000.0).sqrt()).abs() < 1e-9, "{v}");
     }
 
     #[test]

@@ -262,6 +262,12 @@ impl KlipperConfig {
             self.square_corner_velocity.or(Some(5.0)),
         );
         put(&mut l.arc_segment_mm, self.arc_resolution);
+        if let Some(value) = self.instantaneous_corner_velocity {
+            l.instantaneous_corner_velocity = Some(Limit {
+                value,
+                source: LimitSource::PrinterConfig,
+            });
+        }
         let accel = self.max_accel.unwrap_or(l.acceleration.value);
         match version {
             KlipperVersion::Current => {

@@ -7,6 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::klipper_config::KlipperVersion;
 use crate::gcode::Line;
 
 /// Where a limit's current value came from.
@@ -97,6 +98,12 @@ pub struct Limits {
     pub min_travel_feedrate: Limit,
     /// Length of the straight segments arcs are split into, mm.
     pub arc_segment_mm: Limit,
+    /// Klipper's `[extruder] instantaneous_corner_velocity`, mm/s: the largest step in filament
+    /// speed a junction may ask of the extruder. Unset: Klipper's default,
+    /// [`KLIPPER_INSTANT_CORNER_V`](super::junction::KLIPPER_INSTANT_CORNER_V) (and not in the
+    /// report, which is unchanged for every file that sets no Klipper config).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub instantaneous_corner_velocity: Option<Limit>,
 }
 
 /// Units of `M203`/`M566` feed rates: Marlin takes mm/s, RepRapFirmware mm/min.
@@ -135,8 +142,15 @@ impl Limits {
     /// has no `M201`, `M203`, `M205` (its config sets those limits: the lines change nothing);
     /// its `M204` sets the toolhead's acceleration from `S`, or from the lower of `P` and `T`
     /// when both are given (`P` alone is ignored, as Klipper's `cmd_M204` does).
+    /// `version`: the Klipper the file runs on, if known: v0.12 (and Creality's K1 firmware)
+    /// reads `SET_VELOCITY_LIMIT ACCEL_TO_DECEL` and knows no `MINIMUM_CRUISE_RATIO`; Klipper
+    /// since 2025-08 reads only the latter. Unknown: both, the one set last in force.
     #[inline]
-    pub fn apply_klipper_command(&mut self, line: &Line<'_>) -> bool {
+    pub fn apply_klipper_command(
+        &mut self,
+        line: &Line<'_>,
+        version: Option<KlipperVersion>,
+    ) -> bool {
         match line.command {
             crate::gcode::Command::Code(code) if code.is(b'M', 204) => {
                 let p = &line.params;
@@ -150,7 +164,7 @@ impl Limits {
             crate::gcode::Command::Extended(name)
                 if name.eq_ignore_ascii_case(b"SET_VELOCITY_LIMIT") =>
             {
-                self.apply_set_velocity_limit(line);
+                self.apply_set_velocity_limit(line, version);
                 true
             }
             _ => false,
@@ -166,7 +180,7 @@ impl Limits {
         }
         if let crate::gcode::Command::Extended(name) = line.command {
             if name.eq_ignore_ascii_case(b"SET_VELOCITY_LIMIT") {
-                self.apply_set_velocity_limit(line);
+                self.apply_set_velocity_limit(line, None);
                 return true;
             }
         }
@@ -220,8 +234,9 @@ impl Limits {
         true
     }
 
-    /// Klipper's `SET_VELOCITY_LIMIT`.
-    fn apply_set_velocity_limit(&mut self, line: &Line<'_>) {
+    /// Klipper's `SET_VELOCITY_LIMIT`, as `version` reads it (see
+    /// [`Limits::apply_klipper_command`]).
+    fn apply_set_velocity_limit(&mut self, line: &Line<'_>, version: Option<KlipperVersion>) {
         let src = LimitSource::Command;
         let num = |key: &str| {
             line.extended_arg(key)
@@ -229,6 +244,8 @@ impl Limits {
                 .and_then(|v| v.parse::<f64>().ok())
         };
         if let Some(v) = num("VELOCITY") {
+            // Klipper's `max_velocity`, the limit of the speed along the path; kept in the X
+            // and Y slots (the planner reads it as the vector limit under Klipper's model).
             for i in 0..2 {
                 set(&mut self.max_feedrate[i], Some(v), src);
             }
@@ -244,10 +261,11 @@ impl Limits {
             src,
         );
         // Whichever of the two a file sets last is the one in force.
-        if let Some(ratio) = num("MINIMUM_CRUISE_RATIO") {
+        let ratio = num("MINIMUM_CRUISE_RATIO").filter(|_| version != Some(KlipperVersion::Legacy));
+        if let Some(ratio) = ratio {
             set(&mut self.minimum_cruise_ratio, Some(ratio), src);
             set(&mut self.accel_to_decel, Some(0.0), src);
-        } else {
+        } else if version != Some(KlipperVersion::Current) {
             set(&mut self.accel_to_decel, num("ACCEL_TO_DECEL"), src);
         }
     }
@@ -332,7 +350,7 @@ mod tests {
         let read = |src: &str| {
             let mut l = voron();
             let line = crate::gcode::parse_line(src.as_bytes()).expect(src);
-            let taken = l.apply_klipper_command(&line);
+            let taken = l.apply_klipper_command(&line, None);
             (taken, l)
         };
         let (taken, l) = read("M204 S4000 P1000 T500");

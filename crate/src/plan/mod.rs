@@ -38,6 +38,8 @@ pub use trapezoid::Profile;
 pub const KEEP_BLOCKS: usize = 64;
 /// Window size at which the planner recalculates and finalises blocks.
 pub const REFRESH_THRESHOLD: usize = KEEP_BLOCKS * 4;
+/// Klipper: most blocks a window holds while it waits for a second peak to finalise up to.
+pub const KLIPPER_MAX_WINDOW: usize = REFRESH_THRESHOLD * 16;
 /// Most straight segments one arc is split into.
 pub const MAX_ARC_SEGMENTS: usize = 100_000;
 
@@ -162,16 +164,18 @@ fn segment_count(n: f64) -> usize {
 
 /// Number of straight segments the firmware of a junction model cuts an arc into: Klipper's
 /// `[gcode_arcs]` makes pieces of `resolution` (the machine's `arc_segment_mm`, 1 mm unless
-/// set), `floor(length / resolution)` of them; Marlin 2 as in [`arc_segments`].
+/// set) along the helix (`rise`: along its axis), `floor(length / resolution)` of them;
+/// Marlin 2 as in [`arc_segments`], by the planar length.
 pub fn firmware_arc_segments(
     model: JunctionModel,
     radius: f64,
-    planar_length: f64,
+    (planar_length, rise): (f64, f64),
     feed_mm_s: f64,
     max_segment_mm: f64,
 ) -> usize {
     if model == JunctionModel::Klipper {
-        segment_count((planar_length / max_segment_mm.at_least(1e-3)).floor())
+        let length = planar_length.hypot(rise);
+        segment_count((length / max_segment_mm.at_least(1e-3)).floor())
     } else {
         arc_segments(radius, planar_length, feed_mm_s, max_segment_mm)
     }
@@ -291,7 +295,7 @@ impl Planner {
                 let n = firmware_arc_segments(
                     self.model,
                     arc.radius,
-                    arc.planar_length(),
+                    (arc.planar_length(), m.delta[h]),
                     m.feed_mm_s,
                     self.limits.arc_segment_mm.value,
                 );
@@ -299,7 +303,12 @@ impl Planner {
                 for k in 1..=n {
                     let t = k as f64 / n as f64;
                     let mut cur = [0.0f64; 4];
-                    let p = arc.offset_at(t);
+                    // Klipper ends the last piece on the target, which an end point a little
+                    // off the arc's circle (rounded in the file) does not lie on.
+                    let p = match self.model {
+                        JunctionModel::Klipper if k == n => [m.delta[p0], m.delta[p1]],
+                        _ => arc.offset_at(t),
+                    };
                     cur[p0] = p[0];
                     cur[p1] = p[1];
                     cur[h] = m.delta[h] * t;
@@ -340,8 +349,8 @@ impl Planner {
             return;
         };
         let inv_distance = 1.0 / distance;
-        let (cruise, axis_feedrate) = cruise_speed(l, class, feed, &delta, inv_distance);
-        let acceleration = self.acceleration(class, &delta, distance, inv_distance);
+        let (cruise, axis_feedrate, acceleration, toolhead_accel) =
+            self.speed_and_accel(class, feed, &delta, distance, inv_distance);
         let unit = if class == MoveClass::Retract {
             [0.0; 3]
         } else {
@@ -353,8 +362,11 @@ impl Planner {
         };
         let safe = match self.model {
             JunctionModel::ClassicJerk => junction::safe_speed(&axis_feedrate, cruise, l),
-            _ => junction::MINIMUM_PLANNER_SPEED.at_most(cruise),
+            JunctionModel::JunctionDeviation => junction::MINIMUM_PLANNER_SPEED.at_most(cruise),
+            // Klipper starts from and stops at rest.
+            JunctionModel::Klipper => 0.0,
         };
+        let scv = l.square_corner_velocity.value;
         let curr = Segment {
             axis_feedrate,
             cruise,
@@ -362,6 +374,7 @@ impl Planner {
             unit,
             distance,
             acceleration,
+            klipper_jd: junction::klipper_junction_deviation(scv, toolhead_accel),
         };
         let vmax_junction = match (&self.prev, self.model) {
             (None, _) => safe,
@@ -373,7 +386,9 @@ impl Planner {
         };
         let v_allowable = trapezoid::max_allowable_speed(-acceleration, safe, distance);
         let (smooth_delta_v2, max_smoothed_v2) = match self.model {
-            JunctionModel::Klipper => self.klipper_smoothing(distance, acceleration, vmax_junction),
+            JunctionModel::Klipper => {
+                self.klipper_smoothing(distance, acceleration, toolhead_accel, vmax_junction)
+            }
             _ => (0.0, 0.0),
         };
         let block = Block {
@@ -401,7 +416,29 @@ impl Planner {
         }
     }
 
-    /// Acceleration of a move: by kind of move, then every axis within its limit.
+    /// A move's cruise speed, per-axis speeds at it, acceleration, and the toolhead's
+    /// acceleration it was queued with (Klipper's junction deviation and smoothing use it;
+    /// Marlin's models have no other).
+    #[inline]
+    fn speed_and_accel(
+        &self,
+        class: MoveClass,
+        feed: f64,
+        delta: &[f64; 4],
+        distance: f64,
+        inv_distance: f64,
+    ) -> (f64, [f64; 4], f64, f64) {
+        let l = &self.limits;
+        if self.model == JunctionModel::Klipper {
+            return klipper_speed_and_accel(l, class, feed, delta, distance);
+        }
+        let (cruise, axis_feedrate) = cruise_speed(l, class, feed, delta, inv_distance);
+        let acceleration = self.acceleration(class, delta, distance, inv_distance);
+        (cruise, axis_feedrate, acceleration, acceleration)
+    }
+
+    /// Acceleration of a move (Marlin's models): by kind of move, then every axis within its
+    /// limit.
     #[inline]
     fn acceleration(
         &self,
@@ -416,19 +453,9 @@ impl Planner {
             MoveClass::Travel => l.travel_acceleration.value,
             MoveClass::Retract => l.retract_acceleration.value,
         };
-        // Klipper has no X/Y (or extruder) limit of its own on a move that prints or travels:
-        // `M204` and `SET_VELOCITY_LIMIT ACCEL` set the toolhead's `max_accel`, the limit along
-        // the move, whatever the profile's per-axis values; only Z (`max_z_accel`) and
-        // extrude-only moves (`max_extrude_only_accel`) are limited on their own axis.
-        let axis_limited = |axis: usize| match (self.model, class) {
-            (JunctionModel::Klipper, MoveClass::Retract) => axis >= 2,
-            (JunctionModel::Klipper, _) => axis == 2,
-            _ => true,
-        };
-        for (axis, (d, max)) in delta.iter().zip(&l.max_acceleration).enumerate() {
+        for (d, max) in delta.iter().zip(&l.max_acceleration) {
             let (d, max) = (d.abs(), max.value);
-            if axis_limited(axis) && d > 1e-12 && max > 0.0 && acceleration * d * inv_distance > max
-            {
+            if d > 1e-12 && max > 0.0 && acceleration * d * inv_distance > max {
                 acceleration = max * distance / d;
             }
         }
@@ -436,20 +463,26 @@ impl Planner {
     }
 
     /// Klipper's `smooth_delta_v2` and `max_smoothed_v2` of a move of `distance` at
-    /// `acceleration` whose junction allows `vmax_junction`.
+    /// `acceleration` (its own, after the Z and extruder limits), queued while the toolhead's
+    /// `max_accel` was `toolhead_accel`, whose junction allows `vmax_junction`. The smoothed
+    /// rate is the toolhead's (`max_accel_to_decel`, or `max_accel` × (1 − ratio)), capped by
+    /// the move's own acceleration (`Move.limit_speed`): a Z hop or a retraction is smoothed at
+    /// its own lower rate, not at a fraction of it.
     #[inline]
     fn klipper_smoothing(
         &self,
         distance: f64,
         acceleration: f64,
+        toolhead_accel: f64,
         vmax_junction: f64,
     ) -> (f64, f64) {
         let l = &self.limits;
-        let accel_to_decel = if l.accel_to_decel.value > 0.0 {
-            l.accel_to_decel.value.at_most(acceleration)
+        let pseudo = if l.accel_to_decel.value > 0.0 {
+            l.accel_to_decel.value.at_most(toolhead_accel)
         } else {
-            acceleration * (1.0 - l.minimum_cruise_ratio.value.clamp(0.0, 0.99))
+            toolhead_accel * (1.0 - l.minimum_cruise_ratio.value.clamp(0.0, 0.99))
         };
+        let accel_to_decel = pseudo.at_most(acceleration);
         // Klipper's `max_smoothed_v2`: the junction limit, and no more than the chain
         // of blocks before could reach accelerating at their smoothed rate.
         let reach = match (&self.prev, self.blocks.last()) {
@@ -486,19 +519,20 @@ impl Planner {
         reverse_pass(blocks);
         forward_pass(blocks);
         set_exits(blocks);
-        let finalize = n.saturating_sub(keep);
         // The profiles first, in a loop of their own: they are independent of each other, and
         // their divisions overlap there instead of waiting, block by block, between sink calls.
         self.profiles.clear();
-        if self.model == JunctionModel::Klipper {
-            self.klipper_profiles(finalize);
+        let finalize = if self.model == JunctionModel::Klipper {
+            self.klipper_profiles(keep)
         } else {
+            let finalize = n.saturating_sub(keep);
             self.profiles.extend(
                 self.blocks[..finalize]
                     .iter()
                     .map(|b| b.profile(b.entry, b.cruise, b.exit)),
             );
-        }
+            finalize
+        };
         for (b, &profile) in self.blocks.drain(..finalize).zip(&self.profiles) {
             let pm = PlannedMove {
                 line: b.line,
@@ -576,6 +610,66 @@ fn cruise_speed(
         *v *= factor;
     }
     (cruise, axis_feedrate)
+}
+
+/// Klipper's cruise speed, per-axis speeds, acceleration and the toolhead's acceleration of a
+/// move (`toolhead.py` `Move`, then the kinematics' and the extruder's `check_move`):
+/// `max_velocity` caps the speed along the path, not each axis; a move with Z is held to
+/// `max_z_velocity` and `max_z_accel` along Z; a move that retracts, or extrudes without moving
+/// X or Y (a wipe, an extrude-only move, a Z move with E), is also held to
+/// `max_extrude_only_velocity` and `max_extrude_only_accel` along E. Extrude-only moves run at
+/// their feed rate with only the extruder's limits.
+#[inline]
+fn klipper_speed_and_accel(
+    l: &Limits,
+    class: MoveClass,
+    feed: f64,
+    delta: &[f64; 4],
+    distance: f64,
+) -> (f64, [f64; 4], f64, f64) {
+    let feed = feed
+        .at_least(match class {
+            MoveClass::Travel => l.min_travel_feedrate.value,
+            _ => l.min_feedrate.value,
+        })
+        .at_least(crate::machine::MIN_FEED_MM_S);
+    let positive = |v: f64| if v > 0.0 { v } else { f64::INFINITY };
+    let (mut cruise, mut acceleration, toolhead_accel) = match class {
+        MoveClass::Print => (feed, l.acceleration.value, l.acceleration.value),
+        MoveClass::Travel => (
+            feed,
+            l.travel_acceleration.value,
+            l.travel_acceleration.value,
+        ),
+        MoveClass::Retract => (feed, l.retract_acceleration.value, l.acceleration.value),
+    };
+    if class != MoveClass::Retract {
+        // `max_velocity`, kept in the X and Y slots.
+        cruise = cruise
+            .at_most(positive(l.max_feedrate[0].value))
+            .at_most(positive(l.max_feedrate[1].value));
+    }
+    let mut limit = |axis: usize, ratio: f64| {
+        cruise = cruise.at_most(positive(l.max_feedrate[axis].value) * ratio);
+        acceleration = acceleration.at_most(positive(l.max_acceleration[axis].value) * ratio);
+    };
+    if class != MoveClass::Retract && delta[2] != 0.0 {
+        limit(2, distance / delta[2].abs());
+    }
+    let e = delta[3];
+    let no_xy = class == MoveClass::Retract || (delta[0] == 0.0 && delta[1] == 0.0);
+    if e != 0.0 && (no_xy || e < 0.0) {
+        limit(3, distance / e.abs());
+    }
+    let acceleration = acceleration.at_least(1e-3);
+    let inv_distance = 1.0 / distance;
+    let axis_feedrate = delta.map(|d| cruise * d * inv_distance);
+    (
+        cruise,
+        axis_feedrate,
+        acceleration,
+        toolhead_accel.at_least(1e-3),
+    )
 }
 
 /// Reverse pass of the look-ahead: every block must be able to brake to the next block's
@@ -657,11 +751,25 @@ impl Planner {
     /// accel (1 − minimum_cruise_ratio), so short zig-zags and finely cut curves do not reach
     /// full speed only to brake at once. Each block's cruise is capped by its chain's peak
     /// (and a braking block by the speeds it brakes through), and each junction by the
-    /// cruise of both blocks. Profiles of the first `finalize` blocks go to `self.profiles`.
-    fn klipper_profiles(&mut self, finalize: usize) {
+    /// cruise of both blocks.
+    ///
+    /// Blocks are final as Klipper's lazy flush makes them: up to the chain of the last peak
+    /// but one (a later move can still raise what follows it). All but `keep` blocks would
+    /// cut the smoothing of a chain of short pieces (an arc cut at 0.1 mm brakes over far
+    /// more than the 64 blocks kept), and every block before a full flush (`keep` 0). A window
+    /// without two peaks waits for more moves, up to [`KLIPPER_MAX_WINDOW`] blocks. Profiles of
+    /// the blocks finalised go to `self.profiles`; returns how many.
+    fn klipper_profiles(&mut self, keep: usize) -> usize {
         let blocks = &mut self.blocks[..];
         let caps = &mut self.cruise_v2;
-        klipper_cruise_v2(blocks, caps);
+        let n = blocks.len();
+        let lazy = klipper_cruise_v2(blocks, self.limits.accel_to_decel.value > 0.0, caps);
+        let finalize = match lazy {
+            _ if keep == 0 => n,
+            Some(count) => count,
+            None if n > KLIPPER_MAX_WINDOW => n - keep,
+            None => 0,
+        };
         let cap = |i: usize| caps.get(i).copied().unwrap_or(f64::INFINITY).sqrt();
         // Speed at the start of block i: its junction, within the cruise of both blocks (the
         // first block keeps an entry the machine is already committed to).
@@ -671,7 +779,6 @@ impl Planner {
             (None, Some(b)) => b.entry.at_most(cap(0)),
             (Some(p), Some(b)) => b.entry.at_most(cap(p)).at_most(cap(i)),
         };
-        let n = blocks.len();
         for i in 0..finalize {
             let entry = junction(blocks, i);
             let exit = if i + 1 < n {
@@ -690,6 +797,7 @@ impl Planner {
             let entry = junction(blocks, finalize);
             blocks[finalize].entry = entry;
         }
+        finalize
     }
 }
 
@@ -699,12 +807,13 @@ impl Planner {
 /// reach²) / 2`; the braking blocks after it are held to that peak and to the entry speeds
 /// they brake through. Blocks still braking at the window's start (their peak is in an
 /// earlier window) only brake.
-fn klipper_cruise_v2(blocks: &[Block], out: &mut Vec<f64>) {
+fn klipper_cruise_v2(blocks: &[Block], legacy: bool, out: &mut Vec<f64>) -> Option<usize> {
     out.clear();
     out.resize(blocks.len(), f64::INFINITY);
-    let Some(last) = blocks.last() else {
-        return;
-    };
+    let last = blocks.last()?;
+    // Klipper's lazy flush count: the blocks up to the chain of the last peak but one.
+    let mut lazy = None;
+    let mut peaks = 0;
     let sq = |v: f64| v * v;
     let mut next_smoothed_v2 = sq(last.exit);
     let mut peak_v2 = 0.0f64;
@@ -723,16 +832,29 @@ fn klipper_cruise_v2(blocks: &[Block], out: &mut Vec<f64>) {
         let smoothed_v2 = b.max_smoothed_v2.at_most(reach_smoothed_v2);
         if smoothed_v2 < reach_smoothed_v2 {
             if smoothed_v2 + b.smooth_delta_v2 > next_smoothed_v2 || delayed_end.is_some() {
-                peak_v2 = sq(b.cruise).at_most((smoothed_v2 + reach_smoothed_v2) * 0.5);
-                if let Some(end) = delayed_end.take() {
-                    hold(out, i + 1, end, peak_v2);
+                peaks += 1;
+                if peaks == 2 {
+                    lazy = Some(delayed_end.unwrap_or(i) + 1);
+                }
+                // Older Klipper caps a chain's peak by the cruise of the block that sets
+                // it; current Klipper only each block's own cruise.
+                peak_v2 = (smoothed_v2 + reach_smoothed_v2) * 0.5;
+                if legacy {
+                    peak_v2 = peak_v2.at_most(sq(b.cruise));
                 }
             }
             let reach_v2 = sq(b.exit) + 2.0 * b.distance * b.acceleration;
+            let cruise_v2 = ((sq(b.entry) + reach_v2) * 0.5)
+                .at_most(sq(b.cruise))
+                .at_most(peak_v2);
             if let Some(o) = out.get_mut(i) {
-                *o = ((sq(b.entry) + reach_v2) * 0.5)
-                    .at_most(sq(b.cruise))
-                    .at_most(peak_v2);
+                *o = cruise_v2;
+            }
+            if let Some(end) = delayed_end.take() {
+                // Older Klipper holds the braking blocks to the chain's peak; current Klipper
+                // carries this block's own cruise forward to them.
+                let held = if legacy { peak_v2 } else { cruise_v2 };
+                hold(out, i + 1, end, held);
             }
         } else {
             delayed_end.get_or_insert(i);
@@ -742,6 +864,7 @@ fn klipper_cruise_v2(blocks: &[Block], out: &mut Vec<f64>) {
     if let Some(end) = delayed_end {
         hold(out, 0, end, f64::INFINITY);
     }
+    lazy
 }
 
 #[cfg(test)]
@@ -853,6 +976,29 @@ mod tests {
             );
         }
         assert!(p.iter().all(|m| m.profile.peak <= 100.0 + 1e-3), "{p:?}");
+    }
+
+    #[test]
+    fn klipper_caps_the_path_speed_and_holds_wipes_to_the_extruder_limits() {
+        // Klipper's max_velocity is the speed along the path: a diagonal runs at 100 mm/s, not
+        // at 100 mm/s on each axis (141 along it). A move retracting 1 mm over 1 mm (a wipe)
+        // is held to the extrude-only 10 mm/s and 500 mm/s² along E, so along the path too.
+        let cfg = "[printer]\nmax_velocity: 100\nmax_accel: 1000\n\
+                   [extruder]\nmax_extrude_only_velocity: 10\nmax_extrude_only_accel: 500\n";
+        let limits = KlipperConfig::parse_text(cfg)
+            .expect("config")
+            .limits(&test_limits(), KlipperVersion::Current);
+        let src = "M83\nG1 X500 Y500 F60000\nG1 X501 E-1 F6000\nG1 X600 E5";
+        let p = plan_on(limits, src, JunctionModel::Klipper);
+        assert!(
+            (p[0].profile.peak - 100.0).abs() < 1e-9,
+            "{:?}",
+            p[0].profile
+        );
+        assert!(p[1].profile.peak <= 10.0 + 1e-9, "{:?}", p[1].profile);
+        assert_eq!(p[1].profile.acceleration, 500.0);
+        // Printing moves keep the toolhead's acceleration, whatever the extruder's.
+        assert_eq!(p[2].profile.acceleration, 1000.0);
     }
 
     #[test]

@@ -42,6 +42,7 @@ fn limits(
         min_feedrate: Limit::profile(0.0),
         min_travel_feedrate: Limit::profile(0.0),
         arc_segment_mm: Limit::profile(1.0),
+        instantaneous_corner_velocity: None,
     }
 }
 

@@ -51,6 +51,18 @@ pub(crate) struct At<'r> {
     /// Layer of the line by marker and by counting (which one the file uses is known only at
     /// the end, from [`LayerTracker::finish`]).
     pub layers: (u32, u32),
+    /// The file runs on Klipper ([`Setup::klipper`]).
+    pub klipper: bool,
+}
+
+impl At<'_> {
+    /// Whether `m` is homing that takes no planned time: `G28` on Klipper, whose duration
+    /// depends on the printer (endstops, homing speeds, probing macros) and no file tells. It
+    /// empties the look-ahead (the toolhead stops) and is counted apart. Marlin-style files
+    /// keep timing `G28` as a move to 0, as PrusaSlicer's estimator does.
+    pub fn untimed_homing(&self, m: &Move) -> bool {
+        self.klipper && matches!(m.kind, crate::machine::MoveKind::Home)
+    }
 }
 
 /// A pass over a file. Every method has a default that does nothing, so a fold says only what
@@ -121,6 +133,7 @@ impl Reader {
         let units = setup.units;
         // Klipper reads its limit commands its own way (see `Limits::apply_klipper_command`).
         let klipper = setup.klipper();
+        let version = setup.klipper_version;
         gcode::for_each_line(
             input,
             setup.strictness,
@@ -141,7 +154,7 @@ impl Reader {
                     }
                 }
                 let limit_command = if klipper {
-                    limits.apply_klipper_command(line)
+                    limits.apply_klipper_command(line, version)
                 } else {
                     limits.apply_command(line, units)
                 };
@@ -164,6 +177,7 @@ impl Reader {
                     line: raw.number,
                     machine,
                     layers: layers.current(),
+                    klipper,
                 };
                 fold.event(line, event, at)
             },

@@ -117,6 +117,9 @@ pub(crate) struct Setup {
     pub units: FeedUnits,
     /// Firmware retraction length and speed the printer's config sets, if it does.
     pub retract: (Option<f64>, Option<f64>),
+    /// The Klipper version a config was given for (it decides how `SET_VELOCITY_LIMIT`
+    /// reads); `None` without a config, where the file's commands are read as they come.
+    pub klipper_version: Option<KlipperVersion>,
 }
 
 impl Setup {
@@ -184,6 +187,10 @@ pub(crate) fn prepare(input: &[u8], options: &AnalyzeOptions) -> Result<Setup, E
             limits
         }
     };
+    let klipper_version = options
+        .klipper_config
+        .as_ref()
+        .map(|_| options.klipper_version.unwrap_or_default());
     let retract = options
         .klipper_config
         .as_ref()
@@ -211,6 +218,7 @@ pub(crate) fn prepare(input: &[u8], options: &AnalyzeOptions) -> Result<Setup, E
         limits,
         units,
         retract: retract.unwrap_or_default(),
+        klipper_version,
     })
 }
 

@@ -21,6 +21,8 @@ export interface Limits {
   min_feedrate: Limit;
   min_travel_feedrate: Limit;
   arc_segment_mm: Limit;
+  /** Klipper's [extruder] instantaneous_corner_velocity, mm/s; absent: Klipper's 1 mm/s. */
+  instantaneous_corner_velocity?: Limit;
 }
 export interface MachineProfile {
   name: string;
@@ -146,6 +148,9 @@ export interface Report {
   time_s: number;
   /** Time in dwells (G4), s, included in time_s. */
   dwell_s: number;
+  /** Homings (G28) on Klipper, left out of time_s and of moves (no file tells how long they
+   * take); absent when none, and on Marlin-style files (G28 timed as a move there). */
+  homing_count?: number;
   time_model: string;
   machine: { profile: string; junction_model: JunctionModel; reason: string; limits: Limits };
   moves: number;

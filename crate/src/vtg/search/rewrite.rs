@@ -867,9 +867,9 @@ fn with_arcs(
     let max_segment = limits.arc_segment_mm.value;
     let model = machine.model;
     // As the planner times them: Klipper's [gcode_arcs] cuts an arc into pieces of
-    // `resolution`, Marlin 2 by chord deviation and segment rate.
+    // `resolution` (VTG writes planar arcs), Marlin 2 by chord deviation and segment rate.
     let segments = move |r: f64, len: f64, feed: f64| {
-        crate::plan::firmware_arc_segments(model, r, len, feed, max_segment)
+        crate::plan::firmware_arc_segments(model, r, (len, 0.0), feed, max_segment)
     };
     let firmware = arcs::Firmware {
         segments: &segments,
