@@ -77,6 +77,14 @@ pub enum ErrorKind {
         /// Why.
         reason: &'static str,
     },
+    /// A line of the printer's settings (`machine_gcode`, Marlin's `M503` text) is not G-code.
+    #[error("machine settings, line {line}: {reason}")]
+    MachineSettings {
+        /// 1-based line of the settings text.
+        line: u32,
+        /// Why, with the line.
+        reason: String,
+    },
     /// The job was cancelled by the caller.
     #[error("cancelled")]
     Cancelled,

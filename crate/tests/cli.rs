@@ -148,3 +148,52 @@ fn utf16_input_is_a_clear_error() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("UTF-16"));
 }
+
+/// A Marlin printer's own settings as `M503` prints them set the limits the file is timed
+/// with (a slower acceleration makes the print longer), each limit says so, and a line that is
+/// not G-code is an error naming its line.
+#[test]
+fn machine_gcode_sets_the_printers_limits() {
+    let dir = std::env::temp_dir().join(format!("quietpath-m503-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let m503 = dir.join("m503.txt");
+    std::fs::write(
+        &m503,
+        "echo:; Maximum Acceleration (units/s2):\necho:  M201 X500 Y500 Z100 E1000\n\
+         echo:; Acceleration (units/s2): P<print_accel> R<retract_accel> T<travel_accel>\n\
+         echo:  M204 P400.00 R1000.00 T400.00\necho:  M92 X80.00 Y80.00 Z400.00 E93.00\nok\n",
+    )
+    .unwrap();
+    // A Marlin file without limit commands of its own (they would win, as on the printer).
+    let file = corpus("slic3r-pe-1.33.3_benchy_arcwelder.gcode");
+    let run = |extra: &[&std::ffi::OsStr]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_quietpath"))
+            .arg("analyze")
+            .arg(&file)
+            .arg("--json")
+            .args(extra)
+            .output()
+            .unwrap();
+        (
+            out.status.success(),
+            out.stdout,
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let (ok, plain, err) = run(&[]);
+    assert!(ok, "{err}");
+    let (ok, slow, err) = run(&["--machine-gcode".as_ref(), m503.as_os_str()]);
+    assert!(ok, "{err}");
+    let (plain, slow): (serde_json::Value, serde_json::Value) = (
+        serde_json::from_slice(&plain).unwrap(),
+        serde_json::from_slice(&slow).unwrap(),
+    );
+    assert!(slow["time_s"].as_f64() > plain["time_s"].as_f64());
+    let accel = &slow["machine"]["limits"]["max_acceleration"][0];
+    assert_eq!(accel["value"], 500.0);
+    assert_eq!(accel["source"], "machine_settings");
+    std::fs::write(&m503, "Recv: echo:  M201 X500\nG1 X1..5\n").unwrap();
+    let (ok, _, err) = run(&["--machine-gcode".as_ref(), m503.as_os_str()]);
+    assert!(!ok);
+    assert!(err.contains("machine settings, line 2"), "{err}");
+}

@@ -86,7 +86,10 @@ fn compare(files: &[PathBuf], version: &str) -> Vec<(String, f64, f64, f64)> {
         part.iter()
             .map(|f| {
                 let (k, q) = (klipper_time(f, version), our_time(f, version));
-                let name = f.file_name().unwrap().to_string_lossy().to_string();
+                let name = f
+                    .file_name()
+                    .map(|n| n.to_string_lossy().to_string())
+                    .unwrap_or_default();
                 (name, k, q, 100.0 * (q - k) / k)
             })
             .collect()

@@ -135,6 +135,10 @@ struct AnalyzeArgs {
     /// with its [printer], [extruder], [gcode_arcs] and [firmware_retraction] settings.
     #[arg(long, value_name = "FILE")]
     klipper_config: Option<PathBuf>,
+    /// A Marlin printer's own settings: the text its M503 prints (M201, M203, M204, M205…),
+    /// applied before the file, over the preset and the slicer's settings block.
+    #[arg(long, value_name = "FILE")]
+    machine_gcode: Option<PathBuf>,
     /// How that Klipper reads max_accel_to_decel: legacy (v0.12, Creality's K1 family) or
     /// current (Klipper since 2025-08, minimum_cruise_ratio only) [default: current].
     #[arg(long, value_enum)]
@@ -174,6 +178,7 @@ impl AnalyzeArgs {
             || self.energy.is_some()
             || self.klipper_config.is_some()
             || self.klipper_version.is_some()
+            || self.machine_gcode.is_some()
     }
 
     fn options(&self) -> Result<AnalyzeOptions, String> {
@@ -200,7 +205,14 @@ impl AnalyzeArgs {
             Some(path) => Some(klipper::read_config(path)?),
             None => None,
         };
+        let machine_gcode = match &self.machine_gcode {
+            Some(path) => Some(
+                std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?,
+            ),
+            None => None,
+        };
         Ok(AnalyzeOptions {
+            machine_gcode,
             klipper_config,
             klipper_version: self.klipper_version.map(|v| match v {
                 KlipperVersionArg::Legacy => KlipperVersion::Legacy,

@@ -20,6 +20,8 @@ pub enum LimitSource {
     SlicerSettings,
     /// The printer's firmware configuration (Klipper's `printer.cfg`).
     PrinterConfig,
+    /// The printer's own settings as Marlin's `M503` prints them (`--machine-gcode`).
+    MachineSettings,
     /// A command in the file (`M201`…, `SET_VELOCITY_LIMIT`).
     Command,
     /// An option of the analysis.
@@ -122,6 +124,74 @@ fn set(limit: &mut Limit, value: Option<f64>, source: LimitSource) {
 }
 
 impl Limits {
+    /// Applies a Marlin printer's own settings, as its `M503` prints them (`echo:  M201 X1000
+    /// Y1000 …`, `M203`, `M204`, `M205`; other lines, such as `M92` or `M301`, comments and a
+    /// host terminal's `Send:`/`Recv:`/`ok` are skipped), before the file: they describe the machine the file runs on, where a
+    /// slicer's settings block describes the one it was sliced for. Returns how many limit
+    /// commands were applied, or the 1-based line and reason of a line that is not G-code.
+    pub fn apply_machine_settings(
+        &mut self,
+        text: &str,
+        units: FeedUnits,
+    ) -> Result<usize, (u32, String)> {
+        let mut applied = 0;
+        for (i, raw) in text.lines().enumerate() {
+            // As the printer prints it, or copied from a host's terminal (OctoPrint's `Recv:`).
+            let mut l = raw.trim();
+            while let Some(rest) = l.strip_prefix("Recv:").or_else(|| l.strip_prefix("echo:")) {
+                l = rest.trim_start();
+            }
+            let chatter = ["ok", "Send:", "Recv:", ";", "//"];
+            if l.is_empty() || chatter.iter().any(|c| l.starts_with(c)) {
+                continue;
+            }
+            let line = crate::gcode::parse_line(l.as_bytes()).map_err(|e| {
+                (
+                    i as u32 + 1,
+                    format!("{}, column {}: {raw}", e.kind, e.column),
+                )
+            })?;
+            if self.apply_command(&line, units) {
+                applied += 1;
+            }
+        }
+        self.for_each_mut(|limit| {
+            if limit.source == LimitSource::Command {
+                limit.source = LimitSource::MachineSettings;
+            }
+        });
+        Ok(applied)
+    }
+
+    /// Every limit, for a pass over all of them.
+    fn for_each_mut(&mut self, mut f: impl FnMut(&mut Limit)) {
+        let arrays = [
+            &mut self.max_feedrate,
+            &mut self.max_acceleration,
+            &mut self.max_jerk,
+        ];
+        for array in arrays {
+            array.iter_mut().for_each(&mut f);
+        }
+        for limit in [
+            &mut self.acceleration,
+            &mut self.retract_acceleration,
+            &mut self.travel_acceleration,
+            &mut self.junction_deviation,
+            &mut self.square_corner_velocity,
+            &mut self.minimum_cruise_ratio,
+            &mut self.accel_to_decel,
+            &mut self.min_feedrate,
+            &mut self.min_travel_feedrate,
+            &mut self.arc_segment_mm,
+        ] {
+            f(limit);
+        }
+        if let Some(l) = &mut self.instantaneous_corner_velocity {
+            f(l);
+        }
+    }
+
     /// Applies a limit command; returns whether the line was one.
     ///
     /// Analysis asks this of every line: the test that rules out all other lines is inlined

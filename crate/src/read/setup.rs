@@ -42,6 +42,10 @@ pub struct AnalyzeOptions {
     pub klipper_config: Option<KlipperConfig>,
     /// How that Klipper reads `max_accel_to_decel` (default: current Klipper).
     pub klipper_version: Option<KlipperVersion>,
+    /// A Marlin printer's own settings as its `M503` prints them (`M201`, `M203`, `M204`,
+    /// `M205`…), applied before the file, over the profile's limits and the slicer's settings
+    /// block. Not with `klipper_config` (a Klipper printer's settings are its config).
+    pub machine_gcode: Option<String>,
 }
 
 /// Starting extrusion mode, as an option.
@@ -175,18 +179,7 @@ pub(crate) fn prepare(input: &[u8], options: &AnalyzeOptions) -> Result<Setup, E
 
     let pre = prescan::prescan(input);
     let (profile, model, model_reason) = choose_machine(options, &pre)?;
-    let mut limits = match &options.klipper_config {
-        // Klipper takes its limits from its config alone: a slicer's machine_max_* block
-        // describes some other machine.
-        Some(config) => config.limits(&profile.limits, options.klipper_version.unwrap_or_default()),
-        None => {
-            let mut limits = profile.limits.clone();
-            for (key, value) in &pre.limit_settings {
-                limits.apply_setting(key, value);
-            }
-            limits
-        }
-    };
+    let mut limits = starting_limits(options, &profile, &pre)?;
     let klipper_version = options
         .klipper_config
         .as_ref()
@@ -222,6 +215,32 @@ pub(crate) fn prepare(input: &[u8], options: &AnalyzeOptions) -> Result<Setup, E
     })
 }
 
+/// The limits before the file's first line: Klipper's config alone when given (a slicer's
+/// `machine_max_*` block describes some other machine); otherwise the profile's, then the
+/// slicer's settings block (the best evidence of the printer a file without a config was
+/// sliced for, Klipper or not), then the printer's own `M503` settings when given.
+fn starting_limits(
+    options: &AnalyzeOptions,
+    profile: &MachineProfile,
+    pre: &prescan::Prescan,
+) -> Result<crate::plan::Limits, Error> {
+    if let Some(config) = &options.klipper_config {
+        return Ok(config.limits(&profile.limits, options.klipper_version.unwrap_or_default()));
+    }
+    let mut limits = profile.limits.clone();
+    for (key, value) in &pre.limit_settings {
+        limits.apply_setting(key, value);
+    }
+    if let Some(text) = &options.machine_gcode {
+        limits
+            .apply_machine_settings(text, FeedUnits::PerSecond)
+            .map_err(|(line, reason)| {
+                Error::new(0, 0, ErrorKind::MachineSettings { line, reason })
+            })?;
+    }
+    Ok(limits)
+}
+
 fn validate_options(o: &AnalyzeOptions) -> Result<(), Error> {
     let positive = |v: Option<f64>| v.is_none_or(|x| x.is_finite() && x > 0.0);
     if let Some(reason) = o.energy.as_ref().and_then(|e| e.validate().err()) {
@@ -236,6 +255,15 @@ fn validate_options(o: &AnalyzeOptions) -> Result<(), Error> {
             0,
             ErrorKind::InvalidOption {
                 reason: "filament_diameter_mm, density_g_cm3 and arc_segment_mm must be positive numbers",
+            },
+        ));
+    }
+    if o.machine_gcode.is_some() && o.klipper_config.is_some() {
+        return Err(Error::new(
+            0,
+            0,
+            ErrorKind::InvalidOption {
+                reason: "machine_gcode is a Marlin printer's M503 settings; a Klipper printer's are its klipper_config, give one of them",
             },
         ));
     }

@@ -238,6 +238,18 @@ pub fn vtg_with_progress(
             attempt(variant, before, &mut |g| progress(f + 0.05 * g))
         })?;
     }
+    let report = with_estimates(input, report, options)?;
+    progress(1.0);
+    Ok(report)
+}
+
+/// The report with its file's time comments and `M73` lines rewritten from the planner
+/// ([`crate::estimate`]) when the toolpath changed and the options ask for it.
+fn with_estimates(
+    input: &[u8],
+    mut report: VtgReport,
+    options: &VtgOptions,
+) -> Result<VtgReport, Error> {
     if options.estimates && report.output != input {
         let note = format!("vtg: corners rounded within {} mm", options.tolerance_mm);
         if let Some((output, after)) =
@@ -247,7 +259,6 @@ pub fn vtg_with_progress(
             report.after = after;
         }
     }
-    progress(1.0);
     Ok(report)
 }
 

@@ -2,7 +2,7 @@
 // CLI's --json). Checked against real CLI output by tests/js/types.test.mjs. ──
 
 /** Where a machine limit came from, in order of precedence. */
-export type LimitSource = "command" | "slicer_settings" | "printer_config" | "profile" | "option";
+export type LimitSource = "command" | "slicer_settings" | "printer_config" | "machine_settings" | "profile" | "option";
 export interface Limit { value: number; source: LimitSource }
 export type JunctionModel = "classic_jerk" | "junction_deviation" | "klipper";
 /** Machine limits; arrays are per axis X, Y, Z, E. */
@@ -68,6 +68,8 @@ export interface AnalyzeOptions {
   klipper_config?: string | null;
   /** How that Klipper reads max_accel_to_decel (default "current"). */
   klipper_version?: "legacy" | "current" | null;
+  /** A Marlin printer's own settings as its M503 prints them (M201, M203, M204, M205…), applied before the file; not with klipper_config. */
+  machine_gcode?: string | null;
 }
 export interface Warning { line: number; message: string }
 export type FeatureKind =
