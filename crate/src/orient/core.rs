@@ -63,12 +63,18 @@ pub fn smooth_run(
     let b: Vec<V3> = run.iter().map(|s| s.v).collect();
     let s = arc_length(&p);
     let smoothed = filter::smooth(&b, &s, settings.filter, settings.window);
+    // Kept as written: the ends, points whose original is near the singular direction, and
+    // points the filter would pull into it (a path crossing near the axis: pushed back out, the
+    // smoothed vectors would go round the axis where the input crosses it, and the turntable
+    // would then owe half a turn that only a branch flip pays back).
     let fixed: Vec<bool> = run
         .iter()
+        .zip(&smoothed)
         .enumerate()
-        .map(|(i, x)| {
+        .map(|(i, (x, t))| {
             (fixed_ends && (i == 0 || i + 1 == run.len()))
                 || in_singular_zone(kin, x.v, settings.singular_angle)
+                || in_singular_zone(kin, *t, settings.singular_angle)
         })
         .collect();
     let weights = anchor_weights(&fixed, &s, settings.window);
@@ -167,14 +173,20 @@ pub fn choose_rotary(kin: &Kinematics, run: &[Sample], vectors: &[Option<V3>]) -
     out
 }
 
-/// Cost of moving the rotary axes from `a` to `b` in one move: the axis motion, plus a penalty
-/// that makes a step of half a turn or more of the second axis the last resort.
+/// Cost of moving the rotary axes from `a` to `b` in one move: the square of the axis motion,
+/// plus a penalty that makes a step of half a turn or more of the second axis the last resort.
+///
+/// The square, not the motion itself: summed over a run, the motion alone is the same whether
+/// a turn of the table is spread over many moves or made in one, so the choice could gather it
+/// into one move just short of the half-turn penalty (a peak of angular velocity the input did
+/// not have). The sum of squares is least when the motion is spread evenly.
 fn transition_cost(kin: &Kinematics, a: [f64; 2], b: [f64; 2]) -> f64 {
     let step = kin.step(a, b);
+    let cost = step * step;
     if (a[1] - b[1]).abs() >= 180.0 {
-        step + 1e6
+        cost + 1e12
     } else {
-        step
+        cost
     }
 }
 

@@ -59,6 +59,20 @@ pub enum InputFormat {
     Json,
 }
 
+/// What the X, Y, Z words of multi-axis G-code are.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Coordinates {
+    /// Machine axes: the tool tip in the workpiece frame follows through the kinematic model
+    /// (no RTCP); smoothing rewrites X, Y, Z and the rotary words.
+    #[default]
+    Machine,
+    /// The tool tip in the workpiece frame, as a controller with RTCP / TCPM active reads them
+    /// (the paper's robot cell, many 5-axis printers); the rotary words give the orientation
+    /// through the kinematic model. Smoothing keeps X, Y, Z and rewrites only the rotary words.
+    Workpiece,
+}
+
 /// Options of [`smooth`]. Every field is optional in JSON.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -66,6 +80,8 @@ pub struct SmoothOptions {
     /// Kinematic model (default: table-tilting B then rotary C, axes through the origin, as in
     /// the corpus 5-axis file).
     pub kinematics: Kinematics,
+    /// G-code: what X, Y, Z are (default machine axes).
+    pub coordinates: Coordinates,
     /// Filter (default: zero-phase moving average, the paper's choice).
     pub filter: FilterKind,
     /// Window (default: 15 points).
@@ -98,6 +114,7 @@ impl Default for SmoothOptions {
     fn default() -> Self {
         SmoothOptions {
             kinematics: Kinematics::default(),
+            coordinates: Coordinates::Machine,
             filter: FilterKind::default(),
             window: Window::default(),
             cone_deg: 60.0,
@@ -173,6 +190,8 @@ pub struct SmoothReport {
     pub format: InputFormat,
     /// Kinematic model used.
     pub kinematics: KinematicModel,
+    /// What X, Y, Z were read as (G-code).
+    pub coordinates: Coordinates,
     /// Filter used.
     pub filter: FilterKind,
     /// Window used.
