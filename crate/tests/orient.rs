@@ -898,3 +898,44 @@ fn quarter_torus_gcode_is_smoothed_by_default() {
         check_part("quarter torus (CIRP eq. 1)", &torus, &conv, 0.3);
     }
 }
+
+#[test]
+fn a_branch_flip_inside_a_printed_line_is_unwrapped_not_a_cut() {
+    // A line printed 40 mm from the table axis with the tool leaning 20° and wobbling ±3°;
+    // halfway the file switches to the other inverse-kinematics solution (B → −B, C → C + 180°,
+    // the same tool vector): the machine XYZ swings 80 mm for a 0.5 mm step of the tip.
+    let kin = Kinematics::default();
+    let mut g = String::from("G90\nM82\nG92 E0\n");
+    for i in 0..=80 {
+        let p = [40.0, i as f64 * 0.5 - 20.0, 5.0];
+        let tilt = 20.0 + if (i / 6) % 2 == 0 { 3.0 } else { -3.0 };
+        let rot = if i < 40 { [-tilt, 10.0] } else { [tilt, 190.0] };
+        let m = kin.machine_xyz(p, rot);
+        let cmd = if i == 0 { "G0" } else { "G1" };
+        g.push_str(&format!(
+            "{cmd} X{:.3} Y{:.3} Z{:.3} B{:.3} C{:.3} E{:.3} F1200\n",
+            m[0],
+            m[1],
+            m[2],
+            rot[0],
+            rot[1],
+            i as f64 * 0.02
+        ));
+    }
+    let report = orient::smooth(g.as_bytes(), &SmoothOptions::default()).expect("smooth");
+    assert_eq!(report.runs, 1, "{:?}", report.warnings);
+    assert!(
+        report.roughness_reduction > 0.3,
+        "{}",
+        report.roughness_reduction
+    );
+    assert!(report.max_tip_deviation_mm <= 1e-3);
+    // The written C flips at most once (where the file's own ends force it), not back and forth.
+    let path = quietpath::path::extract(&report.output, &Default::default(), false).expect("read");
+    let flips = path
+        .moves
+        .windows(2)
+        .filter(|w| (w[1].to[6] - w[0].to[6]).abs() >= 90.0)
+        .count();
+    assert!(flips <= 1, "{flips}");
+}

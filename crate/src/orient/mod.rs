@@ -5,8 +5,10 @@
 //! smoothed with a median or moving-average filter (causal or zero-phase, section 3.2), and every
 //! smoothed vector that leaves the tolerance cone of opening `γ` around its original build
 //! direction is rotated back onto the cone's edge (CIRP eq. 4–7). The result is written back
-//! through a kinematic model ([`kinematics`]) as new rotary angles and the machine XYZ that keeps
-//! the tool tip on the same workpiece path.
+//! through a kinematic model ([`kinematics`]) as new rotary angles and, in machine coordinates,
+//! the machine XYZ that keeps the tool tip on the same workpiece path (in workpiece coordinates,
+//! [`Coordinates::Workpiece`], X, Y, Z are the tip and stay). The paper's test parts are
+//! [`quarter_torus`] (CIRP eq. 1) and [`square_tube`] (CIRP eq. 2).
 //!
 //! ```
 //! use quietpath::orient::{smooth, SmoothOptions};
@@ -95,9 +97,11 @@ pub struct SmoothOptions {
     /// Default (`None`): 6° for G-code (the λ of the corpus file's generator), 0 for point-vector
     /// data (a robot cell has no turntable singularity; the kinematics only serve the metrics).
     pub singular_deg: Option<f64>,
-    /// Longest step between two points of one continuous path, mm (default 5, the jump length
-    /// of the corpus file's generator). A longer step is a jump to another section: the filter
-    /// does not average across it (in G-code the jumping move stays as written).
+    /// Longest tool-tip step between two points of one continuous path, mm, measured in the
+    /// workpiece frame (default 5, the jump length of the corpus file's generator). A longer
+    /// step is a jump to another section: the filter does not average across it (in G-code the
+    /// jumping move stays as written). Machine-axis travel is no criterion: the table swinging
+    /// round a corner of the path moves the axes far for a short tip step (CIRP section 2.2).
     pub max_gap_mm: f64,
     /// Decimals written for the rewritten axis words (default 3).
     pub decimals: u8,

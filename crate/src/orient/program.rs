@@ -1,7 +1,8 @@
 //! Multi-axis G-code in and out: every extruding `G1` becomes a path point (tool tip in the
 //! workpiece frame and tool vector through the kinematic model), consecutive extruding moves
-//! form a run, and smoothed runs are written back as the same lines with new rotary angles and
-//! the machine XYZ that keeps the tool tip where it was.
+//! form a run (broken only by travel, non-extruding moves and tool-tip jumps), and smoothed runs
+//! are written back as the same lines with new rotary angles and, in machine coordinates, the
+//! machine XYZ that keeps the tool tip where it was.
 //!
 //! Travel moves, arcs, moves in relative positioning (`G91`) and every other line stay
 //! byte-identical. A run starts at the end of the move before it, which is not changed.
