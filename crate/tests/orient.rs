@@ -858,6 +858,11 @@ fn check_part(name: &str, pts: &[PointVector], conv: &Convention, min_reduction:
         "{name}"
     );
     if conv.coordinates == orient::Coordinates::Workpiece {
+        // With RTCP the plan follows the tip, the same before and after: the rotary axes' peak
+        // jerk along it falls.
+        for (b, a) in report.before.rotary.iter().zip(&report.after.rotary) {
+            assert!(a.max_jerk_deg_s3 < b.max_jerk_deg_s3, "{name}: {}", a.axis);
+        }
         // Only rotary words change.
         for (a, b) in input
             .split(|&c| c == b'\n')
