@@ -324,7 +324,8 @@ export interface SmoothReport {
   };
   warnings: Warning[];
 }
-/** smooth() result: the report plus the smoothed file. */
+/** smooth() result: the report plus the smoothed file. A file whose rotary axes never move
+ *  (3-axis) throws a QuietpathError of kind `no_rotary_motion` ({ first, second } axis letters). */
 export interface SmoothResult extends SmoothReport { output: Uint8Array }
 
 // ── infill (`quietpath infill --json`) ──
