@@ -85,6 +85,18 @@ pub enum ErrorKind {
         /// Why, with the line.
         reason: String,
     },
+    /// Tool-orientation smoothing was given a file whose rotary axes never move: a 3-axis
+    /// toolpath (or the wrong kinematic model's letters), with a constant tool vector.
+    #[error(
+        "no {first}/{second} rotary motion in the file: the tool vector is constant, there is \
+         nothing to smooth (a 3-axis toolpath, or the wrong --kinematics / `kinematics.model`)"
+    )]
+    NoRotaryMotion {
+        /// The first rotary axis letter of the kinematic model.
+        first: char,
+        /// The second rotary axis letter.
+        second: char,
+    },
     /// The job was cancelled by the caller.
     #[error("cancelled")]
     Cancelled,

@@ -358,11 +358,19 @@ fn bad_options_are_errors_not_panics() {
         path: 0,
     }];
     assert!(smooth_points(&bad, &SmoothOptions::default()).is_err());
-    // Plain 3-axis G-code: nothing to smooth, a warning, output identical.
+    // Plain 3-axis G-code: nothing to smooth is an error, not a success.
     let plain = b"G90\nG1 X1 Y1 E1 F600\nG1 X2 Y1 E2\n";
-    let r = orient::smooth(plain, &SmoothOptions::default()).expect("smooth");
-    assert_eq!(r.output, plain.to_vec());
-    assert!(!r.warnings.is_empty());
+    let r = orient::smooth(plain, &SmoothOptions::default());
+    assert!(
+        matches!(
+            r.map_err(|e| e.kind),
+            Err(quietpath::ErrorKind::NoRotaryMotion {
+                first: 'B',
+                second: 'C'
+            })
+        ),
+        "3-axis file"
+    );
 }
 
 fn unit_vector() -> impl Strategy<Value = [f64; 3]> {
@@ -638,4 +646,301 @@ fn a_g92_shift_carries_into_the_words_written_after_it() {
         "{}",
         r.max_angle_to_original_deg
     );
+}
+
+// ── The paper's parts as G-code (issue 28) ──
+
+/// How a generated part is written: the machine, and what its X, Y, Z words are.
+struct Convention {
+    name: &'static str,
+    kin: Kinematics,
+    coordinates: orient::Coordinates,
+}
+
+fn conventions() -> Vec<Convention> {
+    let through_origin = Kinematics::default();
+    let offset = Kinematics {
+        b_axis_point_mm: [5.0, -3.0, -60.0],
+        c_axis_point_mm: [2.0, 4.0, 0.0],
+        ..Kinematics::default()
+    };
+    vec![
+        Convention {
+            name: "table-bc, axes through the origin",
+            kin: through_origin.clone(),
+            coordinates: orient::Coordinates::Machine,
+        },
+        Convention {
+            name: "table-bc, offset axes",
+            kin: offset,
+            coordinates: orient::Coordinates::Machine,
+        },
+        Convention {
+            name: "workpiece coordinates (RTCP)",
+            kin: through_origin,
+            coordinates: orient::Coordinates::Workpiece,
+        },
+    ]
+}
+
+/// G-code for a generated part: each layer (path) starts with a travel move, then one
+/// extruding `G1` per point; rotary angles from the tool vector (the branch nearest the point
+/// before), X, Y, Z the machine position or the tip.
+fn part_gcode(pts: &[PointVector], conv: &Convention) -> Vec<u8> {
+    let mut g = String::from("; generated part\nG90\nM82\nG92 E0\nG1 F1200\n");
+    let (mut prev, mut e, mut path) = ([0.0, 0.0], 0.0, None);
+    for q in pts {
+        let rot = conv.kin.rotary_for(unit(q), prev);
+        prev = rot;
+        let p = [q.x, q.y, q.z];
+        let xyz = match conv.coordinates {
+            orient::Coordinates::Machine => conv.kin.machine_xyz(p, rot),
+            orient::Coordinates::Workpiece => p,
+        };
+        let words = format!(
+            "X{:.3} Y{:.3} Z{:.3} B{:.3} C{:.3}",
+            xyz[0], xyz[1], xyz[2], rot[0], rot[1]
+        );
+        if path != Some(q.path) {
+            path = Some(q.path);
+            g.push_str(&format!("G0 Z{:.3}\nG0 {words}\n", xyz[2] + 5.0));
+        } else {
+            e += 0.02;
+            g.push_str(&format!("G1 {words} E{e:.4}\n"));
+        }
+    }
+    g.push_str("G0 Z200\nM84\n");
+    g.into_bytes()
+}
+
+/// The table-BC model written out independently of `orient::kinematics`: the tip in the
+/// workpiece frame `p = R_z(−C)(R_y(−B)(M − b) + b − c) + c`, and the tool vector
+/// `(−cos C sin B, sin C sin B, cos B)`.
+fn tip_and_vector(conv: &Convention, m: [f64; 3], b_deg: f64, c_deg: f64) -> ([f64; 3], [f64; 3]) {
+    let (b, c) = (b_deg.to_radians(), c_deg.to_radians());
+    let v = [-c.cos() * b.sin(), c.sin() * b.sin(), b.cos()];
+    if conv.coordinates == orient::Coordinates::Workpiece {
+        return (m, v);
+    }
+    let (bp, cp) = (conv.kin.b_axis_point_mm, conv.kin.c_axis_point_mm);
+    let d = [m[0] - bp[0], m[1] - bp[1], m[2] - bp[2]];
+    // R_y(−B)
+    let q = [
+        b.cos() * d[0] - b.sin() * d[2],
+        d[1],
+        b.sin() * d[0] + b.cos() * d[2],
+    ];
+    let q = [
+        q[0] + bp[0] - cp[0],
+        q[1] + bp[1] - cp[1],
+        q[2] + bp[2] - cp[2],
+    ];
+    // R_z(−C)
+    let p = [
+        c.cos() * q[0] + c.sin() * q[1] + cp[0],
+        -c.sin() * q[0] + c.cos() * q[1] + cp[1],
+        q[2] + cp[2],
+    ];
+    (p, v)
+}
+
+/// A written point: motion line, tip, tool vector, whether the move extrudes.
+type Written = (u32, [f64; 3], [f64; 3], bool);
+
+fn read_written(gcode: &[u8], conv: &Convention) -> Vec<Written> {
+    let path = quietpath::path::extract(gcode, &Default::default(), false).expect("extract");
+    path.moves
+        .iter()
+        .map(|m| {
+            let (p, v) = tip_and_vector(conv, [m.to[0], m.to[1], m.to[2]], m.to[5], m.to[6]);
+            (m.line, p, v, m.is_extruding())
+        })
+        .collect()
+}
+
+/// RMS second difference of the unit tool vector over consecutive points of each run, the
+/// runs taken from the input: extruding moves, broken at any other move and at a tip jump
+/// over 5 mm.
+fn rms_roughness(points: &[Written], runs_of: &[Written]) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    let mut run: Vec<[f64; 3]> = Vec::new();
+    let mut flush = |run: &mut Vec<[f64; 3]>| {
+        for w in run.windows(3) {
+            let d = vec3::add(vec3::sub(w[0], vec3::scale(w[1], 2.0)), w[2]);
+            sum += vec3::dot(d, d);
+            n += 1;
+        }
+        run.clear();
+    };
+    for (i, ((_, _, v, _), (_, p, _, ext))) in points.iter().zip(runs_of).enumerate() {
+        let jump = i > 0 && vec3::norm(vec3::sub(*p, runs_of[i - 1].1)) > 5.0;
+        if !ext || jump {
+            flush(&mut run);
+        }
+        run.push(*v);
+    }
+    flush(&mut run);
+    (sum / n.max(1) as f64).sqrt()
+}
+
+/// What the written file shows against the input.
+#[derive(Debug)]
+struct Bars {
+    roughness_before: f64,
+    roughness_after: f64,
+    worst_angle_deg: f64,
+    worst_tip_mm: f64,
+}
+
+fn measure_written(input: &[u8], output: &[u8], conv: &Convention) -> Bars {
+    let (a, b) = (read_written(input, conv), read_written(output, conv));
+    assert_eq!(a.len(), b.len());
+    let mut worst_angle_deg = 0.0f64;
+    let mut worst_tip_mm = 0.0f64;
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!(x.0, y.0);
+        worst_angle_deg = worst_angle_deg.max(vec3::deg(vec3::angle(x.2, y.2)));
+        worst_tip_mm = worst_tip_mm.max(vec3::norm(vec3::sub(x.1, y.1)));
+    }
+    Bars {
+        roughness_before: rms_roughness(&a, &a),
+        roughness_after: rms_roughness(&b, &a),
+        worst_angle_deg,
+        worst_tip_mm,
+    }
+}
+
+/// Smooths a part written in `conv` with the defaults and a 60° cone; checks the bars on the
+/// written file.
+fn check_part(name: &str, pts: &[PointVector], conv: &Convention, min_reduction: f64) {
+    let input = part_gcode(pts, conv);
+    let options = SmoothOptions {
+        kinematics: conv.kin.clone(),
+        coordinates: conv.coordinates,
+        cone_deg: 60.0,
+        ..SmoothOptions::default()
+    };
+    let report = orient::smooth(&input, &options).expect("smooth");
+    if let Ok(dir) = std::env::var("QUIETPATH_ORIENT_DUMP") {
+        let stem = format!("{name}-{}", conv.name).replace([' ', ',', '(', ')', '.'], "_");
+        std::fs::write(format!("{dir}/{stem}.gcode"), &input).expect("dump");
+        std::fs::write(format!("{dir}/{stem}-out.gcode"), &report.output).expect("dump");
+    }
+    let bars = measure_written(&input, &report.output, conv);
+    let reduction = 1.0 - bars.roughness_after / bars.roughness_before;
+    let jerk = |m: &orient::OrientationMetrics| {
+        m.rotary
+            .iter()
+            .map(|r| format!("{} {:.0}", r.axis, r.max_jerk_deg_s3))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    println!(
+        "{name}, {}: {} points in {} runs; roughness {:.5} -> {:.5} (-{:.1} %), worst angle \
+         {:.3}°, worst tip {:.2e} mm; peak jerk before {} after {} °/s³",
+        conv.name,
+        report.points,
+        report.runs,
+        bars.roughness_before,
+        bars.roughness_after,
+        100.0 * reduction,
+        bars.worst_angle_deg,
+        bars.worst_tip_mm,
+        jerk(&report.before),
+        jerk(&report.after),
+    );
+    assert!(bars.worst_angle_deg <= 30.0 + 1e-9, "{name}: {bars:?}");
+    assert!(bars.worst_tip_mm <= 1e-3, "{name}: {bars:?}");
+    assert!(reduction >= min_reduction, "{name}: {bars:?}");
+    // The report says the same as the file.
+    assert!(
+        (report.roughness_reduction - reduction).abs() < 0.05,
+        "{name}"
+    );
+    if conv.coordinates == orient::Coordinates::Workpiece {
+        // With RTCP the plan follows the tip, the same before and after: the rotary axes' peak
+        // jerk along it falls.
+        for (b, a) in report.before.rotary.iter().zip(&report.after.rotary) {
+            assert!(a.max_jerk_deg_s3 < b.max_jerk_deg_s3, "{name}: {}", a.axis);
+        }
+        // Only rotary words change.
+        for (a, b) in input
+            .split(|&c| c == b'\n')
+            .zip(report.output.split(|&c| c == b'\n'))
+        {
+            let xyz = |l: &[u8]| {
+                String::from_utf8_lossy(l)
+                    .split_whitespace()
+                    .filter(|w| w.starts_with(['X', 'Y', 'Z']))
+                    .map(str::to_owned)
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(xyz(a), xyz(b));
+        }
+    }
+}
+
+fn gcode_part_options() -> PartOptions {
+    PartOptions {
+        layer_height_mm: 2.0,
+        point_spacing_mm: 0.5,
+        height_mm: 30.0,
+    }
+}
+
+#[test]
+fn square_tube_gcode_is_smoothed_by_default_in_every_convention() {
+    let tube = square_tube(&gcode_part_options());
+    for conv in conventions() {
+        check_part("square tube (CIRP eq. 2)", &tube, &conv, 0.6);
+    }
+}
+
+#[test]
+fn quarter_torus_gcode_is_smoothed_by_default() {
+    let torus = quarter_torus(&gcode_part_options());
+    for conv in conventions() {
+        check_part("quarter torus (CIRP eq. 1)", &torus, &conv, 0.3);
+    }
+}
+
+#[test]
+fn a_branch_flip_inside_a_printed_line_is_unwrapped_not_a_cut() {
+    // A line printed 40 mm from the table axis with the tool leaning 20° and wobbling ±3°;
+    // halfway the file switches to the other inverse-kinematics solution (B → −B, C → C + 180°,
+    // the same tool vector): the machine XYZ swings 80 mm for a 0.5 mm step of the tip.
+    let kin = Kinematics::default();
+    let mut g = String::from("G90\nM82\nG92 E0\n");
+    for i in 0..=80 {
+        let p = [40.0, i as f64 * 0.5 - 20.0, 5.0];
+        let tilt = 20.0 + if (i / 6) % 2 == 0 { 3.0 } else { -3.0 };
+        let rot = if i < 40 { [-tilt, 10.0] } else { [tilt, 190.0] };
+        let m = kin.machine_xyz(p, rot);
+        let cmd = if i == 0 { "G0" } else { "G1" };
+        g.push_str(&format!(
+            "{cmd} X{:.3} Y{:.3} Z{:.3} B{:.3} C{:.3} E{:.3} F1200\n",
+            m[0],
+            m[1],
+            m[2],
+            rot[0],
+            rot[1],
+            i as f64 * 0.02
+        ));
+    }
+    let report = orient::smooth(g.as_bytes(), &SmoothOptions::default()).expect("smooth");
+    assert_eq!(report.runs, 1, "{:?}", report.warnings);
+    assert!(
+        report.roughness_reduction > 0.3,
+        "{}",
+        report.roughness_reduction
+    );
+    assert!(report.max_tip_deviation_mm <= 1e-3);
+    // The written C flips at most once (where the file's own ends force it), not back and forth.
+    let path = quietpath::path::extract(&report.output, &Default::default(), false).expect("read");
+    let flips = path
+        .moves
+        .windows(2)
+        .filter(|w| (w[1].to[6] - w[0].to[6]).abs() >= 90.0)
+        .count();
+    assert!(flips <= 1, "{flips}");
 }

@@ -40,12 +40,20 @@ fn five_axis_corpus_file_is_smoothed_within_the_cone() {
     );
     assert!(report.points > 30_000);
     assert!(report.max_angle_to_original_deg <= half);
-    // Done when: roughness falls by at least 30 %.
+    // Runs are cut only by travel and tool-tip jumps now (47 runs, not the 414 the machine-XYZ
+    // rule made): the pole crossings of Zhang's generator, which carry most of the file's
+    // orientation roughness, are inside runs, smoothed in joint space, and measured.
+    // Done when: roughness falls by at least 30 % (82 %), the turntable's peaks do not rise.
+    assert!(report.runs < 100, "{}", report.runs);
     assert!(
         report.roughness_reduction >= 0.3,
         "{}",
         report.roughness_reduction
     );
+    let (b, a) = (&report.before.rotary[1], &report.after.rotary[1]);
+    assert!(a.max_velocity_deg_s < b.max_velocity_deg_s);
+    assert!(a.max_acceleration_deg_s2 < b.max_acceleration_deg_s2);
+    assert!(a.max_jerk_deg_s3 < b.max_jerk_deg_s3);
 
     // Same motion lines; every line that is not an extruding G1 byte-identical.
     let out = &report.output;
@@ -70,7 +78,7 @@ fn five_axis_corpus_file_is_smoothed_within_the_cone() {
     for ((la, pa, printing), (lb, pb, _)) in before.iter().zip(&after) {
         assert_eq!(la, lb);
         let tip = vec3::norm(vec3::sub(kin.tip(pa), kin.tip(pb)));
-        assert!(tip < 2e-3, "line {la}: tip moved {tip} mm");
+        assert!(tip <= 1e-3, "line {la}: tip moved {tip} mm");
         let ang = vec3::deg(vec3::angle(
             kin.tool_vector(pa.rot),
             kin.tool_vector(pb.rot),

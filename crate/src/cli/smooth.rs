@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use clap::ValueEnum;
 
 use quietpath::orient::{
-    smooth_with_progress, FilterKind, InputFormat, KinematicModel, Kinematics, SmoothOptions,
-    SmoothReport, Window,
+    smooth_with_progress, Coordinates, FilterKind, InputFormat, KinematicModel, Kinematics,
+    SmoothOptions, SmoothReport, Window,
 };
 
 use super::output;
@@ -29,6 +29,10 @@ pub struct Args {
     /// table-bc: a point on the C axis (direction +Z) at B = 0, "x,y,z" mm.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_point)]
     pub c_axis_point: Option<[f64; 3]>,
+    /// What X, Y, Z are: machine axes, or the tool tip in the workpiece frame (RTCP/TCPM; only
+    /// the rotary words are rewritten).
+    #[arg(long, value_enum, default_value_t = CoordinatesArg::Machine)]
+    pub coordinates: CoordinatesArg,
     /// head-ab: nozzle tip to pivot point distance, mm (0 with RTCP/TCPM).
     #[arg(long, value_name = "MM", default_value_t = 0.0)]
     pub pivot_length: f64,
@@ -77,6 +81,15 @@ pub enum KinematicsArg {
     HeadAb,
 }
 
+/// `--coordinates` values.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum CoordinatesArg {
+    /// X, Y, Z are machine axes; the tip follows through the kinematic model.
+    Machine,
+    /// X, Y, Z are the tool tip in the workpiece frame (RTCP / TCPM).
+    Workpiece,
+}
+
 /// `--filter` values.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum FilterArg {
@@ -123,6 +136,10 @@ pub fn run(args: Args) -> Result<(), String> {
             b_axis_point_mm: args.b_axis_point.unwrap_or(defaults.b_axis_point_mm),
             c_axis_point_mm: args.c_axis_point.unwrap_or(defaults.c_axis_point_mm),
             pivot_length_mm: args.pivot_length,
+        },
+        coordinates: match args.coordinates {
+            CoordinatesArg::Machine => Coordinates::Machine,
+            CoordinatesArg::Workpiece => Coordinates::Workpiece,
         },
         filter: match args.filter {
             FilterArg::ZeroPhaseMovingAverage => FilterKind::ZeroPhaseMovingAverage,
@@ -182,7 +199,7 @@ fn print(out: &mut impl Write, args: &Args, r: &SmoothReport) -> std::io::Result
     };
     row(
         out,
-        "roughness (mean |d2 T|)",
+        "roughness (rms |d2 T|)",
         r.before.roughness,
         r.after.roughness,
     )?;
@@ -205,30 +222,34 @@ fn print(out: &mut impl Write, args: &Args, r: &SmoothReport) -> std::io::Result
         r.after.mean_angle_change_per_mm_deg,
     )?;
     for (b, a) in r.before.rotary.iter().zip(&r.after.rotary) {
-        row(
-            out,
-            &format!("{} velocity rms, deg/s", b.axis),
-            b.rms_velocity_deg_s,
-            a.rms_velocity_deg_s,
-        )?;
-        row(
-            out,
-            &format!("{} acceleration rms, deg/s2", b.axis),
-            b.rms_acceleration_deg_s2,
-            a.rms_acceleration_deg_s2,
-        )?;
-        row(
-            out,
-            &format!("{} jerk rms, deg/s3", b.axis),
-            b.rms_jerk_deg_s3,
-            a.rms_jerk_deg_s3,
-        )?;
-        row(
-            out,
-            &format!("{} travel, deg", b.axis),
-            b.travel_deg,
-            a.travel_deg,
-        )?;
+        let rows = [
+            (
+                "velocity peak, deg/s",
+                b.max_velocity_deg_s,
+                a.max_velocity_deg_s,
+            ),
+            (
+                "velocity rms, deg/s",
+                b.rms_velocity_deg_s,
+                a.rms_velocity_deg_s,
+            ),
+            (
+                "acceleration peak, deg/s2",
+                b.max_acceleration_deg_s2,
+                a.max_acceleration_deg_s2,
+            ),
+            (
+                "acceleration rms, deg/s2",
+                b.rms_acceleration_deg_s2,
+                a.rms_acceleration_deg_s2,
+            ),
+            ("jerk peak, deg/s3", b.max_jerk_deg_s3, a.max_jerk_deg_s3),
+            ("jerk rms, deg/s3", b.rms_jerk_deg_s3, a.rms_jerk_deg_s3),
+            ("travel, deg", b.travel_deg, a.travel_deg),
+        ];
+        for (name, before, after) in rows {
+            row(out, &format!("{} {name}", b.axis), before, after)?;
+        }
     }
     writeln!(
         out,

@@ -51,8 +51,9 @@ pub fn arc_length(p: &[V3]) -> Vec<f64> {
 /// Smooths one run. With `fixed_ends` its first sample (where the run starts: the end of the
 /// move before it, in G-code) and its last stay as they are: the lines after the run then mean
 /// what they meant (a following line that omits an axis word inherits the run's last values),
-/// and the smoothing ramps in and out ([`anchor_weights`]). Fixed samples still take part in the
-/// filter.
+/// and the smoothing ramps in and out ([`anchor_weights`]). Points near the kinematic
+/// singularity are smoothed in joint space instead (`joint_smoothed`) and anchor the vector
+/// smoothing of their neighbours. Fixed samples still take part in the filter.
 pub fn smooth_run(
     run: &[Sample],
     kin: &Kinematics,
@@ -63,15 +64,15 @@ pub fn smooth_run(
     let b: Vec<V3> = run.iter().map(|s| s.v).collect();
     let s = arc_length(&p);
     let smoothed = filter::smooth(&b, &s, settings.filter, settings.window);
-    let fixed: Vec<bool> = run
-        .iter()
-        .enumerate()
-        .map(|(i, x)| {
-            (fixed_ends && (i == 0 || i + 1 == run.len()))
-                || in_singular_zone(kin, x.v, settings.singular_angle)
-        })
-        .collect();
-    let weights = anchor_weights(&fixed, &s, settings.window);
+    let marks = Marks::new(run, &smoothed, &s, kin, settings, fixed_ends);
+    let weights = anchor_weights(&marks.fixed, &s, settings.window);
+    let fixed = &marks.fixed;
+    let joint = Joint {
+        singular: &marks.singular,
+        weights: &marks.end_weights,
+        s: &s,
+    };
+    let run = &joint_smoothed(run, &joint, kin, settings);
     // The new tool vectors (fixed points keep theirs).
     let mut vectors = Vec::with_capacity(run.len());
     let mut corrected = 0usize;
@@ -110,6 +111,135 @@ pub fn smooth_run(
         })
         .collect();
     RunOutput { samples, corrected }
+}
+
+/// Which points of a run the vector filter leaves alone.
+struct Marks {
+    /// Smoothed in joint space (`joint_smoothed`).
+    singular: Vec<bool>,
+    /// Not smoothed as vectors: the joint-space points and the run's kept ends.
+    fixed: Vec<bool>,
+    /// Ramp of the smoothing from the run's kept ends.
+    end_weights: Vec<f64>,
+}
+
+impl Marks {
+    /// Points whose original, or whose filtered vector, is near the singular direction (a path
+    /// crossing near the axis), and their neighbours within a window (so that the joint-space
+    /// average at the edge of the set no longer reaches them and meets the vector-smoothed
+    /// points without a step) go to joint space; with `fixed_ends` the run's ends stay.
+    fn new(
+        run: &[Sample],
+        smoothed: &[V3],
+        s: &[f64],
+        kin: &Kinematics,
+        settings: &RunSettings,
+        fixed_ends: bool,
+    ) -> Self {
+        let ends = |i: usize| fixed_ends && (i == 0 || i + 1 == run.len());
+        let near_axis: Vec<bool> = run
+            .iter()
+            .zip(smoothed)
+            .map(|(x, t)| {
+                in_singular_zone(kin, x.v, settings.singular_angle)
+                    || in_singular_zone(kin, *t, settings.singular_angle)
+            })
+            .collect();
+        let wider = match settings.window {
+            Window::Points(w) => Window::Points(2 * w),
+            Window::Millimetres(mm) => Window::Millimetres(2.0 * mm),
+        };
+        let reach = anchor_weights(&near_axis, s, wider);
+        let singular: Vec<bool> = reach
+            .iter()
+            .enumerate()
+            .map(|(i, w)| *w < 1.0 && !ends(i))
+            .collect();
+        let fixed = (0..run.len())
+            .map(|i| singular.get(i).copied().unwrap_or(false) || ends(i))
+            .collect();
+        let end_flags: Vec<bool> = (0..run.len()).map(ends).collect();
+        Marks {
+            singular,
+            fixed,
+            end_weights: anchor_weights(&end_flags, s, settings.window),
+        }
+    }
+}
+
+/// Which points [`joint_smoothed`] changes, and how far.
+#[derive(Debug, Clone, Copy)]
+struct Joint<'a> {
+    /// The points smoothed in joint space.
+    singular: &'a [bool],
+    /// Weight of the smoothing at each point (0 at the run's kept ends).
+    weights: &'a [f64],
+    /// Cumulative path length, mm.
+    s: &'a [f64],
+}
+
+/// The run with the points near the singular direction (`singular`) smoothed in joint space:
+/// their rotary angles become the centred moving average of the file's own angles over the
+/// window, where that keeps the tool vector inside the cone.
+///
+/// Near the table axis the tool vector is a poor thing to average: a path that crosses near the
+/// axis has its azimuth, and so the turntable angle, change by half a turn over a few points,
+/// and an averaged vector (pushed out of the keep-out) would go round the axis where the input
+/// crosses it. The file's own B and C are continuous there (Zhang's generator takes B through
+/// 0 and turns C), so their average is a smooth crossing with the same winding of the table.
+/// Table-BC only (the head's angles wrap).
+fn joint_smoothed(
+    run: &[Sample],
+    joint: &Joint<'_>,
+    kin: &Kinematics,
+    settings: &RunSettings,
+) -> Vec<Sample> {
+    let Joint {
+        singular,
+        weights,
+        s,
+    } = *joint;
+    let mut out = run.to_vec();
+    if kin.model != super::kinematics::KinematicModel::TableBc {
+        return out;
+    }
+    let near = |i: usize, j: usize| match settings.window {
+        Window::Points(w) => i.abs_diff(j) <= w / 2,
+        Window::Millimetres(mm) => {
+            (s.get(i).copied().unwrap_or(0.0) - s.get(j).copied().unwrap_or(0.0)).abs() <= mm / 2.0
+        }
+    };
+    for (i, x) in out.iter_mut().enumerate() {
+        if !singular.get(i).copied().unwrap_or(false) {
+            continue;
+        }
+        let lo = (0..=i)
+            .rev()
+            .take_while(|&j| near(i, j))
+            .last()
+            .unwrap_or(i);
+        let hi = (i..run.len())
+            .take_while(|&j| near(i, j))
+            .last()
+            .unwrap_or(i);
+        let window = run.get(lo..=hi).unwrap_or_default();
+        let n = window.len().max(1) as f64;
+        let rot = window
+            .iter()
+            .fold([0.0; 2], |a, y| [a[0] + y.rot[0], a[1] + y.rot[1]]);
+        // Ramped in from the run's kept ends, as the vector smoothing is.
+        let w = weights.get(i).copied().unwrap_or(1.0);
+        let rot = [
+            x.rot[0] + w * (rot[0] / n - x.rot[0]),
+            x.rot[1] + w * (rot[1] / n - x.rot[1]),
+        ];
+        let v = kin.tool_vector(rot);
+        if vec3::angle(v, x.v) <= settings.half_angle {
+            x.rot = rot;
+            x.v = v;
+        }
+    }
+    out
 }
 
 /// Rotary angles for the new vectors of a run (`None`: the point keeps its original angles),
@@ -167,14 +297,20 @@ pub fn choose_rotary(kin: &Kinematics, run: &[Sample], vectors: &[Option<V3>]) -
     out
 }
 
-/// Cost of moving the rotary axes from `a` to `b` in one move: the axis motion, plus a penalty
-/// that makes a step of half a turn or more of the second axis the last resort.
+/// Cost of moving the rotary axes from `a` to `b` in one move: the square of the axis motion,
+/// plus a penalty that makes a step of half a turn or more of the second axis the last resort.
+///
+/// The square, not the motion itself: summed over a run, the motion alone is the same whether
+/// a turn of the table is spread over many moves or made in one, so the choice could gather it
+/// into one move just short of the half-turn penalty (a peak of angular velocity the input did
+/// not have). The sum of squares is least when the motion is spread evenly.
 fn transition_cost(kin: &Kinematics, a: [f64; 2], b: [f64; 2]) -> f64 {
     let step = kin.step(a, b);
+    let cost = step * step;
     if (a[1] - b[1]).abs() >= 180.0 {
-        step + 1e6
+        cost + 1e12
     } else {
-        step
+        cost
     }
 }
 
@@ -232,10 +368,11 @@ pub fn blend(b: V3, t: V3, w: f64) -> V3 {
 
 /// Whether the original vector `b` is within `keep_out` of the singular direction.
 ///
-/// Such points are left exactly as written: there the rotary angles are what the CAM's own
+/// Such points are not smoothed as vectors: there the rotary angles are what the CAM's own
 /// motion planning chose to cross the singularity (Zhang's generator interpolates B through 0
-/// while C turns), and any change of the vector, however small, would ask the turntable for a
-/// large, fast turn or a flip to the other solution branch.
+/// while C turns), and a change of the vector, however small, could ask the turntable for a
+/// large, fast turn or a flip to the other solution branch. They are smoothed in joint space
+/// (`joint_smoothed`), which keeps the crossing's winding.
 pub fn in_singular_zone(kin: &Kinematics, b: V3, keep_out: f64) -> bool {
     if keep_out <= 0.0 {
         return false;
@@ -301,6 +438,44 @@ mod tests {
         assert_eq!(w[4], 1.0);
         let none = anchor_weights(&[false; 5], &s[..5], Window::Points(4));
         assert!(none.iter().all(|&x| x == 1.0));
+    }
+
+    #[test]
+    fn a_crossing_of_the_table_axis_is_spread_in_joint_space() {
+        // The tool crosses the C axis in one step (B −6° → +6°, C turning 40°), as Zhang's
+        // generator writes it: smoothed, B goes through 0 over several points and C follows.
+        let kin = Kinematics::default();
+        let run: Vec<Sample> = (0..41)
+            .map(|i| {
+                let rot = if i < 20 { [-6.0, 10.0] } else { [6.0, 50.0] };
+                Sample {
+                    p: [i as f64 * 0.5, 0.0, 0.0],
+                    v: kin.tool_vector(rot),
+                    rot,
+                    dt: 0.1,
+                }
+            })
+            .collect();
+        let settings = RunSettings {
+            filter: FilterKind::ZeroPhaseMovingAverage,
+            window: Window::Points(15),
+            half_angle: vec3::rad(30.0),
+            singular_angle: vec3::rad(6.0),
+        };
+        let out = smooth_run(&run, &kin, &settings, true);
+        let steps = |k: usize| {
+            out.samples
+                .windows(2)
+                .map(|w| (w[1].rot[k] - w[0].rot[k]).abs())
+                .fold(0.0, f64::max)
+        };
+        assert!(steps(0) < 1.5, "B step {}", steps(0));
+        assert!(steps(1) < 5.0, "C step {}", steps(1));
+        assert_eq!(out.samples.first(), run.first());
+        assert_eq!(out.samples.last(), run.last());
+        for (a, b) in out.samples.iter().zip(&run) {
+            assert!(vec3::angle(a.v, b.v) <= settings.half_angle);
+        }
     }
 
     #[test]

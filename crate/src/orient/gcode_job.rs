@@ -3,11 +3,11 @@
 use super::core::{self, RunSettings};
 use super::kinematics::{Kinematics, Pose};
 use super::metrics::Sample;
-use super::program::{self, MotionLine, Run};
+use super::program::{self, Frame, MotionLine, Run};
 use super::summary::{self, Counts};
 use super::words;
-use super::{InputFormat, SmoothOptions, SmoothReport};
-use crate::error::{Error, Warning};
+use super::{Coordinates, InputFormat, SmoothOptions, SmoothReport};
+use crate::error::{Error, ErrorKind, Warning};
 use crate::gcode::{self, Edit};
 use crate::path::{self, PathMove};
 use crate::progress::Progress;
@@ -18,54 +18,40 @@ pub(super) fn run(
     options: &SmoothOptions,
     progress: Progress<'_>,
 ) -> Result<SmoothReport, Error> {
-    let kin = &options.kinematics;
+    let frame = Frame {
+        kin: &options.kinematics,
+        coordinates: options.coordinates,
+    };
     summary::tick(progress, 0.0)?;
     let read = path::extract(input, &options.analyze, true)?;
     let moves = &read.moves;
+    check_rotary(frame.kin, moves)?;
     let mut warnings = read.warnings.clone();
     summary::tick(progress, 0.3)?;
     let lines = program::motion_lines(input, &options.analyze)?;
     let line_of = program::line_of_moves(moves, &lines);
-    let runs = program::runs(kin, moves, &line_of, options.max_gap_mm);
-    let [r0, r1] = kin.model.rotary_axes();
-    let has_rotary = moves
-        .iter()
-        .any(|m| m.to[r0] != 0.0 || m.to[r1] != 0.0 || m.from[r0] != 0.0 || m.from[r1] != 0.0);
-    if !has_rotary {
-        let [a, b] = kin.model.rotary_letters();
-        warnings.push(Warning {
-            line: 0,
-            message: format!(
-                "no {a}/{b} rotary motion in the file: the tool vector is constant, nothing to smooth"
-            ),
-        });
-    }
+    let runs = program::runs(&frame, moves, &line_of, options.max_gap_mm);
 
     let decimals = usize::from(options.decimals);
     let half = vec3::rad(0.5 * options.cone_deg);
     let settings = run_settings(options, half, decimals);
     let before: Vec<Vec<Sample>> = runs
         .iter()
-        .map(|r| program::samples(kin, moves, r))
+        .map(|r| program::samples(&frame, moves, r))
         .collect();
-    warnings.extend(summary::short_run_warning(&before, true));
-    if !has_rotary {
-        // A constant tool vector: nothing to filter, nothing to write, nothing to read back.
-        let done = Done {
-            motion_lines: lines.len(),
-            corrected: 0,
-            changed: 0,
-            output: input.to_vec(),
-            planned_time_before_s: read.time_s,
-            planned_time_after_s: read.time_s,
-        };
-        return finish(options, &before, &before, warnings, done, progress);
-    }
-    let (smoothed, corrected) = smooth_runs(&before, kin, &settings, progress)?;
+    warnings.extend(summary::short_run_warning(&before, true, options));
+    let (smoothed, corrected) = smooth_runs(&before, frame.kin, &settings, progress)?;
+    warnings.extend(summary::unsmoothed_warning(
+        &before,
+        &smoothed,
+        frame.kin,
+        &settings,
+        options.max_gap_mm,
+    ));
 
     let writer = Writer {
         input,
-        kin,
+        frame,
         decimals,
         half,
     };
@@ -73,16 +59,14 @@ pub(super) fn run(
     summary::tick(progress, 0.65)?;
     let output = gcode::apply_edits(input, &edits);
 
-    let (after, planned_time_after_s) = match read_back(&output, options, moves, &runs, &before) {
-        Some(back) => back,
-        None => {
-            warnings.push(Warning {
-                line: 0,
-                message: "the output could not be re-read move for move; after-metrics use the input's timing".into(),
-            });
-            (after_est, read.time_s)
-        }
-    };
+    let back = read_back(&output, options, moves, &runs, &before);
+    let (after, planned_time_after_s) = back.unwrap_or_else(|| {
+        warnings.push(Warning {
+            line: 0,
+            message: "the output could not be re-read move for move; after-metrics use the input's timing".into(),
+        });
+        (after_est, read.time_s)
+    });
     let done = Done {
         motion_lines: lines.len(),
         corrected,
@@ -92,6 +76,24 @@ pub(super) fn run(
         planned_time_after_s,
     };
     finish(options, &before, &after, warnings, done, progress)
+}
+
+/// Refuses a file whose rotary axes never leave zero: a 3-axis toolpath has a constant tool
+/// vector, and smoothing it would report a success that did nothing.
+fn check_rotary(kin: &Kinematics, moves: &[PathMove]) -> Result<(), Error> {
+    let [r0, r1] = kin.model.rotary_axes();
+    let moved = |p: &crate::machine::Pos| {
+        p.get(r0).is_some_and(|&v| v != 0.0) || p.get(r1).is_some_and(|&v| v != 0.0)
+    };
+    if moves.iter().any(|m| moved(&m.from) || moved(&m.to)) {
+        return Ok(());
+    }
+    let [first, second] = kin.model.rotary_letters();
+    Err(Error::new(
+        0,
+        0,
+        ErrorKind::NoRotaryMotion { first, second },
+    ))
 }
 
 /// The smoothing settings for a cone of half-angle `half` (rad) written with `decimals`
@@ -131,7 +133,8 @@ fn smooth_runs(
 /// Writes smoothed poses into the motion lines of the input.
 struct Writer<'a> {
     input: &'a [u8],
-    kin: &'a Kinematics,
+    /// Kinematic model and coordinate convention.
+    frame: Frame<'a>,
     /// Decimal places of the written words.
     decimals: usize,
     /// Half-angle of the cone the written vector must stay in, rad.
@@ -149,7 +152,7 @@ impl Writer<'_> {
         before: &[Vec<Sample>],
         smoothed: &[Vec<Sample>],
     ) -> (Vec<Edit>, Vec<Vec<Sample>>) {
-        let kin = self.kin;
+        let kin = self.frame.kin;
         // Where each move's new pose is: (run, sample index).
         let mut slot: Vec<Option<(usize, usize)>> = vec![None; moves.len()];
         for (r, run) in runs.iter().enumerate() {
@@ -195,6 +198,7 @@ impl Writer<'_> {
                 kin,
                 offsets: &offsets,
                 decimals: self.decimals,
+                rewrite_xyz: self.frame.coordinates == Coordinates::Machine,
             };
             match program::edit_for(self.input, line, &fmt, &m.to, &pose, force) {
                 Some(e) => {
@@ -220,7 +224,7 @@ impl Writer<'_> {
         new: &Sample,
         offsets: &program::Offsets,
     ) -> (Pose, Sample) {
-        let kin = self.kin;
+        let kin = self.frame.kin;
         let [r0, r1] = kin.model.rotary_axes();
         let xyz_axes = [
             crate::machine::axis::X,
@@ -236,7 +240,7 @@ impl Writer<'_> {
             rot = orig.rot;
             v = orig.v;
         }
-        let xyz = kin.machine_xyz(orig.p, rot);
+        let xyz = self.frame.xyz_for(orig.p, rot);
         let xyz = [0, 1, 2].map(|k| {
             q(
                 xyz.get(k).copied().unwrap_or(0.0),
@@ -245,7 +249,7 @@ impl Writer<'_> {
         });
         let pose = Pose { xyz, rot };
         let sample = Sample {
-            p: kin.tip(&pose),
+            p: self.frame.tip(&pose),
             v,
             rot,
             dt: orig.dt,
@@ -264,7 +268,10 @@ fn read_back(
     runs: &[Run],
     before: &[Vec<Sample>],
 ) -> Option<(Vec<Vec<Sample>>, f64)> {
-    let kin = &options.kinematics;
+    let frame = Frame {
+        kin: &options.kinematics,
+        coordinates: options.coordinates,
+    };
     let back = path::extract(output, &options.analyze, true).ok()?;
     if back.moves.len() != moves.len()
         || !back.moves.iter().zip(moves).all(|(a, b)| a.line == b.line)
@@ -275,7 +282,7 @@ fn read_back(
         .iter()
         .zip(before)
         .map(|(r, b)| {
-            let mut s = program::samples(kin, &back.moves, r);
+            let mut s = program::samples(&frame, &back.moves, r);
             for (x, y) in s.iter_mut().zip(b) {
                 x.dt = y.dt;
             }

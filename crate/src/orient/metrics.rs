@@ -43,9 +43,12 @@ pub struct RotaryMetrics {
 /// Orientation metrics of a set of runs.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct OrientationMetrics {
-    /// Mean norm of the second difference of the unit tool vector,
-    /// `‖T_{m+1} − 2 T_m + T_{m−1}‖`, over interior points of every run.
+    /// Orientation roughness: root mean square of the second difference of the unit tool
+    /// vector, `‖T_{m+1} − 2 T_m + T_{m−1}‖`, over the interior points of every run (consecutive
+    /// points of one continuous path; the discrete curvature the CIRP paper's filters act on).
     pub roughness: f64,
+    /// Mean of the same norm.
+    pub mean_second_difference: f64,
     /// Largest second-difference norm.
     pub max_second_difference: f64,
     /// Mean angle between consecutive tool vectors, degrees.
@@ -152,7 +155,8 @@ pub fn measure<'a>(
         }
     }
     OrientationMetrics {
-        roughness: second.mean(),
+        roughness: second.rms(),
+        mean_second_difference: second.mean(),
         max_second_difference: second.max,
         mean_angle_change_deg: turn.mean(),
         max_angle_change_deg: turn.max,
@@ -199,5 +203,6 @@ mod tests {
         // Second difference of a uniform rotation by δ: 2 (1 − cos δ) = 4 sin²(δ/2).
         let d = vec3::rad(1.0);
         assert!((m.roughness - 4.0 * (d / 2.0).sin().powi(2)).abs() < 1e-12);
+        assert!((m.mean_second_difference - m.roughness).abs() < 1e-12);
     }
 }

@@ -5,8 +5,10 @@
 //! smoothed with a median or moving-average filter (causal or zero-phase, section 3.2), and every
 //! smoothed vector that leaves the tolerance cone of opening `γ` around its original build
 //! direction is rotated back onto the cone's edge (CIRP eq. 4–7). The result is written back
-//! through a kinematic model ([`kinematics`]) as new rotary angles and the machine XYZ that keeps
-//! the tool tip on the same workpiece path.
+//! through a kinematic model ([`kinematics`]) as new rotary angles and, in machine coordinates,
+//! the machine XYZ that keeps the tool tip on the same workpiece path (in workpiece coordinates,
+//! [`Coordinates::Workpiece`], X, Y, Z are the tip and stay). The paper's test parts are
+//! [`quarter_torus`] (CIRP eq. 1) and [`square_tube`] (CIRP eq. 2).
 //!
 //! ```
 //! use quietpath::orient::{smooth, SmoothOptions};
@@ -59,6 +61,20 @@ pub enum InputFormat {
     Json,
 }
 
+/// What the X, Y, Z words of multi-axis G-code are.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Coordinates {
+    /// Machine axes: the tool tip in the workpiece frame follows through the kinematic model
+    /// (no RTCP); smoothing rewrites X, Y, Z and the rotary words.
+    #[default]
+    Machine,
+    /// The tool tip in the workpiece frame, as a controller with RTCP / TCPM active reads them
+    /// (the paper's robot cell, many 5-axis printers); the rotary words give the orientation
+    /// through the kinematic model. Smoothing keeps X, Y, Z and rewrites only the rotary words.
+    Workpiece,
+}
+
 /// Options of [`smooth`]. Every field is optional in JSON.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -66,6 +82,8 @@ pub struct SmoothOptions {
     /// Kinematic model (default: table-tilting B then rotary C, axes through the origin, as in
     /// the corpus 5-axis file).
     pub kinematics: Kinematics,
+    /// G-code: what X, Y, Z are (default machine axes).
+    pub coordinates: Coordinates,
     /// Filter (default: zero-phase moving average, the paper's choice).
     pub filter: FilterKind,
     /// Window (default: 15 points).
@@ -79,9 +97,11 @@ pub struct SmoothOptions {
     /// Default (`None`): 6° for G-code (the λ of the corpus file's generator), 0 for point-vector
     /// data (a robot cell has no turntable singularity; the kinematics only serve the metrics).
     pub singular_deg: Option<f64>,
-    /// Longest step between two points of one continuous path, mm (default 5, the jump length
-    /// of the corpus file's generator). A longer step is a jump to another section: the filter
-    /// does not average across it (in G-code the jumping move stays as written).
+    /// Longest tool-tip step between two points of one continuous path, mm, measured in the
+    /// workpiece frame (default 5, the jump length of the corpus file's generator). A longer
+    /// step is a jump to another section: the filter does not average across it (in G-code the
+    /// jumping move stays as written). Machine-axis travel is no criterion: the table swinging
+    /// round a corner of the path moves the axes far for a short tip step (CIRP section 2.2).
     pub max_gap_mm: f64,
     /// Decimals written for the rewritten axis words (default 3).
     pub decimals: u8,
@@ -98,6 +118,7 @@ impl Default for SmoothOptions {
     fn default() -> Self {
         SmoothOptions {
             kinematics: Kinematics::default(),
+            coordinates: Coordinates::Machine,
             filter: FilterKind::default(),
             window: Window::default(),
             cone_deg: 60.0,
@@ -173,6 +194,8 @@ pub struct SmoothReport {
     pub format: InputFormat,
     /// Kinematic model used.
     pub kinematics: KinematicModel,
+    /// What X, Y, Z were read as (G-code).
+    pub coordinates: Coordinates,
     /// Filter used.
     pub filter: FilterKind,
     /// Window used.

@@ -44,7 +44,7 @@ pub(super) fn run(
         },
         &runs,
         &after,
-        summary::short_run_warning(&runs, false)
+        summary::short_run_warning(&runs, false, options)
             .into_iter()
             .collect(),
         Vec::new(),

@@ -1,7 +1,8 @@
 //! Multi-axis G-code in and out: every extruding `G1` becomes a path point (tool tip in the
 //! workpiece frame and tool vector through the kinematic model), consecutive extruding moves
-//! form a run, and smoothed runs are written back as the same lines with new rotary angles and
-//! the machine XYZ that keeps the tool tip where it was.
+//! form a run (broken only by travel, non-extruding moves and tool-tip jumps), and smoothed runs
+//! are written back as the same lines with new rotary angles and, in machine coordinates, the
+//! machine XYZ that keeps the tool tip where it was.
 //!
 //! Travel moves, arcs, moves in relative positioning (`G91`) and every other line stay
 //! byte-identical. A run starts at the end of the move before it, which is not changed.
@@ -15,6 +16,8 @@ use crate::read::{AnalyzeOptions, Flow, Fold, Reader};
 use super::kinematics::{Kinematics, Pose};
 use super::metrics::Sample;
 use super::words;
+use super::Coordinates;
+use crate::vec3::V3;
 
 /// Word letters the rewriting can change: X, Y, Z and the rotary axes.
 const AXIS_INDEX: [(u8, usize); 6] = [
@@ -87,27 +90,60 @@ pub(super) fn motion_lines(
 /// One run: indexes of its moves in the path.
 pub(super) type Run = Vec<usize>;
 
+/// The kinematic model and the coordinate convention the words are written in: what a
+/// machine pose means in the workpiece frame.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Frame<'a> {
+    /// Kinematic model.
+    pub kin: &'a Kinematics,
+    /// Whether X, Y, Z are machine axes or the tool tip in the workpiece frame (RTCP).
+    pub coordinates: Coordinates,
+}
+
+impl Frame<'_> {
+    /// Tool-tip position in the workpiece frame of a pose as written: through the kinematic
+    /// model for machine coordinates, the X, Y, Z words themselves for workpiece coordinates.
+    pub fn tip(&self, pose: &Pose) -> V3 {
+        match self.coordinates {
+            Coordinates::Machine => self.kin.tip(pose),
+            Coordinates::Workpiece => pose.xyz,
+        }
+    }
+
+    /// The X, Y, Z words that put the tip on workpiece point `p` with rotary angles `rot`.
+    pub fn xyz_for(&self, p: V3, rot: [f64; 2]) -> V3 {
+        match self.coordinates {
+            Coordinates::Machine => self.kin.machine_xyz(p, rot),
+            Coordinates::Workpiece => p,
+        }
+    }
+}
+
 /// Whether a move can be smoothed: an extruding straight `G1` in absolute positioning whose
-/// tool tip, and whose machine XYZ, move no more than `max_gap_mm`. A longer tip move is a jump
-/// to another section of the part; a long machine move for a short tip move is the table
-/// swinging round (a change of inverse-kinematics branch, as the corpus file does at every
-/// section change). Either way the orientations on both sides have nothing to average (a longer extruding move is a jump between sections of the path,
-/// whose orientations have nothing to do with each other; it stays as written and separates
-/// the runs).
-fn eligible(kin: &Kinematics, m: &PathMove, line: Option<&MotionLine>, max_gap_mm: f64) -> bool {
+/// tool tip moves no more than `max_gap_mm` in the workpiece frame. A longer tip move is a
+/// jump to another section of the part, whose orientations have nothing to do with those
+/// before it; it stays as written and separates the runs.
+///
+/// The machine XYZ travel is no criterion: at a corner of the path (a tangency discontinuity,
+/// where the build direction jumps) the table turns and the machine axes travel far for a
+/// short step of the tip, which is exactly where the smoothing is wanted (CIRP section 2.2). A
+/// change of inverse-kinematics branch inside a run (the same tool vector reached by the other
+/// solution) does not cut it either: the filter works on the tool vectors, which do not depend
+/// on the branch, and the rotary angles are chosen afresh over the whole run on the branch of
+/// the neighbours ([`super::core::choose_rotary`]).
+fn eligible(frame: &Frame<'_>, m: &PathMove, line: Option<&MotionLine>, max_gap_mm: f64) -> bool {
     matches!(m.kind, MoveKind::Linear)
         && m.is_extruding()
         && line.is_some_and(|l| !l.relative)
-        && tip_length(kin, m) <= max_gap_mm
-        && m.length_mm <= max_gap_mm
+        && tip_length(frame, m) <= max_gap_mm
 }
 
 /// Length of a move's tool-tip path in the workpiece frame (chord), mm. The machine XYZ length
 /// is no measure of it: turning the table moves the machine axes a long way for a short step of
 /// the tip.
-pub(super) fn tip_length(kin: &Kinematics, m: &PathMove) -> f64 {
-    let a = kin.tip(&pose(kin, &m.from));
-    let b = kin.tip(&pose(kin, &m.to));
+pub(super) fn tip_length(frame: &Frame<'_>, m: &PathMove) -> f64 {
+    let a = frame.tip(&pose(frame.kin, &m.from));
+    let b = frame.tip(&pose(frame.kin, &m.to));
     crate::vec3::norm(crate::vec3::sub(b, a))
 }
 
@@ -130,7 +166,7 @@ pub(super) fn line_of_moves<'l>(
 
 /// Splits the moves into runs of consecutive eligible moves.
 pub(super) fn runs(
-    kin: &Kinematics,
+    frame: &Frame<'_>,
     moves: &[PathMove],
     lines: &[Option<&MotionLine>],
     max_gap_mm: f64,
@@ -138,7 +174,7 @@ pub(super) fn runs(
     let mut out = Vec::new();
     let mut cur: Run = Vec::new();
     for (i, m) in moves.iter().enumerate() {
-        if eligible(kin, m, lines.get(i).copied().flatten(), max_gap_mm) {
+        if eligible(frame, m, lines.get(i).copied().flatten(), max_gap_mm) {
             cur.push(i);
         } else if !cur.is_empty() {
             out.push(std::mem::take(&mut cur));
@@ -160,13 +196,13 @@ pub(super) fn pose(kin: &Kinematics, pos: &Pos) -> Pose {
 }
 
 /// The samples of a run: where it starts, then the end of each move.
-pub(super) fn samples(kin: &Kinematics, moves: &[PathMove], run: &Run) -> Vec<Sample> {
+pub(super) fn samples(frame: &Frame<'_>, moves: &[PathMove], run: &Run) -> Vec<Sample> {
     let mut out = Vec::with_capacity(run.len() + 1);
     let mut push = |pos: &Pos, dt: f64| {
-        let pose = pose(kin, pos);
+        let pose = pose(frame.kin, pos);
         out.push(Sample {
-            p: kin.tip(&pose),
-            v: kin.tool_vector(pose.rot),
+            p: frame.tip(&pose),
+            v: frame.kin.tool_vector(pose.rot),
             rot: pose.rot,
             dt,
         });
@@ -206,6 +242,9 @@ pub(super) struct WordFormat<'a> {
     pub offsets: &'a Offsets,
     /// Decimals written.
     pub decimals: usize,
+    /// Whether X, Y, Z are rewritten (machine coordinates); in workpiece coordinates they are
+    /// the tool tip, which stays, and only the rotary words change.
+    pub rewrite_xyz: bool,
 }
 
 /// Which of the five axes the new pose writes differently from the original position.
@@ -214,6 +253,7 @@ pub(super) fn differs(fmt: &WordFormat<'_>, old_to: &Pos, new: &Pose) -> [bool; 
         kin,
         offsets,
         decimals,
+        ..
     } = *fmt;
     let values = [new.xyz[0], new.xyz[1], new.xyz[2], new.rot[0], new.rot[1]];
     let axes = five_axes(kin);
@@ -271,6 +311,7 @@ pub(super) fn edit_for(
         kin,
         offsets,
         decimals,
+        rewrite_xyz,
     } = *fmt;
     let [r0, r1] = kin.model.rotary_axes();
     let targets = [
@@ -282,7 +323,8 @@ pub(super) fn edit_for(
     ];
     let mut values = Vec::with_capacity(5);
     let mut changed = force;
-    for (letter, ax, v) in targets {
+    let skip = if rewrite_xyz { 0 } else { 3 };
+    for (letter, ax, v) in targets.into_iter().skip(skip) {
         let text = words::format_value(v + offsets.of(ax), decimals);
         // What the line means now: its word, or the modal position it leaves unchanged.
         let old = old_to.get(ax).copied().unwrap_or(0.0) + offsets.of(ax);

@@ -1,5 +1,8 @@
 //! Assembling a [`SmoothReport`] from the runs before and after smoothing.
 
+use super::core::{self, RunSettings};
+use super::filter::Window;
+use super::kinematics::Kinematics;
 use super::metrics::{self, Sample};
 use super::{InputFormat, Series, SmoothOptions, SmoothReport, SERIES_MAX};
 use crate::error::{Error, ErrorKind, Warning};
@@ -24,21 +27,86 @@ pub(super) struct Counts {
     pub skip_first: bool,
 }
 
-/// A warning when most points sit in runs too short to smooth (the gap limit or the path
-/// numbering cuts every path apart).
-pub(super) fn short_run_warning(runs: &[Vec<Sample>], skip_first: bool) -> Option<Warning> {
+/// A warning when most points sit in runs shorter than the filter's window: there the filter
+/// has too few neighbours to average (travel moves, tool-tip jumps over `max_gap_mm` or the
+/// path numbering cut every path apart).
+pub(super) fn short_run_warning(
+    runs: &[Vec<Sample>],
+    skip_first: bool,
+    options: &SmoothOptions,
+) -> Option<Warning> {
     let skip = usize::from(skip_first);
+    let short_run = |r: &Vec<Sample>| match options.window {
+        Window::Points(w) => r.len().saturating_sub(skip) < w,
+        Window::Millimetres(mm) => {
+            let p: Vec<_> = r.iter().map(|x| x.p).collect();
+            core::arc_length(&p).last().copied().unwrap_or(0.0) < mm
+        }
+    };
     let total: usize = runs.iter().map(|r| r.len().saturating_sub(skip)).sum();
     let short: usize = runs
         .iter()
+        .filter(|r| short_run(r))
         .map(|r| r.len().saturating_sub(skip))
-        .filter(|&n| n < 3)
         .sum();
     (total > 0 && 2 * short > total).then(|| Warning {
         line: 0,
         message: format!(
-            "{short} of {total} points are in runs of fewer than 3 points and cannot be smoothed; \
-             is max_gap_mm (--max-gap) shorter than the point spacing?"
+            "{short} of {total} points are in runs shorter than the filter window ({}), which \
+             smooths them little or not at all; runs break at travel moves and where the tool \
+             tip jumps more than max_gap_mm (--max-gap, now {} mm): a larger max_gap_mm or a \
+             smaller window (--window / --window-mm) changes it",
+            window_text(options.window),
+            options.max_gap_mm
+        ),
+    })
+}
+
+fn window_text(window: Window) -> String {
+    match window {
+        Window::Points(n) => format!("{n} points"),
+        Window::Millimetres(mm) => format!("{mm} mm"),
+    }
+}
+
+/// A warning for runs whose tool vector varies but which came out unchanged, with the reason:
+/// every point inside the singular keep-out cone, or too few points for the filter.
+pub(super) fn unsmoothed_warning(
+    before: &[Vec<Sample>],
+    after: &[Vec<Sample>],
+    kin: &Kinematics,
+    settings: &RunSettings,
+    max_gap_mm: f64,
+) -> Option<Warning> {
+    let (mut singular, mut short, mut points) = (0usize, 0usize, 0usize);
+    for (b, a) in before.iter().zip(after) {
+        let varies = b.windows(2).any(|w| match w {
+            [x, y] => vec3::angle(x.v, y.v) > 1e-9,
+            _ => false,
+        });
+        let unchanged = b.iter().zip(a).all(|(x, y)| x.v == y.v);
+        if !(varies && unchanged) {
+            continue;
+        }
+        points += b.len();
+        if b.iter()
+            .all(|x| core::in_singular_zone(kin, x.v, settings.singular_angle))
+        {
+            singular += 1;
+        } else {
+            short += 1;
+        }
+    }
+    (singular + short > 0).then(|| Warning {
+        line: 0,
+        message: format!(
+            "{} runs ({points} points) whose tool vector varies were left as written: {singular} \
+             have every point within singular_deg ({:.1}°) of the kinematic singularity \
+             (--singular-deg / singular_deg lowers it), {short} are too short for the filter \
+             (runs break at travel moves and at tool-tip jumps over max_gap_mm; --max-gap, \
+             now {max_gap_mm} mm)",
+            singular + short,
+            vec3::deg(settings.singular_angle)
         ),
     })
 }
@@ -91,6 +159,7 @@ pub(super) fn assemble(
     SmoothReport {
         format: counts.format,
         kinematics: options.kinematics.model,
+        coordinates: options.coordinates,
         filter: options.filter,
         window: options.window,
         cone_deg: options.cone_deg,

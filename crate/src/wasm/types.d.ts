@@ -265,6 +265,8 @@ export interface VibrationResult extends Omit<VibrationReport, "psd"> {
 export type FilterKind = "zero-phase-moving-average" | "zero-phase-median" | "moving-average" | "median";
 export interface SmoothOptions {
   kinematics?: { model?: "table-bc" | "head-ab"; b_axis_point_mm?: number[]; c_axis_point_mm?: number[]; pivot_length_mm?: number };
+  /** G-code: X/Y/Z are machine axes (default) or the tool tip in the workpiece frame (RTCP/TCPM; only rotary words are rewritten). */
+  coordinates?: "machine" | "workpiece";
   filter?: FilterKind;
   /** Window by point count or by path length. */
   window?: { points: number } | { millimetres: number };
@@ -288,7 +290,9 @@ export interface RotaryMetrics {
   rms_jerk_deg_s3: number;
 }
 export interface OrientationMetrics {
+  /** RMS of ‖T(m+1) − 2T(m) + T(m−1)‖ over consecutive points of each run. */
   roughness: number;
+  mean_second_difference: number;
   max_second_difference: number;
   mean_angle_change_deg: number;
   max_angle_change_deg: number;
@@ -299,6 +303,7 @@ export interface OrientationMetrics {
 export interface SmoothReport {
   format: string;
   kinematics: string;
+  coordinates: "machine" | "workpiece";
   filter: FilterKind;
   window: { points: number } | { millimetres: number };
   cone_deg: number;
@@ -326,7 +331,8 @@ export interface SmoothReport {
   };
   warnings: Warning[];
 }
-/** smooth() result: the report plus the smoothed file. */
+/** smooth() result: the report plus the smoothed file. A file whose rotary axes never move
+ *  (3-axis) throws a QuietpathError of kind `no_rotary_motion` ({ first, second } axis letters). */
 export interface SmoothResult extends SmoothReport { output: Uint8Array }
 
 // ── infill (`quietpath infill --json`) ──
