@@ -58,7 +58,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     (
         "orient",
         &[
-            "gcode", "machine", "plan", "read", "energy", "analyze", "path",
+            "gcode", "machine", "plan", "read", "energy", "analyze", "path", "estimate",
         ],
     ),
     (

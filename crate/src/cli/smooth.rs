@@ -62,6 +62,9 @@ pub struct Args {
     /// Point-vector data: feed used for the rotary timing metrics, mm/s.
     #[arg(long, value_name = "MM_S", default_value_t = 6.0)]
     pub feed: f64,
+    /// Leave a G-code file's time comments and M73 lines as they were written.
+    #[arg(long)]
+    pub no_estimates: bool,
     /// Allow the output to replace the input file.
     #[arg(long)]
     pub force: bool,
@@ -159,6 +162,7 @@ pub fn run(args: Args) -> Result<(), String> {
         format,
         feed_mm_s: args.feed,
         analyze: args.opts.options()?,
+        estimates: !args.no_estimates,
     };
     let mut bar = output::ProgressBar::for_input(input.len());
     let report = smooth_with_progress(&input, &options, &mut |f| bar.update(f))

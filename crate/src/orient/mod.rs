@@ -112,6 +112,9 @@ pub struct SmoothOptions {
     pub feed_mm_s: f64,
     /// How G-code is read and planned (machine preset, limits).
     pub analyze: AnalyzeOptions,
+    /// Rewrite a G-code file's time comments and `M73` lines from the planner when the file
+    /// changed (default true; see [`crate::estimate`]).
+    pub estimates: bool,
 }
 
 impl Default for SmoothOptions {
@@ -128,6 +131,7 @@ impl Default for SmoothOptions {
             format: InputFormat::Auto,
             feed_mm_s: 6.0,
             analyze: AnalyzeOptions::default(),
+            estimates: true,
         }
     }
 }
@@ -277,7 +281,21 @@ pub fn smooth_with_progress(
             };
             Ok(report)
         }
-        _ => gcode_job::run(input, options, progress),
+        _ => {
+            let mut report = gcode_job::run(input, options, progress)?;
+            if options.estimates && report.output != input {
+                let note = format!(
+                    "smooth: tool orientation within a {}° cone",
+                    options.cone_deg
+                );
+                if let Some((output, _)) =
+                    crate::estimate::refresh(&report.output, &options.analyze, &note)?
+                {
+                    report.output = output;
+                }
+            }
+            Ok(report)
+        }
     }
 }
 

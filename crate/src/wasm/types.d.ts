@@ -278,6 +278,8 @@ export interface SmoothOptions {
   format?: "auto" | "gcode" | "csv" | "json";
   feed_mm_s?: number;
   analyze?: AnalyzeOptions;
+  /** Rewrite a G-code file's time comments and M73 lines from the planner when it changed (default true). */
+  estimates?: boolean;
 }
 export interface RotaryMetrics {
   axis: string;
