@@ -144,10 +144,15 @@ function failRun(err, { keepResults }) {
 
 // ── Loading a file ─────────────────────────────────────────────────────────
 
+// The printer's own settings, uploaded: { name, text, key } with key `klipper_config` (a
+// printer.cfg, recognised by its [printer] section) or `machine_gcode` (Marlin's M503 text).
+let printerSettings = null;
+
 function readOptions() {
   const form = new FormData(els.optionsForm);
   const options = {};
   if (form.get('strict')) options.strict = true;
+  if (printerSettings) options[printerSettings.key] = printerSettings.text;
   for (const key of ['filament_diameter_mm', 'density_g_cm3']) {
     const raw = String(form.get(key) ?? '').trim();
     if (raw === '') continue;
@@ -1004,6 +1009,28 @@ els.demo.addEventListener('click', () => run(demoSource()));
 els.cancel.addEventListener('click', () => cancel());
 els.download.addEventListener('click', downloadReport);
 els.downloadGcode.addEventListener('click', downloadGcode);
+async function setPrinterSettings(file) {
+  const nameEl = document.getElementById('printer-settings-name');
+  const clear = document.getElementById('printer-settings-clear');
+  if (file) {
+    const text = await file.text();
+    const key = /^\s*\[printer\]/m.test(text) ? 'klipper_config' : 'machine_gcode';
+    printerSettings = { name: file.name, text, key };
+    nameEl.textContent = `${file.name} (${key === 'klipper_config' ? 'Klipper printer.cfg' : 'Marlin M503 settings'})`;
+  } else {
+    printerSettings = null;
+    nameEl.textContent = 'none: limits from the file and the preset';
+  }
+  clear.hidden = !printerSettings;
+  if (lastSource && lastSource.name && !current) run(lastSource);
+}
+
+document.getElementById('printer-settings').addEventListener('change', (e) => {
+  e.stopPropagation();
+  setPrinterSettings(e.target.files?.[0] ?? null);
+  e.target.value = '';
+});
+document.getElementById('printer-settings-clear').addEventListener('click', () => setPrinterSettings(null));
 els.optionsForm.addEventListener('submit', (e) => e.preventDefault());
 els.optionsForm.addEventListener('change', () => {
   if (lastSource && lastSource.name && !current) run(lastSource);

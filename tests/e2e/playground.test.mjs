@@ -719,6 +719,38 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
   assert.deepEqual(report, runCli('analyze', file).json, 'the worker report differs from the CLI');
 });
 
+test('printer settings: a Klipper printer.cfg and Marlin M503 text time the file as the CLI does with them', { timeout: 4 * STEP_TIMEOUT }, async () => {
+  const name = 'superslicer-2.3.56_klipper_arcwelder.gcode';
+  await loadCorpus(name);
+  const cfg = path.join(corpusDir, '..', 'klipper', 'head', 'printer.cfg');
+  const m503 = path.join(os.tmpdir(), `quietpath-e2e-${process.pid}-m503.txt`);
+  fs.writeFileSync(m503, 'echo:  M201 X400 Y400 Z100 E1000\necho:  M204 P300 R1000 T300\n');
+  const analyzeCli = (extra) => {
+    const r = spawnSync(cli, ['analyze', path.join(corpusDir, name), '--json', ...extra], { encoding: 'utf8', maxBuffer: 1 << 28 });
+    assert.equal(r.status, 0, r.stderr);
+    return JSON.parse(r.stdout);
+  };
+  const pick = async (file) => {
+    const before = await byTestId('report-json').textContent();
+    await byTestId('opt-printer-settings').setInputFiles(file);
+    await page.waitForFunction((b) => document.querySelector('[data-testid="status"]').textContent === 'ready' && document.querySelector('[data-testid="report-json"]').textContent !== b, before, { timeout: STEP_TIMEOUT });
+    return reportJson();
+  };
+  const klipper = await pick(cfg);
+  assert.match(await byTestId('printer-settings-name').textContent(), /Klipper printer\.cfg/);
+  assert.equal(klipper.time_s, analyzeCli(['--klipper-config', cfg]).time_s);
+  assert.equal(klipper.machine.limits.square_corner_velocity.source, 'printer_config');
+  // The same file without a Klipper config, with a Marlin printer's settings (read as Marlin's).
+  await loadCorpus('slic3r-pe-1.33.3_benchy_arcwelder.gcode');
+  const marlin = await pick(m503);
+  assert.match(await byTestId('printer-settings-name').textContent(), /M503/);
+  const r = spawnSync(cli, ['analyze', path.join(corpusDir, 'slic3r-pe-1.33.3_benchy_arcwelder.gcode'), '--json', '--machine-gcode', m503], { encoding: 'utf8', maxBuffer: 1 << 28 });
+  assert.equal(marlin.time_s, JSON.parse(r.stdout).time_s);
+  assert.equal(marlin.machine.limits.max_acceleration[0].source, 'machine_settings');
+  await byTestId('printer-settings-clear').click();
+  await waitForStatus('ready');
+});
+
 test('screenshot of the playground with the viewer (docs/screenshot.png with UPDATE_SCREENSHOT=1)', { timeout: JOB_TIMEOUT }, async () => {
   await loadCorpus(BENCHY);
   await setSlider(40);
