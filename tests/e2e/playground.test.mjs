@@ -747,8 +747,12 @@ test('printer settings: a Klipper printer.cfg and Marlin M503 text time the file
   const r = spawnSync(cli, ['analyze', path.join(corpusDir, 'slic3r-pe-1.33.3_benchy_arcwelder.gcode'), '--json', '--machine-gcode', m503], { encoding: 'utf8', maxBuffer: 1 << 28 });
   assert.equal(marlin.time_s, JSON.parse(r.stdout).time_s);
   assert.equal(marlin.machine.limits.max_acceleration[0].source, 'machine_settings');
+  // The button sits in the Options panel: open it, forget the settings, close it again.
+  await page.locator('#options').evaluate((d) => { d.open = true; });
   await byTestId('printer-settings-clear').click();
   await waitForStatus('ready');
+  assert.match(await byTestId('printer-settings-name').textContent(), /^none/);
+  await page.locator('#options').evaluate((d) => { d.open = false; });
 });
 
 test('screenshot of the playground with the viewer (docs/screenshot.png with UPDATE_SCREENSHOT=1)', { timeout: JOB_TIMEOUT }, async () => {
