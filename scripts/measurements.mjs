@@ -233,7 +233,7 @@ async function infill() {
       row([
         name(file),
         set,
-        `${best.pattern} ${best.angle_deg}°`,
+        best.pattern === 'original' ? 'original kept' : `${best.pattern} ${best.angle_deg}°`,
         fx(before.energy.total_j / 1000, 2),
         fx(best.total_j / 1000, 2),
         pct(change(before.energy.total_j, best.total_j)),
@@ -252,9 +252,10 @@ async function infill() {
     header('infill: best candidate against the original', 'quietpath infill FILE -o OUT --angles 0,90 --patterns rectilinear,concentric --json') +
       '\nEvery corpus file and fixture; four candidates each (rectilinear and concentric at 0° and 90°, ' +
       'rotation 0), objective energy (the lowest `total_j` wins). Original: `before` (the analyze ' +
-      'report of the input); best: `best` (whole-file figures with that candidate applied). The ' +
-      "original's own angle and pattern need not be among the four, so the best can cost more than " +
-      'the original. Total energy: `energy.total_j` / `best.total_j`; stepper energy (thesis eq. 28): ' +
+      'report of the input); best: `best` (the written file, as analyze gives it). No file is ' +
+      'handed back that costs more energy than its input: where no candidate beats the original ' +
+      '(its own pattern and angle need not be among the four), the input is kept, byte for byte ' +
+      '("original kept", change 0). Total energy: `energy.total_j` / `best.total_j`; stepper energy (thesis eq. 28): ' +
       '`energy.thesis_j` / `best.thesis_j`; time: `time_s` / `best.time_s`. Wall time of the whole ' +
       'command (search, regenerate, write, re-analyse).\n\n' +
       table(
