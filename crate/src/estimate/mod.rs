@@ -121,6 +121,18 @@ pub fn has_estimates(input: &[u8]) -> bool {
         .any(|l| format::rewrite(l.text, &at).is_some())
 }
 
+/// [`rewrite_estimates`], and `analyze` of the file it writes: what a job hands back (the
+/// header shifts the lines, so the report is of the written file, not the one before).
+pub fn rewrite_and_analyze(
+    input: &[u8],
+    options: &AnalyzeOptions,
+    notes: &[String],
+) -> Result<(Estimated, crate::analyze::Report), Error> {
+    let e = rewrite_estimates(input, options, notes)?;
+    let after = crate::analyze::analyze(&e.output, options)?;
+    Ok((e, after))
+}
+
 /// What a rewriting job hands back: its output with true estimates and a header naming `job`,
 /// and the output's analysis; `None` when the file carries no estimate to correct (nothing is
 /// added then).
@@ -132,8 +144,7 @@ pub fn refresh(
     if !has_estimates(output) {
         return Ok(None);
     }
-    let e = rewrite_estimates(output, options, &[job.to_string()])?;
-    let after = crate::analyze::analyze(&e.output, options)?;
+    let (e, after) = rewrite_and_analyze(output, options, &[job.to_string()])?;
     Ok(Some((e.output, after)))
 }
 

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::analyze::{analyze, AnalyzeOptions, Report};
 use crate::error::Error;
-use crate::estimate::{rewrite_estimates, EstimateReport};
+use crate::estimate::EstimateReport;
 use crate::infill::InfillOptions;
 use crate::progress::Progress;
 use crate::vtg::VtgOptions;
@@ -144,7 +144,7 @@ pub fn optimize_with_progress(
 }
 
 /// The header notes that say what quietpath changed in a file.
-fn notes(stages: &[StageReport]) -> Vec<String> {
+pub(crate) fn notes(stages: &[StageReport]) -> Vec<String> {
     stages
         .iter()
         .map(|s| {
@@ -156,13 +156,4 @@ fn notes(stages: &[StageReport]) -> Vec<String> {
             )
         })
         .collect()
-}
-
-/// The estimates stage's own input: the notes of the stages before it.
-pub(crate) fn estimate_file(
-    file: &[u8],
-    stages: &[StageReport],
-    analyze: &AnalyzeOptions,
-) -> Result<crate::estimate::Estimated, Error> {
-    rewrite_estimates(file, analyze, &notes(stages))
 }

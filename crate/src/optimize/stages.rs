@@ -1,9 +1,9 @@
 //! The pipeline's stages, each kept only when it makes the file no dearer.
 
-use super::{estimate_file, OptimizeOptions, StageReport};
+use super::{notes, OptimizeOptions, StageReport};
 use crate::analyze::{AnalyzeOptions, Report};
 use crate::error::Error;
-use crate::estimate::EstimateReport;
+use crate::estimate::{rewrite_and_analyze, EstimateReport};
 use crate::infill::{infill_with_progress, Choice, InfillOptions};
 use crate::progress::Progress;
 use crate::vtg::{vtg_with_progress, VtgOptions};
@@ -124,8 +124,7 @@ impl Stage {
         stages: &[StageReport],
         analyze: &AnalyzeOptions,
     ) -> Result<(EstimateReport, StageReport), Error> {
-        let e = estimate_file(&self.file, stages, analyze)?;
-        let after = crate::analyze::analyze(&e.output, analyze)?;
+        let (e, after) = rewrite_and_analyze(&self.file, analyze, &notes(stages))?;
         let done = format!(
             "{} M73 lines and {} time comments rewritten",
             e.report.progress_lines, e.report.time_comments
