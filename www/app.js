@@ -87,10 +87,12 @@ const vibrationRuns = {}; // target → vibration result, for the before/after c
 const downloadUrls = {};
 
 const client = new JobClient('./worker.js', {
-  onHello(version, caps) {
+  onHello(version, caps, presets) {
     els.version.textContent = version ? `v${version}` : '';
     capabilities = new Set(caps);
     document.body.dataset.capabilities = caps.join(' '); // for tests and curious users
+    machines = Array.isArray(presets) ? presets : [];
+    renderMachinePicker();
     updateActions();
   },
   onCrash(detail, wasLoaded, hadPending) {
@@ -117,8 +119,22 @@ function startRun(kind, name) {
   updateActions();
 }
 
+// The status, progress and Cancel move beside a running job's button (and stay in view while
+// it runs: sticky), and back under the file picker afterwards.
+const runState = document.querySelector('.run-state');
+const runStateHome = runState.parentElement;
+const runStateNext = runState.nextElementSibling;
+
+function placeRunState(form) {
+  for (const f of els.actionForms) f.classList.toggle('running', f === form);
+  if (form) form.querySelector('button[type="submit"]').after(runState);
+  else runStateHome.insertBefore(runState, runStateNext);
+  runState.classList.toggle('in-job', !!form);
+}
+
 function finishRun(status) {
   if (current && status !== 'ready') els.elapsed.textContent = `${formatMs(performance.now() - current.startedAt)} total`;
+  if (current?.kind === 'job') placeRunState(null);
   current = null;
   els.cancel.disabled = true;
   document.body.classList.remove('busy');
@@ -146,20 +162,170 @@ function failRun(err, { keepResults }) {
 
 // The printer's own settings, uploaded: { name, text, key } with key `klipper_config` (a
 // printer.cfg, recognised by its [printer] section) or `machine_gcode` (Marlin's M503 text).
-let printerSettings = null;
+// Kept in localStorage (on this computer only) with the printer choice, so a visit later
+// times files for the same printer.
+const STORE_MACHINE = 'quietpath.machine';
+const STORE_SETTINGS = 'quietpath.printer-settings';
+const store = {
+  get(key) {
+    try {
+      return localStorage.getItem(key);
+    } catch {
+      return null; // storage disabled: nothing is remembered
+    }
+  },
+  set(key, value) {
+    try {
+      if (value === null) localStorage.removeItem(key);
+      else localStorage.setItem(key, value);
+    } catch {
+      // full or disabled: the choice holds for this visit only
+    }
+  },
+};
+let printerSettings = (() => {
+  try {
+    const v = JSON.parse(store.get(STORE_SETTINGS) ?? 'null');
+    return v && typeof v.text === 'string' && typeof v.name === 'string' && ['klipper_config', 'machine_gcode'].includes(v.key) ? v : null;
+  } catch {
+    return null;
+  }
+})();
+// The printer picked: '' (from the file: the default preset for its flavour, under the limits
+// the file itself sets), a preset name, or 'upload' (the uploaded printer settings).
+let machineChoice = store.get(STORE_MACHINE) ?? '';
+if (machineChoice === 'upload' && !printerSettings) machineChoice = '';
+let machines = []; // the package's presets (machines()), from the worker's hello
 
+const LIMIT_SOURCES = {
+  profile: 'the printer preset',
+  slicer_settings: "the slicer's settings in the file",
+  printer_config: 'your printer.cfg',
+  machine_settings: 'your M503 settings',
+  command: 'a command in the file (M201, M203, M204, M205, SET_VELOCITY_LIMIT…)',
+  option: 'an option of this page',
+};
+const LIMIT_NAMES = {
+  max_feedrate: ['Top speed per axis (X, Y, Z, E)', 'mm/s'],
+  max_acceleration: ['Top acceleration per axis (X, Y, Z, E)', 'mm/s²'],
+  acceleration: ['Printing acceleration', 'mm/s²'],
+  retract_acceleration: ['Retraction acceleration', 'mm/s²'],
+  travel_acceleration: ['Travel acceleration', 'mm/s²'],
+  max_jerk: ['Jerk per axis (X, Y, Z, E): speed change taken without slowing', 'mm/s'],
+  junction_deviation: ['Junction deviation (Marlin 2 cornering)', 'mm'],
+  square_corner_velocity: ['Square-corner velocity (Klipper cornering)', 'mm/s'],
+  minimum_cruise_ratio: ['Minimum cruise ratio (Klipper)', ''],
+  accel_to_decel: ['Acceleration to deceleration (Klipper)', 'mm/s²'],
+  min_feedrate: ['Lowest printing speed', 'mm/s'],
+  min_travel_feedrate: ['Lowest travel speed', 'mm/s'],
+  arc_segment_mm: ['Arc segment length', 'mm'],
+  instantaneous_corner_velocity: ['Extruder corner velocity (Klipper)', 'mm/s'],
+};
+
+/** Limits the file itself sets (commands or the slicer's settings block). */
+function fileLimitCount(report) {
+  let n = 0;
+  for (const v of Object.values(report?.machine?.limits ?? {})) {
+    for (const l of Array.isArray(v) ? v : [v]) if (l && ['command', 'slicer_settings'].includes(l.source)) n++;
+  }
+  return n;
+}
+
+function renderMachinePicker() {
+  const sel = document.getElementById('machine');
+  const report = loaded?.report;
+  const fromFile = fileLimitCount(report);
+  const auto = report?.machine?.profile && machineChoice === '' ? report.machine.profile : null;
+  const fileLabel = !report
+    ? 'from the file'
+    : fromFile > 0
+      ? `from the file (its ${fromFile} limits${auto ? `, the rest from ${auto}` : ''})`
+      : `from the file (it sets no limits: ${auto ?? 'the default preset'})`;
+  const opts = [el('option', { value: '', text: fileLabel })];
+  for (const m of machines) opts.push(el('option', { value: m.name, text: `${m.name}: ${m.description ?? ''}`.replace(/: $/, '') }));
+  if (printerSettings) opts.push(el('option', { value: 'upload', text: `${printerSettings.name} (your ${printerSettings.key === 'klipper_config' ? 'Klipper printer.cfg' : 'Marlin M503 settings'})` }));
+  sel.replaceChildren(...opts);
+  const known = opts.some((o) => o.value === machineChoice);
+  // Presets arrive with the worker: an unknown name from an older visit falls back to the file.
+  if (!known && machines.length) machineChoice = '';
+  sel.value = known ? machineChoice : '';
+  sel.dataset.fileLimits = String(fromFile);
+}
+
+function optionError(input, message) {
+  input.setAttribute('aria-invalid', 'true');
+  return `${input.closest('label')?.firstChild?.textContent?.trim() || input.name}: ${message}`;
+}
+
+/** A number field against its min/max: the number, '' when empty, or an error message. */
+function checkNumber(input) {
+  input.removeAttribute('aria-invalid');
+  const raw = String(input.value ?? '').trim();
+  // A number field holding text reads as '' with badInput set.
+  if (raw === '' && !input.validity?.badInput) return { value: '' };
+  const v = Number(raw);
+  const unit = input.closest('label')?.lastChild?.textContent?.trim() ?? '';
+  const u = unit && unit.length < 8 ? ` ${unit}` : '';
+  if (raw === '' || !Number.isFinite(v)) return { error: optionError(input, `"${raw || input.value}" is not a number`) };
+  if (input.min !== '' && v < Number(input.min)) return { error: optionError(input, `${raw}${u} is too small: at least ${input.min}${u}`) };
+  if (input.max !== '' && v > Number(input.max)) return { error: optionError(input, `${raw}${u} is too large: at most ${input.max}${u}`) };
+  if (input.step && input.step !== 'any' && Number(input.step) === 1 && !Number.isInteger(v)) return { error: optionError(input, `${raw} is not a whole number`) };
+  return { value: v };
+}
+
+/** The analyze options of the Options panel and the printer picker: { options, errors }. */
 function readOptions() {
   const form = new FormData(els.optionsForm);
   const options = {};
+  const errors = [];
   if (form.get('strict')) options.strict = true;
-  if (printerSettings) options[printerSettings.key] = printerSettings.text;
+  if (machineChoice === 'upload' && printerSettings) options[printerSettings.key] = printerSettings.text;
+  else if (machineChoice && machineChoice !== 'upload') options.machine = machineChoice;
   for (const key of ['filament_diameter_mm', 'density_g_cm3']) {
-    const raw = String(form.get(key) ?? '').trim();
-    if (raw === '') continue;
-    const v = Number(raw);
-    if (Number.isFinite(v) && v > 0) options[key] = v;
+    const r = checkNumber(els.optionsForm.elements[key]);
+    if (r.error) errors.push(r.error);
+    else if (r.value !== '') options[key] = r.value;
   }
-  return options;
+  const box = document.getElementById('options-error');
+  box.textContent = errors.join(' ');
+  box.hidden = errors.length === 0;
+  if (errors.length) document.getElementById('options').open = true;
+  return { options, errors };
+}
+
+// What a file is when it is not G-code text, from its first bytes; null when it may be G-code.
+function notGcode(bytes) {
+  const b = new Uint8Array(bytes, 0, Math.min(bytes.byteLength, 65536));
+  if (b.length === 0) return 'The file is empty (0 bytes): there is nothing to analyze.';
+  const starts = (...sig) => sig.every((v, i) => b[i] === (typeof v === 'string' ? v.charCodeAt(0) : v));
+  const kinds = [
+    [[0x89, 'P', 'N', 'G'], 'a PNG image'],
+    [[0xff, 0xd8, 0xff], 'a JPEG image'],
+    [['G', 'I', 'F', '8'], 'a GIF image'],
+    [['%', 'P', 'D', 'F'], 'a PDF document'],
+    [['P', 'K', 3, 4], 'a ZIP archive (a 3MF project is one: export G-code from the slicer)'],
+    [['G', 'C', 'D', 'E'], 'a binary G-code file (.bgcode): export plain-text G-code from the slicer'],
+    [[0x1f, 0x8b], 'a gzip archive (unpack it first)'],
+  ];
+  for (const [sig, what] of kinds) if (starts(...sig)) return `This is ${what}, not G-code text.`;
+  // UTF-16 is the analyzer's to explain; other binary data: control bytes a text never has.
+  if ((b[0] === 0xff && b[1] === 0xfe) || (b[0] === 0xfe && b[1] === 0xff)) return null;
+  let control = 0;
+  for (const x of b) if (x === 0 || (x < 32 && x !== 9 && x !== 10 && x !== 13 && x !== 12 && x !== 27) || x === 127) control++;
+  if (control > Math.max(2, b.length / 200)) return `This is binary data, not G-code text: ${formatCount(control)} of its first ${formatCount(b.length)} bytes are control characters no text file holds.`;
+  return null;
+}
+
+// A report with no move at all, on a file whose lines do not read as G-code: the reason, or null.
+function noGcodeIn(report) {
+  if (!report || report.moves > 0) return null;
+  const warnings = Array.isArray(report.warnings) ? report.warnings : [];
+  const lines = report.file?.lines ?? 0;
+  const unread = warnings.filter((w) => w && w.line > 0).length;
+  if (lines === 0) return 'The file holds no G-code lines: there is nothing to analyze.';
+  const first = warnings.find((w) => w && w.line > 0);
+  if (!first) return `No G-code moves found in its ${formatCount(lines)} lines (no G0/G1/G2/G3 command): nothing to time or draw. Is this a G-code file for a printer?`;
+  return `No G-code moves found: ${formatCount(unread)} of ${formatCount(lines)} lines could not be read as G-code (line ${first.line}: ${first.message ?? 'unreadable'}). Is this a G-code file?`;
 }
 
 async function run(source) {
@@ -181,15 +347,33 @@ async function run(source) {
     return;
   }
   if (current !== run) return; // cancelled while reading
+  const { options, errors } = readOptions();
+  const problem = errors.length ? `Check the options: ${errors.join(' ')}` : notGcode(bytes);
+  if (problem) {
+    loaded = null;
+    resetOptimized();
+    showError({ message: problem });
+    finishRun('error');
+    renderMachinePicker();
+    return;
+  }
   run.posted = true;
   setStatus('analyzing');
   // The old file is gone from the worker from here on.
   loaded = null;
   resetOptimized();
   try {
-    const msg = await client.load(bytes, source.name, readOptions(), onProgress);
+    const msg = await client.load(bytes, source.name, options, onProgress);
     if (current !== run) return;
+    const notG = noGcodeIn(plain(msg.report));
+    if (notG) {
+      showError({ message: notG });
+      finishRun('error');
+      renderMachinePicker();
+      return;
+    }
     loaded = { name: source.name, report: msg.report };
+    renderMachinePicker();
     showReport(msg.report, source.name, msg.ms);
     els.elapsed.dataset.totalMs = String(msg.totalMs);
     finishRun('ready');
@@ -286,24 +470,52 @@ function updateActions() {
     const needsOutput = job === 'vibration' && form.elements.target.value === 'output' && !output;
     button.disabled = !available || !loaded || busy || needsOutput;
     button.textContent = known && !available ? 'Not available in this build' : button.dataset.label;
+    if (note.classList.contains('field-error')) continue;
     note.textContent = !known ? '' : !available ? `${JOB_NAMES[job]} is not available in this build of the package.` : needsOutput ? 'Run VTG, infill or smoothing first.' : '';
     if (job === 'vibration') form.elements.target.querySelector('option[value="output"]').disabled = !output;
   }
   els.viewMode.disabled = !output;
 }
 
+/** Number fields of an action form against their min/max: the messages (empty: fine). */
+function jobErrors(form) {
+  const errors = [];
+  for (const input of form.elements) {
+    if (input.type !== 'number') continue;
+    const r = checkNumber(input);
+    if (r.error) errors.push(r.error);
+  }
+  for (const input of form.querySelectorAll('input[type="text"][name$="_deg"]')) {
+    input.removeAttribute('aria-invalid');
+    const bad = String(input.value).split(/[\s,;]+/).filter(Boolean).filter((x) => !Number.isFinite(Number(x)));
+    if (bad.length) errors.push(optionError(input, `${bad.map((b) => `"${b}"`).join(', ')} ${bad.length > 1 ? 'are not numbers' : 'is not a number'} (give degrees separated by commas)`));
+  }
+  return errors;
+}
+
 async function runJob(job, form) {
   if (!loaded || current) return;
+  const errors = jobErrors(form);
+  const note = form.querySelector('.availability');
+  if (errors.length) {
+    note.textContent = errors.join(' ');
+    note.classList.add('field-error');
+    return;
+  }
+  note.classList.remove('field-error');
   const target = job === 'vibration' ? form.elements.target.value : 'input';
   const options = jobOptions(form);
   startRun('job', loaded.name);
   const run = current;
   run.posted = true;
+  placeRunState(form);
   setStatus(`running ${job}`);
   try {
     const msg = await client.job(job, options, target, onProgress);
     if (current !== run) return;
-    showJobResult(job, plain(msg.result), msg.output, target);
+    const result = plain(msg.result);
+    showJobResult(job, result, msg.output, target);
+    addJobEntry(job, result, msg.output, target, msg.ms);
     els.elapsed.textContent = `${JOB_NAMES[job]} in ${formatMs(msg.ms)}`;
     els.elapsed.dataset.ms = String(msg.ms);
     finishRun('ready');
@@ -326,13 +538,22 @@ function resetOptimized() {
   clearChart(els.chartOrientation, 'Run the orientation smoothing to see the rotary axes.');
 }
 
-function showJobResult(job, result, outBytes, target) {
+function showJobResult(job, result, outBytes, target, { fromList = false } = {}) {
   showJson(result, `${baseName(loaded.name)}.${job}${target === 'output' ? '.output' : ''}.json`);
   els.resultPanel.hidden = false;
   els.resultJob.textContent = `· ${JOB_NAMES[job]}${target === 'output' ? ' of the optimized output' : ''}`;
   els.resultLine.textContent = resultLine(job, result);
   // An infill search that kept the original hands back the input: nothing better to download.
   const keptOriginal = job === 'infill' && result.best?.pattern === 'original';
+  if (fromList) {
+    // An earlier job shown again: its tables and JSON; the viewer keeps the latest output.
+    if (job === 'vibration') renderCompare(vibrationCompare());
+    else {
+      renderCompare(compareRows(result, job));
+      renderPaperTables(result);
+    }
+    return;
+  }
   if (keptOriginal && output) {
     // The download and the after view would otherwise offer an earlier job's file as this one's.
     output = null;
@@ -368,6 +589,48 @@ function showJobResult(job, result, outBytes, target) {
   writeHash();
 }
 
+// Every job's result, kept (newest first): its line, its main changes, its JSON and its file.
+const jobEntries = [];
+
+function addJobEntry(job, result, outBytes, target, ms) {
+  const keptOriginal = job === 'infill' && result.best?.pattern === 'original';
+  const entry = { id: jobEntries.length + 1, job, result, target, ms, file: loaded?.name, bytes: outBytes && !keptOriginal ? outBytes : null };
+  jobEntries.push(entry);
+  renderJobList(entry.id);
+}
+
+function renderJobList(activeId) {
+  const list = document.getElementById('job-list');
+  const pct = (a, b) => (isNum(a) && isNum(b) && b !== 0 ? signedPercent(a / b - 1) : null);
+  list.replaceChildren(
+    ...[...jobEntries].reverse().map((e) => {
+      const r = e.result;
+      const changes = [
+        ['time', pct(r.after?.time_s, r.before?.time_s)],
+        ['energy', pct(r.after?.energy?.total_j, r.before?.energy?.total_j)],
+      ].filter(([, v]) => v !== null);
+      const show = el('button', { type: 'button', class: 'button small', text: 'Show' });
+      show.addEventListener('click', () => {
+        showJobResult(e.job, e.result, null, e.target, { fromList: true });
+        renderJobList(e.id);
+      });
+      const save = el('button', { type: 'button', class: 'button small', text: 'Download G-code', 'data-testid': 'job-download' });
+      save.disabled = !e.bytes;
+      save.title = e.bytes ? 'The file this job wrote' : 'This job wrote no better file: keep your original';
+      save.addEventListener('click', () => e.bytes && saveBlob(`gcode-${e.id}`, new Blob([e.bytes], { type: 'text/plain' }), `${baseName(e.file)}.${e.job}-${e.id}.gcode`));
+      return el(
+        'li',
+        { class: e.id === activeId ? 'job-entry active' : 'job-entry', 'data-job': e.job, 'data-testid': 'job-entry' },
+        el('span', { class: 'job-name', text: `#${e.id} ${JOB_NAMES[e.job]}${e.target === 'output' ? ' of the output' : ''}` }),
+        el('span', { class: 'muted small', text: `${e.file ?? ''} · ${formatMs(e.ms)}` }),
+        el('span', { class: 'job-changes', text: changes.map(([k, v]) => `${k} ${v}`).join(', ') || resultLine(e.job, r).slice(0, 120) }),
+        el('span', { class: 'job-buttons' }, show, save),
+      );
+    }),
+  );
+  document.getElementById('job-list-panel').hidden = jobEntries.length === 0;
+}
+
 function resultLine(job, r) {
   const n = (v, d = 3) => (isNum(v) ? String(Math.round(v * 10 ** d) / 10 ** d) : '—');
   const pct = (a, b) => (isNum(a) && isNum(b) && b !== 0 ? signedPercent(a / b - 1) : '—');
@@ -392,17 +655,57 @@ function resultLine(job, r) {
   }
 }
 
+// Every metric the page shows by its key: [name, unit, one-line explanation]. The names of the
+// VTG paper's Tables 1 and 2 where they come from it (docs/method/ says how each is computed).
+const METRICS = {
+  time_s: ['Print time', 's', 'How long the printer takes, planned with its accelerations and cornering.'],
+  planned_time_s: ['Print time (planned)', 's', 'How long the printer takes, planned with its accelerations and cornering.'],
+  energy_j: ['Energy', 'J', 'Electricity for the whole print: motors, heating the filament and the rest of the machine.'],
+  total_j: ['Energy', 'J', 'Electricity for the whole print: motors, heating the filament and the rest of the machine.'],
+  thesis_j: ['Motor energy (stepper model)', 'J', "Energy the axis motors use, from the thesis's stepper model."],
+  servo_energy_j: ['Motor energy (servo model)', 'J', "Energy the axis motors of the VTG paper's servo printer use."],
+  fuse_j: ['Melting energy', 'J', 'Heat that melts the filament.'],
+  aux_j: ['Machine upkeep energy', 'J', 'Fans, electronics and keeping the bed and nozzle hot, over the print time.'],
+  co2_g: ['CO₂ emitted', 'g', "Carbon dioxide of that electricity, at the grid's average intensity."],
+  material_g: ['Filament used', 'g', 'Weight of the filament the print uses.'],
+  distance_mm: ['Head travel', 'mm', 'How far the nozzle moves in all, printing and travelling.'],
+  filament_mm: ['Filament length', 'mm', 'How much filament goes through the extruder.'],
+  l_total_mm: ['Path length L', 'mm', 'Length of the whole printed path (VTG paper, Table 1).'],
+  n_total: ['Segments N', '', 'Number of straight pieces the path is cut into.'],
+  l_infill_mm: ['Infill path length', 'mm', 'Length of the infill part of the path.'],
+  n_infill: ['Infill segments', '', 'Number of straight pieces in the infill.'],
+  n_turning: ['Sharp turns', '', 'Corners sharper than the critical angle: the head brakes there and shakes.'],
+  n_corners: ['Corners', '', 'Every change of direction along the path.'],
+  mean_turn_deg: ['Mean turning angle', '°', 'Average change of direction at a corner; smaller is smoother.'],
+  mean_chord_error_mm: ['Mean chord error', 'mm', 'Average gap between the straight pieces and the smooth curve through them.'],
+  max_mm: ['largest', 'mm', ''],
+  min_mm: ['smallest', 'mm', ''],
+  mean_mm: ['mean', 'mm', ''],
+  deviation: ['Vibration deviation', 'mm', 'How far vibration pushes the nozzle off its path (the dynamics model).'],
+  max_deviation_mm: ['Largest path change', 'mm', 'Farthest the new path goes from the original one (at most the tolerance).'],
+  max_tip_deviation_mm: ['Largest nozzle-tip change', 'mm', 'Farthest the smoothed orientation moves the nozzle tip.'],
+};
+
+/** [name, unit, explanation] of a key, with a readable fallback for keys not in METRICS. */
+function metricInfo(key) {
+  if (METRICS[key]) return METRICS[key];
+  const m = /_(mm|s|g|j|deg|hz|pct|mm3|c|w|kwh)$/.exec(key);
+  const units = { mm: 'mm', s: 's', g: 'g', j: 'J', deg: '°', hz: 'Hz', pct: '%', mm3: 'mm³', c: '°C', w: 'W', kwh: 'kWh' };
+  const base = (m ? key.slice(0, -m[0].length) : key).replaceAll('_', ' ');
+  return [base.charAt(0).toUpperCase() + base.slice(1), m ? units[m[1]] : '', ''];
+}
+
 // Rows of the before/after table, in the order of the VTG paper's Tables 1 and 2.
 const REPORT_METRICS = [
-  ['Print time', (r) => r.time_s, formatDuration],
-  ['Energy', (r) => r.energy?.total_j, formatEnergy],
-  ['Stepper energy', (r) => r.energy?.thesis_j, formatEnergy],
-  ['CO₂', (r) => r.energy?.co2_g, (v) => `${fmt2.format(v)} g`],
-  ['Material', (r) => r.material_g, (v) => `${fmt2.format(v)} g`],
-  ['Path length', (r) => r.toolpath?.l_total_mm ?? r.distance_mm, formatLength],
-  ['Turning points', (r) => r.toolpath?.n_turning, formatCount],
-  ['Mean turning angle', (r) => r.toolpath?.mean_turn_deg, (v) => `${fmt1.format(v)}°`],
-  ['Mean chord error', (r) => r.toolpath?.mean_chord_error_mm, (v) => `${v.toFixed(4)} mm`],
+  ['Print time', (r) => r.time_s, formatDuration, METRICS.time_s[2]],
+  ['Energy', (r) => r.energy?.total_j, formatEnergy, METRICS.total_j[2]],
+  ['Stepper energy', (r) => r.energy?.thesis_j, formatEnergy, METRICS.thesis_j[2]],
+  ['CO₂', (r) => r.energy?.co2_g, (v) => `${fmt2.format(v)} g`, METRICS.co2_g[2]],
+  ['Material', (r) => r.material_g, (v) => `${fmt2.format(v)} g`, METRICS.material_g[2]],
+  ['Path length', (r) => r.toolpath?.l_total_mm ?? r.distance_mm, formatLength, METRICS.l_total_mm[2]],
+  ['Turning points', (r) => r.toolpath?.n_turning, formatCount, METRICS.n_turning[2]],
+  ['Mean turning angle', (r) => r.toolpath?.mean_turn_deg, (v) => `${fmt1.format(v)}°`, METRICS.mean_turn_deg[2]],
+  ['Mean chord error', (r) => r.toolpath?.mean_chord_error_mm, (v) => `${v.toFixed(4)} mm`, METRICS.mean_chord_error_mm[2]],
 ];
 
 function compareRows(result, job) {
@@ -411,16 +714,19 @@ function compareRows(result, job) {
   const isReport = (r) => isNum(r.time_s) || isNum(r.energy?.total_j);
   const rows = [];
   if (isReport(before) && isReport(after)) {
-    for (const [name, get, format] of REPORT_METRICS) {
+    for (const [name, get, format, explain] of REPORT_METRICS) {
       const b = get(before);
       const a = get(after);
-      if (isNum(b) || isNum(a)) rows.push({ name, before: b, after: a, format });
+      if (isNum(b) || isNum(a)) rows.push({ name, before: b, after: a, format, explain });
     }
   } else {
     // Metrics objects (smoothing): every numeric field, formatted by its unit.
     const keys = [...new Set([...Object.keys(before), ...Object.keys(after)])];
     for (const k of keys) {
-      if (isNum(before[k]) || isNum(after[k])) rows.push({ name: k.replaceAll('_', ' '), before: before[k], after: after[k], format: (v) => formatByKey(k, v) });
+      if (isNum(before[k]) || isNum(after[k])) {
+        const [name, , explain] = metricInfo(k);
+        rows.push({ name, before: before[k], after: after[k], format: (v) => formatByKey(k, v), explain });
+      }
     }
   }
   if (isNum(result.planned_time_before_s) && isNum(result.planned_time_after_s)) {
@@ -462,7 +768,8 @@ function renderCompare(rows) {
   els.compareTable.tBodies[0].replaceChildren(
     ...rows.map((r) => {
       const change = !r.noChange && isNum(r.before) && isNum(r.after) && r.before !== 0 ? signedPercent(r.after / r.before - 1) : '—';
-      const tr = el('tr', {}, el('th', { scope: 'row', text: r.name }), cell(r.before, r.format), cell(r.after, r.format), el('td', { class: 'num', text: change }));
+      const explain = r.explain ?? Object.values(METRICS).find(([name]) => name === r.name)?.[2];
+      const tr = el('tr', {}, el('th', { scope: 'row' }, r.name, explain ? el('small', { class: 'explain', text: explain }) : null), cell(r.before, r.format), cell(r.after, r.format), el('td', { class: 'num', text: change }));
       if (change.startsWith('−')) tr.classList.add('better');
       return tr;
     }),
@@ -478,10 +785,58 @@ function tableRows(t) {
   return [];
 }
 
+/** A paper table's { before, after, change_pct } rows, nested groups flattened: [{ key, name, before, after, change }]. */
+function paperRows(t, prefix = null) {
+  const rows = [];
+  if (!t || typeof t !== 'object' || Array.isArray(t)) return rows;
+  for (const [k, v] of Object.entries(t)) {
+    if (!v || typeof v !== 'object') continue;
+    if ('before' in v || 'after' in v) {
+      const [name, unit, explain] = metricInfo(k);
+      const [pname, , pexplain] = prefix ? metricInfo(prefix) : [];
+      rows.push({ key: k, name: prefix ? `${pname}, ${name}` : name, unit, explain: prefix ? pexplain : explain, before: v.before, after: v.after, change: v.change_pct });
+    } else rows.push(...paperRows(v, k));
+  }
+  return rows;
+}
+
 function renderPaperTables(result) {
   const tables = Object.keys(result).filter((k) => /^table\d+$/.test(k));
+  const titles = { table1: 'VTG paper, Table 1: the toolpath', table2: 'VTG paper, Table 2: vibration, energy and time' };
   els.paperTables.replaceChildren(
     ...tables.map((k) => {
+      const flat = paperRows(result[k]);
+      if (flat.length) {
+        const value = (r, v) => (isNum(v) ? formatByKey(r.key, v) : '—');
+        return el(
+          'div',
+          { class: 'paper-table', 'data-table': k },
+          el('h3', { text: titles[k] ?? `Paper ${k.replace('table', 'Table ')}` }),
+          el(
+            'div',
+            { class: 'table-scroll' },
+            el(
+              'table',
+              { class: 'grid' },
+              el('thead', {}, el('tr', {}, el('th', { text: 'Metric' }), el('th', { class: 'num', text: 'Before' }), el('th', { class: 'num', text: 'After' }), el('th', { class: 'num', text: 'Change' }))),
+              el(
+                'tbody',
+                {},
+                ...flat.map((r) =>
+                  el(
+                    'tr',
+                    {},
+                    el('th', { scope: 'row' }, r.name, r.explain ? el('small', { class: 'explain', text: r.explain }) : null),
+                    el('td', { class: 'num', text: value(r, r.before) }),
+                    el('td', { class: 'num', text: value(r, r.after) }),
+                    el('td', { class: 'num', text: isNum(r.change) ? signedPercent(r.change / 100) : '—' }),
+                  ),
+                ),
+              ),
+            ),
+          ),
+        );
+      }
       const rows = tableRows(result[k]);
       const first = ['metric', 'name', 'quantity'];
       const cols = [...new Set(rows.flatMap((r) => Object.keys(r)))].sort((a, b) => (first.includes(b) ? 1 : 0) - (first.includes(a) ? 1 : 0));
@@ -563,6 +918,73 @@ function renderCharts(job, r) {
   }
 }
 
+// ── Per-layer charts ───────────────────────────────────────────────────────
+
+// Time, energy and filament of every layer (the report's layer_list); a click shows that
+// layer in the viewer (the viewer's layer at the same height).
+function renderLayerCharts(report) {
+  const list = Array.isArray(report.layer_list) ? report.layer_list : [];
+  const ids = [
+    ['chart-layer-time', 'time_s', 'time, s'],
+    ['chart-layer-energy', 'energy_j', 'energy, J'],
+    ['chart-layer-filament', 'filament_mm', 'filament, mm'],
+  ];
+  const summary = document.getElementById('layers-summary');
+  if (list.length === 0) {
+    for (const [id] of ids) clearChart(document.getElementById(id), 'No layers in this file.');
+    summary.textContent = '';
+    return;
+  }
+  const x = list.map((l, i) => (isNum(l.index) ? l.index : i) + 1);
+  const pick = (i) => showLayerAt(i, list[i]?.z);
+  for (const [id, key, label] of ids) {
+    lineChart(document.getElementById(id), { x, xLabel: 'layer', yLabel: label, height: 200, points: list.length <= 60, series: [{ label, values: list.map((l) => (isNum(l[key]) ? l[key] : null)) }], onPick: pick });
+  }
+  // Text alternative: the layers that take longest and shortest.
+  const times = list.map((l) => l.time_s).filter(isNum);
+  if (times.length) {
+    const lo = Math.min(...times);
+    const hi = Math.max(...times);
+    summary.textContent = `${list.length} layers; the shortest takes ${formatDuration(lo)}, the longest ${formatDuration(hi)}.`;
+  }
+  layerTimes = list.map((l) => ({ z: l.z, t: l.time_s }));
+  updateLayerTime();
+}
+
+let layerTimes = []; // [{ z, t }] of the loaded file, for the 'layer time' colouring
+
+/** The time of the report layer nearest height z. */
+function layerTimeAt(z) {
+  if (!isNum(z) || layerTimes.length === 0) return null;
+  let best = null;
+  for (const l of layerTimes) if (isNum(l.z) && isNum(l.t) && (!best || Math.abs(l.z - z) < Math.abs(best.z - z))) best = l;
+  return best ? best.t : null;
+}
+
+function updateLayerTime() {
+  const ts = layerTimes.map((l) => l.t).filter(isNum);
+  viewer.layerTime = {
+    before: layerTimeAt(viewer.before?.z),
+    after: layerTimeAt(viewer.after?.z),
+    lo: ts.length ? Math.min(...ts) : 0,
+    hi: ts.length ? Math.max(...ts) : 1,
+  };
+  viewer.requestDraw();
+}
+
+/** Shows the viewer's layer at height z (a report layer's), else the layer numbered i. */
+async function showLayerAt(i, z) {
+  try {
+    const g = await getLayer('before', i, isNum(z) ? z : null);
+    els.layerSlider.value = String(g.index);
+    refreshLayers();
+    writeHash();
+    els.canvas.scrollIntoView({ block: 'nearest', behavior: 'smooth' });
+  } catch (err) {
+    if (!(err instanceof Cancelled)) els.layerInfo.textContent = `Cannot show that layer: ${err.message}`;
+  }
+}
+
 // ── Layer viewer ───────────────────────────────────────────────────────────
 
 const hoverInfo = $('hover-info');
@@ -578,12 +1000,14 @@ const layerCounts = { before: 0, after: 0 };
 let layerLoading = false;
 let layerWanted = false;
 
-async function getLayer(which, index) {
-  const key = `${fileToken}:${which}:${index}`;
+// With a number `z`, the layer nearest that height (the worker finds it): how "after" shows
+// the layer at the same height as "before", whatever the output's layer count.
+async function getLayer(which, index, z = null) {
+  const key = `${fileToken}:${which}:${isNum(z) ? `z${z}` : index}`;
   if (layerCache.has(key)) return layerCache.get(key);
   // The first layer of a file makes the worker read the whole toolpath (seconds on 34 MB).
   if (layerCounts[which] === 0) els.layerInfo.textContent = `reading the ${which === 'after' ? 'optimized ' : ''}toolpath…`;
-  const g = await client.layer(which, index);
+  const g = await client.layer(which, index, isNum(z) ? z : null);
   layerCounts[which] = g.count;
   layerCache.set(key, g);
   if (layerCache.size > LAYER_CACHE) layerCache.delete(layerCache.keys().next().value);
@@ -608,7 +1032,9 @@ async function refreshLayers() {
       const token = fileToken;
       const index = Number(els.layerSlider.value);
       const before = await getLayer('before', index);
-      const after = output ? await getLayer('after', Math.min(index, Math.max(0, (layerCounts.after || 1) - 1))) : null;
+      // The after layer at the before layer's height (its index may differ, and the output's
+      // layer count is unknown until its first layer arrives).
+      const after = output ? await getLayer('after', before.index, before.z) : null;
       if (token !== fileToken) {
         layerWanted = true;
         continue;
@@ -619,7 +1045,11 @@ async function refreshLayers() {
       els.layerNumber.textContent = `${before.index + 1} / ${count}`;
       els.layerInfo.textContent = `${isNum(before.z) ? `z = ${before.z.toFixed(2)} mm · ` : ''}${formatCount(before.kind.length)} segments${after ? ` before, ${formatCount(after.kind.length)} after` : ''}`;
       els.canvas.dataset.layer = String(before.index);
+      els.canvas.dataset.z = isNum(before.z) ? before.z.toFixed(3) : '';
+      if (after) els.canvas.dataset.afterZ = isNum(after.z) ? after.z.toFixed(3) : '';
+      else delete els.canvas.dataset.afterZ;
       viewer.setLayers(before, after);
+      updateLayerTime();
     } while (layerWanted && loaded);
   } catch (err) {
     if (!(err instanceof Cancelled)) els.layerInfo.textContent = `Cannot draw this layer: ${err.message}`;
@@ -635,6 +1065,8 @@ function resetViewer() {
   layerCounts.before = 0;
   layerCounts.after = 0;
   viewer.clear();
+  const b = loaded?.report?.bounds;
+  viewer.bounds = b && Array.isArray(b.min) && Array.isArray(b.max) ? { minX: b.min[0], minY: b.min[1], maxX: b.max[0], maxY: b.max[1] } : null;
   const wanted = Number(hashState().get('layer'));
   // The slider's max is unknown until the first layer arrives: allow the wish.
   els.layerSlider.max = String(Math.max(Number.isInteger(wanted) ? wanted : 0, loaded?.report?.layers ?? 1));
@@ -671,7 +1103,7 @@ function writeHash() {
 function readHash() {
   const p = hashState();
   const color = p.get('color');
-  if (['feature', 'speed', 'curvature'].includes(color)) els.colorBy.value = color;
+  if (['feature', 'speed', 'curvature', 'layer-time'].includes(color)) els.colorBy.value = color;
   els.showTravel.checked = p.get('travel') === '1';
   const view = p.get('view');
   if (['before', 'after', 'side', 'overlay'].includes(view)) els.viewMode.value = view;
@@ -775,13 +1207,16 @@ function plain(value) {
 
 function formatEnergy(j) {
   if (!isNum(j)) return '—';
-  if (Math.abs(j) >= 3.6e6) return `${fmt1.format(j / 3.6e6)} kWh`;
+  if (Math.abs(j) >= 3.6e5) return `${fmt2.format(j / 3.6e6)} kWh`;
   if (Math.abs(j) >= 1e3) return `${fmt1.format(j / 1e3)} kJ`;
   return `${fmt1.format(j)} J`;
 }
 
 function signedPercent(x) {
-  return `${x >= 0 ? '+' : '−'}${fmt1.format(Math.abs(x) * 100)} %`;
+  const text = fmt1.format(Math.abs(x) * 100);
+  // A change that rounds to nothing has no sign ("0.0 %", not "−0.0 %").
+  if (Number(text.replaceAll(',', '')) === 0) return '0.0 %';
+  return `${x >= 0 ? '+' : '−'}${text} %`;
 }
 
 function summaryRows(r, name, ms) {
@@ -792,7 +1227,7 @@ function summaryRows(r, name, ms) {
     ['File', name],
     ['Print time', formatDuration(r.time_s)],
     ['Slicer estimate', isNum(file.slicer_time_s) ? `${formatDuration(file.slicer_time_s)} (${signedPercent(r.time_s / file.slicer_time_s - 1)})` : '—'],
-    ['Machine', r.machine ? `${r.machine.profile} · ${String(r.machine.junction_model).replaceAll('_', ' ')}` : '—'],
+    ['Timed as', r.machine ? timedAs(r.machine) : '—'],
     ['Moves', formatCount(r.moves)],
     ['Layers', formatCount(r.layers)],
     ['Distance', formatLength(r.distance_mm)],
@@ -815,6 +1250,34 @@ function summaryRows(r, name, ms) {
   return rows;
 }
 
+/** What the file was timed as, in words: the printer, its cornering model and why. */
+function timedAs(m) {
+  const preset = machines.find((p) => p.name === m.profile);
+  const junction = { classic_jerk: 'classic jerk cornering', junction_deviation: 'junction-deviation cornering', klipper: "Klipper's square-corner cornering" }[m.junction_model] ?? String(m.junction_model).replaceAll('_', ' ');
+  const settings = machineChoice === 'upload' && printerSettings ? ` with your ${printerSettings.name}` : '';
+  return `${preset?.description ?? m.profile}${settings} · ${junction} · chosen because: ${m.reason}`;
+}
+
+/** The planner's limits, each with its value, unit and where it came from. */
+function renderLimits(r) {
+  const box = document.getElementById('machine-limits');
+  const limits = r.machine?.limits ?? {};
+  const source = (l) => (l.source === 'profile' ? `the ${r.machine.profile} preset` : LIMIT_SOURCES[l.source] ?? String(l.source).replaceAll('_', ' '));
+  const rows = Object.entries(limits)
+    .filter(([, v]) => v !== null && v !== undefined)
+    .map(([k, v]) => {
+      const [name, unit] = LIMIT_NAMES[k] ?? [k.replaceAll('_', ' '), ''];
+      const list = Array.isArray(v) ? v : [v];
+      const value = `${list.map((l) => formatScalar(l?.value)).join(' / ')}${unit ? ` ${unit}` : ''}`;
+      const from = [...new Set(list.map(source))].join('; ');
+      return el('tr', { 'data-limit': k }, el('th', { scope: 'row', text: name }), el('td', { class: 'num', text: value }), el('td', { text: from }));
+    });
+  box.querySelector('tbody').replaceChildren(...rows);
+  const fromFile = fileLimitCount(r);
+  box.querySelector('summary').textContent = `Printer limits and where each came from (${fromFile ? `${fromFile} set by the file` : 'none set by the file'})`;
+  box.hidden = rows.length === 0;
+}
+
 function renderStats(r) {
   const warnings = Array.isArray(r.warnings) ? r.warnings.length : 0;
   const cards = [
@@ -831,11 +1294,30 @@ function renderStats(r) {
   );
 }
 
+const SUMMARY_EXPLAIN = {
+  'Print time': METRICS.time_s[2],
+  'Slicer estimate': "The slicer's own estimate written in the file, and how far ours is from it.",
+  'Timed as': 'The printer whose limits the time, energy and vibration are computed for (change it above).',
+  Moves: 'G-code moves: printing, travel and retraction.',
+  Distance: METRICS.distance_mm[2],
+  Filament: METRICS.filament_mm[2],
+  Material: METRICS.material_g[2],
+  'Extrusion mode': 'Whether E values are absolute (M82) or relative (M83), and how we know.',
+  Energy: METRICS.total_j[2],
+  'CO₂': METRICS.co2_g[2],
+  Bounds: 'Size of the printed part: width × depth × height.',
+};
+
 function renderSummary(r, name, ms) {
   const tbody = els.summary.tBodies[0];
   tbody.replaceChildren(
     ...summaryRows(r, name, ms).map(([k, v]) =>
-      el('tr', { 'data-key': k.toLowerCase().replace(/\s+/g, '-') }, el('th', { scope: 'row', text: k }), el('td', { text: v })),
+      el(
+        'tr',
+        { 'data-key': k.toLowerCase().replace(/\s+/g, '-') },
+        el('th', { scope: 'row' }, k, SUMMARY_EXPLAIN[k] ? el('small', { class: 'explain', text: SUMMARY_EXPLAIN[k] }) : null),
+        el('td', { text: v }),
+      ),
     ),
   );
 }
@@ -886,15 +1368,18 @@ function renderWarnings(r) {
 // A scalar, formatted by the unit its key names (`_mm`, `_s`, `_g`, …).
 function formatByKey(key, v) {
   if (!isNum(v)) return formatScalar(v);
-  if (/_mm3$/.test(key)) return `${fmt1.format(v)} mm³`;
-  if (/_per_mm_deg$/.test(key)) return `${formatScalar(v)} °/mm`;
-  if (/_deg$/.test(key)) return `${formatScalar(v)}°`;
-  if (/_hz$/.test(key)) return `${formatScalar(v)} Hz`;
+  // Compound units first: `_mm_s` is a speed, not a duration.
+  const units = [
+    [/_mm_s3$/, 'mm/s³'], [/_mm_s2$/, 'mm/s²'], [/_mm_s$/, 'mm/s'], [/_m_s2$/, 'm/s²'], [/_per_mm_deg$/, '°/mm'], [/_per_mm$/, '/mm'],
+    [/_g_cm3$/, 'g/cm³'], [/_mm3$/, 'mm³'], [/_mm2$/, 'mm²'], [/_kwh$/i, 'kWh'], [/_wh$/i, 'Wh'], [/_w$/i, 'W'], [/_c$/i, '°C'],
+    [/_(pct|percent)$/, '%'], [/_hz$/, 'Hz'], [/_deg$/, '°'],
+  ];
+  for (const [re, unit] of units) if (re.test(key)) return `${formatScalar(v)}${unit === '°' ? '' : ' '}${unit}`;
   if (/_mm$/.test(key)) return formatLength(v);
-  if (/_s$/.test(key)) return formatDuration(v);
   if (/_ms$/.test(key)) return formatMs(v);
+  if (/_s$/.test(key)) return formatDuration(v);
   if (/_g$/.test(key)) return `${fmt2.format(v)} g`;
-  if (/_(wh|kwh|j|w|c|pct|percent)$/i.test(key)) return `${formatScalar(v)} ${key.split('_').pop()}`;
+  if (/_j$/i.test(key)) return formatEnergy(v);
   return formatScalar(v);
 }
 
@@ -905,7 +1390,7 @@ function renderValue(v, depth = 0, key = '') {
     if (v.every((x) => x === null || typeof x !== 'object')) {
       return document.createTextNode(v.length > 12 ? `[${v.slice(0, 12).map(formatScalar).join(', ')}, … ${v.length} items]` : `[${v.map(formatScalar).join(', ')}]`);
     }
-    return document.createTextNode(`${v.length} items (see JSON)`);
+    return document.createTextNode(key === 'layer_list' ? `${v.length} layers (see the per-layer charts)` : `${v.length} items (in the report JSON)`);
   }
   const entries = Object.entries(v);
   if (entries.length === 0) return el('span', { class: 'muted', text: 'empty' });
@@ -913,14 +1398,14 @@ function renderValue(v, depth = 0, key = '') {
   return el(
     'table',
     { class: 'kv nested' },
-    el('tbody', {}, ...entries.map(([k, x]) => el('tr', {}, el('th', { scope: 'row', text: k }), el('td', {}, renderValue(x, depth + 1, k))))),
+    el('tbody', {}, ...entries.map(([k, x]) => el('tr', {}, el('th', { scope: 'row', text: metricInfo(k)[0], title: k }), el('td', {}, renderValue(x, depth + 1, k))))),
   );
 }
 
 function renderExtra(r) {
   const extra = Object.entries(r).filter(([k]) => !KNOWN_FIELDS.has(k));
   els.extra.replaceChildren(
-    ...extra.map(([k, v]) => el('div', { class: 'extra-item', 'data-field': k }, el('h3', { text: k }), renderValue(v, 0, k))),
+    ...extra.map(([k, v]) => el('div', { class: 'extra-item', 'data-field': k }, el('h3', { text: metricInfo(k)[0], title: k }), renderValue(v, 0, k))),
   );
   els.extraPanel.hidden = extra.length === 0;
 }
@@ -929,9 +1414,11 @@ function showReport(rawReport, name, ms) {
   const report = plain(rawReport);
   renderStats(report);
   renderSummary(report, name, ms);
+  renderLimits(report);
   renderFeatures(report);
   renderWarnings(report);
   renderExtra(report);
+  renderLayerCharts(report);
   showJson(report, `${baseName(name)}.quietpath.json`);
   els.elapsed.textContent = `analyzed in ${formatMs(ms)}`;
   els.elapsed.dataset.ms = String(ms);
@@ -1009,21 +1496,40 @@ els.demo.addEventListener('click', () => run(demoSource()));
 els.cancel.addEventListener('click', () => cancel());
 els.download.addEventListener('click', downloadReport);
 els.downloadGcode.addEventListener('click', downloadGcode);
-async function setPrinterSettings(file) {
+function showPrinterSettingsName() {
   const nameEl = document.getElementById('printer-settings-name');
-  const clear = document.getElementById('printer-settings-clear');
+  nameEl.textContent = printerSettings
+    ? `${printerSettings.name} (${printerSettings.key === 'klipper_config' ? 'Klipper printer.cfg' : 'Marlin M503 settings'})`
+    : 'none: limits from the file and the preset';
+  document.getElementById('printer-settings-clear').hidden = !printerSettings;
+}
+
+function setMachine(choice) {
+  machineChoice = choice;
+  store.set(STORE_MACHINE, choice || null);
+  renderMachinePicker();
+}
+
+async function setPrinterSettings(file) {
   if (file) {
     const text = await file.text();
     const key = /^\s*\[printer\]/m.test(text) ? 'klipper_config' : 'machine_gcode';
     printerSettings = { name: file.name, text, key };
-    nameEl.textContent = `${file.name} (${key === 'klipper_config' ? 'Klipper printer.cfg' : 'Marlin M503 settings'})`;
+    store.set(STORE_SETTINGS, text.length < 1_000_000 ? JSON.stringify(printerSettings) : null);
+    setMachine('upload');
   } else {
     printerSettings = null;
-    nameEl.textContent = 'none: limits from the file and the preset';
+    store.set(STORE_SETTINGS, null);
+    setMachine(machineChoice === 'upload' ? '' : machineChoice);
   }
-  clear.hidden = !printerSettings;
+  showPrinterSettingsName();
   if (lastSource && lastSource.name && !current) run(lastSource);
 }
+
+document.getElementById('machine').addEventListener('change', (e) => {
+  setMachine(e.target.value);
+  if (lastSource && lastSource.name && !current) run(lastSource);
+});
 
 document.getElementById('printer-settings').addEventListener('change', (e) => {
   e.stopPropagation();
@@ -1095,6 +1601,8 @@ window.addEventListener('drop', (e) => {
 // Restore the shared view, start the worker right away (the wasm compiles
 // while the demo downloads), then analyze the bundled demo.
 readHash();
+showPrinterSettingsName();
+renderMachinePicker();
 resetOptimized();
 updateActions();
 client.warm();

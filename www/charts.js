@@ -37,7 +37,8 @@ function thin(x, ys) {
 /**
  * Draws a line chart in `container`.
  * @param {object} spec { title, x: number[], xLabel, yLabel, logY?, points?,
- *   series: [{ label, values: (number|null)[], color?, dash? }] }
+ *   series: [{ label, values: (number|null)[], color?, dash? }],
+ *   onPick?(index, x): a click on the plot, at the data point under the cursor }
  */
 export function lineChart(container, spec) {
   const prev = charts.get(container);
@@ -74,6 +75,19 @@ export function lineChart(container, spec) {
     cursor: { drag: { x: true, y: false } },
   };
   const plot = new uPlot(opts, data, container);
+  if (spec.onPick) {
+    plot.over.style.cursor = 'pointer';
+    let down = null;
+    plot.over.addEventListener('mousedown', (e) => {
+      down = [e.clientX, e.clientY];
+    });
+    plot.over.addEventListener('click', (e) => {
+      // A drag is a zoom, not a pick.
+      if (down && Math.hypot(e.clientX - down[0], e.clientY - down[1]) > 4) return;
+      const i = plot.cursor.idx ?? plot.posToIdx(e.offsetX);
+      if (i !== null && i !== undefined && i >= 0) spec.onPick(i, x[i]);
+    });
+  }
   const observer = new ResizeObserver(() => {
     const w = Math.max(280, container.clientWidth);
     if (Math.abs(w - plot.width) > 2) plot.setSize({ width: w, height: plot.height });

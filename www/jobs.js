@@ -27,7 +27,8 @@ export class JobError extends Error {
 export class JobClient {
   /**
    * @param {object} hooks
-   *   onHello(version, capabilities): a worker has loaded the wasm;
+   *   onHello(version, capabilities, machines): a worker has loaded the wasm
+   *   (machines: the built-in presets, MachineProfile[]);
    *   onCrash(detail, loaded, hadPending): the worker died (pending requests
    *   were rejected with a JobError; hadPending says whether there were any).
    */
@@ -99,7 +100,7 @@ export class JobClient {
     if (w !== this.worker || !msg) return;
     if (msg.type === 'hello') {
       w.loaded = true;
-      this.hooks.onHello?.(msg.version, msg.capabilities ?? ['analyze']);
+      this.hooks.onHello?.(msg.version, msg.capabilities ?? ['analyze'], msg.machines ?? []);
       return;
     }
     const p = this.pending.get(msg.id);
@@ -184,9 +185,10 @@ export class JobClient {
   }
 
   /** Drawing data of layer `index` of 'before' (input) or 'after' (output). */
-  async layer(which, index) {
+  /** One layer's drawing data; with a number `z`, the layer nearest that height. */
+  async layer(which, index, z = null) {
     await this.restore(which === 'after');
-    const { promise } = this.post({ type: 'layer', which, index });
+    const { promise } = this.post({ type: 'layer', which, index, z });
     return promise;
   }
 }

@@ -37,6 +37,9 @@ export class LayerViewer {
     this.showTravel = false;
     this.mode = 'before'; // before | after | side | overlay
     this.view = null; // { cx, cy, scale } (scale: CSS px per mm)
+    this.userMoved = false; // zoomed or panned since the last fit: keep that view across layers
+    this.bounds = null; // the whole print's XY extent { minX, minY, maxX, maxY }, outlined
+    this.layerTime = null; // 'layer-time' colouring: { before, after, lo, hi } in s
     this.frame = 0;
     this.installInput();
     this.resizeObserver = new ResizeObserver(() => this.resize());
@@ -47,9 +50,12 @@ export class LayerViewer {
   /** Sets the geometry to draw; `after` may be null. Keeps the view. */
   setLayers(before, after) {
     const panes = this.panes().length;
+    const newLayer = this.before?.index !== before?.index;
     this.before = before;
     this.after = after;
-    if (!this.view || this.panes().length !== panes) this.fit();
+    // Each layer is fitted anew (a small top layer is not a speck), unless the user has
+    // zoomed or panned: then the view they chose stays.
+    if (!this.view || this.panes().length !== panes || (newLayer && !this.userMoved)) this.fit();
     this.requestDraw();
   }
 
@@ -92,6 +98,7 @@ export class LayerViewer {
    * purge line at the bed's edge does not shrink the part to a speck.
    */
   fit() {
+    this.userMoved = false;
     const g = this.before ?? this.after;
     if (!g) return;
     const xs = [];
@@ -177,6 +184,7 @@ export class LayerViewer {
           cx: wx - (x - pane.x - pane.w / 2) / scale,
           cy: wy + (y - h / 2) / scale,
         };
+        this.userMoved = true;
         this.requestDraw();
         this.hooks.onViewChange?.();
       },
@@ -205,6 +213,7 @@ export class LayerViewer {
         return;
       }
       const s = this.view.scale;
+      if (e.clientX !== drag.x || e.clientY !== drag.y) this.userMoved = true;
       this.view = { ...this.view, cx: drag.cx - (e.clientX - drag.x) / s, cy: drag.cy + (e.clientY - drag.y) / s };
       this.requestDraw();
     });
@@ -232,6 +241,7 @@ export class LayerViewer {
       else if (e.key === '0') return this.fit();
       else return;
       e.preventDefault();
+      this.userMoved = true;
       this.view = v;
       this.requestDraw();
     });
@@ -274,6 +284,10 @@ export class LayerViewer {
   /** Value range for speed / curvature colouring, shared by before and after. */
   range() {
     if (this.colorBy === 'feature') return null;
+    if (this.colorBy === 'layer-time') {
+      const t = this.layerTime;
+      return { key: 'layer-time', lo: t?.lo ?? 0, hi: t && t.hi > t.lo ? t.hi : (t?.lo ?? 0) + 1 };
+    }
     const key = this.colorBy === 'speed' ? 'speed' : 'curvature';
     const values = [];
     for (const g of [this.before, this.after]) {
@@ -306,6 +320,7 @@ export class LayerViewer {
         ctx.beginPath();
         ctx.rect(p.x, 0, p.w, h);
         ctx.clip();
+        this.drawBounds(p, h);
         if (p.ghost) this.drawGeometry(p.ghost, p, h, null, true);
         if (p.geom) drawn += this.drawGeometry(p.geom, p, h, range, false);
         if (panes.length > 1 || p.label) {
@@ -325,8 +340,55 @@ export class LayerViewer {
         ctx.stroke();
       }
     }
+    if (this.view && (this.before || this.after)) this.drawScaleBar(canvas.clientHeight);
     canvas.dataset.segments = String(drawn);
+    canvas.dataset.scale = this.view ? String(this.view.scale) : '';
     this.renderLegend(range);
+  }
+
+  /** The whole print's XY extent as a dashed outline, so a layer is seen in its place. */
+  drawBounds(pane, h) {
+    const b = this.bounds;
+    if (!b || !this.view) return;
+    const { ctx } = this;
+    const { cx, cy, scale } = this.view;
+    const ox = pane.x + pane.w / 2 - cx * scale;
+    const oy = h / 2 + cy * scale;
+    ctx.save();
+    ctx.strokeStyle = 'rgba(128,128,128,0.55)';
+    ctx.lineWidth = 1;
+    ctx.setLineDash([6, 4]);
+    ctx.strokeRect(ox + b.minX * scale, oy - b.maxY * scale, (b.maxX - b.minX) * scale, (b.maxY - b.minY) * scale);
+    ctx.restore();
+  }
+
+  /** A scale bar of a round length (1, 2 or 5 × 10ⁿ mm), about 100 px long, bottom left. */
+  drawScaleBar(h) {
+    const { ctx } = this;
+    const dpr = window.devicePixelRatio || 1;
+    const target = 100 / this.view.scale; // mm in 100 px
+    const pow = 10 ** Math.floor(Math.log10(target));
+    const mm = [1, 2, 5, 10].map((m) => m * pow).filter((v) => v <= target * 1.5).pop() ?? pow;
+    const px = mm * this.view.scale;
+    ctx.save();
+    ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+    const color = getComputedStyle(this.canvas).color;
+    ctx.strokeStyle = color;
+    ctx.fillStyle = color;
+    ctx.lineWidth = 2;
+    const x = 12;
+    const y = h - 14;
+    ctx.beginPath();
+    ctx.moveTo(x, y - 5);
+    ctx.lineTo(x, y);
+    ctx.lineTo(x + px, y);
+    ctx.lineTo(x + px, y - 5);
+    ctx.stroke();
+    ctx.font = '12px system-ui, sans-serif';
+    const label = mm >= 1 ? `${+mm.toFixed(0)} mm` : `${+mm.toPrecision(1)} mm`;
+    ctx.fillText(label, x + px + 6, y + 1);
+    ctx.restore();
+    this.canvas.dataset.scaleBar = label;
   }
 
   /** Strokes one geometry into a pane; returns the number of segments drawn. */
@@ -348,12 +410,19 @@ export class LayerViewer {
       for (let i = 0; i < n; i++) bucket[i] = kind[i];
     } else {
       colors = [null, ...RAMP];
-      const a = g[range.key];
       const k = BUCKETS / (range.hi - range.lo);
-      for (let i = 0; i < n; i++) {
-        if (kind[i] === 0) continue;
-        const b = Math.floor((a[i] - range.lo) * k);
-        bucket[i] = 1 + (b < 0 ? 0 : b >= BUCKETS ? BUCKETS - 1 : b);
+      const toBucket = (v) => {
+        const b = Math.floor((v - range.lo) * k);
+        return 1 + (b < 0 ? 0 : b >= BUCKETS ? BUCKETS - 1 : b);
+      };
+      if (range.key === 'layer-time') {
+        // The whole layer in the colour of its print time (short layers cool badly).
+        const t = g === this.after ? this.layerTime?.after : this.layerTime?.before;
+        const b = Number.isFinite(t) ? toBucket(t) : -1;
+        for (let i = 0; i < n; i++) bucket[i] = kind[i] === 0 ? 0 : b;
+      } else {
+        const a = g[range.key];
+        for (let i = 0; i < n; i++) if (kind[i] !== 0) bucket[i] = toBucket(a[i]);
       }
     }
     // Extrusion lines about as wide as a real line when zoomed in.
@@ -407,7 +476,7 @@ export class LayerViewer {
       for (const g of [this.before, this.after]) if (g) for (const k of g.kind) present.add(k);
       for (let k = 1; k < KINDS.length; k++) if (present.has(k)) items.push(swatch(KIND_COLORS[k], KINDS[k]));
     } else {
-      const unit = range.key === 'speed' ? 'mm/s' : '1/mm';
+      const unit = range.key === 'speed' ? 'mm/s' : range.key === 'layer-time' ? 's per layer' : '1/mm';
       const fmt = (v) => (Math.abs(v) >= 10 ? v.toFixed(0) : v.toFixed(2));
       const li = document.createElement('li');
       li.className = 'ramp';

@@ -30,17 +30,19 @@
 //         result: the function's result without its `output` bytes;
 //         output: those bytes (transferred). When present they also become
 //         the new `output` session (for the viewer's "after").
-//   { id, type: 'layer', which: 'before'|'after', index }
+//   { id, type: 'layer', which: 'before'|'after', index, z? }
 //       Drawing data of one layer of the input ('before') or output ('after')
-//       session.
+//       session. With a number `z`, the layer nearest that height instead of
+//       `index` (how "after" follows "before": a rewrite may change the count).
 //       → { id, type: 'layer', which, index, count, z, xy, kind, speed,
 //           curvature }   (typed arrays transferred; see types.d.ts
 //           LayerGeometry; count: the session's number of layers)
 //
 // worker → page
-//   { type: 'hello', version, capabilities: string[] }
+//   { type: 'hello', version, capabilities: string[], machines: MachineProfile[] }
 //       once, when the wasm is loaded; capabilities lists the jobs this build
-//       has (e.g. ['analyze', 'vtg']): the page disables the others.
+//       has (e.g. ['analyze', 'vtg']): the page disables the others;
+//       machines: the built-in presets (machines(); [] in a build without it).
 //   { id, type: 'progress', fraction }   0 ≤ fraction ≤ 1, increasing,
 //                                        throttled (≈ every 1 % / 50 ms)
 //   { id, type: 'error', message, line, column, excerpt, kind, fatal }
@@ -77,7 +79,13 @@ const ready = init().then(
     } catch {
       // version() is informational only
     }
-    self.postMessage({ type: 'hello', version: v, capabilities: capabilities() });
+    let machines = [];
+    try {
+      machines = typeof qp.machines === 'function' ? qp.machines() : [];
+    } catch {
+      // an older build without the preset list: the picker offers "from the file" only
+    }
+    self.postMessage({ type: 'hello', version: v, capabilities: capabilities(), machines });
   },
   (err) => {
     loadError = err;
@@ -277,8 +285,10 @@ function handleLayer(msg) {
   }
   try {
     const count = s.session.layerCount();
-    const i = Math.max(0, Math.min(count - 1, index | 0));
-    const g = count > 0 ? s.session.layer(i) : { z: null, xy: new Float32Array(), kind: new Uint8Array(), speed: new Float32Array(), curvature: new Float32Array() };
+    let i = Math.max(0, Math.min(count - 1, index | 0));
+    let g = null;
+    if (count > 0 && typeof msg.z === 'number' && Number.isFinite(msg.z)) [i, g] = nearestZ(s.session, count, msg.z, i);
+    g ??= count > 0 ? s.session.layer(i) : { z: null, xy: new Float32Array(), kind: new Uint8Array(), speed: new Float32Array(), curvature: new Float32Array() };
     self.postMessage(
       { id, type: 'layer', which, index: i, count, z: g.z, xy: g.xy, kind: g.kind, speed: g.speed, curvature: g.curvature },
       [g.xy.buffer, g.kind.buffer, g.speed.buffer, g.curvature.buffer],
@@ -286,6 +296,36 @@ function handleLayer(msg) {
   } catch (err) {
     postError(id, err, s.bytes);
   }
+}
+
+// The layer of `session` whose z is nearest `z`: a binary search over the layers' heights
+// (increasing in a layered print), then the neighbours; `hint` (the same index) wins ties.
+// Returns [index, geometry].
+function nearestZ(session, count, z, hint) {
+  const zs = new Map();
+  const zAt = (i) => {
+    if (!zs.has(i)) zs.set(i, session.layer(i));
+    const v = zs.get(i).z;
+    return typeof v === 'number' ? v : NaN;
+  };
+  let lo = 0;
+  let hi = count - 1;
+  while (lo < hi) {
+    const mid = (lo + hi) >> 1;
+    if (zAt(mid) < z) lo = mid + 1;
+    else hi = mid;
+  }
+  let best = hint;
+  let bestErr = Math.abs(zAt(hint) - z);
+  for (const i of [lo - 1, lo, lo + 1]) {
+    if (i < 0 || i >= count) continue;
+    const err = Math.abs(zAt(i) - z);
+    if (err < bestErr || !(bestErr === bestErr)) {
+      best = i;
+      bestErr = err;
+    }
+  }
+  return [best, zs.get(best) ?? session.layer(best)];
 }
 
 const HANDLERS = { load: handleLoad, job: handleJob, layer: handleLayer, analyze: handleLoad };

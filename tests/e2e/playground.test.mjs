@@ -619,7 +619,10 @@ test('the job UI with every capability: tables, charts, downloads, before/after 
   await id('run-smooth').click();
   await idle();
   assert.equal(await id('chart-orientation').getAttribute('data-series'), '4');
-  assert.ok((await id('compare-table').textContent()).includes('max jerk deg'));
+  // Human names, not raw keys (issue 32): max_jerk_deg reads "Max jerk", in degrees.
+  const smoothRows = await id('compare-table').textContent();
+  assert.ok(smoothRows.includes('Max jerk') && !smoothRows.includes('max jerk deg'), smoothRows);
+  assert.match(smoothRows, /4°/);
 
   // Vibration on the file, then on the optimized output: PSD before and after.
   await id('run-vibration').click();

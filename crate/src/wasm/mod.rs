@@ -17,6 +17,8 @@ use wasm_bindgen::JsCast;
 use crate::analyze::{analyze_with_progress, AnalyzeOptions};
 use crate::energy::calibrate::{self, CalibrationError, CsvRows, Observation};
 use crate::error::Error;
+use crate::plan::profiles::PRESETS;
+use crate::plan::MachineProfile;
 
 #[wasm_bindgen(typescript_custom_section)]
 const TYPES: &str = include_str!("types.d.ts");
@@ -44,6 +46,18 @@ pub fn start() {
 #[wasm_bindgen]
 pub fn version() -> String {
     crate::VERSION.to_string()
+}
+
+/// The built-in machine presets (`--machine NAME`), each as its profile: name, description,
+/// junction model and limits.
+#[wasm_bindgen(unchecked_return_type = "MachineProfile[]")]
+pub fn machines() -> Result<JsValue, JsValue> {
+    let list: Vec<MachineProfile> = PRESETS
+        .iter()
+        .copied()
+        .filter_map(MachineProfile::preset)
+        .collect();
+    to_js(&list)
 }
 
 /// Turns a core error into a JS `Error` with position properties. The one error helper.

@@ -1,0 +1,313 @@
+// Browser tests of the playground as a person meets it (issue 32): the printer picker, input
+// states, the before/after layer after a job, a running job's progress and the list of jobs,
+// readable results, per-layer charts and the phone layout. Same set-up as playground.test.mjs:
+// scripts/serve.mjs, Debian's Chromium through playwright-core, www/pkg built, the corpus in
+// ../shared/corpus and the native CLI (target/release/quietpath or $QUIETPATH_CLI).
+
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { spawnSync } from 'node:child_process';
+import { chromium } from 'playwright-core';
+import { startServer } from '../../scripts/serve.mjs';
+
+const repoRoot = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+const wwwRoot = path.join(repoRoot, 'www');
+const corpusDir = path.resolve(repoRoot, '../shared/corpus');
+const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
+const cli = process.env.QUIETPATH_CLI ?? path.join(repoRoot, 'target', 'release', 'quietpath');
+const BENCHY = 'prusaslicer-2.6.1_benchy_marlin2.gcode';
+const STEP_TIMEOUT = 30_000;
+const JOB_TIMEOUT = 180_000;
+
+let server;
+let browser;
+let context;
+let page;
+let baseUrl;
+const pageErrors = [];
+const requests = [];
+
+before(async () => {
+  assert.ok(fs.existsSync(path.join(wwwRoot, 'pkg', 'quietpath_bg.wasm')), 'www/pkg is missing: make pkg');
+  server = await startServer({ root: wwwRoot, port: 0 });
+  baseUrl = `http://127.0.0.1:${server.address().port}/`;
+  browser = await chromium.launch({
+    executablePath: chromiumPath,
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic'],
+  });
+  context = await browser.newContext({ viewport: { width: 1280, height: 900 }, serviceWorkers: 'block' });
+  context.on('request', (req) => requests.push(req.url()));
+  page = await context.newPage();
+  page.setDefaultTimeout(STEP_TIMEOUT);
+  page.on('pageerror', (err) => pageErrors.push(String(err)));
+});
+
+after(async () => {
+  await browser?.close();
+  await new Promise((resolve) => (server ? server.close(resolve) : resolve()));
+});
+
+const byTestId = (id, p = page) => p.locator(`[data-testid="${id}"]`);
+
+async function settled(p = page) {
+  await p.waitForFunction(() => {
+    const st = document.querySelector('[data-testid="status"]')?.textContent;
+    return ['ready', 'error', 'cancelled'].includes(st) && !document.body.classList.contains('busy');
+  }, null, { timeout: JOB_TIMEOUT });
+  return byTestId('status', p).textContent();
+}
+
+async function loadFile(file, p = page) {
+  await byTestId('file', p).setInputFiles(file);
+  await p.waitForFunction((n) => document.querySelector('[data-testid="filename"]').textContent === n, typeof file === 'string' ? path.basename(file) : file.name);
+  return settled(p);
+}
+
+async function reportJson(p = page) {
+  return JSON.parse(await byTestId('report-json', p).textContent());
+}
+
+function cliJson(args) {
+  const r = spawnSync(cli, args, { encoding: 'utf8', maxBuffer: 1 << 28 });
+  assert.equal(r.status, 0, r.stderr);
+  return JSON.parse(r.stdout);
+}
+
+test('machine picker: the presets, "from the file", the time of the CLI for that printer, remembered', { timeout: 4 * STEP_TIMEOUT }, async () => {
+  await page.goto(baseUrl);
+  assert.equal(await settled(), 'ready');
+  const values = await byTestId('machine').locator('option').evaluateAll((o) => o.map((x) => x.value));
+  for (const preset of ['', 'prusa-mk3s', 'creality-ender3', 'voron-klipper', 'vtg-ldam-servo']) assert.ok(values.includes(preset), `no option "${preset}" in ${values}`);
+
+  const benchy = path.join(corpusDir, BENCHY);
+  assert.equal(await loadFile(benchy), 'ready');
+  // The benchy sets its own limits (M201, M203…): "from the file" says so.
+  const fileOption = await byTestId('machine').locator('option[value=""]').textContent();
+  assert.match(fileOption, /from the file \(its \d+ limits/);
+  assert.match(await byTestId('machine-limits').textContent(), /a command in the file/);
+
+  const before = await reportJson();
+  await byTestId('machine').selectOption('creality-ender3');
+  await page.waitForFunction((b) => document.querySelector('[data-testid="report-json"]').textContent !== b, JSON.stringify(before, null, 2));
+  assert.equal(await settled(), 'ready');
+  const ender = await reportJson();
+  assert.equal(ender.machine.profile, 'creality-ender3');
+  assert.equal(ender.time_s, cliJson(['analyze', benchy, '--json', '--machine', 'creality-ender3']).time_s, 'the time of the CLI for that printer');
+  assert.notEqual(ender.time_s, before.time_s);
+  const summary = await byTestId('summary').textContent();
+  assert.match(summary, /Timed as.*Ender-3.*junction-deviation/s);
+  assert.match(await byTestId('machine-limits').textContent(), /the creality-ender3 preset/);
+
+  // Remembered across visits.
+  await page.reload();
+  await settled();
+  await page.waitForFunction(() => document.querySelector('[data-testid="machine"]').value === 'creality-ender3');
+  assert.equal((await reportJson()).machine.profile, 'creality-ender3');
+  await byTestId('machine').selectOption('');
+  await settled();
+  assert.equal(await page.evaluate(() => localStorage.getItem('quietpath.machine')), null);
+  assert.deepEqual(pageErrors, []);
+});
+
+test('input states: random bytes, a PNG and an empty file are errors with a reason; bad options say why', { timeout: 4 * STEP_TIMEOUT }, async () => {
+  await page.goto(baseUrl);
+  await settled();
+  let seed = 7;
+  const random = Buffer.alloc(8192).map(() => {
+    seed = (seed * 1103515245 + 12345) & 0x7fffffff;
+    return seed >> 16;
+  });
+  const cases = [
+    [{ name: 'random.gcode', mimeType: 'application/octet-stream', buffer: random }, /binary data/],
+    [{ name: 'picture.gcode', mimeType: 'image/png', buffer: fs.readFileSync(path.join(repoRoot, 'docs', 'screenshot.png')) }, /PNG image/],
+    [{ name: 'empty.gcode', mimeType: 'text/plain', buffer: Buffer.alloc(0) }, /empty/],
+    [{ name: 'words.gcode', mimeType: 'text/plain', buffer: Buffer.from('Dear printer,\nplease print a boat.\n') }, /No G-code moves found/],
+  ];
+  for (const [file, reason] of cases) {
+    assert.equal(await loadFile(file), 'error', `${file.name} should be an error`);
+    const text = await byTestId('error').textContent();
+    assert.match(text, reason, `${file.name}: ${text}`);
+    assert.equal(await page.locator('#results').isVisible(), false, `${file.name}: no report cards for a file that is not G-code`);
+  }
+  // A negative filament diameter: a message at the option, and no analysis with it.
+  await page.locator('#options').evaluate((d) => { d.open = true; });
+  await byTestId('opt-diameter').fill('-1.75');
+  await byTestId('opt-diameter').dispatchEvent('change');
+  await byTestId('demo').click();
+  assert.equal(await settled(), 'error');
+  assert.match(await byTestId('options-error').textContent(), /Filament diameter: -1\.75 mm is too small: at least 0\.1 mm/);
+  assert.match(await byTestId('error').textContent(), /Check the options/);
+  await byTestId('opt-diameter').fill('');
+  await byTestId('opt-diameter').dispatchEvent('change');
+  await byTestId('demo').click();
+  assert.equal(await settled(), 'ready');
+  assert.equal(await byTestId('options-error').isVisible(), false);
+  await page.locator('#options').evaluate((d) => { d.open = false; });
+  // A job option out of range: the job says why and does not run.
+  await byTestId('opt-vtg-tolerance').fill('-0.1');
+  await byTestId('run-vtg').click();
+  assert.match(await page.locator('form#form-vtg .availability').textContent(), /Tolerance: -0\.1 mm is too small/);
+  assert.equal(await byTestId('job-list').locator('li').count(), 0);
+  await byTestId('opt-vtg-tolerance').fill('');
+  assert.deepEqual(pageErrors, []);
+});
+
+test('after a VTG run the after pane shows the layer at the before pane\'s height', { timeout: JOB_TIMEOUT }, async () => {
+  await page.goto(baseUrl);
+  await settled();
+  const count = Number(await byTestId('layer-slider').getAttribute('max'));
+  const wanted = Math.floor(count * 0.6);
+  await byTestId('layer-slider').evaluate((s, i) => {
+    s.value = String(i);
+    s.dispatchEvent(new Event('input', { bubbles: true }));
+  }, wanted);
+  await page.waitForFunction((i) => document.querySelector('[data-testid="viewer"]').dataset.layer === String(i), wanted);
+  await byTestId('run-vtg').click();
+  assert.equal(await settled(), 'ready');
+  await page.waitForFunction(() => document.querySelector('[data-testid="viewer"]').dataset.afterZ !== undefined);
+  const { z, afterZ, layer } = await page.evaluate(() => ({ ...document.querySelector('[data-testid="viewer"]').dataset }));
+  assert.equal(layer, String(wanted));
+  assert.ok(Number(z) > 1, `before z = ${z}`);
+  assert.ok(Math.abs(Number(z) - Number(afterZ)) < 1e-3, `before z = ${z}, after z = ${afterZ}`);
+});
+
+test('a running job shows its progress and Cancel beside it, in view; every result is kept in a list', { timeout: 2 * JOB_TIMEOUT }, async () => {
+  await page.goto(baseUrl);
+  await settled();
+  assert.equal(await loadFile(path.join(corpusDir, BENCHY)), 'ready');
+  await page.locator('#form-vtg').scrollIntoViewIfNeeded();
+  await byTestId('run-vtg').click();
+  await page.waitForFunction(() => document.body.classList.contains('busy'));
+  const where = await page.evaluate(() => {
+    const box = (id) => document.querySelector(`[data-testid="${id}"]`).getBoundingClientRect();
+    const inView = (r) => r.top >= 0 && r.bottom <= innerHeight && r.left >= 0 && r.right <= innerWidth && r.width > 0;
+    return {
+      cancelInView: inView(box('cancel')),
+      progressInView: inView(box('progress')),
+      inForm: !!document.querySelector('#form-vtg [data-testid="cancel"]'),
+      cancelEnabled: !document.querySelector('[data-testid="cancel"]').disabled,
+    };
+  });
+  assert.deepEqual(where, { cancelInView: true, progressInView: true, inForm: true, cancelEnabled: true });
+  // Scrolled away, the progress stays in view while the job runs (sticky).
+  await page.evaluate(() => window.scrollBy(0, 250));
+  const stillInView = await page.evaluate(() => {
+    const r = document.querySelector('[data-testid="cancel"]').getBoundingClientRect();
+    return document.body.classList.contains('busy') ? r.top >= 0 && r.bottom <= innerHeight : true;
+  });
+  assert.ok(stillInView, 'Cancel scrolled out of view while the job runs');
+  assert.equal(await settled(), 'ready');
+  assert.equal(await page.locator('#form-vtg [data-testid="cancel"]').count(), 0, 'the progress goes back under the file picker');
+  // A second job: both results are listed, the first still there.
+  await byTestId('opt-vtg-tolerance').fill('0.05');
+  await byTestId('run-vtg').click();
+  assert.equal(await settled(), 'ready');
+  const entries = byTestId('job-entry');
+  assert.equal(await entries.count(), 2);
+  const first = await reportJson();
+  assert.equal(first.tolerance_mm, 0.05);
+  await entries.nth(1).locator('button', { hasText: 'Show' }).click();
+  assert.notEqual((await reportJson()).tolerance_mm, 0.05, 'the earlier result is shown again');
+  await byTestId('opt-vtg-tolerance').fill('');
+  assert.deepEqual(pageErrors, []);
+});
+
+test('results read as words: named metrics with units and explanations, tidy units, JSON and "More" collapsed', { timeout: JOB_TIMEOUT }, async () => {
+  await page.goto(baseUrl);
+  assert.equal(await settled(), 'ready');
+  assert.equal(await page.locator('#json-details').evaluate((d) => d.open), false, 'the report JSON starts collapsed');
+  assert.equal(await page.locator('#extra-details').evaluate((d) => d.open), false, '"More" starts collapsed');
+  await byTestId('run-vtg').click();
+  assert.equal(await settled(), 'ready');
+  const tables = await byTestId('paper-tables').textContent();
+  assert.doesNotMatch(tables, /\[object Object\]/);
+  assert.match(tables, /Vibration deviation, largest/);
+  assert.match(tables, /Path length L/);
+  // Every row of the before/after and paper tables: a name and a one-line explanation.
+  const rows = await page.locator('[data-testid="compare-table"] tbody th, [data-testid="paper-tables"] tbody th').evaluateAll((ths) => ths.map((th) => ({ name: th.firstChild?.textContent ?? '', explain: th.querySelector('small.explain')?.textContent ?? '' })));
+  assert.ok(rows.length > 10);
+  for (const r of rows) {
+    assert.doesNotMatch(r.name, /_/, `raw key as a name: ${r.name}`);
+    assert.ok(r.explain.length > 10 || /^Deviation/.test(r.name), `no explanation for ${r.name}`);
+  }
+  await page.locator('#extra-details').evaluate((d) => { d.open = true; });
+  const text = await page.locator('main').innerText();
+  assert.doesNotMatch(text, /\d kwh\b/, 'kWh spelled kwh');
+  assert.doesNotMatch(text, /\d c\b/, '°C spelled c');
+  assert.doesNotMatch(text, /−0\.0 %/, 'a signed zero change');
+  assert.doesNotMatch(text, /\b(l_total_mm|change pct|change_pct)\b/, 'raw keys');
+  assert.match(text, /°C/);
+  await page.locator('#extra-details').evaluate((d) => { d.open = false; });
+});
+
+test('per-layer charts: time, energy and filament; a click shows the layer; layer-time colours; the view refits per layer with a scale bar', { timeout: JOB_TIMEOUT }, async () => {
+  await page.goto(baseUrl);
+  assert.equal(await settled(), 'ready');
+  const report = await reportJson();
+  for (const id of ['chart-layer-time', 'chart-layer-energy', 'chart-layer-filament']) {
+    assert.equal(await byTestId(id).getAttribute('data-points'), String(report.layer_list.length), id);
+    assert.equal(await byTestId(id).locator('canvas').count(), 1, `${id} drawn`);
+  }
+  assert.match(await byTestId('layers-summary').textContent(), /the longest \d/);
+  await page.waitForFunction(() => document.querySelector('[data-testid="viewer"]').dataset.layer === '0');
+  // Click near the right end of the time chart: a late layer in the viewer.
+  const over = byTestId('chart-layer-time').locator('.u-over');
+  const box = await over.boundingBox();
+  await over.hover({ position: { x: box.width * 0.9, y: box.height / 2 } });
+  await over.click({ position: { x: box.width * 0.9, y: box.height / 2 } });
+  await page.waitForFunction(() => Number(document.querySelector('[data-testid="viewer"]').dataset.layer) > 0);
+  const layer = Number(await byTestId('viewer').getAttribute('data-layer'));
+  const n = report.layer_list.length;
+  assert.ok(layer > n * 0.7, `clicked at 90 % of ${n} layers, viewer shows layer ${layer}`);
+  assert.equal(await byTestId('layer-slider').inputValue(), String(layer));
+  // Layer-time colouring, with its legend.
+  await byTestId('color-by').selectOption('layer-time');
+  await page.waitForFunction(() => /s per layer/.test(document.querySelector('[data-testid="legend"]').textContent));
+  await byTestId('color-by').selectOption('feature');
+  // Refit per layer: the first and a late (smaller) layer get different scales; a scale bar.
+  const scaleAt = async (i) => {
+    await byTestId('layer-slider').evaluate((s, v) => {
+      s.value = String(v);
+      s.dispatchEvent(new Event('input', { bubbles: true }));
+    }, i);
+    await page.waitForFunction((v) => document.querySelector('[data-testid="viewer"]').dataset.layer === String(v), i);
+    await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    return Number(await byTestId('viewer').getAttribute('data-scale'));
+  };
+  const s0 = await scaleAt(0);
+  const sTop = await scaleAt(n - 1);
+  assert.notEqual(s0, sTop, 'the view refits to each layer');
+  assert.match(await byTestId('viewer').getAttribute('data-scale-bar'), /^\d+(\.\d+)? mm$/);
+});
+
+test('phone width (390 px): no sideways scroll, the picker and results fit', { timeout: JOB_TIMEOUT }, async () => {
+  const phone = await browser.newContext({ viewport: { width: 390, height: 844 }, deviceScaleFactor: 2, isMobile: true, hasTouch: true, serviceWorkers: 'block' });
+  const p = await phone.newPage();
+  p.setDefaultTimeout(STEP_TIMEOUT);
+  await p.goto(baseUrl);
+  assert.equal(await settled(p), 'ready');
+  await byTestId('run-vtg', p).click();
+  assert.equal(await settled(p), 'ready');
+  const wide = await p.evaluate(() => {
+    const out = [];
+    for (const e of document.querySelectorAll('body *')) {
+      const r = e.getBoundingClientRect();
+      if (r.width > 0 && r.right > innerWidth + 1 && !e.closest('.table-scroll, .json, details:not([open])')) out.push(`${e.tagName}.${e.className} ${Math.round(r.right)}`);
+    }
+    return { scroll: document.documentElement.scrollWidth, inner: innerWidth, out: out.slice(0, 8) };
+  });
+  assert.ok(wide.scroll <= wide.inner, `page scrolls sideways: ${wide.scroll} > ${wide.inner}: ${wide.out.join(', ')}`);
+  const shot = process.env.UPDATE_SCREENSHOT ? path.join(repoRoot, 'docs', 'screenshot-phone.png') : path.join(os.tmpdir(), 'playground-phone.png');
+  await p.evaluate(() => window.scrollTo(0, 0));
+  await p.screenshot({ path: shot, fullPage: false });
+  await phone.close();
+});
+
+test('no request leaves 127.0.0.1', () => {
+  const outside = requests.filter((u) => !u.startsWith(baseUrl) && !u.startsWith('blob:') && !u.startsWith('data:'));
+  assert.deepEqual(outside, []);
+});
