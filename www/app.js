@@ -662,7 +662,7 @@ const METRICS = {
   planned_time_s: ['Print time (planned)', 's', 'How long the printer takes, planned with its accelerations and cornering.'],
   energy_j: ['Energy', 'J', 'Electricity for the whole print: motors, heating the filament and the rest of the machine.'],
   total_j: ['Energy', 'J', 'Electricity for the whole print: motors, heating the filament and the rest of the machine.'],
-  thesis_j: ['Motor energy (stepper model)', 'J', "Energy the axis motors use, from the thesis's stepper model."],
+  thesis_j: ['Motor energy (stepper model)', 'J', 'Energy the axis motors use, from a measured stepper-motor model.'],
   servo_energy_j: ['Motor energy (servo model)', 'J', "Energy the axis motors of the VTG paper's servo printer use."],
   fuse_j: ['Melting energy', 'J', 'Heat that melts the filament.'],
   aux_j: ['Machine upkeep energy', 'J', 'Fans, electronics and keeping the bed and nozzle hot, over the print time.'],
@@ -733,10 +733,10 @@ function compareRows(result, job) {
     rows.unshift({ name: 'Print time (planned)', before: result.planned_time_before_s, after: result.planned_time_after_s, format: formatDuration });
   }
   if (isNum(result.max_tip_deviation_mm)) {
-    rows.push({ name: 'Tool-tip deviation (max)', before: 0, after: result.max_tip_deviation_mm, format: (v) => `${v.toFixed(4)} mm`, noChange: true });
+    rows.push({ name: 'Tool-tip deviation (max)', before: 0, after: result.max_tip_deviation_mm, format: (v) => `${v.toFixed(4)} mm`, noChange: true, explain: METRICS.max_tip_deviation_mm[2] });
   }
   if (job === 'vtg' && isNum(result.max_deviation_mm)) {
-    rows.push({ name: 'Deviation (max)', before: 0, after: result.max_deviation_mm, format: (v) => `${v.toFixed(4)} mm`, noChange: true });
+    rows.push({ name: 'Deviation (max)', before: 0, after: result.max_deviation_mm, format: (v) => `${v.toFixed(4)} mm`, noChange: true, explain: METRICS.max_deviation_mm[2] });
   }
   return rows;
 }
@@ -755,11 +755,11 @@ function vibrationCompare() {
   };
   const mm = (v) => `${v.toFixed(4)} mm`;
   return [
-    { name: 'Deviation (max)', before: b?.deviation_mm?.max, after: a?.deviation_mm?.max, format: mm },
-    { name: 'Deviation (mean)', before: b?.deviation_mm?.mean, after: a?.deviation_mm?.mean, format: mm },
-    { name: 'Mean layer amplitude', before: mean(b), after: mean(a), format: mm },
-    { name: 'Mean layer acceleration RMS', before: meanOf(b, 'acceleration_rms'), after: meanOf(a, 'acceleration_rms'), format: (v) => `${fmt2.format(v)} m/s²` },
-    { name: 'Strongest PSD peak', before: peak(b), after: peak(a), format: (v) => `${fmt1.format(v)} Hz`, noChange: true },
+    { name: 'Deviation (max)', before: b?.deviation_mm?.max, after: a?.deviation_mm?.max, format: mm, explain: 'Farthest vibration pushes the nozzle off its path.' },
+    { name: 'Deviation (mean)', before: b?.deviation_mm?.mean, after: a?.deviation_mm?.mean, format: mm, explain: 'How far vibration pushes the nozzle off its path, on average.' },
+    { name: 'Mean layer amplitude', before: mean(b), after: mean(a), format: mm, explain: 'Vibration amplitude of a layer, averaged over the layers.' },
+    { name: 'Mean layer acceleration RMS', before: meanOf(b, 'acceleration_rms'), after: meanOf(a, 'acceleration_rms'), format: (v) => `${fmt2.format(v)} m/s²`, explain: 'How hard the head shakes (root mean square acceleration), averaged over the layers.' },
+    { name: 'Strongest PSD peak', before: peak(b), after: peak(a), format: (v) => `${fmt1.format(v)} Hz`, noChange: true, explain: 'Frequency at which the machine shakes most (peak of the power spectrum).' },
   ].filter((r) => isNum(r.before) || isNum(r.after));
 }
 
@@ -1165,6 +1165,8 @@ function formatDuration(s) {
 function formatLength(mm) {
   if (!isNum(mm)) return '—';
   if (Math.abs(mm) >= 1000) return `${fmt2.format(mm / 1000)} m`;
+  // Small lengths (deviations, chord errors): three significant digits, not "0.0 mm".
+  if (mm !== 0 && Math.abs(mm) < 1) return Math.abs(mm) < 1e-4 ? '< 0.0001 mm' : `${Number(mm.toPrecision(3))} mm`;
   return `${fmt1.format(mm)} mm`;
 }
 
@@ -1374,7 +1376,11 @@ function formatByKey(key, v) {
     [/_g_cm3$/, 'g/cm³'], [/_mm3$/, 'mm³'], [/_mm2$/, 'mm²'], [/_kwh$/i, 'kWh'], [/_wh$/i, 'Wh'], [/_w$/i, 'W'], [/_c$/i, '°C'],
     [/_(pct|percent)$/, '%'], [/_hz$/, 'Hz'], [/_deg$/, '°'],
   ];
-  for (const [re, unit] of units) if (re.test(key)) return `${formatScalar(v)}${unit === '°' ? '' : ' '}${unit}`;
+  for (const [re, unit] of units) {
+    if (!re.test(key)) continue;
+    const n = Math.abs(v) >= 100 || Number.isInteger(v) ? formatScalar(v) : String(Number(v.toPrecision(3)));
+    return `${n}${unit === '°' ? '' : ' '}${unit}`;
+  }
   if (/_mm$/.test(key)) return formatLength(v);
   if (/_ms$/.test(key)) return formatMs(v);
   if (/_s$/.test(key)) return formatDuration(v);

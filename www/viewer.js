@@ -191,15 +191,45 @@ export class LayerViewer {
       { passive: false },
     );
     let drag = null;
+    // Two fingers: pinch to zoom about their midpoint (phones and tablets).
+    const touches = new Map();
+    let pinch = null;
+    const pinchState = () => {
+      const [a, b] = [...touches.values()];
+      const r = c.getBoundingClientRect();
+      return { d: Math.hypot(a.x - b.x, a.y - b.y) || 1, x: (a.x + b.x) / 2 - r.left, y: (a.y + b.y) / 2 - r.top };
+    };
     c.addEventListener('pointerdown', (e) => {
+      if (e.pointerType === 'touch') touches.set(e.pointerId, { x: e.clientX, y: e.clientY });
+      if (touches.size === 2 && this.view) {
+        const p = pinchState();
+        pinch = { ...p, scale: this.view.scale, world: this.locate(p.x, p.y) };
+        drag = null;
+        return;
+      }
       if (!this.view || e.button !== 0) return;
       drag = { x: e.clientX, y: e.clientY, cx: this.view.cx, cy: this.view.cy };
-      c.setPointerCapture(e.pointerId);
+      try {
+        c.setPointerCapture(e.pointerId);
+      } catch {
+        // a pointer the browser no longer tracks: drag without capture
+      }
       c.classList.add('dragging');
     });
     let hoverFrame = 0;
     let hoverAt = [0, 0];
     c.addEventListener('pointermove', (e) => {
+      if (touches.has(e.pointerId)) touches.set(e.pointerId, { x: e.clientX, y: e.clientY });
+      if (pinch && touches.size === 2) {
+        const p = pinchState();
+        const scale = Math.min(MAX_SCALE, Math.max(MIN_SCALE, (pinch.scale * p.d) / pinch.d));
+        const { pane, wx, wy } = pinch.world;
+        const h = c.clientHeight;
+        this.view = { scale, cx: wx - (p.x - pane.x - pane.w / 2) / scale, cy: wy + (p.y - h / 2) / scale };
+        this.userMoved = true;
+        this.requestDraw();
+        return;
+      }
       if (!drag) {
         // Readout of the segment under the cursor, at most once per frame.
         const r = c.getBoundingClientRect();
@@ -217,7 +247,9 @@ export class LayerViewer {
       this.view = { ...this.view, cx: drag.cx - (e.clientX - drag.x) / s, cy: drag.cy + (e.clientY - drag.y) / s };
       this.requestDraw();
     });
-    const end = () => {
+    const end = (e) => {
+      touches.delete(e?.pointerId);
+      if (touches.size < 2) pinch = null;
       if (!drag) return;
       drag = null;
       c.classList.remove('dragging');

@@ -307,6 +307,28 @@ test('phone width (390 px): no sideways scroll, the picker and results fit', { t
   await phone.close();
 });
 
+test('phones: two fingers pinch-zoom the layer view', async () => {
+  await page.goto(baseUrl);
+  assert.equal(await settled(), 'ready');
+  await page.waitForFunction(() => Number(document.querySelector('[data-testid="viewer"]').dataset.segments) > 0);
+  const before = Number(await byTestId('viewer').getAttribute('data-scale'));
+  await byTestId('viewer').evaluate((c) => {
+    const r = c.getBoundingClientRect();
+    const cx = r.left + r.width / 2;
+    const cy = r.top + r.height / 2;
+    const ev = (type, id, x) => c.dispatchEvent(new PointerEvent(type, { pointerId: id, pointerType: 'touch', isPrimary: id === 11, clientX: x, clientY: cy, bubbles: true }));
+    ev('pointerdown', 11, cx - 20);
+    ev('pointerdown', 12, cx + 20);
+    ev('pointermove', 11, cx - 60);
+    ev('pointermove', 12, cx + 60);
+    ev('pointerup', 11, cx - 60);
+    ev('pointerup', 12, cx + 60);
+  });
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  const after = Number(await byTestId('viewer').getAttribute('data-scale'));
+  assert.ok(Math.abs(after / before - 3) < 0.01, `pinch from 40 px to 120 px: scale ${before} → ${after}`);
+});
+
 test('no request leaves 127.0.0.1', () => {
   const outside = requests.filter((u) => !u.startsWith(baseUrl) && !u.startsWith('blob:') && !u.startsWith('data:'));
   assert.deepEqual(outside, []);
