@@ -19,7 +19,7 @@ setup-test:
 	@scripts/setup.sh test
 
 ## Build the npm package (pkg/: web, node and bundler builds under one package.json), link the
-## web build into the playground and copy uPlot beside it.
+## web build into the playground and copy uPlot and three.js (the 3-D view) beside it.
 pkg: setup
 	wasm-pack build crate --release --target web --out-dir ../pkg/web --out-name quietpath
 	wasm-pack build crate --release --target nodejs --out-dir ../pkg/node --out-name quietpath
@@ -28,6 +28,7 @@ pkg: setup
 	ln -sfn ../pkg/web www/pkg
 	mkdir -p www/vendor
 	cp node_modules/uplot/dist/uPlot.esm.js node_modules/uplot/dist/uPlot.min.css www/vendor/
+	cp node_modules/three/build/three.module.js node_modules/three/build/three.core.js www/vendor/
 
 ## Build the wasm and serve the playground on http://127.0.0.1:$(PORT)
 serve: pkg

@@ -564,6 +564,7 @@ function showJobResult(job, result, outBytes, target, { fromList = false } = {})
     if (els.viewMode.value !== 'before') els.viewMode.value = 'before';
     viewer.set('mode', els.viewMode.value);
     refreshLayers();
+    refresh3d();
   }
   if (outBytes && !keptOriginal) {
     output = { job, bytes: outBytes };
@@ -575,6 +576,7 @@ function showJobResult(job, result, outBytes, target, { fromList = false } = {})
     if (els.viewMode.value === 'before') els.viewMode.value = 'side';
     viewer.set('mode', els.viewMode.value);
     refreshLayers();
+    refresh3d();
   }
   if (job === 'vibration') {
     vibrationRuns[target] = result;
@@ -985,6 +987,102 @@ async function showLayerAt(i, z) {
   }
 }
 
+// ── 3-D view ───────────────────────────────────────────────────────────────
+
+const viewKind = $('view-kind');
+const canvas3d = $('view-3d');
+const range3d = $('range-3d');
+const layerFrom = $('layer-from');
+const layerTo = $('layer-to');
+const MAX_3D_SEGMENTS = 1_500_000;
+let partView = null; // view3d.js's PartView, made the first time the 3-D view is shown
+const part3d = new Map(); // `${fileToken}:${which}` → (index → geometry), of the current file only
+let part3dRun = 0;
+
+/** Layers from..to (0-based) of `which`, every `stride`-th, fetched once per file. */
+async function partLayers(which, from, to, stride, run) {
+  const key = `${fileToken}:${which}`;
+  for (const k of part3d.keys()) if (!k.startsWith(`${fileToken}:`)) part3d.delete(k);
+  if (!part3d.has(key)) part3d.set(key, new Map());
+  const cache = part3d.get(key);
+  const out = [];
+  for (let i = from; i <= to; i += stride) {
+    if (run !== part3dRun) return null;
+    let g = cache.get(i);
+    if (!g) {
+      g = await client.layer(which, i);
+      cache.set(i, g);
+    }
+    if (g.index !== i) break; // past the last layer of this file
+    out.push({ ...g, time: layerTimeAt(g.z) });
+  }
+  return out;
+}
+
+/** Draws the chosen layer range in 3-D: "after" over a grey "before" when there is an output. */
+async function refresh3d(refit = false) {
+  if (viewKind.value !== '3d' || !loaded) return;
+  const run = ++part3dRun;
+  try {
+    if (!partView) {
+      const { PartView } = await import('./view3d.js');
+      partView = new PartView(canvas3d);
+    }
+    const first = await client.layer('before', 0);
+    const count = first.count;
+    layerFrom.max = layerTo.max = String(count);
+    if (!layerTo.value || Number(layerTo.value) > count) layerTo.value = String(count);
+    const from = Math.max(0, Math.min(count - 1, Math.round(Number(layerFrom.value) || 1) - 1));
+    const to = Math.max(from, Math.min(count - 1, Math.round(Number(layerTo.value) || count) - 1));
+    // Thin out the layers of a big file so the view stays quick (every k-th layer).
+    const share = (to - from + 1) / Math.max(1, count);
+    const stride = Math.max(1, Math.ceil(((loaded.report.moves ?? 0) * share) / MAX_3D_SEGMENTS));
+    els.layerInfo.textContent = 'reading the layers for the 3-D view…';
+    const mode = els.viewMode.value;
+    const which = output && mode !== 'before' ? 'after' : 'before';
+    const shown = await partLayers(which, from, to, stride, run);
+    const ghost = which === 'after' && (mode === 'side' || mode === 'overlay') ? await partLayers('before', from, to, stride, run) : null;
+    if (!shown || run !== part3dRun) return;
+    const range = viewer.colorBy === 'layer-time' ? { lo: viewer.layerTime?.lo ?? 0, hi: viewer.layerTime?.hi ?? 1 } : rangeOf(shown, viewer.colorBy);
+    partView.setLayers(shown, ghost, { colorBy: viewer.colorBy, showTravel: viewer.showTravel, range }, refit);
+    canvas3d.dataset.layers = String(shown.length);
+    els.layerInfo.textContent = `3-D: layers ${from + 1}–${to + 1}${stride > 1 ? ` (every ${stride}th, to stay quick)` : ''} of the ${which === 'after' ? 'optimized output' : 'file'} · ${formatCount(Number(canvas3d.dataset.segments))} segments`;
+  } catch (err) {
+    if (!(err instanceof Cancelled)) els.layerInfo.textContent = `Cannot draw the 3-D view: ${err.message}`;
+  }
+}
+
+/** Colour range of speed or curvature over the layers (curvature clipped at its 95th percentile). */
+function rangeOf(layers, key) {
+  if (key !== 'speed' && key !== 'curvature') return null;
+  const values = [];
+  for (const g of layers) {
+    const a = g[key];
+    const step = Math.max(1, Math.floor(a.length / 500));
+    for (let i = 0; i < a.length; i += step) if (g.kind[i] !== 0 && Number.isFinite(a[i])) values.push(a[i]);
+  }
+  if (!values.length) return { lo: 0, hi: 1 };
+  values.sort((p, q) => p - q);
+  const lo = key === 'speed' ? values[0] : 0;
+  const hi = key === 'speed' ? values[values.length - 1] : values[Math.floor(0.95 * (values.length - 1))];
+  return { lo, hi: hi > lo ? hi : lo + 1 };
+}
+
+function setViewKind(kind) {
+  const three = kind === '3d';
+  els.canvas.hidden = three;
+  canvas3d.hidden = !three;
+  range3d.hidden = !three;
+  els.layerSlider.disabled = three;
+  els.fit.disabled = three;
+  if (three) refresh3d(true);
+  else refreshLayers();
+}
+
+viewKind.addEventListener('change', () => setViewKind(viewKind.value));
+layerFrom.addEventListener('change', () => refresh3d(true));
+layerTo.addEventListener('change', () => refresh3d(true));
+
 // ── Layer viewer ───────────────────────────────────────────────────────────
 
 const hoverInfo = $('hover-info');
@@ -1071,7 +1169,10 @@ function resetViewer() {
   // The slider's max is unknown until the first layer arrives: allow the wish.
   els.layerSlider.max = String(Math.max(Number.isInteger(wanted) ? wanted : 0, loaded?.report?.layers ?? 1));
   els.layerSlider.value = String(Number.isInteger(wanted) && wanted >= 0 ? wanted : 0);
+  layerFrom.value = '1';
+  layerTo.value = '';
   refreshLayers();
+  refresh3d(true);
 }
 
 // ── URL hash state (never the file) ────────────────────────────────────────
@@ -1566,14 +1667,17 @@ els.layerSlider.addEventListener('input', () => {
 });
 els.colorBy.addEventListener('change', () => {
   viewer.set('colorBy', els.colorBy.value);
+  refresh3d();
   writeHash();
 });
 els.showTravel.addEventListener('change', () => {
   viewer.set('showTravel', els.showTravel.checked);
+  refresh3d();
   writeHash();
 });
 els.viewMode.addEventListener('change', () => {
   viewer.set('mode', els.viewMode.value);
+  refresh3d();
   writeHash();
 });
 els.fit.addEventListener('click', () => viewer.fit());

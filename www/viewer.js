@@ -11,10 +11,10 @@
 
 /** Feature kinds of LayerGeometry.kind (see crate/src/wasm/types.d.ts). */
 export const KINDS = ['travel', 'outer wall', 'inner wall', 'sparse infill', 'solid infill', 'bridge', 'gap fill', 'support', 'adhesion', 'other'];
-const KIND_COLORS = ['#9aa4a0', '#e4572e', '#f3a712', '#2e86ab', '#5a4fcf', '#29bf12', '#a23b72', '#8d6a9f', '#6c8ead', '#7f7f7f'];
+export const KIND_COLORS = ['#9aa4a0', '#e4572e', '#f3a712', '#2e86ab', '#5a4fcf', '#29bf12', '#a23b72', '#8d6a9f', '#6c8ead', '#7f7f7f'];
 
 // A perceptually ordered ramp (viridis-like) for speed and curvature.
-const RAMP = ['#440154', '#482878', '#3e4a89', '#31688e', '#26828e', '#1f9e89', '#35b779', '#6ece58', '#b5de2b', '#fde725'];
+export const RAMP = ['#440154', '#482878', '#3e4a89', '#31688e', '#26828e', '#1f9e89', '#35b779', '#6ece58', '#b5de2b', '#fde725'];
 const BUCKETS = RAMP.length;
 
 const MIN_SCALE = 1e-3;

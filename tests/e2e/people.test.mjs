@@ -329,6 +329,69 @@ test('phones: two fingers pinch-zoom the layer view', async () => {
   assert.ok(Math.abs(after / before - 3) < 0.01, `pinch from 40 px to 120 px: scale ${before} → ${after}`);
 });
 
+// Pixels of the 3-D canvas that differ from its background colour (the WebGL picture).
+async function inked3d(p = page, hash = false) {
+  return p.evaluate((hash) => {
+    const c = document.querySelector('[data-testid="view-3d"]');
+    const t = document.createElement('canvas');
+    t.width = c.width;
+    t.height = c.height;
+    const ctx = t.getContext('2d');
+    ctx.drawImage(c, 0, 0);
+    const d = ctx.getImageData(0, 0, t.width, t.height).data;
+    const bg = [d[0], d[1], d[2]];
+    let n = 0;
+    let h = 0;
+    for (let i = 0; i < d.length; i += 4) {
+      if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 30) {
+        n++;
+        h = (h * 31 + i) | 0;
+      }
+    }
+    return hash ? h : n;
+  }, hash);
+}
+
+test('3-D view: the demo drawn with WebGL, a layer range, orbit, the 5-axis file', { timeout: JOB_TIMEOUT }, async () => {
+  await page.goto(baseUrl);
+  assert.equal(await settled(), 'ready');
+  assert.equal(await byTestId('view-3d').isVisible(), false, 'the 2-D view by default');
+  await byTestId('view-kind').selectOption('3d');
+  await page.waitForFunction(() => Number(document.querySelector('[data-testid="view-3d"]').dataset.segments) > 0, null, { timeout: JOB_TIMEOUT });
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  assert.equal(await byTestId('view-3d').isVisible(), true);
+  assert.equal(await byTestId('viewer').isVisible(), false);
+  const report = await reportJson();
+  assert.equal(await byTestId('view-3d').getAttribute('data-layers'), String(report.layers), 'every layer of the demo');
+  const whole = Number(await byTestId('view-3d').getAttribute('data-segments'));
+  const ink = await inked3d();
+  assert.ok(ink > 2000, `the WebGL canvas is drawn: ${ink} pixels`);
+  // A layer range: fewer segments.
+  await byTestId('layer-from').fill('10');
+  await byTestId('layer-from').dispatchEvent('change');
+  await byTestId('layer-to').fill('12');
+  await byTestId('layer-to').dispatchEvent('change');
+  await page.waitForFunction(() => document.querySelector('[data-testid="view-3d"]').dataset.layers === '3');
+  assert.ok(Number(await byTestId('view-3d').getAttribute('data-segments')) < whole / 3);
+  // Orbit by dragging: the picture changes.
+  await byTestId('view-3d').scrollIntoViewIfNeeded();
+  const before = await inked3d(page, true);
+  const box = await byTestId('view-3d').boundingBox();
+  await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+  await page.mouse.down();
+  await page.mouse.move(box.x + box.width / 2 + 120, box.y + box.height / 2 + 40, { steps: 5 });
+  await page.mouse.up();
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  assert.notEqual(await inked3d(page, true), before, 'orbiting redraws the part');
+  // The 5-axis corpus file draws too.
+  assert.equal(await loadFile(path.join(corpusDir, 'multiaxis-xyzbc_zhang-ral2021_model1.gcode')), 'ready');
+  await page.waitForFunction(() => Number(document.querySelector('[data-testid="view-3d"]').dataset.segments) > 0 && document.querySelector('[data-testid="view-3d"]').dataset.layers !== '3', null, { timeout: JOB_TIMEOUT });
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  assert.ok((await inked3d()) > 500, '5-axis file drawn in 3-D');
+  await byTestId('view-kind').selectOption('2d');
+  assert.deepEqual(pageErrors, []);
+});
+
 test('no request leaves 127.0.0.1', () => {
   const outside = requests.filter((u) => !u.startsWith(baseUrl) && !u.startsWith('blob:') && !u.startsWith('data:'));
   assert.deepEqual(outside, []);

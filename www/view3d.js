@@ -1,0 +1,222 @@
+// 3-D view of the whole part (or a layer range): every layer's toolpath (Session.layer
+// geometry) stacked at its height, drawn with three.js (vendored by `make pkg` into
+// www/vendor/ from npm, so the page still makes no outside request). Loaded on demand by
+// app.js (dynamic import) the first time the 3-D view is picked: the 2-D page never pays for it.
+//
+// Orbit by dragging, pan with the right button (or Shift+drag), zoom with the wheel, two
+// fingers pinch to zoom and drag to orbit. Colours are those of the 2-D viewer (feature,
+// speed, curvature, layer time); travels on demand; "after" over a grey "before".
+
+import * as THREE from './vendor/three.module.js';
+import { KINDS, KIND_COLORS, RAMP } from './viewer.js';
+
+const GHOST = new THREE.Color('#9aa4a0');
+const TRAVEL = new THREE.Color('#8c9692');
+
+export class PartView {
+  /** @param {HTMLCanvasElement} canvas */
+  constructor(canvas) {
+    this.canvas = canvas;
+    // preserveDrawingBuffer: the picture can be read back (tests, screenshots).
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+    this.renderer.setPixelRatio(window.devicePixelRatio || 1);
+    this.scene = new THREE.Scene();
+    this.camera = new THREE.PerspectiveCamera(40, 1, 0.1, 100000);
+    this.camera.up.set(0, 0, 1);
+    this.orbit = { theta: -Math.PI / 3, phi: Math.PI / 3.2, radius: 200, target: new THREE.Vector3() };
+    this.objects = [];
+    this.frame = 0;
+    this.installInput();
+    this.resizeObserver = new ResizeObserver(() => this.resize());
+    this.resizeObserver.observe(canvas);
+    this.resize();
+  }
+
+  /**
+   * Draws layers: `layers` [{ z, xy, kind, speed, curvature, time }] of the shown file,
+   * `ghost` the same of the other one (drawn grey) or null; `opts` { colorBy, showTravel,
+   * range: { lo, hi } for speed/curvature/layer time }. Keeps the camera unless `refit`.
+   */
+  setLayers(layers, ghost, opts, refit) {
+    for (const o of this.objects) {
+      this.scene.remove(o);
+      o.geometry.dispose();
+      o.material.dispose();
+    }
+    this.objects = [];
+    let segments = 0;
+    const box = new THREE.Box3();
+    const add = (list, isGhost) => {
+      const lines = build(list, isGhost, opts);
+      if (!lines) return;
+      segments += lines.geometry.getAttribute('position').count / 2;
+      lines.geometry.computeBoundingBox();
+      box.union(lines.geometry.boundingBox);
+      this.scene.add(lines);
+      this.objects.push(lines);
+    };
+    if (ghost) add(ghost, true);
+    add(layers, false);
+    this.canvas.dataset.segments = String(segments);
+    if ((refit || !this.fitted) && !box.isEmpty()) this.fit(box);
+    this.requestDraw();
+  }
+
+  fit(box) {
+    const size = box.getSize(new THREE.Vector3());
+    box.getCenter(this.orbit.target);
+    this.orbit.radius = Math.max(size.x, size.y, size.z, 1) * 1.6;
+    this.fitted = true;
+    this.requestDraw();
+  }
+
+  resize() {
+    const w = Math.max(1, this.canvas.clientWidth);
+    const h = Math.max(1, this.canvas.clientHeight);
+    this.renderer.setSize(w, h, false);
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+    this.draw();
+  }
+
+  requestDraw() {
+    if (this.frame) return;
+    this.frame = requestAnimationFrame(() => {
+      this.frame = 0;
+      this.draw();
+    });
+  }
+
+  draw() {
+    const { theta, phi, radius, target } = this.orbit;
+    this.camera.position.set(
+      target.x + radius * Math.sin(phi) * Math.cos(theta),
+      target.y + radius * Math.sin(phi) * Math.sin(theta),
+      target.z + radius * Math.cos(phi),
+    );
+    this.camera.near = Math.max(0.01, radius / 1000);
+    this.camera.far = radius * 20;
+    this.camera.updateProjectionMatrix();
+    this.camera.lookAt(target);
+    this.renderer.setClearColor(getComputedStyle(this.canvas).backgroundColor || '#f4f6f5', 1);
+    this.renderer.render(this.scene, this.camera);
+  }
+
+  installInput() {
+    const c = this.canvas;
+    const pointers = new Map();
+    let last = null;
+    const orbitBy = (dx, dy) => {
+      this.orbit.theta -= dx * 0.008;
+      this.orbit.phi = Math.min(Math.PI - 0.05, Math.max(0.05, this.orbit.phi - dy * 0.008));
+    };
+    const panBy = (dx, dy) => {
+      const scale = this.orbit.radius / c.clientHeight;
+      const right = new THREE.Vector3().setFromMatrixColumn(this.camera.matrixWorld, 0);
+      const up = new THREE.Vector3().setFromMatrixColumn(this.camera.matrixWorld, 1);
+      this.orbit.target.addScaledVector(right, -dx * scale).addScaledVector(up, dy * scale);
+    };
+    const zoom = (factor) => {
+      this.orbit.radius = Math.min(1e5, Math.max(0.5, this.orbit.radius * factor));
+    };
+    c.addEventListener('pointerdown', (e) => {
+      pointers.set(e.pointerId, { x: e.clientX, y: e.clientY });
+      last = { x: e.clientX, y: e.clientY, pan: e.button === 2 || e.shiftKey, d: null };
+      try {
+        c.setPointerCapture(e.pointerId);
+      } catch {
+        // not a tracked pointer: no capture
+      }
+    });
+    c.addEventListener('pointermove', (e) => {
+      if (!pointers.has(e.pointerId) || !last) return;
+      pointers.set(e.pointerId, { x: e.clientX, y: e.clientY });
+      if (pointers.size === 2) {
+        const [a, b] = [...pointers.values()];
+        const d = Math.hypot(a.x - b.x, a.y - b.y);
+        if (last.d) zoom(last.d / d);
+        last.d = d;
+      } else {
+        const dx = e.clientX - last.x;
+        const dy = e.clientY - last.y;
+        if (last.pan) panBy(dx, dy);
+        else orbitBy(dx, dy);
+        last.x = e.clientX;
+        last.y = e.clientY;
+      }
+      this.requestDraw();
+    });
+    const end = (e) => {
+      pointers.delete(e.pointerId);
+      if (pointers.size === 0) last = null;
+      else if (last) last.d = null;
+    };
+    c.addEventListener('pointerup', end);
+    c.addEventListener('pointercancel', end);
+    c.addEventListener('contextmenu', (e) => e.preventDefault());
+    c.addEventListener(
+      'wheel',
+      (e) => {
+        e.preventDefault();
+        zoom(Math.exp(e.deltaY * (e.deltaMode === 1 ? 0.05 : 0.0015)));
+        this.requestDraw();
+      },
+      { passive: false },
+    );
+    c.addEventListener('keydown', (e) => {
+      const keys = { ArrowLeft: [-20, 0], ArrowRight: [20, 0], ArrowUp: [0, -20], ArrowDown: [0, 20] };
+      if (keys[e.key]) orbitBy(...keys[e.key]);
+      else if (e.key === '+' || e.key === '=') zoom(0.8);
+      else if (e.key === '-') zoom(1.25);
+      else return;
+      e.preventDefault();
+      this.requestDraw();
+    });
+  }
+
+  dispose() {
+    this.resizeObserver.disconnect();
+    this.renderer.dispose();
+  }
+}
+
+/** One LineSegments of every segment of `list`, coloured per vertex. */
+function build(list, ghost, { colorBy, showTravel, range }) {
+  let n = 0;
+  for (const g of list) for (const k of g.kind) if (k !== 0 || (showTravel && !ghost)) n++;
+  if (n === 0) return null;
+  const pos = new Float32Array(n * 6);
+  const col = new Float32Array(n * 6);
+  const kindColors = KIND_COLORS.map((c) => new THREE.Color(c));
+  const ramp = RAMP.map((c) => new THREE.Color(c));
+  const rampAt = (v) => {
+    if (!range || !Number.isFinite(v)) return ramp[0];
+    const t = (v - range.lo) / (range.hi - range.lo || 1);
+    return ramp[Math.min(ramp.length - 1, Math.max(0, Math.floor(t * ramp.length)))];
+  };
+  let j = 0;
+  for (const g of list) {
+    const z = Number.isFinite(g.z) ? g.z : 0;
+    const { xy, kind } = g;
+    for (let i = 0; i < kind.length; i++) {
+      const travel = kind[i] === 0;
+      if (travel && !(showTravel && !ghost)) continue;
+      let c;
+      if (ghost) c = GHOST;
+      else if (travel) c = TRAVEL;
+      else if (colorBy === 'speed') c = rampAt(g.speed[i]);
+      else if (colorBy === 'curvature') c = rampAt(g.curvature[i]);
+      else if (colorBy === 'layer-time') c = rampAt(g.time);
+      else c = kindColors[kind[i]] ?? kindColors[KINDS.length - 1];
+      const o = 4 * i;
+      pos.set([xy[o], xy[o + 1], z, xy[o + 2], xy[o + 3], z], j * 6);
+      col.set([c.r, c.g, c.b, c.r, c.g, c.b], j * 6);
+      j++;
+    }
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+  geometry.setAttribute('color', new THREE.BufferAttribute(col, 3));
+  const material = new THREE.LineBasicMaterial({ vertexColors: true, transparent: ghost, opacity: ghost ? 0.35 : 1 });
+  return new THREE.LineSegments(geometry, material);
+}
