@@ -72,6 +72,7 @@ const LAYER_CACHE = 32;
 const KNOWN_FIELDS = new Set([
   'time_s', 'moves', 'layers', 'distance_mm', 'filament_mm', 'material_g',
   'warnings', 'file', 'extrusion', 'features', 'bounds',
+  'machine', 'layer_list', 'version', // the limits table, the per-layer charts, the footer
 ]);
 
 // ── State ──────────────────────────────────────────────────────────────────
@@ -202,7 +203,7 @@ const LIMIT_SOURCES = {
   slicer_settings: "the slicer's settings in the file",
   printer_config: 'your printer.cfg',
   machine_settings: 'your M503 settings',
-  command: 'a command in the file (M201, M203, M204, M205, SET_VELOCITY_LIMIT…)',
+  command: 'a command in the file (M201…, SET_VELOCITY_LIMIT)',
   option: 'an option of this page',
 };
 const LIMIT_NAMES = {
@@ -616,9 +617,14 @@ function renderJobList(activeId) {
         showJobResult(e.job, e.result, null, e.target, { fromList: true });
         renderJobList(e.id);
       });
-      const save = el('button', { type: 'button', class: 'button small', text: 'Download G-code', 'data-testid': 'job-download' });
+      // A file slower or dearer than the original is offered only marked as such.
+      const worse = [
+        ['slower', r.after?.time_s, r.before?.time_s],
+        ['uses more energy', r.after?.energy?.total_j, r.before?.energy?.total_j],
+      ].filter(([, a, b]) => isNum(a) && isNum(b) && a > b * 1.0005).map(([w]) => w);
+      const save = el('button', { type: 'button', class: worse.length ? 'button small worse' : 'button small', text: worse.length ? `Download (${worse.join(', ')})` : 'Download G-code', 'data-testid': 'job-download' });
       save.disabled = !e.bytes;
-      save.title = e.bytes ? 'The file this job wrote' : 'This job wrote no better file: keep your original';
+      save.title = !e.bytes ? 'This job wrote no better file: keep your original' : worse.length ? `This file is ${worse.join(' and ')} than your original` : 'The file this job wrote';
       save.addEventListener('click', () => e.bytes && saveBlob(`gcode-${e.id}`, new Blob([e.bytes], { type: 'text/plain' }), `${baseName(e.file)}.${e.job}-${e.id}.gcode`));
       return el(
         'li',
@@ -680,6 +686,14 @@ const METRICS = {
   n_corners: ['Corners', '', 'Every change of direction along the path.'],
   mean_turn_deg: ['Mean turning angle', '°', 'Average change of direction at a corner; smaller is smoother.'],
   mean_chord_error_mm: ['Mean chord error', 'mm', 'Average gap between the straight pieces and the smooth curve through them.'],
+  co2: ['CO₂', 'g', ''],
+  aux: ['Machine upkeep', 'J', ''],
+  fuse: ['Melting the filament', 'J', ''],
+  thesis: ['Stepper motor model', '', ''],
+  grid_kg_per_kwh: ['Grid carbon intensity', 'kg/kWh', 'CO₂ per kWh of the electricity.'],
+  material_kg_per_kg: ['Material carbon intensity', 'kg/kg', 'CO₂ of making a kilogram of the filament.'],
+  print_temp_c: ['Nozzle temperature', '°C', ''],
+  ambient_c: ['Room temperature', '°C', ''],
   max_mm: ['largest', 'mm', ''],
   min_mm: ['smallest', 'mm', ''],
   mean_mm: ['mean', 'mm', ''],
@@ -1373,7 +1387,7 @@ function renderLimits(r) {
       const list = Array.isArray(v) ? v : [v];
       const value = `${list.map((l) => formatScalar(l?.value)).join(' / ')}${unit ? ` ${unit}` : ''}`;
       const from = [...new Set(list.map(source))].join('; ');
-      return el('tr', { 'data-limit': k }, el('th', { scope: 'row', text: name }), el('td', { class: 'num', text: value }), el('td', { text: from }));
+      return el('tr', { 'data-limit': k }, el('th', { scope: 'row', text: name }), el('td', {}, value, el('small', { class: 'explain', text: `from ${from}` })));
     });
   box.querySelector('tbody').replaceChildren(...rows);
   const fromFile = fileLimitCount(r);
@@ -1473,6 +1487,7 @@ function formatByKey(key, v) {
   if (!isNum(v)) return formatScalar(v);
   // Compound units first: `_mm_s` is a speed, not a duration.
   const units = [
+    [/_kg_per_kwh$/, 'kg/kWh'], [/_kg_per_kg$/, 'kg/kg'],
     [/_mm_s3$/, 'mm/s³'], [/_mm_s2$/, 'mm/s²'], [/_mm_s$/, 'mm/s'], [/_m_s2$/, 'm/s²'], [/_per_mm_deg$/, '°/mm'], [/_per_mm$/, '/mm'],
     [/_g_cm3$/, 'g/cm³'], [/_mm3$/, 'mm³'], [/_mm2$/, 'mm²'], [/_kwh$/i, 'kWh'], [/_wh$/i, 'Wh'], [/_w$/i, 'W'], [/_c$/i, '°C'],
     [/_(pct|percent)$/, '%'], [/_hz$/, 'Hz'], [/_deg$/, '°'],
@@ -1505,7 +1520,15 @@ function renderValue(v, depth = 0, key = '') {
   return el(
     'table',
     { class: 'kv nested' },
-    el('tbody', {}, ...entries.map(([k, x]) => el('tr', {}, el('th', { scope: 'row', text: metricInfo(k)[0], title: k }), el('td', {}, renderValue(x, depth + 1, k))))),
+    el(
+      'tbody',
+      {},
+      ...entries.map(([k, x]) => {
+        // Inside "co2", grams are CO₂ grams: "CO₂ of the energy", not "Energy".
+        const name = key === 'co2' && /_g$/.test(k) ? `CO₂ of the ${k.replace(/_g$/, '').replaceAll('_', ' ')}` : metricInfo(k)[0];
+        return el('tr', {}, el('th', { scope: 'row', text: name, title: k }), el('td', {}, renderValue(x, depth + 1, k)));
+      }),
+    ),
   );
 }
 
