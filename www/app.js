@@ -126,10 +126,19 @@ const runState = document.querySelector('.run-state');
 const runStateHome = runState.parentElement;
 const runStateNext = runState.nextElementSibling;
 
+// Scrolled away from the running job's form, the progress floats at the bottom of the window.
+const runFormObserver = new IntersectionObserver((entries) => {
+  for (const e of entries) runState.classList.toggle('floating', runState.classList.contains('in-job') && !e.isIntersecting);
+});
+
 function placeRunState(form) {
   for (const f of els.actionForms) f.classList.toggle('running', f === form);
-  if (form) form.querySelector('button[type="submit"]').after(runState);
-  else runStateHome.insertBefore(runState, runStateNext);
+  runFormObserver.disconnect();
+  runState.classList.remove('floating');
+  if (form) {
+    form.querySelector('button[type="submit"]').after(runState);
+    runFormObserver.observe(form);
+  } else runStateHome.insertBefore(runState, runStateNext);
   runState.classList.toggle('in-job', !!form);
 }
 

@@ -200,6 +200,14 @@ test('a running job shows its progress and Cancel beside it, in view; every resu
     return document.body.classList.contains('busy') ? r.top >= 0 && r.bottom <= innerHeight : true;
   });
   assert.ok(stillInView, 'Cancel scrolled out of view while the job runs');
+  // Far away (the top of the page), it floats at the bottom of the window.
+  await page.evaluate(() => window.scrollTo(0, 0));
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  const floating = await page.evaluate(() => {
+    const r = document.querySelector('[data-testid="cancel"]').getBoundingClientRect();
+    return document.body.classList.contains('busy') ? r.top >= 0 && r.bottom <= innerHeight : true;
+  });
+  assert.ok(floating, 'Cancel out of view at the top of the page while the job runs');
   assert.equal(await settled(), 'ready');
   assert.equal(await page.locator('#form-vtg [data-testid="cancel"]').count(), 0, 'the progress goes back under the file picker');
   // A second job: both results are listed, the first still there.
