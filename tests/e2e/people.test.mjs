@@ -311,7 +311,8 @@ test('phone width (390 px): no sideways scroll, the picker and results fit', { t
   assert.ok(wide.scroll <= wide.inner, `page scrolls sideways: ${wide.scroll} > ${wide.inner}: ${wide.out.join(', ')}`);
   const shot = process.env.UPDATE_SCREENSHOT ? path.join(repoRoot, 'docs', 'screenshot-phone.png') : path.join(os.tmpdir(), 'playground-phone.png');
   await p.evaluate(() => window.scrollTo(0, 0));
-  await p.screenshot({ path: shot, fullPage: false });
+  await p.screenshot({ path: shot, fullPage: true, clip: { x: 0, y: 0, width: 390, height: 1690 } });
+  assert.ok(fs.statSync(shot).size > 30_000, 'phone screenshot is suspiciously small');
   await phone.close();
 });
 
