@@ -326,6 +326,34 @@ function notGcode(bytes) {
   return null;
 }
 
+// The printer bed's outline, [[x, y], …] in mm, from the slicer's settings in the file
+// (PrusaSlicer/SuperSlicer `; bed_shape = 0x0,180x0,…`, Orca/Creality `; printable_area = …`) or
+// an uploaded Klipper printer.cfg ([stepper_x]/[stepper_y] position_min/max); null if unknown.
+function bedShape(bytes) {
+  const text = (a, b) => new TextDecoder('latin1').decode(new Uint8Array(bytes, a, b - a));
+  const n = bytes.byteLength;
+  const parts = [text(Math.max(0, n - 262144), n), text(0, Math.min(n, 65536))];
+  for (const t of parts) {
+    const m = /^;\s*(?:bed_shape|printable_area)\s*=\s*([-\d.]+x[-\d.]+(?:\s*,\s*[-\d.]+x[-\d.]+){2,})\s*$/m.exec(t);
+    if (m) {
+      const pts = m[1].split(',').map((p) => p.trim().split('x').map(Number));
+      if (pts.every((p) => p.length === 2 && p.every(Number.isFinite))) return pts;
+    }
+  }
+  if (machineChoice === 'upload' && printerSettings?.key === 'klipper_config') {
+    const axis = (a) => {
+      const sec = new RegExp(`^\\[stepper_${a}\\]([\\s\\S]*?)(?=^\\[|$(?![\\s\\S]))`, 'm').exec(printerSettings.text)?.[1] ?? '';
+      const get = (k) => Number(new RegExp(`^\\s*${k}\\s*[:=]\\s*([-\\d.]+)`, 'm').exec(sec)?.[1]);
+      const lo = Number.isFinite(get('position_min')) ? get('position_min') : 0;
+      return [lo, get('position_max')];
+    };
+    const [x0, x1] = axis('x');
+    const [y0, y1] = axis('y');
+    if ([x0, x1, y0, y1].every(Number.isFinite) && x1 > x0 && y1 > y0) return [[x0, y0], [x1, y0], [x1, y1], [x0, y1]];
+  }
+  return null;
+}
+
 // A report with no move at all, on a file whose lines do not read as G-code: the reason, or null.
 function noGcodeIn(report) {
   if (!report || report.moves > 0) return null;
@@ -373,6 +401,7 @@ async function run(source) {
   loaded = null;
   resetOptimized();
   try {
+    const bed = bedShape(bytes); // before the bytes go to the worker
     const msg = await client.load(bytes, source.name, options, onProgress);
     if (current !== run) return;
     const notG = noGcodeIn(plain(msg.report));
@@ -383,6 +412,7 @@ async function run(source) {
       return;
     }
     loaded = { name: source.name, report: msg.report };
+    viewer.bed = bed;
     renderMachinePicker();
     showReport(msg.report, source.name, msg.ms);
     els.elapsed.dataset.totalMs = String(msg.totalMs);
@@ -1067,7 +1097,7 @@ async function refresh3d(refit = false) {
     const ghost = which === 'after' && (mode === 'side' || mode === 'overlay') ? await partLayers('before', from, to, stride, run) : null;
     if (!shown || run !== part3dRun) return;
     const range = viewer.colorBy === 'layer-time' ? { lo: viewer.layerTime?.lo ?? 0, hi: viewer.layerTime?.hi ?? 1 } : rangeOf(shown, viewer.colorBy);
-    partView.setLayers(shown, ghost, { colorBy: viewer.colorBy, showTravel: viewer.showTravel, range }, refit);
+    partView.setLayers(shown, ghost, { colorBy: viewer.colorBy, showTravel: viewer.showTravel, range, bed: viewer.bed }, refit);
     canvas3d.dataset.layers = String(shown.length);
     els.layerInfo.textContent = `3-D: layers ${from + 1}–${to + 1}${stride > 1 ? ` (every ${stride}th, to stay quick)` : ''} of the ${which === 'after' ? 'optimized output' : 'file'} · ${formatCount(Number(canvas3d.dataset.segments))} segments`;
   } catch (err) {

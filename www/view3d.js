@@ -57,6 +57,13 @@ export class PartView {
     };
     if (ghost) add(ghost, true);
     add(layers, false);
+    if (opts.bed?.length >= 3) {
+      // The bed at z = 0, as an outline.
+      const pts = opts.bed.map(([x, y]) => new THREE.Vector3(x, y, 0));
+      const bed = new THREE.LineLoop(new THREE.BufferGeometry().setFromPoints(pts), new THREE.LineBasicMaterial({ color: '#8c9692' }));
+      this.scene.add(bed);
+      this.objects.push(bed);
+    }
     this.canvas.dataset.segments = String(segments);
     if ((refit || !this.fitted) && !box.isEmpty()) this.fit(box);
     this.requestDraw();

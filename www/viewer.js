@@ -39,6 +39,7 @@ export class LayerViewer {
     this.view = null; // { cx, cy, scale } (scale: CSS px per mm)
     this.userMoved = false; // zoomed or panned since the last fit: keep that view across layers
     this.bounds = null; // the whole print's XY extent { minX, minY, maxX, maxY }, outlined
+    this.bed = null; // the printer bed's outline [[x, y], …] in mm, when the file or printer.cfg says
     this.layerTime = null; // 'layer-time' colouring: { before, after, lo, hi } in s
     this.frame = 0;
     this.installInput();
@@ -124,6 +125,15 @@ export class LayerViewer {
     const lo = Math.floor(0.01 * (sx.length - 1));
     const hi = Math.ceil(0.99 * (sx.length - 1));
     this.fitBox(sx[lo], sy[lo], sx[hi], sy[hi]);
+  }
+
+  /** The whole bed in view (B key), else the layer. */
+  fitBed() {
+    if (!(this.bed?.length >= 3)) return this.fit();
+    const xs = this.bed.map((p) => p[0]);
+    const ys = this.bed.map((p) => p[1]);
+    this.fitBox(Math.min(...xs), Math.min(...ys), Math.max(...xs), Math.max(...ys));
+    this.userMoved = true;
   }
 
   fitBox(minX, minY, maxX, maxY) {
@@ -271,6 +281,7 @@ export class LayerViewer {
       else if (e.key === '+' || e.key === '=') v.scale = Math.min(MAX_SCALE, v.scale * 1.25);
       else if (e.key === '-') v.scale = Math.max(MIN_SCALE, v.scale / 1.25);
       else if (e.key === '0') return this.fit();
+      else if (e.key === 'b' || e.key === 'B') return this.fitBed();
       else return;
       e.preventDefault();
       this.userMoved = true;
@@ -375,17 +386,36 @@ export class LayerViewer {
     if (this.view && (this.before || this.after)) this.drawScaleBar(canvas.clientHeight);
     canvas.dataset.segments = String(drawn);
     canvas.dataset.scale = this.view ? String(this.view.scale) : '';
+    if (this.bed?.length >= 3) {
+      const xs = this.bed.map((p) => p[0]);
+      const ys = this.bed.map((p) => p[1]);
+      canvas.dataset.bed = `${+(Math.max(...xs) - Math.min(...xs)).toFixed(1)} × ${+(Math.max(...ys) - Math.min(...ys)).toFixed(1)} mm`;
+    } else delete canvas.dataset.bed;
     this.renderLegend(range);
   }
 
   /** The whole print's XY extent as a dashed outline, so a layer is seen in its place. */
   drawBounds(pane, h) {
     const b = this.bounds;
-    if (!b || !this.view) return;
+    if (!this.view) return;
     const { ctx } = this;
     const { cx, cy, scale } = this.view;
     const ox = pane.x + pane.w / 2 - cx * scale;
     const oy = h / 2 + cy * scale;
+    if (this.bed?.length >= 3) {
+      // The bed: a solid outline and a faint fill.
+      ctx.save();
+      ctx.beginPath();
+      this.bed.forEach(([x, y], i) => (i ? ctx.lineTo(ox + x * scale, oy - y * scale) : ctx.moveTo(ox + x * scale, oy - y * scale)));
+      ctx.closePath();
+      ctx.fillStyle = 'rgba(128,128,128,0.06)';
+      ctx.fill();
+      ctx.strokeStyle = 'rgba(128,128,128,0.8)';
+      ctx.lineWidth = 1.5;
+      ctx.stroke();
+      ctx.restore();
+    }
+    if (!b) return;
     ctx.save();
     ctx.strokeStyle = 'rgba(128,128,128,0.55)';
     ctx.lineWidth = 1;
@@ -519,6 +549,8 @@ export class LayerViewer {
       items.push(li);
     }
     if (this.showTravel) items.push(swatch('#9aa4a0', 'travel', true));
+    if (this.bed?.length >= 3) items.push(swatch('rgba(128,128,128,0.8)', `bed ${this.canvas.dataset.bed ?? ''}`, true));
+    if (this.bounds) items.push(swatch('rgba(128,128,128,0.55)', 'the whole print', true));
     this.legend.replaceChildren(...items);
   }
 }

@@ -290,6 +290,14 @@ test('per-layer charts: time, energy and filament; a click shows the layer; laye
   const sTop = await scaleAt(n - 1);
   assert.notEqual(s0, sTop, 'the view refits to each layer');
   assert.match(await byTestId('viewer').getAttribute('data-scale-bar'), /^\d+(\.\d+)? mm$/);
+  // The bed from the slicer's settings in the file (the demo: bed_shape 250 × 210), outlined.
+  assert.equal(await byTestId('viewer').getAttribute('data-bed'), '250 × 210 mm');
+  assert.match(await byTestId('legend').textContent(), /bed 250 × 210 mm/);
+  // B shows the whole bed: a smaller scale than the top layer's fit.
+  await byTestId('viewer').focus();
+  await page.keyboard.press('b');
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  assert.ok(Number(await byTestId('viewer').getAttribute('data-scale')) < sTop, 'B zooms out to the bed');
 });
 
 test('phone width (390 px): no sideways scroll, the picker and results fit', { timeout: JOB_TIMEOUT }, async () => {
