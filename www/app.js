@@ -110,6 +110,8 @@ function setStatus(text) {
 }
 
 function startRun(kind, name) {
+  // A file loaded over a running job: the progress goes back under the file picker.
+  if (kind === 'load' && runState.classList.contains('in-job')) placeRunState(null);
   current = { kind, name, startedAt: performance.now() };
   hideError();
   els.elapsed.textContent = '';
