@@ -64,21 +64,7 @@ pub struct Command {
 impl Segment {
     /// Distance and speed along the path `tau` seconds into the segment.
     fn along(&self, tau: f64) -> (f64, f64) {
-        let p = &self.profile;
-        let a = p.acceleration;
-        if tau <= p.accel_s {
-            let t = tau.max(0.0);
-            (p.entry * t + 0.5 * a * t * t, p.entry + a * t)
-        } else if tau <= p.accel_s + p.cruise_s {
-            let t = tau - p.accel_s;
-            (p.accel_mm + p.peak * t, p.peak)
-        } else {
-            let t = (tau - p.accel_s - p.cruise_s).min(p.decel_s);
-            (
-                p.accel_mm + p.cruise_mm + p.peak * t - 0.5 * a * t * t,
-                (p.peak - a * t).max(0.0),
-            )
-        }
+        self.profile.at_time(tau)
     }
 
     /// The commanded state `tau` seconds into the segment.

@@ -453,6 +453,7 @@ mod tests {
                     v: kin.tool_vector(rot),
                     rot,
                     dt: 0.1,
+                    profile: None,
                 }
             })
             .collect();

@@ -4,6 +4,7 @@ use super::core::{self, RunSettings};
 use super::kinematics::{Kinematics, Pose};
 use super::metrics::Sample;
 use super::program::{self, Frame, MotionLine, Run};
+use super::schedule;
 use super::summary::{self, Counts};
 use super::words;
 use super::{Coordinates, InputFormat, SmoothOptions, SmoothReport};
@@ -35,9 +36,11 @@ pub(super) fn run(
     let decimals = usize::from(options.decimals);
     let half = vec3::rad(0.5 * options.cone_deg);
     let settings = run_settings(options, half, decimals);
+    // The rotary rates are measured on the tool tip's schedule, the same before and after.
+    let timed = schedule::tip_timed(input, &frame, moves, &lines, options);
     let before: Vec<Vec<Sample>> = runs
         .iter()
-        .map(|r| program::samples(&frame, moves, r))
+        .map(|r| program::samples(&frame, &timed, r))
         .collect();
     warnings.extend(summary::short_run_warning(&before, true, options));
     let (smoothed, corrected) = smooth_runs(&before, frame.kin, &settings, progress)?;
@@ -253,6 +256,7 @@ impl Writer<'_> {
             v,
             rot,
             dt: orig.dt,
+            profile: orig.profile,
         };
         (pose, sample)
     }
@@ -285,6 +289,7 @@ fn read_back(
             let mut s = program::samples(&frame, &back.moves, r);
             for (x, y) in s.iter_mut().zip(b) {
                 x.dt = y.dt;
+                x.profile = y.profile;
             }
             s
         })

@@ -1,9 +1,18 @@
 //! Orientation-variation metrics (what the smoothing is for): angle change per point and per
 //! millimetre, roughness, and the rotary axes' angular velocity, acceleration and jerk under
 //! the move timing (the planner's for G-code, a constant feed for point-vector data).
+//!
+//! The rotary rates are read off the timed motion, not off per-move averages. Each move
+//! interpolates its axes linearly along its path (as G-code controllers do), so an axis's
+//! angle at time `t` is the move's start angle plus its share of the angle change at the
+//! distance the planner's speed profile has covered. That angle is sampled every
+//! [`RATE_RESOLUTION_S`] and differenced three times. Per-move averages would make a move's
+//! length the unit of time: a 90° turn inside one long move would look gentle, and the
+//! same turn spread over fifteen short moves would look violent.
 
 use serde::Serialize;
 
+use crate::plan::Profile;
 use crate::vec3::{self, V3};
 
 /// One path point as the metrics see it.
@@ -17,6 +26,8 @@ pub struct Sample {
     pub rot: [f64; 2],
     /// Duration of the move ending here, s (unused for a run's first sample).
     pub dt: f64,
+    /// The planner's speed profile of that move; `None` travels it at constant speed.
+    pub profile: Option<Profile>,
 }
 
 /// Motion of one rotary axis.
@@ -26,7 +37,7 @@ pub struct RotaryMetrics {
     pub axis: String,
     /// Total angle travelled, degrees.
     pub travel_deg: f64,
-    /// Largest angular velocity (per-move average), °/s.
+    /// Largest angular velocity, °/s.
     pub max_velocity_deg_s: f64,
     /// Root-mean-square angular velocity, °/s.
     pub rms_velocity_deg_s: f64,
@@ -63,8 +74,12 @@ pub struct OrientationMetrics {
     pub rotary: Vec<RotaryMetrics>,
 }
 
-/// Shortest move duration the rates are computed with, s (guards zero-time moves).
-const MIN_DT_S: f64 = 1e-4;
+/// Time step the rotary angles are sampled and differenced at, s. Velocity is the angle
+/// change over one step, acceleration the change of that over the next, jerk likewise, so a
+/// speed step of `Δω` between two moves reads as `Δω / h` and `Δω / h²`. 10 ms is the order of
+/// a rotary servo's position-loop bandwidth and of the smoothing time of Klipper's input
+/// shapers: what an axis can follow, not the step rate.
+pub const RATE_RESOLUTION_S: f64 = 0.01;
 
 #[derive(Default)]
 struct Acc {
@@ -131,27 +146,12 @@ pub fn measure<'a>(
             }
         }
         for k in 0..2 {
-            // Per-move average velocity, then differences at the move boundaries.
-            let mut prev_v: Option<(f64, f64)> = None;
-            let mut prev_a: Option<(f64, f64)> = None;
             for w in run.windows(2) {
-                let [a, b] = w else { continue };
-                let d = b.rot[k] - a.rot[k];
-                travel[k] += d.abs();
-                let dt = b.dt.max(MIN_DT_S);
-                let v = d / dt;
-                vel[k].push(v);
-                if let Some((pv, pdt)) = prev_v {
-                    let h = 0.5 * (dt + pdt);
-                    let a_now = (v - pv) / h;
-                    acc[k].push(a_now);
-                    if let Some((pa, ph)) = prev_a {
-                        jerk[k].push((a_now - pa) / (0.5 * (h + ph)));
-                    }
-                    prev_a = Some((a_now, h));
+                if let [a, b] = w {
+                    travel[k] += (b.rot[k] - a.rot[k]).abs();
                 }
-                prev_v = Some((v, dt));
             }
+            rates(run, k, [&mut vel[k], &mut acc[k], &mut jerk[k]]);
         }
     }
     OrientationMetrics {
@@ -177,6 +177,64 @@ pub fn measure<'a>(
     }
 }
 
+/// Share of a move's path covered `tau` seconds into it (0 to 1).
+fn fraction(sample: &Sample, tau: f64) -> f64 {
+    if sample.dt <= 0.0 {
+        return 1.0;
+    }
+    match sample.profile {
+        Some(p) if p.duration() > 0.0 => {
+            // An arc's stored profile is its last segment's: scale it to the whole move.
+            let total = p.at_time(p.duration()).0;
+            let (d, _) = p.at_time(tau * p.duration() / sample.dt);
+            if total > 0.0 {
+                (d / total).clamp(0.0, 1.0)
+            } else {
+                (tau / sample.dt).clamp(0.0, 1.0)
+            }
+        }
+        _ => (tau / sample.dt).clamp(0.0, 1.0),
+    }
+}
+
+/// Angle of axis `k` along a run, every [`RATE_RESOLUTION_S`] from its start.
+fn sampled_angles(run: &[Sample], k: usize) -> Vec<f64> {
+    let total: f64 = run.iter().skip(1).map(|s| s.dt.max(0.0)).sum();
+    let (Some(first), true) = (run.first(), total.is_finite()) else {
+        return Vec::new();
+    };
+    let steps = (total / RATE_RESOLUTION_S).floor() as usize;
+    let mut out = Vec::with_capacity(steps + 1);
+    let (mut j, mut start) = (1usize, 0.0f64);
+    let mut from = first.rot[k];
+    for i in 0..=steps {
+        let t = i as f64 * RATE_RESOLUTION_S;
+        while let Some(m) = run.get(j) {
+            if t <= start + m.dt || j + 1 == run.len() {
+                break;
+            }
+            start += m.dt.max(0.0);
+            from = m.rot[k];
+            j += 1;
+        }
+        let Some(m) = run.get(j) else { break };
+        out.push(from + (m.rot[k] - from) * fraction(m, t - start));
+    }
+    out
+}
+
+/// Velocity, acceleration and jerk of axis `k` along a run, on the sampled angles.
+fn rates(run: &[Sample], k: usize, acc: [&mut Acc; 3]) {
+    let h = RATE_RESOLUTION_S;
+    let mut d: Vec<f64> = sampled_angles(run, k);
+    for a in acc {
+        d = d.windows(2).map(|w| (w[1] - w[0]) / h).collect();
+        for &x in &d {
+            a.push(x);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -191,6 +249,7 @@ mod tests {
                     v: [a.sin(), 0.0, a.cos()],
                     rot: [0.0, 2.0 * i as f64],
                     dt: 0.5,
+                    profile: None,
                 }
             })
             .collect();

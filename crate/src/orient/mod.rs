@@ -237,8 +237,9 @@ pub struct SmoothReport {
     /// XYZ motion, and smoother orientation needs less compensating XYZ motion, so the output
     /// usually plans faster. The planner knows no rotary-axis limits, so a rewritten move whose
     /// XYZ motion shrinks would get an unbounded rotary speed; the rotary rates in
-    /// [`SmoothReport::before`] and [`SmoothReport::after`] are therefore both computed on the
-    /// input's schedule (same tool-tip path, same move durations).
+    /// [`SmoothReport::before`] and [`SmoothReport::after`] are therefore both measured on the
+    /// tool tip's planned schedule (the file's X, Y, Z replaced by the tip, as an RTCP
+    /// controller runs it; the same for both files, whose tips agree within rounding).
     pub planned_time_after_s: f64,
     /// Per-point rotary angles for a chart.
     pub series: Series,
@@ -343,4 +344,5 @@ pub fn smooth_points_with_progress(
 
 mod gcode_job;
 mod point_job;
+mod schedule;
 mod summary;

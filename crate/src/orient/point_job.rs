@@ -89,7 +89,13 @@ fn sample_runs(input: &[PointVector], options: &SmoothOptions) -> Result<Vec<Vec
         let dt = prev_p.map_or(0.0, |a| vec3::norm(vec3::sub(p, a)) / options.feed_mm_s);
         prev_p = Some(p);
         if let Some(r) = runs.last_mut() {
-            r.push(Sample { p, v, rot, dt });
+            r.push(Sample {
+                p,
+                v,
+                rot,
+                dt,
+                profile: None,
+            });
         }
     }
     Ok(runs)

@@ -11,6 +11,7 @@ use crate::error::Error;
 use crate::gcode::{Edit, Line, RawLine};
 use crate::machine::{axis, Machine, MoveKind, Pos};
 use crate::path::PathMove;
+use crate::plan::Profile;
 use crate::read::{AnalyzeOptions, Flow, Fold, Reader};
 
 use super::kinematics::{Kinematics, Pose};
@@ -198,20 +199,25 @@ pub(super) fn pose(kin: &Kinematics, pos: &Pos) -> Pose {
 /// The samples of a run: where it starts, then the end of each move.
 pub(super) fn samples(frame: &Frame<'_>, moves: &[PathMove], run: &Run) -> Vec<Sample> {
     let mut out = Vec::with_capacity(run.len() + 1);
-    let mut push = |pos: &Pos, dt: f64| {
+    let mut push = |pos: &Pos, dt: f64, profile: Option<Profile>| {
         let pose = pose(frame.kin, pos);
         out.push(Sample {
             p: frame.tip(&pose),
             v: frame.kin.tool_vector(pose.rot),
             rot: pose.rot,
             dt,
+            profile,
         });
     };
     if let Some(first) = run.first().and_then(|&i| moves.get(i)) {
-        push(&first.from, 0.0);
+        push(&first.from, 0.0, None);
     }
     for m in run.iter().filter_map(|&i| moves.get(i)) {
-        push(&m.to, m.timing.map_or(0.0, |t| t.duration_s));
+        push(
+            &m.to,
+            m.timing.map_or(0.0, |t| t.duration_s),
+            m.timing.map(|t| t.profile),
+        );
     }
     out
 }

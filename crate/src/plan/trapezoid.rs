@@ -59,6 +59,25 @@ impl Profile {
         self.accel_s + self.cruise_s + self.decel_s
     }
 
+    /// Distance covered (mm) and speed (mm/s) `tau` seconds into the move: accelerating,
+    /// cruising, then braking (`tau` is clamped to the move).
+    pub fn at_time(&self, tau: f64) -> (f64, f64) {
+        let a = self.acceleration;
+        if tau <= self.accel_s {
+            let t = tau.at_least(0.0);
+            (self.entry * t + 0.5 * a * t * t, self.entry + a * t)
+        } else if tau <= self.accel_s + self.cruise_s {
+            let t = tau - self.accel_s;
+            (self.accel_mm + self.peak * t, self.peak)
+        } else {
+            let t = (tau - self.accel_s - self.cruise_s).at_most(self.decel_s);
+            (
+                self.accel_mm + self.cruise_mm + self.peak * t - 0.5 * a * t * t,
+                (self.peak - a * t).at_least(0.0),
+            )
+        }
+    }
+
     /// Highest speed between distances `x0 ≤ x1` (mm) from the start of the move, mm/s: the
     /// profile rises, holds, then falls, so it is the peak if the interval reaches the top,
     /// else the speed at the interval's end nearer to it.
