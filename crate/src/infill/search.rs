@@ -400,6 +400,11 @@ impl Prepared<'_> {
         let mut motions: Vec<Option<Replacement>> = vec![None; n];
         let tf = |p: P2| rotation.map_or(p, |r| r.apply(p));
         for (w, plan) in self.work.iter().zip(plans) {
+            // An empty plan keeps the layer's original infill (a per-layer choice, or nothing
+            // generated in its region): never a layer without infill.
+            if plan.is_empty() {
+                continue;
+            }
             let habit = Habit {
                 e_per_mm: w.e_per_mm,
                 ..self.habit
