@@ -273,7 +273,9 @@ mod props {
                 ],
             ];
             let p = Pattern::ALL[k];
-            for piece in generate(&region, p, angle, spacing, 1).iter().flatten() {
+            // Linked chains too: their boundary links follow the region's edges.
+            let linked = chains(&region, p, angle, spacing, 1);
+            for piece in generate(&region, p, angle, spacing, 1).iter().flatten().chain(&linked) {
                 for w2 in piece.windows(2) {
                     let mid = [0.5 * (w2[0][0] + w2[1][0]), 0.5 * (w2[0][1] + w2[1][1])];
                     for q in [w2[0], w2[1], mid] {
