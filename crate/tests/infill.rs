@@ -186,6 +186,39 @@ fn per_layer_hybrid_is_kept_only_when_it_wins() {
     }
 }
 
+/// Per layer, the original infill is an option too: with only a dear pattern on offer (the
+/// Hilbert curve), the hybrid keeps the slicer's layers, and the file handed back is never
+/// dearer than the input.
+#[test]
+fn per_layer_keeps_original_layers_no_candidate_beats() {
+    let input = std::fs::read(data("rect_infill_0.gcode")).unwrap();
+    let o = InfillOptions {
+        patterns: vec![Pattern::Hilbert],
+        angles_deg: vec![45.0],
+        per_layer: true,
+        force_candidate: true,
+        ..InfillOptions::default()
+    };
+    let r = infill(&input, &o).unwrap();
+    let layers = r
+        .best
+        .layers
+        .as_ref()
+        .expect("the hybrid beats Hilbert everywhere");
+    let kept = layers
+        .iter()
+        .filter(|l| l.pattern == Choice::Original)
+        .count();
+    assert!(kept * 2 > layers.len(), "{kept} of {} kept", layers.len());
+    assert!(r.best.total_j < r.candidates[0].total_j);
+    let o = InfillOptions {
+        force_candidate: false,
+        ..o
+    };
+    let r = infill(&input, &o).unwrap();
+    assert_never_dearer(&input, &o, &r, "per-layer Hilbert");
+}
+
 /// The VTG paper's Fig. 4–5 comparison (length and turning of each pattern's infill) comes from
 /// the candidates' replay; read back from the written file it must be the same: the infill
 /// moves of the output, through the same metrics, give the same length, turning points and

@@ -172,6 +172,7 @@ pub(crate) fn replay_blocks(
     let mut next_start = 0usize;
     let mut skip_until = 0usize;
     let mut resume_from: Option<[f64; 3]> = None;
+    let mut kept = 0usize;
     let mut infill_metrics = crate::analyze::toolpath::MetricsAccumulator::new(
         crate::analyze::toolpath::DEFAULT_CRITICAL_ANGLE_DEG,
     );
@@ -217,7 +218,15 @@ pub(crate) fn replay_blocks(
         if let Some(end) = resume_from {
             resume_from = resume(&mut m, mv, i, rotation, end);
         }
-        run.push(m, u32::MAX);
+        // A block kept as the file has it is still its own (per-layer choices cost it).
+        while prog.blocks.get(kept).is_some_and(|b| b.end <= i) {
+            kept += 1;
+        }
+        let owner = match prog.blocks.get(kept) {
+            Some(b) if b.first <= i => kept as u32,
+            _ => u32::MAX,
+        };
+        run.push(m, owner);
     }
     run.finish(base, filament, infill_metrics.finish())
 }

@@ -92,6 +92,105 @@ pub(crate) fn link(
     strokes
 }
 
+/// Most chains ordered by nearest neighbour (quadratic); beyond, the generator's order stays.
+const MAX_ORDERED: usize = 2000;
+/// Most chains improved by 2-opt (quadratic per pass).
+const MAX_TWO_OPT: usize = 400;
+
+/// Orders `chains` (each printed in one go, either way round) to make the travel from `start`
+/// short: nearest neighbour choosing each chain's direction, then 2-opt on the chain ends
+/// (reversing a run of chains reverses each of them), as slicers order their infill paths.
+pub(crate) fn order(chains: Vec<Path>, start: P2) -> Vec<Path> {
+    let mut chains: Vec<Path> = chains.into_iter().filter(|c| c.len() >= 2).collect();
+    if chains.len() > MAX_ORDERED {
+        return chains;
+    }
+    let ends = |c: &Path| (c[0], c[c.len() - 1]);
+    let mut out: Vec<Path> = Vec::with_capacity(chains.len());
+    let mut cur = start;
+    while !chains.is_empty() {
+        let mut best = (f64::INFINITY, 0, false);
+        for (i, c) in chains.iter().enumerate() {
+            let (h, t) = ends(c);
+            let (dh, dt) = (dist(cur, h), dist(cur, t));
+            if dh < best.0 {
+                best = (dh, i, false);
+            }
+            if dt < best.0 {
+                best = (dt, i, true);
+            }
+        }
+        let mut c = chains.swap_remove(best.1);
+        if best.2 {
+            c.reverse();
+        }
+        cur = c[c.len() - 1];
+        out.push(c);
+    }
+    if out.len() <= MAX_TWO_OPT {
+        two_opt(&mut out, start);
+    }
+    out
+}
+
+/// 2-opt on an open tour of oriented chains starting at `start`.
+fn two_opt(seq: &mut [Path], start: P2) {
+    let n = seq.len();
+    let head = |c: &Path| c[0];
+    let tail = |c: &Path| c[c.len() - 1];
+    for _ in 0..20 {
+        let mut improved = false;
+        for i in 0..n {
+            let prev = if i == 0 { start } else { tail(&seq[i - 1]) };
+            for j in i..n {
+                let (hi, tj) = (head(&seq[i]), tail(&seq[j]));
+                let (old_next, new_next) = match seq.get(j + 1) {
+                    Some(c) => (dist(tj, head(c)), dist(hi, head(c))),
+                    None => (0.0, 0.0),
+                };
+                let delta = dist(prev, tj) + new_next - dist(prev, hi) - old_next;
+                if delta < -1e-6 {
+                    seq[i..=j].reverse();
+                    seq[i..=j].iter_mut().for_each(|c| c.reverse());
+                    improved = true;
+                }
+            }
+        }
+        if !improved {
+            break;
+        }
+    }
+}
+
+/// Splits `chains` between the blocks of a layer (islands printed apart): each chain goes to
+/// the block whose original infill passes nearest its middle point. `anchors`: per block, points
+/// of its original infill.
+pub(crate) fn split_blocks(chains: Vec<Path>, anchors: &[Vec<P2>]) -> Vec<Vec<Path>> {
+    let mut out: Vec<Vec<Path>> = vec![Vec::new(); anchors.len().max(1)];
+    for c in chains {
+        let Some(&m) = c.get(c.len() / 2) else {
+            continue;
+        };
+        let k = if anchors.len() < 2 {
+            0
+        } else {
+            anchors
+                .iter()
+                .enumerate()
+                .map(|(k, a)| {
+                    (
+                        k,
+                        a.iter().map(|&p| dist(p, m)).fold(f64::INFINITY, f64::min),
+                    )
+                })
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .map_or(0, |b| b.0)
+        };
+        out[k].push(c);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -137,5 +236,24 @@ mod tests {
         ];
         let s = link(rows, [1.0, 9.0], &l, 100.0, 0.01);
         assert_eq!(s.len(), 2, "across the notch: travel");
+    }
+
+    #[test]
+    fn order_picks_nearest_ends_and_directions() {
+        // Three parallel chains listed far-near-middle, each the wrong way round.
+        let chains = vec![
+            vec![[20.0, 10.0], [20.0, 0.0]],
+            vec![[0.0, 10.0], [0.0, 0.0]],
+            vec![[10.0, 0.0], [10.0, 10.0]],
+        ];
+        let o = order(chains, [0.0, 0.0]);
+        let travel: f64 = o
+            .windows(2)
+            .map(|w| dist(w[0][w[0].len() - 1], w[1][0]))
+            .sum();
+        assert_eq!(o[0][0], [0.0, 0.0]);
+        assert!((travel - 20.0).abs() < 1e-9, "{travel}");
+        let split = split_blocks(o, &[vec![[0.0, 5.0]], vec![[20.0, 5.0]]]);
+        assert_eq!((split[0].len(), split[1].len()), (2, 1));
     }
 }

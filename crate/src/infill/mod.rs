@@ -181,8 +181,9 @@ pub struct Candidate {
 pub struct LayerChoice {
     /// Layer index.
     pub layer: usize,
-    /// Pattern.
-    pub pattern: Pattern,
+    /// Pattern, or `original` for a layer that keeps the file's own infill (no candidate beat
+    /// it on that layer).
+    pub pattern: Choice,
     /// Infill angle, degrees.
     pub angle_deg: f64,
 }

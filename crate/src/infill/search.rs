@@ -49,6 +49,10 @@ pub(crate) struct Work {
     pub e_per_mm: f64,
     /// Nozzle position at the first block (part frame).
     pub start: P2,
+    /// Nozzle position at the start of each block (part frame): where the walls before it end.
+    pub starts: Vec<P2>,
+    /// Points of each block's original infill (which island a new chain belongs to).
+    pub anchors: Vec<Vec<P2>>,
 }
 
 pub(crate) struct Prepared<'a> {
@@ -197,15 +201,38 @@ fn work_item(
     }
     let first = blocks.first().and_then(|&b| prog.blocks.get(b))?;
     let p = first.machine.position();
+    let (starts, anchors) = block_points(prog, &blocks);
     (l > 0.0).then(|| Work {
         layer,
         start: [p[axis::X], p[axis::Y]],
+        starts,
+        anchors,
         blocks,
         region,
         target_mm: l,
         nominal_mm: 0.0,
         e_per_mm: e / l,
     })
+}
+
+/// Where each block starts, and up to 256 points of its original infill.
+fn block_points(prog: &Program, blocks: &[usize]) -> (Vec<P2>, Vec<Vec<P2>>) {
+    blocks
+        .iter()
+        .filter_map(|&b| prog.blocks.get(b))
+        .map(|blk| {
+            let p = blk.machine.position();
+            let moves = prog.moves.get(blk.first..blk.end).unwrap_or(&[]);
+            let step = (moves.len() / 256).max(1);
+            let pts = moves
+                .iter()
+                .step_by(step)
+                .filter(|m| m.m.is_extruding())
+                .map(|m| [m.m.to[axis::X], m.m.to[axis::Y]])
+                .collect();
+            ([p[axis::X], p[axis::Y]], pts)
+        })
+        .unzip()
 }
 
 /// The line spacing of the file's sparse infill: the mean (area / length) refined by the
@@ -321,6 +348,9 @@ impl Prepared<'_> {
     /// frame, with the spacing corrected once so the layer's extruded length matches.
     pub(crate) fn plan_layer(&self, w: &Work, pattern: Pattern, beta: f64) -> Vec<Path> {
         let make = |s: f64| {
+            if pattern.is_lines() {
+                return pattern::chains(&w.region.region, pattern, beta, s, w.layer);
+            }
             let rows = pattern::generate(&w.region.region, pattern, beta, s, w.layer);
             link::link(
                 rows,
@@ -356,7 +386,7 @@ impl Prepared<'_> {
             }
             s *= ratio.clamp(0.5, 2.0);
         }
-        best.map(|b| b.1).unwrap_or_default()
+        best.map(|b| arrange(w, b.1)).unwrap_or_default()
     }
 
     /// The texts and motions of every replaced block for per-work-item strokes.
@@ -370,13 +400,23 @@ impl Prepared<'_> {
         let mut motions: Vec<Option<Replacement>> = vec![None; n];
         let tf = |p: P2| rotation.map_or(p, |r| r.apply(p));
         for (w, plan) in self.work.iter().zip(plans) {
+            // An empty plan keeps the layer's original infill (a per-layer choice, or nothing
+            // generated in its region): never a layer without infill.
+            if plan.is_empty() {
+                continue;
+            }
             let habit = Habit {
                 e_per_mm: w.e_per_mm,
                 ..self.habit
             };
-            let moved: Vec<Path> = plan
-                .iter()
-                .map(|s| s.iter().map(|&p| tf(p)).collect())
+            // The plan's groups (one per block) are separated by empty paths.
+            let moved: Vec<Vec<Path>> = plan
+                .split(|s| s.is_empty())
+                .map(|g| {
+                    g.iter()
+                        .map(|s| s.iter().map(|&p| tf(p)).collect())
+                        .collect()
+                })
                 .collect();
             for (k, &b) in w.blocks.iter().enumerate() {
                 let Some(blk) = self.prog.blocks.get(b) else {
@@ -385,7 +425,7 @@ impl Prepared<'_> {
                 let p = blk.machine.position();
                 let start = tf([p[axis::X], p[axis::Y]]);
                 let end = tf([blk.end_physical[0], blk.end_physical[1]]);
-                let strokes: &[Path] = if k == 0 { &moved } else { &[] };
+                let strokes: &[Path] = moved.get(k).map_or(&[], |g| g.as_slice());
                 let text = emit::block_text(blk, strokes, start, end, &habit);
                 motions[b] = Some(emit::motions(blk, &text, start));
                 texts[b] = Some(text);
@@ -393,6 +433,21 @@ impl Prepared<'_> {
         }
         (texts, motions)
     }
+}
+
+/// A layer's strokes split between its blocks and ordered from where each block starts
+/// ([`link::order`]), the blocks' groups separated by an empty path.
+fn arrange(w: &Work, strokes: Vec<Path>) -> Vec<Path> {
+    let groups = link::split_blocks(strokes, &w.anchors);
+    let mut out = Vec::new();
+    for (k, g) in groups.into_iter().enumerate() {
+        if k > 0 {
+            out.push(Path::new());
+        }
+        let start = w.starts.get(k).copied().unwrap_or(w.start);
+        out.extend(link::order(g, start));
+    }
+    out
 }
 
 fn score(objective: Objective, w: &super::Weights, c: &Costs, base: &Costs) -> f64 {

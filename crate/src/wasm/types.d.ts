@@ -388,7 +388,7 @@ export interface InfillReport {
     length_mm: number;
     saving_j: number;
     saving_pct: number;
-    layers: { layer: number; pattern: InfillPattern; angle_deg: number; [key: string]: unknown }[] | null;
+    layers: { layer: number; pattern: InfillPattern | 'original'; angle_deg: number; [key: string]: unknown }[] | null;
     /** Why the original was kept (or that a dearer candidate was forced); null when the output beats the input. */
     message: string | null;
   };

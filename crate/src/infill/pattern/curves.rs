@@ -2,11 +2,8 @@
 //! spiral (the PrusaSlicer patterns of the thesis, Table 4). Curves are built over the region's
 //! bounding box and clipped to the region with `i_overlay`.
 
-use i_overlay::core::fill_rule::FillRule;
-use i_overlay::float::clip::FloatClip;
 use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::OutlineStyle;
-use i_overlay::string::clip::ClipRule;
 
 use super::super::geom::{bbox, region_area, signed_area, Path, Region, P2};
 use super::super::region::flatten;
@@ -17,12 +14,167 @@ const MAX_POINTS: usize = 1 << 20;
 const MAX_LOOPS: usize = 2000;
 
 /// Clips open polylines to the region (even-odd), keeping the pieces in curve order.
+/// The region's edges are bucketed in a grid ([`EdgeGrid`]), so each segment of a curve
+/// meets only the few edges near it: linear in the curve's length for any region, where a
+/// general clipper sweeps the whole curve against every edge again for every candidate.
 pub(crate) fn clip(paths: &[Path], region: &Region) -> Vec<Path> {
-    let rule = ClipRule {
-        invert: false,
-        boundary_included: true,
+    let Some(grid) = EdgeGrid::new(region) else {
+        return Vec::new();
     };
-    paths.clip_by(region, FillRule::EvenOdd, rule)
+    let mut out = Vec::new();
+    let mut ts: Vec<f64> = Vec::new();
+    for path in paths {
+        let mut piece: Path = Vec::new();
+        // Whether the last piece of segment looked at was inside: a segment that crosses no
+        // edge (not even at its ends) keeps it, so the ray test runs only near crossings.
+        let mut state: Option<bool> = None;
+        for w in path.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            ts.clear();
+            ts.push(0.0);
+            grid.crossings(a, b, &mut ts);
+            ts.push(1.0);
+            let crossed = ts.len() > 2;
+            ts.sort_by(f64::total_cmp);
+            let at = |t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+            for k in ts.windows(2) {
+                if k[1] - k[0] < 1e-12 {
+                    continue;
+                }
+                let (p, q) = (at(k[0]), at(k[1]));
+                let inside = match state {
+                    Some(v) if !crossed => v,
+                    _ => grid.inside(at(0.5 * (k[0] + k[1]))),
+                };
+                state = Some(inside);
+                if inside {
+                    if piece.last() != Some(&p) {
+                        if piece.len() >= 2 {
+                            out.push(std::mem::take(&mut piece));
+                        }
+                        piece.clear();
+                        piece.push(p);
+                    }
+                    piece.push(q);
+                } else if piece.len() >= 2 {
+                    out.push(std::mem::take(&mut piece));
+                } else {
+                    piece.clear();
+                }
+            }
+        }
+        if piece.len() >= 2 {
+            out.push(piece);
+        }
+    }
+    out
+}
+
+/// A region's edges bucketed in a uniform grid of about 64 × 64 cells.
+struct EdgeGrid {
+    edges: Vec<(P2, P2)>,
+    origin: P2,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    cells: Vec<Vec<u32>>,
+}
+
+impl EdgeGrid {
+    fn new(region: &Region) -> Option<Self> {
+        let b = bbox(region.iter().flatten())?;
+        let cell = ((b[2] - b[0]).max(b[3] - b[1]) / 64.0).max(1e-3);
+        let nx = ((b[2] - b[0]) / cell).floor() as usize + 1;
+        let ny = ((b[3] - b[1]) / cell).floor() as usize + 1;
+        let mut g = EdgeGrid {
+            edges: Vec::new(),
+            origin: [b[0], b[1]],
+            cell,
+            nx,
+            ny,
+            cells: vec![Vec::new(); nx * ny],
+        };
+        for c in region {
+            for i in 0..c.len() {
+                let (p, q) = (c[i], c[(i + 1) % c.len()]);
+                let e = g.edges.len() as u32;
+                g.edges.push((p, q));
+                let (x0, y0) = g.cell_of([p[0].min(q[0]), p[1].min(q[1])]);
+                let (x1, y1) = g.cell_of([p[0].max(q[0]), p[1].max(q[1])]);
+                for y in y0..=y1 {
+                    for x in x0..=x1 {
+                        g.cells[y * nx + x].push(e);
+                    }
+                }
+            }
+        }
+        Some(g)
+    }
+
+    fn cell_of(&self, p: P2) -> (usize, usize) {
+        let f =
+            |v: f64, o: f64, n: usize| (((v - o) / self.cell).floor().max(0.0) as usize).min(n - 1);
+        (
+            f(p[0], self.origin[0], self.nx),
+            f(p[1], self.origin[1], self.ny),
+        )
+    }
+
+    /// Pushes the parameters in (0, 1) where segment `ab` crosses an edge.
+    fn crossings(&self, a: P2, b: P2, ts: &mut Vec<f64>) {
+        let (x0, y0) = self.cell_of([a[0].min(b[0]), a[1].min(b[1])]);
+        let (x1, y1) = self.cell_of([a[0].max(b[0]), a[1].max(b[1])]);
+        let first = ts.len();
+        let d = [b[0] - a[0], b[1] - a[1]];
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                for &e in &self.cells[y * self.nx + x] {
+                    let (p, q) = self.edges[e as usize];
+                    let r = [q[0] - p[0], q[1] - p[1]];
+                    let den = d[0] * r[1] - d[1] * r[0];
+                    if den.abs() < 1e-18 {
+                        continue;
+                    }
+                    let w = [p[0] - a[0], p[1] - a[1]];
+                    let t = (w[0] * r[1] - w[1] * r[0]) / den;
+                    let u = (w[0] * d[1] - w[1] * d[0]) / den;
+                    // Crossings at t = 0 or 1 (through a vertex of the curve) count as
+                    // crossings too: they cut nothing but make the caller test again.
+                    if (0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u) {
+                        ts.push(t);
+                    }
+                }
+            }
+        }
+        // An edge in several cells is found several times: the duplicates cut nothing.
+        ts[first..].sort_by(f64::total_cmp);
+    }
+
+    /// Even-odd inside test, casting the ray to +x through the point's row of cells only.
+    fn inside(&self, p: P2) -> bool {
+        let (cx, cy) = self.cell_of(p);
+        let mut odd = false;
+        for x in cx..self.nx {
+            let lo = self.origin[0] + x as f64 * self.cell;
+            let hi = if x + 1 == self.nx {
+                f64::INFINITY
+            } else {
+                lo + self.cell
+            };
+            let lo = if x == 0 { f64::NEG_INFINITY } else { lo };
+            for &e in &self.cells[cy * self.nx + x] {
+                let (a, b) = self.edges[e as usize];
+                if (a[1] > p[1]) != (b[1] > p[1]) {
+                    let xc = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+                    // Each crossing counted once: in the cell that holds it.
+                    if xc > p[0] && xc >= lo && xc < hi {
+                        odd = !odd;
+                    }
+                }
+            }
+        }
+        odd
+    }
 }
 
 /// Concentric loops `spacing` apart, outermost first, each closed (last point = first).

@@ -171,6 +171,47 @@ pub(crate) fn generate(
     }
 }
 
+/// Longest boundary link between two lines of a family, in pitches: a wall at 10° to the
+/// lines still links them (pitch / sin 10° = 5.8 pitches), as PrusaSlicer's connected infill
+/// links along the perimeter.
+const LINK_PITCHES: f64 = 6.0;
+
+/// The pieces of a line pattern (`is_lines`) linked into zigzag chains family by family:
+/// neighbouring lines joined along the region's boundary where the boundary between their
+/// ends is at most `LINK_PITCHES` pitches long ([`lines::chains`]). Other patterns: no chains.
+pub(crate) fn chains(
+    region: &Region,
+    pattern: Pattern,
+    angle_deg: f64,
+    spacing: f64,
+    layer: usize,
+) -> Vec<Path> {
+    let pitch = pattern.pitch() * spacing;
+    if pitch.is_nan() || pitch <= 1e-3 || !angle_deg.is_finite() {
+        return Vec::new();
+    }
+    let families: &[(f64, f64)] = match pattern {
+        Pattern::Rectilinear if layer % 2 == 1 => &[(90.0, 0.5)],
+        Pattern::Rectilinear => &[(0.0, 0.5)],
+        Pattern::Grid => &[(0.0, 0.5), (90.0, 0.5)],
+        Pattern::Triangles => &[(0.0, 0.0), (60.0, 0.0), (120.0, 0.0)],
+        Pattern::TriHexagon => &[(0.0, 0.0), (60.0, 0.0), (120.0, 0.5)],
+        _ => &[],
+    };
+    families
+        .iter()
+        .flat_map(|&(a, off)| {
+            lines::chains(
+                region,
+                angle_deg + a,
+                pitch,
+                off * pitch,
+                LINK_PITCHES * pitch,
+            )
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -232,7 +273,9 @@ mod props {
                 ],
             ];
             let p = Pattern::ALL[k];
-            for piece in generate(&region, p, angle, spacing, 1).iter().flatten() {
+            // Linked chains too: their boundary links follow the region's edges.
+            let linked = chains(&region, p, angle, spacing, 1);
+            for piece in generate(&region, p, angle, spacing, 1).iter().flatten().chain(&linked) {
                 for w2 in piece.windows(2) {
                     let mid = [0.5 * (w2[0][0] + w2[1][0]), 0.5 * (w2[0][1] + w2[1][1])];
                     for q in [w2[0], w2[1], mid] {
