@@ -384,6 +384,24 @@ fn options_from_a_config_file() {
     let vtg = |v: &serde_json::Value| v["stages"][0]["message"].as_str().unwrap().to_string();
     assert!(vtg(&run(&[])).contains("of 0.05 mm"), "{}", vtg(&run(&[])));
     assert!(vtg(&run(&["--tolerance", "0.08"])).contains("of 0.08 mm"));
+    // An analyze flag on the command line replaces only its own setting of the file's
+    // [analyze] table: the printer from the file stays, the filament from the flag is used.
+    std::fs::write(
+        &config,
+        "arcs = \"off\"\n[vtg_options]\ndynamics = false\n[analyze]\nmachine = \"creality-ender3\"\n",
+    )
+    .unwrap();
+    let merged = run(&["--filament-diameter", "2.85"]);
+    std::fs::write(&config, "arcs = \"off\"\n[vtg_options]\ndynamics = false\n").unwrap();
+    let flags = run(&[
+        "--machine",
+        "creality-ender3",
+        "--filament-diameter",
+        "2.85",
+    ]);
+    let plain = run(&[]);
+    assert_eq!(merged["before"], flags["before"]);
+    assert_ne!(merged["before"]["time_s"], plain["before"]["time_s"]);
     std::fs::write(&config, "tolerance = 1\n").unwrap();
     let out = cli(
         &[

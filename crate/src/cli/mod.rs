@@ -181,6 +181,26 @@ impl AnalyzeArgs {
             || self.machine_gcode.is_some()
     }
 
+    /// The options given on the command line over `base` (a config file's), field by field:
+    /// a flag replaces only its own setting.
+    fn over(&self, base: AnalyzeOptions) -> Result<AnalyzeOptions, String> {
+        let cli = self.options()?;
+        Ok(AnalyzeOptions {
+            strict: cli.strict || base.strict,
+            filament_diameter_mm: cli.filament_diameter_mm.or(base.filament_diameter_mm),
+            density_g_cm3: cli.density_g_cm3.or(base.density_g_cm3),
+            extrusion_mode: cli.extrusion_mode.or(base.extrusion_mode),
+            machine: cli.machine.or(base.machine),
+            machine_profile: cli.machine_profile.or(base.machine_profile),
+            junction_model: cli.junction_model.or(base.junction_model),
+            arc_segment_mm: cli.arc_segment_mm.or(base.arc_segment_mm),
+            energy: cli.energy.or(base.energy),
+            klipper_config: cli.klipper_config.or(base.klipper_config),
+            klipper_version: cli.klipper_version.or(base.klipper_version),
+            machine_gcode: cli.machine_gcode.or(base.machine_gcode),
+        })
+    }
+
     fn options(&self) -> Result<AnalyzeOptions, String> {
         let machine_profile = match &self.machine_file {
             Some(path) => {

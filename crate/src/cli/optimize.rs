@@ -80,8 +80,10 @@ fn options(args: &Args) -> Result<OptimizeOptions, String> {
         }
         None => OptimizeOptions::default(),
     };
-    if args.config.is_none() || args.opts.any() {
+    if args.config.is_none() {
         o.analyze = args.opts.options()?;
+    } else if args.opts.any() {
+        o.analyze = args.opts.over(std::mem::take(&mut o.analyze))?;
     }
     if args.infill {
         o.infill.get_or_insert_with(Default::default);
