@@ -166,6 +166,9 @@ pub struct VtgReport {
     pub before: Report,
     /// Analysis of the output.
     pub after: Report,
+    /// Both files against the machine's segment budget: lines, bytes, short segments, the
+    /// peak segment rate ([`super::firmware`]); `None` only while the report is assembled.
+    pub firmware: Option<super::firmware::FirmwareReport>,
     /// The rewritten G-code.
     #[serde(skip)]
     pub output: Vec<u8>,
@@ -242,6 +245,7 @@ pub(crate) fn build(
         layers,
         before,
         after,
+        firmware: None,
         output: rewritten.output,
     }
 }

@@ -154,7 +154,15 @@ pub(crate) fn offers(
     if !aligned {
         return Ok(out);
     }
-    let settings = file_settings(path, options, limits, variant);
+    let budget = crate::vtg::firmware::SegmentBudget::for_file(
+        input,
+        path.junction_model,
+        options.min_segment_time_ms,
+    );
+    let settings = Settings {
+        min_segment_s: budget.min_segment_time_s,
+        ..file_settings(path, options, limits, variant)
+    };
     let energy = Accumulator::new(
         &options.analyze.energy.clone().unwrap_or_default(),
         &path.profile.name,
@@ -236,6 +244,7 @@ fn file_settings(
         klipper_scv_mm_s: (path.junction_model == JunctionModel::Klipper)
             .then(|| square_corner_velocity(&path.print_limits))
             .flatten(),
+        min_segment_s: crate::vtg::firmware::MARLIN_MIN_SEGMENT_TIME_S,
         line: if options.inside_corners {
             crate::vtg::blend::Line::Inside
         } else {
