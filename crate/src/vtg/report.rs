@@ -121,6 +121,11 @@ pub struct PathCounts {
     /// dynamics model found that the rewrite at 1 left the machine ringing more than the
     /// original (see [`crate::vtg::VtgOptions::dynamics`]).
     pub feed_cap_scale: f64,
+    /// Whether the walked steps were joined up to the firmware's segment budget
+    /// ([`crate::vtg::VtgOptions::min_segment_time_ms`]); `false` where the dynamics model
+    /// found the joined rewrite ringing more than the original and the steps as walked
+    /// quieter (see [`crate::vtg::VtgOptions::dynamics`]).
+    pub steps_joined: bool,
     /// Arcs (`G2`/`G3`) written (with the `arcs` option), each in place of several steps.
     pub arcs_written: u64,
     /// Single corners too tight to fillet that were turned round a keyhole loop instead
@@ -237,6 +242,7 @@ pub(crate) fn build(
                 0.0
             },
             feed_cap_scale: rewritten.feed_cap_scale,
+            steps_joined: rewritten.steps_joined,
             arcs_written: rewritten.arcs_written,
             keyholes: rewritten.keyholes,
         },

@@ -470,6 +470,8 @@ export interface VtgReport {
     mean_speed_fluctuation_pct: number;
     /** Scale the eq. 29 speeds started from: 1, or 1.5 / 2 where the dynamics model found the rewrite at 1 rang more than the original. */
     feed_cap_scale: number;
+    /** Whether the walked steps were joined up to the firmware's segment budget (false where the dynamics model found the steps as walked quieter). */
+    steps_joined: boolean;
     /** Arcs (G2/G3) written in place of runs of steps on a circle (option `arcs`). */
     arcs_written: number;
     /** Single corners too tight to fillet (wedge tips) turned round a small keyhole loop instead; 0 where the dynamics model found the loops ringing more than the original. */

@@ -68,9 +68,10 @@ pub(crate) struct Settings {
     /// sharp corners are then turned as polygons placed for its look-ahead
     /// ([`crate::vtg::corners::klipper`]).
     pub(crate) klipper_scv_mm_s: Option<f64>,
-    /// The firmware's minimum segment time, s ([`crate::vtg::SegmentBudget`]): walked steps
-    /// are joined up to `v · t_min` where the tolerance allows ([`crate::vtg::thin`]).
-    pub(crate) min_segment_s: f64,
+    /// The firmware's minimum segment time, s ([`crate::vtg::firmware::SegmentBudget`]):
+    /// walked steps are joined up to `v · t_min` where the tolerance allows
+    /// ([`crate::vtg::thin`]); `None`: written as walked.
+    pub(crate) min_segment_s: Option<f64>,
 }
 
 /// A rewritten path: the new geometry, and what the feed of each new segment is made of.
@@ -706,6 +707,9 @@ fn thinned(
     w: &Walk,
     budget: f64,
 ) -> (Vec<Sample>, Vec<[f64; 3]>) {
+    let Some(min_segment_s) = s.min_segment_s else {
+        return (walked, points);
+    };
     let arc = arc_lengths(path.pts);
     let followed = Followed {
         pts: path.pts,
@@ -715,7 +719,7 @@ fn thinned(
     let t = Thin {
         budget_mm: budget,
         max_turn_rad: w.max_turn_rad,
-        min_segment_s: s.min_segment_s,
+        min_segment_s,
         step_mm: s.tolerance_mm / 10.0,
     };
     let u: Vec<f64> = walked.iter().map(|x| x.u).collect();
@@ -843,7 +847,7 @@ mod tests {
             keyholes: true,
             line: blend::Line::Racing,
             klipper_scv_mm_s: None,
-            min_segment_s: 0.0,
+            min_segment_s: Some(0.0),
         }
     }
 
