@@ -244,9 +244,12 @@ fn the_dynamics_model_closes_the_loop() {
     assert_eq!(d.mean_mm.before, before);
     assert_eq!(d.mean_mm.after, mean(&closed.output));
     assert!(d.mean_mm.after < before);
-    // The same corners are rounded, only run faster: past the bar, faster and cheaper.
+    // The same corners are rounded, run faster: past the bar, faster and cheaper than the
+    // original. (Not compared with the open loop's time any more: that one joins its steps up
+    // to the segment budget, the retries write them as walked, so the two differ in more than
+    // their speeds.)
     assert!(closed.table1.n_turning.change_pct <= -40.0);
-    assert!(closed.table2.time_s.change_pct < open.table2.time_s.change_pct);
+    assert!(open.paths.steps_joined && !closed.paths.steps_joined);
     assert!(closed.table2.time_s.change_pct < 0.0);
     assert!(closed.table2.energy_j.change_pct < 0.0);
 }

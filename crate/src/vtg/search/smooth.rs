@@ -710,6 +710,13 @@ fn thinned(
     let Some(min_segment_s) = s.min_segment_s else {
         return (walked, points);
     };
+    // Paths that climb (vase mode) keep their steps: each point's Z is written, and joining
+    // them changes the heights a reader counts layers by (the FullControl ripple vase read
+    // back with another layer count).
+    let z0 = points.first().map_or(0.0, |p| p[2]);
+    if points.iter().any(|p| (p[2] - z0).abs() > 1e-9) {
+        return (walked, points);
+    }
     let arc = arc_lengths(path.pts);
     let followed = Followed {
         pts: path.pts,

@@ -110,7 +110,9 @@ fn join_collinear(out: &mut Written, start: [f64; 3]) {
         let e0 = out.e[i] - if i == 0 { 0.0 } else { out.e[i - 1] };
         let e1 = out.e[i + 1] - out.e[i];
         let even = n0 > 0.0 && n1 > 0.0 && (e0 / n0 - e1 / n1).abs() <= 1e-3 * (e0 / n0).abs();
-        let joined = same_feed && even && cos >= COLLINEAR_RAD.cos();
+        // Only at one height: a climbing path keeps the Z of every point (see `thinned`).
+        let level = d0[2] == 0.0 && d1[2] == 0.0;
+        let joined = level && same_feed && even && cos >= COLLINEAR_RAD.cos();
         if !joined {
             from = b;
         }
