@@ -21,7 +21,7 @@
 //!   more of that link than the original did.
 //!
 //! The rewrite keeps written segments at or above `v · min_segment_time` wherever the
-//! tolerance allows ([`super::thin`]), and the report measures both files against the budget
+//! tolerance allows (`vtg/stages/thin.rs`), and the report measures both files against the budget
 //! ([`FirmwareReport`]).
 
 use serde::{Deserialize, Serialize};
