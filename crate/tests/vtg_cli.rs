@@ -46,10 +46,13 @@ fn vtg_writes_the_file_and_reports_json() {
     let written = std::fs::read(&out_path).expect("output");
     assert!(!written.is_empty());
 
-    // The dynamics model found the first rewrite ringing less than the original, so it was
-    // kept as it is: scale 1, keyhole loops and all.
+    // The closed loop kept scale 1 and the keyhole loops; its first retry writes the steps as
+    // walked (where the joined ones rang more, or peaked higher: see `paths.steps_joined`).
     assert_eq!(json["paths"]["feed_cap_scale"], 1.0);
     assert!(json["paths"]["keyholes"].as_u64().expect("keyholes") > 0);
+    let joined = json["paths"]["steps_joined"]
+        .as_bool()
+        .expect("steps_joined");
     // --no-dynamics skips the simulation (and the closed loop): the same file, deviation rows
     // null.
     let fast = Command::new(env!("CARGO_BIN_EXE_quietpath"))
@@ -63,7 +66,21 @@ fn vtg_writes_the_file_and_reports_json() {
     assert!(fast.status.success());
     let fast: serde_json::Value = serde_json::from_slice(&fast.stdout).expect("json");
     assert!(fast["table2"]["deviation"].is_null());
-    assert_eq!(std::fs::read(&out_path).expect("output"), written);
+    // --no-dynamics keeps the first rewrite, steps joined up to the segment budget: the same
+    // file as the closed loop where that kept it too, else no more lines than its retry.
+    assert_eq!(fast["paths"]["steps_joined"], true);
+    let first = std::fs::read(&out_path).expect("output");
+    if joined {
+        assert_eq!(first, written);
+    } else {
+        let lines = |b: &[u8]| b.iter().filter(|&&c| c == b'\n').count();
+        assert!(
+            lines(&first) < lines(&written),
+            "{} vs {}",
+            lines(&first),
+            lines(&written)
+        );
+    }
 
     // Refuses to overwrite its input without --force.
     let again = Command::new(env!("CARGO_BIN_EXE_quietpath"))

@@ -244,9 +244,12 @@ fn the_dynamics_model_closes_the_loop() {
     assert_eq!(d.mean_mm.before, before);
     assert_eq!(d.mean_mm.after, mean(&closed.output));
     assert!(d.mean_mm.after < before);
-    // The same corners are rounded, only run faster: past the bar, faster and cheaper.
+    // The same corners are rounded, run faster: past the bar, faster and cheaper than the
+    // original. (Not compared with the open loop's time any more: that one joins its steps up
+    // to the segment budget, the retries write them as walked, so the two differ in more than
+    // their speeds.)
     assert!(closed.table1.n_turning.change_pct <= -40.0);
-    assert!(closed.table2.time_s.change_pct < open.table2.time_s.change_pct);
+    assert!(open.paths.steps_joined && !closed.paths.steps_joined);
     assert!(closed.table2.time_s.change_pct < 0.0);
     assert!(closed.table2.energy_j.change_pct < 0.0);
 }
@@ -443,4 +446,123 @@ fn k1_meets_every_bar_with_a_tenth_of_a_percent_of_time() {
     assert!(o.energy_pct < 0.0, "{o:?}");
     assert!(o.time_pct <= 1.0, "{o:?}");
     assert!(o.mean_deviation_pct < 0.0, "{o:?}");
+}
+
+/// Printing `G1` segments of `bytes` (lines with X or Y and a positive E word, relative or
+/// absolute by `M82`/`M83`) and how many are shorter than 0.1 mm, read straight from the text.
+fn printing_segments(bytes: &[u8]) -> (u64, u64) {
+    let (mut x, mut y, mut e, mut absolute) = (0.0f64, 0.0f64, 0.0f64, true);
+    let (mut n, mut short) = (0u64, 0u64);
+    for line in String::from_utf8_lossy(bytes).lines() {
+        let code = line.split(';').next().unwrap_or("").trim();
+        let mut words = code.split_whitespace();
+        let head = words.next().unwrap_or("");
+        match head {
+            "M82" => absolute = true,
+            "M83" => absolute = false,
+            "G92" => {
+                for w in words {
+                    if let Some(v) = w.strip_prefix('E') {
+                        e = v.parse().unwrap_or(e);
+                    }
+                }
+            }
+            "G0" | "G1" => {
+                let (mut nx, mut ny, mut de) = (x, y, 0.0);
+                for w in words {
+                    let (k, v) = w.split_at(1);
+                    let v: f64 = v.parse().unwrap_or(f64::NAN);
+                    match k {
+                        "X" => nx = v,
+                        "Y" => ny = v,
+                        "E" if absolute => {
+                            de = v - e;
+                            e = v;
+                        }
+                        "E" => de = v,
+                        _ => {}
+                    }
+                }
+                let len = (nx - x).hypot(ny - y);
+                if de > 0.0 && len > 0.0 {
+                    n += 1;
+                    short += u64::from(len < 0.1);
+                }
+                (x, y) = (nx, ny);
+            }
+            _ => {}
+        }
+    }
+    (n, short)
+}
+
+/// The firmware figures of the report are those of the written file, read back from its text;
+/// and the segment budget works: joining steps as far as the tolerance allows (0 ms) writes no
+/// more lines than joining them only up to 1 ms at their feed, each rewrite still measured
+/// within the tolerance, and the teardrop's rewrite stays under 1.5 times its lines (the walk
+/// alone wrote 2.5 times: 3506 → 8929; joined, 4768: the rest is what its corners demand,
+/// see `docs/method/vtg.md#segment-budget`).
+#[test]
+fn the_segment_budget_joins_steps_and_the_report_counts_the_written_file() {
+    let name = "prusaslicer-2.5.0_thesis_teardrop.gcode";
+    let bytes = std::fs::read(fixtures_dir().join("gcode").join(name)).unwrap();
+    let with = |ms: f64| VtgOptions {
+        min_segment_time_ms: Some(ms),
+        dynamics: false,
+        ..VtgOptions::default()
+    };
+    let run = |ms: f64| {
+        let o = with(ms);
+        let r = vtg(&bytes, &o).unwrap();
+        let before = extract(&bytes, &o.analyze, false).unwrap();
+        let after = extract(&r.output, &o.analyze, false).unwrap();
+        let measured = file_deviation(&before, &after, o.tolerance_mm / 10.0);
+        assert!(measured <= o.tolerance_mm + 0.001, "{ms} ms: {measured}");
+        r
+    };
+    let (fine, coarse) = (run(1.0), run(0.0));
+    for r in [&fine, &coarse] {
+        let f = r.firmware.as_ref().unwrap();
+        let lines = r.output.split(|&b| b == b'\n').count() as u64
+            - u64::from(r.output.last() == Some(&b'\n'));
+        assert_eq!(f.after.lines, lines);
+        assert_eq!(f.after.bytes, r.output.len() as u64);
+        let (n, short) = printing_segments(&r.output);
+        assert_eq!(
+            (f.after.printing_segments, f.after.segments_under_0_1mm),
+            (n, short)
+        );
+        let (n0, short0) = printing_segments(&bytes);
+        assert_eq!(
+            (f.before.printing_segments, f.before.segments_under_0_1mm),
+            (n0, short0)
+        );
+        assert!(f.after.peak_segments_per_s > 0.0);
+    }
+    let (a, b) = (
+        &fine.firmware.unwrap().after,
+        &coarse.firmware.unwrap().after,
+    );
+    eprintln!("1 ms: {a:?}\n0 ms: {b:?}");
+    assert!(
+        b.lines <= a.lines,
+        "{} lines at 0 ms, {} at 1 ms",
+        b.lines,
+        a.lines
+    );
+    let lines_in = bytes.split(|&c| c == b'\n').count() as f64;
+    let default = vtg(
+        &bytes,
+        &VtgOptions {
+            dynamics: false,
+            ..VtgOptions::default()
+        },
+    )
+    .unwrap();
+    let lines_out = default.output.split(|&c| c == b'\n').count() as f64;
+    assert!(
+        lines_out <= 1.5 * lines_in,
+        "{lines_out} lines out of {lines_in}"
+    );
+    assert!(b.segments_under_0_1mm <= a.segments_under_0_1mm);
 }

@@ -42,6 +42,11 @@ pub struct Args {
     /// line, which eases out by up to the tolerance before a corner for a wider circle.
     #[arg(long)]
     pub inside_corners: bool,
+    /// The firmware's minimum segment time, ms (default: the file's M205 B, else Marlin's
+    /// 20 ms): new segments are made at least this long at their feed where the tolerance
+    /// allows.
+    #[arg(long, value_name = "MS")]
+    pub min_segment_time: Option<f64>,
     /// Leave the file's time comments and M73 lines as the slicer wrote them.
     #[arg(long)]
     pub no_estimates: bool,
@@ -68,6 +73,7 @@ pub fn run(args: Args) -> Result<(), String> {
         allow_slower_pct: args.allow_slower,
         inside_corners: args.inside_corners,
         estimates: !args.no_estimates,
+        min_segment_time_ms: args.min_segment_time,
         ..VtgOptions::default()
     };
     let mut bar = output::ProgressBar::for_input(input.len());
@@ -123,5 +129,60 @@ fn print(out: &mut impl Write, r: &VtgReport) -> std::io::Result<()> {
     row(out, "material (g)", &t.material_g)?;
     row(out, "CO2 (g)", &t.co2_g)?;
     row(out, "time (s)", &t.time_s)?;
+    if let Some(f) = &r.firmware {
+        print_firmware(out, f)?;
+    }
+    Ok(())
+}
+
+/// The firmware's side: lines, bytes, short segments and the peak segment rate against the
+/// budget, and the warning when the rewrite exceeds it.
+fn print_firmware(
+    out: &mut impl Write,
+    f: &quietpath::vtg::firmware::FirmwareReport,
+) -> std::io::Result<()> {
+    let (b, a) = (&f.before, &f.after);
+    let rows: [(&str, f64, f64); 6] = [
+        ("lines", b.lines as f64, a.lines as f64),
+        ("bytes", b.bytes as f64, a.bytes as f64),
+        (
+            "segments < 0.1 mm",
+            b.segments_under_0_1mm as f64,
+            a.segments_under_0_1mm as f64,
+        ),
+        (
+            "segments < min time",
+            b.segments_under_min_time as f64,
+            a.segments_under_min_time as f64,
+        ),
+        (
+            "peak segments/s",
+            b.peak_segments_per_s,
+            a.peak_segments_per_s,
+        ),
+        (
+            "segment budget /s",
+            b.budget_segments_per_s,
+            a.budget_segments_per_s,
+        ),
+    ];
+    for (name, x, y) in rows {
+        let c = Comparison::new(x, y);
+        writeln!(
+            out,
+            "{:<28} {:>14.0} {:>14.0} {:>8.2}%",
+            name, c.before, c.after, c.change_pct
+        )?;
+    }
+    writeln!(
+        out,
+        "min segment time {} ms ({}), block buffer {}",
+        f.budget.min_segment_time_s * 1000.0,
+        f.budget.min_segment_time_source,
+        f.budget.block_buffer
+    )?;
+    if let Some(w) = &f.warning {
+        writeln!(out, "warning: {w}")?;
+    }
     Ok(())
 }

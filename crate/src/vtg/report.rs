@@ -121,6 +121,11 @@ pub struct PathCounts {
     /// dynamics model found that the rewrite at 1 left the machine ringing more than the
     /// original (see [`crate::vtg::VtgOptions::dynamics`]).
     pub feed_cap_scale: f64,
+    /// Whether the walked steps were joined up to the firmware's segment budget
+    /// ([`crate::vtg::VtgOptions::min_segment_time_ms`]); `false` where the dynamics model
+    /// found the joined rewrite ringing more than the original and the steps as walked
+    /// quieter (see [`crate::vtg::VtgOptions::dynamics`]).
+    pub steps_joined: bool,
     /// Arcs (`G2`/`G3`) written (with the `arcs` option), each in place of several steps.
     pub arcs_written: u64,
     /// Single corners too tight to fillet that were turned round a keyhole loop instead
@@ -166,6 +171,9 @@ pub struct VtgReport {
     pub before: Report,
     /// Analysis of the output.
     pub after: Report,
+    /// Both files against the machine's segment budget: lines, bytes, short segments, the
+    /// peak segment rate ([`super::firmware`]); `None` only while the report is assembled.
+    pub firmware: Option<super::firmware::FirmwareReport>,
     /// The rewritten G-code.
     #[serde(skip)]
     pub output: Vec<u8>,
@@ -234,6 +242,7 @@ pub(crate) fn build(
                 0.0
             },
             feed_cap_scale: rewritten.feed_cap_scale,
+            steps_joined: rewritten.steps_joined,
             arcs_written: rewritten.arcs_written,
             keyholes: rewritten.keyholes,
         },
@@ -242,6 +251,7 @@ pub(crate) fn build(
         layers,
         before,
         after,
+        firmware: None,
         output: rewritten.output,
     }
 }

@@ -434,6 +434,8 @@ export interface VtgOptions {
   inside_corners?: boolean;
   /** Rewrite the file's time comments and M73 lines from the planner when the toolpath changed (default true). */
   estimates?: boolean;
+  /** The firmware's minimum segment time, ms (default: the file's M205 B, else Marlin's 20 ms): new segments are joined up to this long at their feed where the tolerance allows. */
+  min_segment_time_ms?: number | null;
 }
 /** before, after and the relative change in percent. */
 export interface Comparison { before: number; after: number; change_pct: number }
@@ -468,6 +470,8 @@ export interface VtgReport {
     mean_speed_fluctuation_pct: number;
     /** Scale the eq. 29 speeds started from: 1, or 1.5 / 2 where the dynamics model found the rewrite at 1 rang more than the original. */
     feed_cap_scale: number;
+    /** Whether the walked steps were joined up to the firmware's segment budget (false where the dynamics model found the steps as walked quieter). */
+    steps_joined: boolean;
     /** Arcs (G2/G3) written in place of runs of steps on a circle (option `arcs`). */
     arcs_written: number;
     /** Single corners too tight to fillet (wedge tips) turned round a small keyhole loop instead; 0 where the dynamics model found the loops ringing more than the original. */
@@ -495,6 +499,32 @@ export interface VtgReport {
   layers: { index: number; before: ToolpathMetrics; after: ToolpathMetrics }[];
   before: Report;
   after: Report;
+  /** Both files against the machine's segment budget (Marlin's min_segment_time and block buffer, a serial stream's line rate). */
+  firmware: {
+    budget: {
+      min_segment_time_s: number;
+      /** "file" (M205 B), "option" or "default". */
+      min_segment_time_source: string;
+      block_buffer: number;
+      stream_bytes_per_s: number;
+    };
+    before: FirmwareFigures;
+    after: FirmwareFigures;
+    /** Set when the rewrite's peak segment rate exceeds the budget (and the original's). */
+    warning: string | null;
+  } | null;
+}
+/** How one file measures against the segment budget. */
+export interface FirmwareFigures {
+  lines: number;
+  bytes: number;
+  printing_segments: number;
+  segments_under_0_1mm: number;
+  segments_under_min_time: number;
+  /** Most planned moves that start within any 1 s of planned time. */
+  peak_segments_per_s: number;
+  /** Segments per second the firmware reads at this file's mean bytes per line. */
+  budget_segments_per_s: number;
 }
 /** vtg() result: the report plus the rewritten file. */
 export interface VtgResult extends VtgReport { output: Uint8Array }

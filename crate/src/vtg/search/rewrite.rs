@@ -66,6 +66,8 @@ pub(crate) struct Rewritten {
     pub(crate) walk: WalkStats,
     /// The first scale of the VTG eq. 29 speeds each rewrite was tried with.
     pub(crate) feed_cap_scale: f64,
+    /// Whether the walked steps were joined up to the segment budget ([`Variant::thin`]).
+    pub(crate) steps_joined: bool,
     /// Arcs (`G2`/`G3`) written.
     pub(crate) arcs_written: u64,
     /// Corners turned round keyhole loops.
@@ -154,7 +156,15 @@ pub(crate) fn offers(
     if !aligned {
         return Ok(out);
     }
-    let settings = file_settings(path, options, limits, variant);
+    let budget = crate::vtg::firmware::SegmentBudget::for_file(
+        input,
+        path.junction_model,
+        options.min_segment_time_ms,
+    );
+    let settings = Settings {
+        min_segment_s: variant.thin.then_some(budget.min_segment_time_s),
+        ..file_settings(path, options, limits, variant)
+    };
     let energy = Accumulator::new(
         &options.analyze.energy.clone().unwrap_or_default(),
         &path.profile.name,
@@ -236,6 +246,7 @@ fn file_settings(
         klipper_scv_mm_s: (path.junction_model == JunctionModel::Klipper)
             .then(|| square_corner_velocity(&path.print_limits))
             .flatten(),
+        min_segment_s: Some(crate::vtg::firmware::MARLIN_MIN_SEGMENT_TIME_S),
         line: if options.inside_corners {
             crate::vtg::blend::Line::Inside
         } else {
@@ -329,6 +340,7 @@ impl Offers {
         let mut out = Rewritten {
             candidate_paths: self.candidate_paths,
             feed_cap_scale: self.variant.feed_cap_scale,
+            steps_joined: self.variant.thin,
             ..Rewritten::default()
         };
         let choice = budget::choose(

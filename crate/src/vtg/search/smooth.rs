@@ -20,6 +20,7 @@ use crate::vtg::fit::fit;
 use crate::vtg::hairpin::{self, Hairpin};
 use crate::vtg::kinematics::KinematicLimits;
 use crate::vtg::resample::{walk_curve, Sample, Walk, WalkStats};
+use crate::vtg::thin::{thin, Followed, Thin};
 use crate::vtg::tuning::TUNING;
 
 /// Settings for [`smooth_path`].
@@ -67,6 +68,10 @@ pub(crate) struct Settings {
     /// sharp corners are then turned as polygons placed for its look-ahead
     /// ([`crate::vtg::corners::klipper`]).
     pub(crate) klipper_scv_mm_s: Option<f64>,
+    /// The firmware's minimum segment time, s ([`crate::vtg::firmware::SegmentBudget`]):
+    /// walked steps are joined up to `v · t_min` where the tolerance allows
+    /// ([`crate::vtg::thin`]); `None`: written as walked.
+    pub(crate) min_segment_s: Option<f64>,
 }
 
 /// A rewritten path: the new geometry, and what the feed of each new segment is made of.
@@ -676,6 +681,7 @@ fn walk_within(
     if let (Some(last), Some(pn)) = (points.last_mut(), pts.last()) {
         *last = *pn;
     }
+    let (walked, points) = thinned(path, walked, points, s, &w, budget);
     // Both ways: the new path stays near the old, and the old is covered by the new.
     let deviation = both_ways(&points, original, tol / 10.0, budget);
     if deviation.is_nan() || deviation > budget {
@@ -687,6 +693,74 @@ fn walk_within(
         deviation_mm: deviation,
         stats,
     })
+}
+
+/// The walked samples and their points thinned to the firmware's segment budget
+/// ([`thin`]): Algorithm 1's `L_i` lengthened up to `v · t_min` where the tolerance and the
+/// turn allow. A joined segment carries the largest curvature of the steps it joins, so its
+/// VTG eq. 29 feed cap is no higher than theirs.
+fn thinned(
+    path: &SmoothPath<'_>,
+    walked: Vec<Sample>,
+    points: Vec<[f64; 3]>,
+    s: &Settings,
+    w: &Walk,
+    budget: f64,
+) -> (Vec<Sample>, Vec<[f64; 3]>) {
+    let Some(min_segment_s) = s.min_segment_s else {
+        return (walked, points);
+    };
+    // Paths that climb (vase mode) keep their steps: each point's Z is written, and joining
+    // them changes the heights a reader counts layers by (the FullControl ripple vase read
+    // back with another layer count).
+    let z0 = points.first().map_or(0.0, |p| p[2]);
+    if points.iter().any(|p| (p[2] - z0).abs() > 1e-9) {
+        return (walked, points);
+    }
+    let arc = arc_lengths(path.pts);
+    let followed = Followed {
+        pts: path.pts,
+        arc: &arc,
+        feed: path.feed,
+    };
+    let t = Thin {
+        budget_mm: budget,
+        max_turn_rad: w.max_turn_rad,
+        min_segment_s,
+        step_mm: s.tolerance_mm / 10.0,
+    };
+    let u: Vec<f64> = walked.iter().map(|x| x.u).collect();
+    let mut keep = thin(&points, &u, &followed, &t);
+    // Still more points than the original had: join as far as the tolerance and the turn
+    // allow, whatever the segment time (the rewrite needs no more lines than it replaces
+    // unless its corners demand them).
+    if keep.len() > path.pts.len() && t.min_segment_s > 0.0 {
+        let longest = Thin {
+            min_segment_s: 0.0,
+            ..t
+        };
+        keep = thin(&points, &u, &followed, &longest);
+    }
+    if keep.len() == points.len() {
+        return (walked, points);
+    }
+    let mut samples = Vec::with_capacity(keep.len());
+    let mut kept = Vec::with_capacity(keep.len());
+    let mut from = 0usize;
+    for &k in &keep {
+        let (Some(x), Some(p)) = (walked.get(k), points.get(k)) else {
+            return (walked, points);
+        };
+        let mut x = *x;
+        for y in walked.get(from + 1..k).unwrap_or(&[]) {
+            x.kappa = x.kappa.max(y.kappa);
+            x.mean_kappa = x.mean_kappa.max(y.mean_kappa);
+        }
+        samples.push(x);
+        kept.push(*p);
+        from = k;
+    }
+    (samples, kept)
 }
 
 /// What [`walk_within`] gives: the walk's samples, their points with the ends pinned, the
@@ -780,6 +854,7 @@ mod tests {
             keyholes: true,
             line: blend::Line::Racing,
             klipper_scv_mm_s: None,
+            min_segment_s: Some(0.0),
         }
     }
 

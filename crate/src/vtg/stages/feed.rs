@@ -76,8 +76,55 @@ impl Smoothed {
             let accel: Vec<f64> = self.steps.iter().map(|st| st.accel).collect();
             ramp_up(&mut out, start, first.programmed, jerk, &accel);
         }
+        join_collinear(&mut out, start);
         out
     }
+}
+
+/// Largest turn between two segments joined as one, rad: well under the 0.001 mm rounding of
+/// written coordinates over the shortest step.
+const COLLINEAR_RAD: f64 = 1e-4;
+
+/// Joins consecutive segments that run in one direction at one feed: the pieces a path was
+/// cut into (at keyholes, polygons, retries) meet on straights, and the firmware gains nothing
+/// from a junction that does not turn (the segment budget, [`crate::vtg::firmware`]). The
+/// filament is cumulative, so the joined segment keeps its end's.
+fn join_collinear(out: &mut Written, start: [f64; 3]) {
+    let n = out.points.len();
+    if n < 2 || out.e.len() != n || out.feed_mm_s.len() != n {
+        return;
+    }
+    let mut keep = Vec::with_capacity(n);
+    let mut from = start;
+    for i in 0..n - 1 {
+        let (a, b, c) = (from, out.points[i], out.points[i + 1]);
+        let (d0, d1) = (sub(b, a), sub(c, b));
+        let (n0, n1) = (norm(d0), norm(d1));
+        let same_feed = (out.feed_mm_s[i] - out.feed_mm_s[i + 1]).abs() <= 1e-9;
+        let cos = if n0 > 0.0 && n1 > 0.0 {
+            crate::vec3::dot(d0, d1) / (n0 * n1)
+        } else {
+            -1.0
+        };
+        // Filament per mm equal too: the joined segment spreads it evenly.
+        let e0 = out.e[i] - if i == 0 { 0.0 } else { out.e[i - 1] };
+        let e1 = out.e[i + 1] - out.e[i];
+        let even = n0 > 0.0 && n1 > 0.0 && (e0 / n0 - e1 / n1).abs() <= 1e-3 * (e0 / n0).abs();
+        // Only at one height: a climbing path keeps the Z of every point (see `thinned`).
+        let level = d0[2] == 0.0 && d1[2] == 0.0;
+        let joined = level && same_feed && even && cos >= COLLINEAR_RAD.cos();
+        if !joined {
+            from = b;
+        }
+        keep.push(!joined);
+    }
+    keep.push(true);
+    let mut k = keep.iter();
+    out.points.retain(|_| k.next() == Some(&true));
+    let mut k = keep.iter();
+    out.e.retain(|_| k.next() == Some(&true));
+    let mut k = keep.iter();
+    out.feed_mm_s.retain(|_| k.next() == Some(&true));
 }
 
 /// Splits segments where the written feed rises by more than a classic-jerk planner takes

@@ -7,3 +7,4 @@ pub(crate) mod feed;
 pub(crate) mod fit;
 pub(crate) mod kinematics;
 pub(crate) mod resample;
+pub(crate) mod thin;
