@@ -34,6 +34,21 @@ fn oracle() -> PathBuf {
     path
 }
 
+/// `run` the oracle for `version`; its first run of each version alone. On first use the
+/// oracle sets itself up (a venv, then a build per Klipper version), and two set-ups at once
+/// fail on a fresh machine (`File exists`); the two versions' tests run in parallel.
+fn first_alone<T>(version: &str, run: impl FnOnce() -> T) -> T {
+    static SET_UP: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+    let mut set_up = SET_UP.lock().unwrap_or_else(|e| e.into_inner());
+    if set_up.iter().any(|v| v == version) {
+        drop(set_up);
+        return run();
+    }
+    let out = run();
+    set_up.push(version.to_owned());
+    out
+}
+
 /// Klipper's planned time of each source line of `file` (summed over its moves), and the
 /// whole file's moves and dwells (without the 2 ms Klipper inserts when it restarts step
 /// generation after `G28`, an artefact of its MCU timing).
@@ -44,13 +59,15 @@ fn klipper_times(file: &Path, version: &str) -> (BTreeMap<u32, f64>, f64) {
         version,
         file.file_stem().and_then(|s| s.to_str()).unwrap_or("file")
     ));
-    let out = Command::new(oracle())
-        .arg(file)
-        .env("KLIPPER_VERSION", version)
-        .env("KLIPPER_JSON", "1")
-        .env("KLIPPER_DUMP", &dump)
-        .output()
-        .expect("run the Klipper oracle");
+    let out = first_alone(version, || {
+        Command::new(oracle())
+            .arg(file)
+            .env("KLIPPER_VERSION", version)
+            .env("KLIPPER_JSON", "1")
+            .env("KLIPPER_DUMP", &dump)
+            .output()
+            .expect("run the Klipper oracle")
+    });
     // klippy may crash on its way out after its report (exit 139): the report decides.
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
         panic!(

@@ -22,6 +22,21 @@ fn shared() -> PathBuf {
     corpus_dir().join("..")
 }
 
+/// `run` the oracle for `version`; its first run of each version alone: the oracle sets
+/// itself up on first use (a venv, a build per version), which is not safe to do twice at
+/// once, and this file's two tests run in parallel.
+fn first_alone<T>(version: &str, run: impl FnOnce() -> T) -> T {
+    static SET_UP: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+    let mut set_up = SET_UP.lock().unwrap_or_else(|e| e.into_inner());
+    if set_up.iter().any(|v| v == version) {
+        drop(set_up);
+        return run();
+    }
+    let out = run();
+    set_up.push(version.to_owned());
+    out
+}
+
 /// The time Klipper plans for `file` (`time_s` of the oracle's report), or a failure that
 /// says why.
 fn klipper_time(file: &Path, version: &str) -> f64 {
@@ -39,13 +54,15 @@ fn klipper_time(file: &Path, version: &str) -> f64 {
     } else {
         "G28"
     };
-    let out = Command::new(&oracle)
-        .arg(file)
-        .env("KLIPPER_VERSION", version)
-        .env("KLIPPER_JSON", "1")
-        .env("KLIPPER_PREAMBLE", preamble)
-        .output()
-        .expect("run the Klipper oracle");
+    let out = first_alone(version, || {
+        Command::new(&oracle)
+            .arg(file)
+            .env("KLIPPER_VERSION", version)
+            .env("KLIPPER_JSON", "1")
+            .env("KLIPPER_PREAMBLE", preamble)
+            .output()
+            .expect("run the Klipper oracle")
+    });
     // klippy may crash on its way out after printing its report: the report decides.
     let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
         panic!(
