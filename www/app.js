@@ -1148,9 +1148,30 @@ async function refresh3d(refit = false) {
     partView.setLayers(shown, ghost, { colorBy: viewer.colorBy, showTravel: viewer.showTravel, range, bed: viewer.bed }, refit);
     canvas3d.dataset.layers = String(shown.length);
     els.layerInfo.textContent = `3-D: layers ${from + 1}–${to + 1}${stride > 1 ? ` (every ${stride}th, to stay quick)` : ''} of the ${which === 'after' ? 'optimized output' : 'file'} · ${formatCount(Number(canvas3d.dataset.segments))} segments`;
+    canvas3d.setAttribute('aria-label', describe3d(shown, { from, to, count, stride, which, ghost: !!ghost }));
   } catch (err) {
     if (!(err instanceof Cancelled)) els.layerInfo.textContent = `Cannot draw the 3-D view: ${/** @type {Error} */ (err).message}`;
   }
+}
+
+const KEYS_3D = 'Drag to orbit, right-drag or Shift+drag to pan, wheel or pinch to zoom, arrow keys to orbit, +/- to zoom.';
+
+/**
+ * The 3-D canvas's text alternative: which layers of which file, their heights, what is
+ * drawn and in which colours, and the keys.
+ * @param {{ z: number | null }[]} shown the layers drawn
+ * @param {{ from: number, to: number, count: number, stride: number, which: 'before' | 'after', ghost: boolean }} what
+ * @returns {string}
+ */
+function describe3d(shown, { from, to, count, stride, which, ghost }) {
+  const zs = shown.map((g) => g.z).filter(isNum);
+  const heights = zs.length ? `, z = ${Math.min(...zs).toFixed(2)} to ${Math.max(...zs).toFixed(2)} mm` : '';
+  const colours = { feature: 'feature', speed: 'speed', curvature: 'curvature', 'layer-time': 'layer time' }[viewer.colorBy] ?? viewer.colorBy;
+  return (
+    `The part in 3-D: layers ${from + 1} to ${to + 1} of ${count}${stride > 1 ? ` (every ${stride}th)` : ''}${heights}, ` +
+    `of the ${which === 'after' ? 'optimized output' : 'file'}${ghost ? ' over the original in grey' : ''}, ` +
+    `${formatCount(Number(canvas3d.dataset.segments))} segments, coloured by ${colours}${viewer.showTravel ? ', travels shown' : ''}. ${KEYS_3D}`
+  );
 }
 
 /** Colour range of speed or curvature over the layers (curvature clipped at its 95th percentile). */

@@ -45,6 +45,38 @@ export function clearChart(container, message) {
   p.textContent = message;
   container.replaceChildren(p);
   container.dataset.series = '0';
+  // The message is text: no picture to describe.
+  container.removeAttribute('role');
+  container.removeAttribute('aria-label');
+}
+
+/**
+ * A chart's text alternative: its caption (or what it plots against what), the x range, and
+ * each series' lowest and highest values with where they are.
+ * @param {HTMLElement} container
+ * @param {ChartSpec} spec
+ * @returns {string}
+ */
+export function describeChart(container, spec) {
+  /** @param {number} v */
+  const fmt = (v) => (Math.abs(v) >= 100 || Number.isInteger(v) ? Math.round(v).toLocaleString('en-US') : String(Number(v.toPrecision(3))));
+  const caption = container.closest('figure')?.querySelector('figcaption')?.textContent?.trim();
+  const name = spec.title ?? caption ?? `${spec.yLabel} against ${spec.xLabel}`;
+  const { x } = spec;
+  if (x.length === 0) return `${name}: no data.`;
+  const series = spec.series.map((s) => {
+    let lo = -1;
+    let hi = -1;
+    s.values.forEach((v, j) => {
+      if (v == null || !Number.isFinite(v)) return;
+      if (lo < 0 || v < /** @type {number} */ (s.values[lo])) lo = j;
+      if (hi < 0 || v > /** @type {number} */ (s.values[hi])) hi = j;
+    });
+    if (lo < 0) return `${s.label}: no values`;
+    const at = (/** @type {number} */ j) => `${fmt(/** @type {number} */ (s.values[j]))} at ${spec.xLabel} ${fmt(x[j])}`;
+    return `${s.label} from ${at(lo)} to ${at(hi)}`;
+  });
+  return `${name}: ${x.length} points, ${spec.xLabel} ${fmt(x[0])} to ${fmt(x[x.length - 1])}; ${series.join('; ')}.`;
 }
 
 /**
@@ -128,6 +160,10 @@ export function lineChart(container, spec) {
   charts.set(container, { plot, observer });
   container.dataset.series = String(spec.series.length);
   container.dataset.points = String(x.length);
+  // A picture to assistive technology, named by what it shows (uPlot's canvas and live legend
+  // are for the pointer).
+  container.setAttribute('role', 'img');
+  container.setAttribute('aria-label', describeChart(container, spec));
   return plot;
 }
 

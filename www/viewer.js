@@ -454,6 +454,31 @@ export class LayerViewer {
       canvas.dataset.bed = `${+(Math.max(...xs) - Math.min(...xs)).toFixed(1)} × ${+(Math.max(...ys) - Math.min(...ys)).toFixed(1)} mm`;
     } else delete canvas.dataset.bed;
     this.renderLegend(range);
+    const label = this.describe(drawn);
+    if (canvas.getAttribute('aria-label') !== label) canvas.setAttribute('aria-label', label);
+  }
+
+  /**
+   * The canvas's text alternative, kept in step with every redraw: which layer is shown (its
+   * number and height), what is drawn and in which colours (the legend), and the keys.
+   * @param {number} segments how many segments the last draw stroked
+   * @returns {string}
+   */
+  describe(segments) {
+    const keys = 'Wheel or +/- to zoom, drag or arrow keys to pan, double-click or 0 to fit the layer, B to see the whole bed.';
+    const g = this.before ?? this.after;
+    if (!g || !this.view) return `Toolpath of the selected layer: nothing loaded yet. ${keys}`;
+    /** @param {LayerMessage | null} l */
+    const z = (l) => (l && typeof l.z === 'number' && Number.isFinite(l.z) ? `z = ${l.z.toFixed(2)} mm` : 'no height');
+    const panes = this.panes();
+    const what = panes.length > 1 ? `before and after side by side (after at ${z(this.after)})` : panes[0].label === 'after over before' ? `the optimized file (at ${z(this.after)}) over the original` : panes[0].label === 'after' ? `the optimized file, at ${z(this.after)}` : 'the file';
+    const colours = { feature: 'feature', speed: 'speed', curvature: 'curvature', 'layer-time': 'layer time' }[this.colorBy] ?? this.colorBy;
+    // The legend's entries: a swatch and its name, or the colour ramp's ends ("12 to 150 mm/s").
+    const legend = [...this.legend.children]
+      .map((li) => [...li.childNodes].map((n) => (n.textContent ?? '').trim()).filter(Boolean).join(li.classList.contains('ramp') ? ' to ' : ' '))
+      .filter(Boolean)
+      .join(', ');
+    return `Layer ${g.index + 1} of ${g.count}, ${z(g)}: ${what}, ${segments.toLocaleString('en-US')} segments drawn, coloured by ${colours}${legend ? ` (${legend})` : ''}. ${keys}`;
   }
 
   /**
