@@ -238,7 +238,7 @@ function build(list, ghost, { colorBy, showTravel, range }) {
   };
   let j = 0;
   for (const g of list) {
-    const z = Number.isFinite(g.z) ? g.z : 0;
+    const z = typeof g.z === 'number' && Number.isFinite(g.z) ? g.z : 0;
     const { xy, kind } = g;
     for (let i = 0; i < kind.length; i++) {
       const travel = kind[i] === 0;

@@ -430,7 +430,7 @@ export class LayerViewer {
         if (panes.length > 1 || p.label) {
           ctx.font = '12px system-ui, sans-serif';
           ctx.fillStyle = getComputedStyle(canvas).color;
-          ctx.fillText(p.label + (p.geom && Number.isFinite(p.geom.z) ? `  z = ${p.geom.z.toFixed(2)} mm` : ''), p.x + 8, 16);
+          ctx.fillText(p.label + (p.geom && typeof p.geom.z === 'number' && Number.isFinite(p.geom.z) ? `  z = ${p.geom.z.toFixed(2)} mm` : ''), p.x + 8, 16);
         }
         ctx.restore();
       }

@@ -96,6 +96,7 @@ const ready = init().then(
     } catch {
       // version() is informational only
     }
+    /** @type {qp.MachineProfile[]} */
     let machines = [];
     try {
       machines = typeof qp.machines === 'function' ? qp.machines() : [];
