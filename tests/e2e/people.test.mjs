@@ -490,10 +490,9 @@ test('accessibility: the viewer, the 3-D view and every chart say what they show
   // Tab order follows the page: no positive tabindex, and Tab visits the controls in document order.
   const positive = await page.evaluate(() => [...document.querySelectorAll('[tabindex]')].filter((e) => e.tabIndex > 0).map((e) => e.outerHTML.slice(0, 100)));
   assert.deepEqual(positive, []);
-  await page.evaluate(() => {
-    document.activeElement?.blur?.();
-    window.scrollTo(0, 0);
-  });
+  // A fresh page: Tab starts from the top of the document.
+  await page.goto(baseUrl);
+  assert.equal(await settled(), 'ready');
   const visited = [];
   for (let i = 0; i < 200; i++) {
     await page.keyboard.press('Tab');
