@@ -452,19 +452,19 @@ test('accessibility: the viewer, the 3-D view and every chart say what they show
     else assert.deepEqual([c.role, c.label], [null, null], c.id);
   }
   const perLayer = [
-    ['chart-layer-time', 'Print time per layer, s', 'time, s'],
-    ['chart-layer-energy', 'Energy per layer, J', 'energy, J'],
-    ['chart-layer-filament', 'Filament per layer, mm', 'filament, mm'],
+    ['chart-layer-time', 'Print time per layer, s', 'time', 's'],
+    ['chart-layer-energy', 'Energy per layer, J', 'energy', 'J'],
+    ['chart-layer-filament', 'Filament per layer, mm', 'filament', 'mm'],
   ];
-  for (const [id, caption, series] of perLayer) {
+  for (const [id, caption, series, unit] of perLayer) {
     const text = await label(id);
-    const re = new RegExp(`^${caption}: ${n} points, layer 1 to ${n}; ${series} from [\\d.,]+ at layer \\d+ to [\\d.,]+ at layer \\d+\\.$`);
+    const re = new RegExp(`^${caption}: ${n} points, layer 1 to ${n}; ${series} from [\\d.,]+ ${unit} at layer \\d+ to [\\d.,]+ ${unit} at layer \\d+\\.$`);
     assert.match(text, re, id);
   }
   // The longest layer the time chart names is the report's.
   const times = report.layer_list.map((l) => l.time_s);
   const longest = times.indexOf(Math.max(...times)) + 1;
-  assert.match(await label('chart-layer-time'), new RegExp(` to [\\d.,]+ at layer ${longest}\\.$`));
+  assert.match(await label('chart-layer-time'), new RegExp(` to [\\d.,]+ s at layer ${longest}\\.$`));
   // Another printer: new per-layer times, a new summary.
   const timeLabel = await label('chart-layer-time');
   await byTestId('machine').selectOption('creality-ender3');
