@@ -8,7 +8,7 @@ export PATH := $(CURDIR)/node_modules/.bin:$(HOME)/.cargo/bin:$(PATH)
 CORPUS ?= $(CURDIR)/../shared/corpus
 LARGE := $(CORPUS)/curaengine-4.13.0_extruder-idler-x2.5_large.gcode
 
-.PHONY: all setup setup-test pkg serve test test-rust test-wasm test-js test-fuzz lint cli bench measurements fuzz clean
+.PHONY: all setup setup-test pkg serve test typecheck test-rust test-wasm test-js test-fuzz lint cli bench measurements fuzz clean
 
 all: pkg cli
 
@@ -19,7 +19,8 @@ setup-test:
 	@scripts/setup.sh test
 
 ## Build the npm package (pkg/: web, node and bundler builds under one package.json), link the
-## web build into the playground and copy uPlot and three.js (the 3-D view) beside it.
+## web build into the playground and copy uPlot and three.js (the 3-D view) beside it, each with
+## its TypeScript declarations for `make typecheck` (a .d.ts beside the .js is what tsc reads).
 pkg: setup
 	wasm-pack build crate --release --target web --out-dir ../pkg/web --out-name quietpath
 	wasm-pack build crate --release --target nodejs --out-dir ../pkg/node --out-name quietpath
@@ -29,6 +30,8 @@ pkg: setup
 	mkdir -p www/vendor
 	cp node_modules/uplot/dist/uPlot.esm.js node_modules/uplot/dist/uPlot.min.css www/vendor/
 	cp node_modules/three/build/three.module.js node_modules/three/build/three.core.js www/vendor/
+	cp node_modules/uplot/dist/uPlot.d.ts www/vendor/uPlot.esm.d.ts
+	cp www/types/three.module.d.ts www/vendor/
 
 ## Build the wasm and serve the playground on http://127.0.0.1:$(PORT)
 serve: pkg
@@ -38,8 +41,15 @@ serve: pkg
 cli:
 	cargo build --release
 
-## Everything: formatting, lints, Rust tests, wasm tests in Node, JS API and browser tests.
-test: setup-test lint test-rust test-wasm test-js test-fuzz
+## Everything: formatting, lints, the playground's type check, Rust tests, wasm tests in Node, JS API and browser tests.
+test: setup-test lint typecheck test-rust test-wasm test-js test-fuzz
+
+## `// @ts-check` on the playground's www/*.js: tsc over the page's modules and app.js (DOM) and
+## over the two workers (worker.js, sw.js: the webworker library). Needs www/pkg and www/vendor.
+typecheck: pkg
+	tsc -p www/tsconfig.json
+	tsc -p www/tsconfig.app.json
+	tsc -p www/tsconfig.worker.json
 
 lint:
 	cargo fmt --all -- --check

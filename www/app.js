@@ -1,3 +1,4 @@
+// @ts-check
 // quietpath playground: page logic.
 //
 // Reads a G-code file (picker, drag-and-drop or the bundled demo) as an
@@ -13,22 +14,29 @@ import { JobClient, Cancelled } from './jobs.js';
 import { LayerViewer } from './viewer.js';
 import { lineChart, clearChart, alignSeries, unionSeries } from './charts.js';
 
-const $ = (id) => document.getElementById(id);
+/** @typedef {import('./jobs.js').LayerMessage} LayerMessage */
+
+/**
+ * The element with this id: index.html has every one this file asks for.
+ * @param {string} id
+ * @returns {HTMLElement}
+ */
+const $ = (id) => /** @type {HTMLElement} */ (document.getElementById(id));
 
 const els = {
   status: $('status'),
   filename: $('filename'),
   elapsed: $('elapsed'),
-  progress: $('progress'),
-  cancel: $('cancel'),
+  progress: /** @type {HTMLProgressElement} */ ($('progress')),
+  cancel: /** @type {HTMLButtonElement} */ ($('cancel')),
   error: $('error'),
-  file: $('file'),
-  demo: $('demo'),
-  optionsForm: $('options-form'),
+  file: /** @type {HTMLInputElement} */ ($('file')),
+  demo: /** @type {HTMLButtonElement} */ ($('demo')),
+  optionsForm: /** @type {HTMLFormElement} */ ($('options-form')),
   results: $('results'),
   stats: $('stats'),
-  summary: $('summary'),
-  features: $('features'),
+  summary: /** @type {HTMLTableElement} */ ($('summary')),
+  features: /** @type {HTMLTableElement} */ ($('features')),
   featuresEmpty: $('features-empty'),
   extraPanel: $('extra-panel'),
   extra: $('extra'),
@@ -36,27 +44,27 @@ const els = {
   warningsCount: $('warnings-count'),
   warningsEmpty: $('warnings-empty'),
   reportJson: $('report-json'),
-  download: $('download'),
+  download: /** @type {HTMLButtonElement} */ ($('download')),
   version: $('version'),
   dropOverlay: $('drop-overlay'),
   // viewer
-  canvas: $('viewer'),
+  canvas: /** @type {HTMLCanvasElement} */ ($('viewer')),
   legend: $('legend'),
-  layerSlider: $('layer-slider'),
-  layerNumber: $('layer-number'),
+  layerSlider: /** @type {HTMLInputElement} */ ($('layer-slider')),
+  layerNumber: /** @type {HTMLOutputElement} */ ($('layer-number')),
   layerInfo: $('layer-info'),
-  colorBy: $('color-by'),
-  showTravel: $('show-travel'),
-  viewMode: $('view-mode'),
-  fit: $('fit'),
+  colorBy: /** @type {HTMLSelectElement} */ ($('color-by')),
+  showTravel: /** @type {HTMLInputElement} */ ($('show-travel')),
+  viewMode: /** @type {HTMLSelectElement} */ ($('view-mode')),
+  fit: /** @type {HTMLButtonElement} */ ($('fit')),
   // jobs
-  actionForms: [...document.querySelectorAll('form.action')],
+  actionForms: [...document.querySelectorAll('form.action')].map((f) => /** @type {HTMLFormElement} */ (f)),
   resultPanel: $('result-panel'),
   resultJob: $('result-job'),
   resultLine: $('result-line'),
-  compareTable: $('compare-table'),
+  compareTable: /** @type {HTMLTableElement} */ ($('compare-table')),
   paperTables: $('paper-tables'),
-  downloadGcode: $('download-gcode'),
+  downloadGcode: /** @type {HTMLButtonElement} */ ($('download-gcode')),
   chartInfill: $('chart-infill'),
   chartPsd: $('chart-psd'),
   chartLayers: $('chart-layers'),
@@ -124,8 +132,8 @@ function startRun(kind, name) {
 
 // The status, progress and Cancel move beside a running job's button (and stay in view while
 // it runs: sticky), and back under the file picker afterwards.
-const runState = document.querySelector('.run-state');
-const runStateHome = runState.parentElement;
+const runState = /** @type {HTMLElement} */ (document.querySelector('.run-state'));
+const runStateHome = /** @type {HTMLElement} */ (runState.parentElement);
 const runStateNext = runState.nextElementSibling;
 
 // Scrolled away from the running job's form, the progress floats at the bottom of the window.
@@ -138,7 +146,7 @@ function placeRunState(form) {
   runFormObserver.disconnect();
   runState.classList.remove('floating');
   if (form) {
-    form.querySelector('button[type="submit"]').after(runState);
+    submitOf(form).after(runState);
     runFormObserver.observe(form);
   } else runStateHome.insertBefore(runState, runStateNext);
   runState.classList.toggle('in-job', !!form);
@@ -244,7 +252,7 @@ function fileLimitCount(report) {
 }
 
 function renderMachinePicker() {
-  const sel = document.getElementById('machine');
+  const sel = /** @type {HTMLSelectElement} */ ($('machine'));
   const report = loaded?.report;
   const fromFile = fileLimitCount(report);
   const auto = report?.machine?.profile && machineChoice === '' ? report.machine.profile : null;
@@ -298,10 +306,10 @@ function readOptions() {
     if (r.error) errors.push(r.error);
     else if (r.value !== '') options[key] = r.value;
   }
-  const box = document.getElementById('options-error');
+  const box = $('options-error');
   box.textContent = errors.join(' ');
   box.hidden = errors.length === 0;
-  if (errors.length) document.getElementById('options').open = true;
+  if (errors.length) /** @type {HTMLDetailsElement} */ ($('options')).open = true;
   return { options, errors };
 }
 
@@ -382,7 +390,7 @@ async function run(source) {
     bytes = await source.load();
   } catch (err) {
     if (current !== run) return;
-    showError({ message: `Could not read ${source.name}: ${err?.message ?? err}` });
+    showError({ message: `Could not read ${source.name}: ${/** @type {Error | undefined} */ (err)?.message ?? err}` });
     finishRun('error');
     return;
   }
@@ -464,7 +472,7 @@ function demoSource() {
 /** Options of an action form: empty fields are left out (the function's defaults). */
 function jobOptions(form) {
   const options = {};
-  for (const input of form.elements) {
+  for (const input of fieldsOf(form)) {
     if (!input.name || input.name === 'target') continue;
     if (input.type === 'checkbox') {
       if (input.checked) options[input.name] = true;
@@ -500,21 +508,53 @@ function jobOptions(form) {
   return options;
 }
 
+/**
+ * An action form's Run button.
+ * @param {HTMLFormElement} form
+ */
+function submitOf(form) {
+  return /** @type {HTMLButtonElement} */ (form.querySelector('button[type="submit"]'));
+}
+
+/**
+ * An action form's line for notes and errors.
+ * @param {HTMLFormElement} form
+ */
+function noteOf(form) {
+  return /** @type {HTMLElement} */ (form.querySelector('.availability'));
+}
+
+/**
+ * The vibration form's "On" select (its `target` field: the loaded file or the output).
+ * @param {HTMLFormElement} form
+ */
+function targetOf(form) {
+  return /** @type {HTMLSelectElement} */ (form.elements.namedItem('target'));
+}
+
+/**
+ * A form's fields (inputs, selects and buttons: each has a name, a type and a value).
+ * @param {HTMLFormElement} form
+ */
+function fieldsOf(form) {
+  return /** @type {HTMLInputElement[]} */ ([...form.elements]);
+}
+
 function updateActions() {
   const busy = !!current;
   for (const form of els.actionForms) {
     const job = form.dataset.job;
-    const button = form.querySelector('button[type="submit"]');
-    const note = form.querySelector('.availability');
-    button.dataset.label ??= button.textContent;
+    const button = submitOf(form);
+    const note = noteOf(form);
+    button.dataset.label ??= button.textContent ?? '';
     const known = capabilities.size > 0;
     const available = capabilities.has(job);
-    const needsOutput = job === 'vibration' && form.elements.target.value === 'output' && !output;
+    const needsOutput = job === 'vibration' && targetOf(form).value === 'output' && !output;
     button.disabled = !available || !loaded || busy || needsOutput;
     button.textContent = known && !available ? 'Not available in this build' : button.dataset.label;
     if (note.classList.contains('field-error')) continue;
     note.textContent = !known ? '' : !available ? `${JOB_NAMES[job]} is not available in this build of the package.` : needsOutput ? 'Run VTG, infill or smoothing first.' : '';
-    if (job === 'vibration') form.elements.target.querySelector('option[value="output"]').disabled = !output;
+    if (job === 'vibration') /** @type {HTMLOptionElement} */ (targetOf(form).querySelector('option[value="output"]')).disabled = !output;
   }
   els.viewMode.disabled = !output;
 }
@@ -522,12 +562,12 @@ function updateActions() {
 /** Number fields of an action form against their min/max: the messages (empty: fine). */
 function jobErrors(form) {
   const errors = [];
-  for (const input of form.elements) {
+  for (const input of fieldsOf(form)) {
     if (input.type !== 'number') continue;
     const r = checkNumber(input);
     if (r.error) errors.push(r.error);
   }
-  for (const input of form.querySelectorAll('input[type="text"][name$="_deg"]')) {
+  for (const input of /** @type {NodeListOf<HTMLInputElement>} */ (form.querySelectorAll('input[type="text"][name$="_deg"]'))) {
     input.removeAttribute('aria-invalid');
     const bad = String(input.value).split(/[\s,;]+/).filter(Boolean).filter((x) => !Number.isFinite(Number(x)));
     if (bad.length) errors.push(optionError(input, `${bad.map((b) => `"${b}"`).join(', ')} ${bad.length > 1 ? 'are not numbers' : 'is not a number'} (give degrees separated by commas)`));
@@ -538,14 +578,14 @@ function jobErrors(form) {
 async function runJob(job, form) {
   if (!loaded || current) return;
   const errors = jobErrors(form);
-  const note = form.querySelector('.availability');
+  const note = noteOf(form);
   if (errors.length) {
     note.textContent = errors.join(' ');
     note.classList.add('field-error');
     return;
   }
   note.classList.remove('field-error');
-  const target = job === 'vibration' ? form.elements.target.value : 'input';
+  const target = job === 'vibration' ? /** @type {'input' | 'output'} */ (targetOf(form).value) : 'input';
   const options = jobOptions(form);
   startRun('job', loaded.name);
   const run = current;
@@ -644,7 +684,7 @@ function addJobEntry(job, result, outBytes, target, ms) {
 }
 
 function renderJobList(activeId) {
-  const list = document.getElementById('job-list');
+  const list = $('job-list');
   const pct = (a, b) => (isNum(a) && isNum(b) && b !== 0 ? signedPercent(a / b - 1) : null);
   list.replaceChildren(
     ...[...jobEntries].reverse().map((e) => {
@@ -677,7 +717,7 @@ function renderJobList(activeId) {
       );
     }),
   );
-  document.getElementById('job-list-panel').hidden = jobEntries.length === 0;
+  $('job-list-panel').hidden = jobEntries.length === 0;
 }
 
 function resultLine(job, r) {
@@ -753,6 +793,7 @@ function metricInfo(key) {
 }
 
 // Rows of the before/after table, in the order of the VTG paper's Tables 1 and 2.
+/** @type {[string, (r: any) => number | undefined, (v: number) => string, string][]} */
 const REPORT_METRICS = [
   ['Print time', (r) => r.time_s, formatDuration, METRICS.time_s[2]],
   ['Energy', (r) => r.energy?.total_j, formatEnergy, METRICS.total_j[2]],
@@ -842,7 +883,12 @@ function tableRows(t) {
   return [];
 }
 
-/** A paper table's { before, after, change_pct } rows, nested groups flattened: [{ key, name, before, after, change }]. */
+/**
+ * A paper table's { before, after, change_pct } rows, nested groups flattened: [{ key, name, before, after, change }].
+ * @param {any} t
+ * @param {string | null} [prefix]
+ * @returns {{ key: string, name: string, unit: string, explain: string, before: any, after: any, change: any }[]}
+ */
 function paperRows(t, prefix = null) {
   const rows = [];
   if (!t || typeof t !== 'object' || Array.isArray(t)) return rows;
@@ -986,16 +1032,16 @@ function renderLayerCharts(report) {
     ['chart-layer-energy', 'energy_j', 'energy, J'],
     ['chart-layer-filament', 'filament_mm', 'filament, mm'],
   ];
-  const summary = document.getElementById('layers-summary');
+  const summary = $('layers-summary');
   if (list.length === 0) {
-    for (const [id] of ids) clearChart(document.getElementById(id), 'No layers in this file.');
+    for (const [id] of ids) clearChart($(id), 'No layers in this file.');
     summary.textContent = '';
     return;
   }
   const x = list.map((l, i) => (isNum(l.index) ? l.index : i) + 1);
   const pick = (i) => showLayerAt(i, list[i]?.z);
   for (const [id, key, label] of ids) {
-    lineChart(document.getElementById(id), { x, xLabel: 'layer', yLabel: label, height: 200, points: list.length <= 60, series: [{ label, values: list.map((l) => (isNum(l[key]) ? l[key] : null)) }], onPick: pick });
+    lineChart($(id), { x, xLabel: 'layer', yLabel: label, height: 200, points: list.length <= 60, series: [{ label, values: list.map((l) => (isNum(l[key]) ? l[key] : null)) }], onPick: pick });
   }
   // Text alternative: the layers that take longest and shortest.
   const times = list.map((l) => l.time_s).filter(isNum);
@@ -1038,17 +1084,17 @@ async function showLayerAt(i, z) {
     writeHash();
     els.canvas.scrollIntoView({ block: 'nearest', behavior: 'smooth' });
   } catch (err) {
-    if (!(err instanceof Cancelled)) els.layerInfo.textContent = `Cannot show that layer: ${err.message}`;
+    if (!(err instanceof Cancelled)) els.layerInfo.textContent = `Cannot show that layer: ${/** @type {Error} */ (err).message}`;
   }
 }
 
 // ── 3-D view ───────────────────────────────────────────────────────────────
 
-const viewKind = $('view-kind');
-const canvas3d = $('view-3d');
+const viewKind = /** @type {HTMLSelectElement} */ ($('view-kind'));
+const canvas3d = /** @type {HTMLCanvasElement} */ ($('view-3d'));
 const range3d = $('range-3d');
-const layerFrom = $('layer-from');
-const layerTo = $('layer-to');
+const layerFrom = /** @type {HTMLInputElement} */ ($('layer-from'));
+const layerTo = /** @type {HTMLInputElement} */ ($('layer-to'));
 const MAX_3D_SEGMENTS = 1_500_000;
 let partView = null; // view3d.js's PartView, made the first time the 3-D view is shown
 const part3d = new Map(); // `${fileToken}:${which}` → (index → geometry), of the current file only
@@ -1102,9 +1148,30 @@ async function refresh3d(refit = false) {
     partView.setLayers(shown, ghost, { colorBy: viewer.colorBy, showTravel: viewer.showTravel, range, bed: viewer.bed }, refit);
     canvas3d.dataset.layers = String(shown.length);
     els.layerInfo.textContent = `3-D: layers ${from + 1}–${to + 1}${stride > 1 ? ` (every ${stride}th, to stay quick)` : ''} of the ${which === 'after' ? 'optimized output' : 'file'} · ${formatCount(Number(canvas3d.dataset.segments))} segments`;
+    canvas3d.setAttribute('aria-label', describe3d(shown, { from, to, count, stride, which, ghost: !!ghost }));
   } catch (err) {
-    if (!(err instanceof Cancelled)) els.layerInfo.textContent = `Cannot draw the 3-D view: ${err.message}`;
+    if (!(err instanceof Cancelled)) els.layerInfo.textContent = `Cannot draw the 3-D view: ${/** @type {Error} */ (err).message}`;
   }
+}
+
+const KEYS_3D = 'Drag to orbit, right-drag or Shift+drag to pan, wheel or pinch to zoom, arrow keys to orbit, +/- to zoom.';
+
+/**
+ * The 3-D canvas's text alternative: which layers of which file, their heights, what is
+ * drawn and in which colours, and the keys.
+ * @param {{ z: number | null }[]} shown the layers drawn
+ * @param {{ from: number, to: number, count: number, stride: number, which: 'before' | 'after', ghost: boolean }} what
+ * @returns {string}
+ */
+function describe3d(shown, { from, to, count, stride, which, ghost }) {
+  const zs = shown.map((g) => g.z).filter(isNum);
+  const heights = zs.length ? `, z = ${Math.min(...zs).toFixed(2)} to ${Math.max(...zs).toFixed(2)} mm` : '';
+  const colours = { feature: 'feature', speed: 'speed', curvature: 'curvature', 'layer-time': 'layer time' }[viewer.colorBy] ?? viewer.colorBy;
+  return (
+    `The part in 3-D: layers ${from + 1} to ${to + 1} of ${count}${stride > 1 ? ` (every ${stride}th)` : ''}${heights}, ` +
+    `of the ${which === 'after' ? 'optimized output' : 'file'}${ghost ? ' over the original in grey' : ''}, ` +
+    `${formatCount(Number(canvas3d.dataset.segments))} segments, coloured by ${colours}${viewer.showTravel ? ', travels shown' : ''}. ${KEYS_3D}`
+  );
 }
 
 /** Colour range of speed or curvature over the layers (curvature clipped at its 95th percentile). */
@@ -1153,8 +1220,15 @@ const layerCounts = { before: 0, after: 0 };
 let layerLoading = false;
 let layerWanted = false;
 
-// With a number `z`, the layer nearest that height (the worker finds it): how "after" shows
-// the layer at the same height as "before", whatever the output's layer count.
+/**
+ * One layer's drawing data, cached. With a number `z`, the layer nearest that height (the
+ * worker finds it): how "after" shows the layer at the same height as "before", whatever the
+ * output's layer count.
+ * @param {'before' | 'after'} which
+ * @param {number} index
+ * @param {number | null} [z]
+ * @returns {Promise<LayerMessage>}
+ */
 async function getLayer(which, index, z = null) {
   const key = `${fileToken}:${which}:${isNum(z) ? `z${z}` : index}`;
   if (layerCache.has(key)) return layerCache.get(key);
@@ -1205,7 +1279,7 @@ async function refreshLayers() {
       updateLayerTime();
     } while (layerWanted && loaded);
   } catch (err) {
-    if (!(err instanceof Cancelled)) els.layerInfo.textContent = `Cannot draw this layer: ${err.message}`;
+    if (!(err instanceof Cancelled)) els.layerInfo.textContent = `Cannot draw this layer: ${/** @type {Error} */ (err).message}`;
   } finally {
     layerLoading = false;
   }
@@ -1243,7 +1317,7 @@ function writeHash() {
   if (els.showTravel.checked) p.set('travel', '1');
   p.set('view', els.viewMode.value);
   for (const form of els.actionForms) {
-    for (const input of form.elements) {
+    for (const input of fieldsOf(form)) {
       if (input.type === 'checkbox') {
         if (input.checked) p.set(`${form.dataset.job}.${input.name}`, '1');
       } else if (input.name && String(input.value).trim() !== '' && !(input.name === 'target' && input.value === 'input')) {
@@ -1259,12 +1333,12 @@ function writeHash() {
 function readHash() {
   const p = hashState();
   const color = p.get('color');
-  if (['feature', 'speed', 'curvature', 'layer-time'].includes(color)) els.colorBy.value = color;
+  if (color && ['feature', 'speed', 'curvature', 'layer-time'].includes(color)) els.colorBy.value = color;
   els.showTravel.checked = p.get('travel') === '1';
   const view = p.get('view');
-  if (['before', 'after', 'side', 'overlay'].includes(view)) els.viewMode.value = view;
+  if (view && ['before', 'after', 'side', 'overlay'].includes(view)) els.viewMode.value = view;
   for (const form of els.actionForms) {
-    for (const input of form.elements) {
+    for (const input of fieldsOf(form)) {
       if (!input.name) continue;
       const v = p.get(`${form.dataset.job}.${input.name}`);
       if (input.type === 'checkbox') input.checked = v === '1';
@@ -1298,6 +1372,7 @@ function el(tag, attrs = {}, ...children) {
   return node;
 }
 
+/** @type {(v: unknown) => v is number} */
 const isNum = (v) => typeof v === 'number' && Number.isFinite(v);
 const nf = (digits) => new Intl.NumberFormat('en-US', { maximumFractionDigits: digits, minimumFractionDigits: digits });
 const fmt0 = nf(0);
@@ -1350,7 +1425,7 @@ function toJson(value, space) {
   return JSON.stringify(
     value,
     (_key, v) => {
-      if (ArrayBuffer.isView(v)) return Array.from(v);
+      if (ArrayBuffer.isView(v)) return Array.from(/** @type {Float64Array} */ (v)); // a typed array
       if (v instanceof Map) return Object.fromEntries(v);
       if (typeof v === 'bigint') return Number.isSafeInteger(Number(v)) ? Number(v) : v.toString();
       return v;
@@ -1418,7 +1493,7 @@ function timedAs(m) {
 
 /** The planner's limits, each with its value, unit and where it came from. */
 function renderLimits(r) {
-  const box = document.getElementById('machine-limits');
+  const box = $('machine-limits');
   const limits = r.machine?.limits ?? {};
   const source = (l) => (l.source === 'profile' ? `the ${r.machine.profile} preset` : LIMIT_SOURCES[l.source] ?? String(l.source).replaceAll('_', ' '));
   const rows = Object.entries(limits)
@@ -1430,9 +1505,9 @@ function renderLimits(r) {
       const from = [...new Set(list.map(source))].join('; ');
       return el('tr', { 'data-limit': k }, el('th', { scope: 'row', text: name }), el('td', {}, value, el('small', { class: 'explain', text: `from ${from}` })));
     });
-  box.querySelector('tbody').replaceChildren(...rows);
+  /** @type {HTMLElement} */ (box.querySelector('tbody')).replaceChildren(...rows);
   const fromFile = fileLimitCount(r);
-  box.querySelector('summary').textContent = `Printer limits and where each came from (${fromFile ? `${fromFile} set by the file` : 'none set by the file'})`;
+  /** @type {HTMLElement} */ (box.querySelector('summary')).textContent = `Printer limits and where each came from (${fromFile ? `${fromFile} set by the file` : 'none set by the file'})`;
   box.hidden = rows.length === 0;
 }
 
@@ -1527,6 +1602,7 @@ function renderWarnings(r) {
 function formatByKey(key, v) {
   if (!isNum(v)) return formatScalar(v);
   // Compound units first: `_mm_s` is a speed, not a duration.
+  /** @type {[RegExp, string][]} */
   const units = [
     [/_kg_per_kwh$/, 'kg/kWh'], [/_kg_per_kg$/, 'kg/kg'],
     [/_mm_s3$/, 'mm/s³'], [/_mm_s2$/, 'mm/s²'], [/_mm_s$/, 'mm/s'], [/_m_s2$/, 'm/s²'], [/_per_mm_deg$/, '°/mm'], [/_per_mm$/, '/mm'],
@@ -1603,6 +1679,12 @@ function showJson(value, filename) {
   els.reportJson.textContent = toJson(value, 2);
 }
 
+/**
+ * Shows a failure: its message, and where it is in the file when known (line, column, the
+ * line's text with a caret).
+ * @param {{ message?: string, line?: number | null, column?: number | null, excerpt?: string | null }} err
+ * @param {{ keepResults?: boolean }} [opts]
+ */
 function showError({ message, line, column, excerpt }, { keepResults = false } = {}) {
   // After a failed load, whatever report is shown belongs to another file.
   if (!keepResults) els.results.hidden = true;
@@ -1668,11 +1750,11 @@ els.cancel.addEventListener('click', () => cancel());
 els.download.addEventListener('click', downloadReport);
 els.downloadGcode.addEventListener('click', downloadGcode);
 function showPrinterSettingsName() {
-  const nameEl = document.getElementById('printer-settings-name');
+  const nameEl = $('printer-settings-name');
   nameEl.textContent = printerSettings
     ? `${printerSettings.name} (${printerSettings.key === 'klipper_config' ? 'Klipper printer.cfg' : 'Marlin M503 settings'})`
     : 'none: limits from the file and the preset';
-  document.getElementById('printer-settings-clear').hidden = !printerSettings;
+  $('printer-settings-clear').hidden = !printerSettings;
 }
 
 function setMachine(choice) {
@@ -1697,17 +1779,18 @@ async function setPrinterSettings(file) {
   if (lastSource && lastSource.name && !current) run(lastSource);
 }
 
-document.getElementById('machine').addEventListener('change', (e) => {
-  setMachine(e.target.value);
+$('machine').addEventListener('change', (e) => {
+  setMachine(/** @type {HTMLSelectElement} */ (e.target).value);
   if (lastSource && lastSource.name && !current) run(lastSource);
 });
 
-document.getElementById('printer-settings').addEventListener('change', (e) => {
+$('printer-settings').addEventListener('change', (e) => {
   e.stopPropagation();
-  setPrinterSettings(e.target.files?.[0] ?? null);
-  e.target.value = '';
+  const input = /** @type {HTMLInputElement} */ (e.target);
+  setPrinterSettings(input.files?.[0] ?? null);
+  input.value = '';
 });
-document.getElementById('printer-settings-clear').addEventListener('click', () => setPrinterSettings(null));
+$('printer-settings-clear').addEventListener('click', () => setPrinterSettings(null));
 els.optionsForm.addEventListener('submit', (e) => e.preventDefault());
 els.optionsForm.addEventListener('change', () => {
   if (lastSource && lastSource.name && !current) run(lastSource);
@@ -1758,7 +1841,7 @@ window.addEventListener('dragenter', (e) => {
 window.addEventListener('dragover', (e) => {
   if (!hasFiles(e)) return;
   e.preventDefault();
-  e.dataTransfer.dropEffect = 'copy';
+  /** @type {DataTransfer} */ (e.dataTransfer).dropEffect = 'copy'; // hasFiles: there is one
 });
 window.addEventListener('dragleave', () => {
   dragDepth = Math.max(0, dragDepth - 1);

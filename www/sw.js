@@ -1,3 +1,4 @@
+// @ts-check
 // quietpath service worker: the playground keeps working offline once loaded.
 //
 // Network first, cache as the fallback: online, every request goes to the
@@ -7,6 +8,9 @@
 // cancel (which starts a new Web Worker, so fetches worker.js and the wasm
 // again) would fail offline. Only this origin's own files are ever fetched or
 // cached; user files are read from disk by the page and never pass through.
+
+/** This file runs as the page's service worker: `self` is its global scope. */
+const sw = /** @type {ServiceWorkerGlobalScope} */ (/** @type {unknown} */ (self));
 
 const CACHE = 'quietpath-v1';
 const SHELL = [
@@ -29,27 +33,27 @@ const SHELL = [
   'demo/demo.gcode',
 ];
 
-self.addEventListener('install', (event) => {
+sw.addEventListener('install', (event) => {
   event.waitUntil(
     caches
       .open(CACHE)
       .then((cache) => cache.addAll(SHELL))
-      .then(() => self.skipWaiting()),
+      .then(() => sw.skipWaiting()),
   );
 });
 
-self.addEventListener('activate', (event) => {
+sw.addEventListener('activate', (event) => {
   event.waitUntil(
     caches
       .keys()
       .then((keys) => Promise.all(keys.filter((k) => k !== CACHE).map((k) => caches.delete(k))))
-      .then(() => self.clients.claim()),
+      .then(() => sw.clients.claim()),
   );
 });
 
-self.addEventListener('fetch', (event) => {
+sw.addEventListener('fetch', (event) => {
   const req = event.request;
-  if (req.method !== 'GET' || new URL(req.url).origin !== self.location.origin) return;
+  if (req.method !== 'GET' || new URL(req.url).origin !== sw.location.origin) return;
   event.respondWith(
     fetch(req)
       .then((res) => {

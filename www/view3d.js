@@ -1,3 +1,4 @@
+// @ts-check
 // 3-D view of the whole part (or a layer range): every layer's toolpath (Session.layer
 // geometry) stacked at its height, drawn with three.js (vendored by `make pkg` into
 // www/vendor/ from npm, so the page still makes no outside request). Loaded on demand by
@@ -9,6 +10,16 @@
 
 import * as THREE from './vendor/three.module.js';
 import { KINDS, KIND_COLORS, RAMP } from './viewer.js';
+
+/**
+ * One layer to draw: its drawing data and its print time (for the layer-time colours).
+ * @typedef {import('./jobs.js').LayerMessage & { time?: number | null }} PartLayer
+ */
+/**
+ * How to draw: the colouring, travels, the value range of speed, curvature or layer time,
+ * and the bed's outline ([[x, y], …] in mm) when known.
+ * @typedef {{ colorBy: string, showTravel: boolean, range: { lo: number, hi: number } | null, bed?: number[][] | null }} DrawOptions
+ */
 
 const GHOST = new THREE.Color('#9aa4a0');
 const TRAVEL = new THREE.Color('#8c9692');
@@ -24,8 +35,10 @@ export class PartView {
     this.camera = new THREE.PerspectiveCamera(40, 1, 0.1, 100000);
     this.camera.up.set(0, 0, 1);
     this.orbit = { theta: -Math.PI / 3, phi: Math.PI / 3.2, radius: 200, target: new THREE.Vector3() };
+    /** @type {THREE.Line<THREE.BufferGeometry, THREE.LineBasicMaterial>[]} */
     this.objects = [];
     this.frame = 0;
+    this.fitted = false;
     this.installInput();
     this.resizeObserver = new ResizeObserver(() => this.resize());
     this.resizeObserver.observe(canvas);
@@ -36,6 +49,10 @@ export class PartView {
    * Draws layers: `layers` [{ z, xy, kind, speed, curvature, time }] of the shown file,
    * `ghost` the same of the other one (drawn grey) or null; `opts` { colorBy, showTravel,
    * range: { lo, hi } for speed/curvature/layer time }. Keeps the camera unless `refit`.
+   * @param {PartLayer[]} layers
+   * @param {PartLayer[] | null} ghost
+   * @param {DrawOptions} opts
+   * @param {boolean} refit
    */
   setLayers(layers, ghost, opts, refit) {
     for (const o of this.objects) {
@@ -46,18 +63,22 @@ export class PartView {
     this.objects = [];
     let segments = 0;
     const box = new THREE.Box3();
+    /**
+     * @param {PartLayer[]} list
+     * @param {boolean} isGhost
+     */
     const add = (list, isGhost) => {
       const lines = build(list, isGhost, opts);
       if (!lines) return;
       segments += lines.geometry.getAttribute('position').count / 2;
       lines.geometry.computeBoundingBox();
-      box.union(lines.geometry.boundingBox);
+      box.union(/** @type {THREE.Box3} */ (lines.geometry.boundingBox));
       this.scene.add(lines);
       this.objects.push(lines);
     };
     if (ghost) add(ghost, true);
     add(layers, false);
-    if (opts.bed?.length >= 3) {
+    if (opts.bed && opts.bed.length >= 3) {
       // The bed at z = 0, as an outline.
       const pts = opts.bed.map(([x, y]) => new THREE.Vector3(x, y, 0));
       const bed = new THREE.LineLoop(new THREE.BufferGeometry().setFromPoints(pts), new THREE.LineBasicMaterial({ color: '#8c9692' }));
@@ -69,6 +90,7 @@ export class PartView {
     this.requestDraw();
   }
 
+  /** @param {THREE.Box3} box */
   fit(box) {
     const size = box.getSize(new THREE.Vector3());
     box.getCenter(this.orbit.target);
@@ -112,17 +134,21 @@ export class PartView {
   installInput() {
     const c = this.canvas;
     const pointers = new Map();
+    /** @type {{ x: number, y: number, pan: boolean, d: number | null } | null} */
     let last = null;
+    /** @type {(dx: number, dy: number) => void} */
     const orbitBy = (dx, dy) => {
       this.orbit.theta -= dx * 0.008;
       this.orbit.phi = Math.min(Math.PI - 0.05, Math.max(0.05, this.orbit.phi - dy * 0.008));
     };
+    /** @type {(dx: number, dy: number) => void} */
     const panBy = (dx, dy) => {
       const scale = this.orbit.radius / c.clientHeight;
       const right = new THREE.Vector3().setFromMatrixColumn(this.camera.matrixWorld, 0);
       const up = new THREE.Vector3().setFromMatrixColumn(this.camera.matrixWorld, 1);
       this.orbit.target.addScaledVector(right, -dx * scale).addScaledVector(up, dy * scale);
     };
+    /** @param {number} factor */
     const zoom = (factor) => {
       this.orbit.radius = Math.min(1e5, Math.max(0.5, this.orbit.radius * factor));
     };
@@ -153,6 +179,7 @@ export class PartView {
       }
       this.requestDraw();
     });
+    /** @param {PointerEvent} e */
     const end = (e) => {
       pointers.delete(e.pointerId);
       if (pointers.size === 0) last = null;
@@ -171,6 +198,7 @@ export class PartView {
       { passive: false },
     );
     c.addEventListener('keydown', (e) => {
+      /** @type {Record<string, [number, number]>} */
       const keys = { ArrowLeft: [-20, 0], ArrowRight: [20, 0], ArrowUp: [0, -20], ArrowDown: [0, 20] };
       if (keys[e.key]) orbitBy(...keys[e.key]);
       else if (e.key === '+' || e.key === '=') zoom(0.8);
@@ -187,7 +215,13 @@ export class PartView {
   }
 }
 
-/** One LineSegments of every segment of `list`, coloured per vertex. */
+/**
+ * One LineSegments of every segment of `list`, coloured per vertex.
+ * @param {PartLayer[]} list
+ * @param {boolean} ghost
+ * @param {DrawOptions} opts
+ * @returns {THREE.LineSegments<THREE.BufferGeometry, THREE.LineBasicMaterial> | null}
+ */
 function build(list, ghost, { colorBy, showTravel, range }) {
   let n = 0;
   for (const g of list) for (const k of g.kind) if (k !== 0 || (showTravel && !ghost)) n++;
@@ -196,14 +230,15 @@ function build(list, ghost, { colorBy, showTravel, range }) {
   const col = new Float32Array(n * 6);
   const kindColors = KIND_COLORS.map((c) => new THREE.Color(c));
   const ramp = RAMP.map((c) => new THREE.Color(c));
+  /** @param {number | null | undefined} v */
   const rampAt = (v) => {
-    if (!range || !Number.isFinite(v)) return ramp[0];
+    if (!range || typeof v !== 'number' || !Number.isFinite(v)) return ramp[0];
     const t = (v - range.lo) / (range.hi - range.lo || 1);
     return ramp[Math.min(ramp.length - 1, Math.max(0, Math.floor(t * ramp.length)))];
   };
   let j = 0;
   for (const g of list) {
-    const z = Number.isFinite(g.z) ? g.z : 0;
+    const z = typeof g.z === 'number' && Number.isFinite(g.z) ? g.z : 0;
     const { xy, kind } = g;
     for (let i = 0; i < kind.length; i++) {
       const travel = kind[i] === 0;

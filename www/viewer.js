@@ -1,3 +1,4 @@
+// @ts-check
 // Layer viewer: draws one layer's toolpath (Session.layer geometry) on a 2D
 // canvas, before and after an optimization, coloured by feature, speed or
 // curvature.
@@ -20,26 +21,44 @@ const BUCKETS = RAMP.length;
 const MIN_SCALE = 1e-3;
 const MAX_SCALE = 1e4;
 
+/** @typedef {import('./jobs.js').LayerMessage} LayerMessage one layer's drawing data */
+/** @typedef {{ cx: number, cy: number, scale: number }} View the centre (mm) and CSS px per mm */
+/** @typedef {{ geom: LayerMessage | null, ghost?: LayerMessage | null, x: number, w: number, label: string }} Pane */
+/** @typedef {{ key: 'speed' | 'curvature' | 'layer-time', lo: number, hi: number }} Range */
+/**
+ * A segment under the pointer (LayerViewer.pick).
+ * @typedef {{ which: string, kind: string, speed: number, curvature: number, x: number, y: number }} Hit
+ */
+
 export class LayerViewer {
   /**
    * @param {HTMLCanvasElement} canvas
    * @param {HTMLElement} legend  gets the colour legend
-   * @param {object} hooks       onViewChange(): the user zoomed or panned
+   * @param {object} [hooks]
+   * @param {() => void} [hooks.onViewChange] the user zoomed or panned
+   * @param {(hit: Hit | null) => void} [hooks.onHover] the segment under the pointer, or none
    */
   constructor(canvas, legend, hooks = {}) {
     this.canvas = canvas;
-    this.ctx = canvas.getContext('2d');
+    // A fresh canvas always has a 2-D context to give.
+    this.ctx = /** @type {CanvasRenderingContext2D} */ (canvas.getContext('2d'));
     this.legend = legend;
     this.hooks = hooks;
+    /** @type {LayerMessage | null} */
     this.before = null; // LayerGeometry (+ index, count)
+    /** @type {LayerMessage | null} */
     this.after = null;
     this.colorBy = 'feature';
     this.showTravel = false;
     this.mode = 'before'; // before | after | side | overlay
+    /** @type {View | null} */
     this.view = null; // { cx, cy, scale } (scale: CSS px per mm)
     this.userMoved = false; // zoomed or panned since the last fit: keep that view across layers
+    /** @type {{ minX: number, minY: number, maxX: number, maxY: number } | null} */
     this.bounds = null; // the whole print's XY extent { minX, minY, maxX, maxY }, outlined
+    /** @type {number[][] | null} */
     this.bed = null; // the printer bed's outline [[x, y], …] in mm, when the file or printer.cfg says
+    /** @type {{ before: number | null, after: number | null, lo: number, hi: number } | null} */
     this.layerTime = null; // 'layer-time' colouring: { before, after, lo, hi } in s
     this.frame = 0;
     this.installInput();
@@ -48,7 +67,11 @@ export class LayerViewer {
     this.resize();
   }
 
-  /** Sets the geometry to draw; `after` may be null. Keeps the view. */
+  /**
+   * Sets the geometry to draw; `after` may be null. Keeps the view.
+   * @param {LayerMessage} before
+   * @param {LayerMessage | null} after
+   */
   setLayers(before, after) {
     const panes = this.panes().length;
     const newLayer = this.before?.index !== before?.index;
@@ -68,6 +91,12 @@ export class LayerViewer {
     this.requestDraw();
   }
 
+  /**
+   * Changes a drawing setting and redraws.
+   * @template {'colorBy' | 'showTravel' | 'mode'} K
+   * @param {K} key
+   * @param {this[K]} value
+   */
   set(key, value) {
     const panes = this.panes().length;
     this[key] = value;
@@ -76,7 +105,10 @@ export class LayerViewer {
     this.requestDraw();
   }
 
-  /** The panes to draw: [{ geom, ghost, x, w }] in CSS px. */
+  /**
+   * The panes to draw: [{ geom, ghost, x, w }] in CSS px.
+   * @returns {Pane[]}
+   */
   panes() {
     const w = this.canvas.clientWidth;
     const hasAfter = !!this.after;
@@ -102,8 +134,11 @@ export class LayerViewer {
     this.userMoved = false;
     const g = this.before ?? this.after;
     if (!g) return;
+    /** @type {number[]} */
     const xs = [];
+    /** @type {number[]} */
     const ys = [];
+    /** @param {boolean} onlyPrinting */
     const collect = (onlyPrinting) => {
       const { xy, kind } = g;
       for (let i = 0, n = kind.length; i < n; i++) {
@@ -119,6 +154,7 @@ export class LayerViewer {
       this.fitBox(0, 0, 100, 100);
       return;
     }
+    /** @param {number[]} a */
     const f = (a) => Float64Array.from(a).sort();
     const sx = f(xs);
     const sy = f(ys);
@@ -129,13 +165,19 @@ export class LayerViewer {
 
   /** The whole bed in view (B key), else the layer. */
   fitBed() {
-    if (!(this.bed?.length >= 3)) return this.fit();
+    if (!this.bed || !(this.bed.length >= 3)) return this.fit();
     const xs = this.bed.map((p) => p[0]);
     const ys = this.bed.map((p) => p[1]);
     this.fitBox(Math.min(...xs), Math.min(...ys), Math.max(...xs), Math.max(...ys));
     this.userMoved = true;
   }
 
+  /**
+   * @param {number} minX
+   * @param {number} minY
+   * @param {number} maxX
+   * @param {number} maxY
+   */
   fitBox(minX, minY, maxX, maxY) {
     const pane = this.panes()[0];
     const h = this.canvas.clientHeight || 1;
@@ -165,12 +207,17 @@ export class LayerViewer {
     });
   }
 
-  /** Pane under CSS x, and the world point under (x, y). */
+  /**
+   * Pane under CSS x, and the world point under (x, y). Needs a view.
+   * @param {number} x
+   * @param {number} y
+   * @returns {{ pane: Pane, wx: number, wy: number }}
+   */
   locate(x, y) {
     const panes = this.panes();
     const pane = panes.find((p) => x >= p.x && x < p.x + p.w) ?? panes[0];
     const h = this.canvas.clientHeight;
-    const { cx, cy, scale } = this.view;
+    const { cx, cy, scale } = /** @type {View} */ (this.view);
     return { pane, wx: cx + (x - pane.x - pane.w / 2) / scale, wy: cy - (y - h / 2) / scale };
   }
 
@@ -200,9 +247,11 @@ export class LayerViewer {
       },
       { passive: false },
     );
+    /** @type {{ x: number, y: number, cx: number, cy: number } | null} */
     let drag = null;
     // Two fingers: pinch to zoom about their midpoint (phones and tablets).
     const touches = new Map();
+    /** @type {{ d: number, x: number, y: number, scale: number, world: { pane: Pane, wx: number, wy: number } } | null} */
     let pinch = null;
     const pinchState = () => {
       const [a, b] = [...touches.values()];
@@ -227,6 +276,7 @@ export class LayerViewer {
       c.classList.add('dragging');
     });
     let hoverFrame = 0;
+    /** @type {[number, number]} */
     let hoverAt = [0, 0];
     c.addEventListener('pointermove', (e) => {
       if (touches.has(e.pointerId)) touches.set(e.pointerId, { x: e.clientX, y: e.clientY });
@@ -252,11 +302,13 @@ export class LayerViewer {
         }
         return;
       }
-      const s = this.view.scale;
+      const view = /** @type {View} */ (this.view); // a drag starts only with a view
+      const s = view.scale;
       if (e.clientX !== drag.x || e.clientY !== drag.y) this.userMoved = true;
-      this.view = { ...this.view, cx: drag.cx - (e.clientX - drag.x) / s, cy: drag.cy + (e.clientY - drag.y) / s };
+      this.view = { ...view, cx: drag.cx - (e.clientX - drag.x) / s, cy: drag.cy + (e.clientY - drag.y) / s };
       this.requestDraw();
     });
+    /** @param {PointerEvent} e */
     const end = (e) => {
       touches.delete(e?.pointerId);
       if (touches.size < 2) pinch = null;
@@ -294,6 +346,11 @@ export class LayerViewer {
    * The drawn segment nearest to CSS point (x, y), within a few pixels:
    * { which, kind, speed, curvature } or null.
    */
+  /**
+   * @param {number} x
+   * @param {number} y
+   * @returns {Hit | null}
+   */
   pick(x, y) {
     if (!this.view) return null;
     const { pane, wx, wy } = this.locate(x, y);
@@ -324,7 +381,10 @@ export class LayerViewer {
     return { which: pane.label, kind: KINDS[kind[found]] ?? 'other', speed: g.speed[found], curvature: g.curvature[found], x: wx, y: wy };
   }
 
-  /** Value range for speed / curvature colouring, shared by before and after. */
+  /**
+   * Value range for speed / curvature colouring, shared by before and after.
+   * @returns {Range | null}
+   */
   range() {
     if (this.colorBy === 'feature') return null;
     if (this.colorBy === 'layer-time') {
@@ -332,6 +392,7 @@ export class LayerViewer {
       return { key: 'layer-time', lo: t?.lo ?? 0, hi: t && t.hi > t.lo ? t.hi : (t?.lo ?? 0) + 1 };
     }
     const key = this.colorBy === 'speed' ? 'speed' : 'curvature';
+    /** @type {number[]} */
     const values = [];
     for (const g of [this.before, this.after]) {
       if (!g) continue;
@@ -369,7 +430,7 @@ export class LayerViewer {
         if (panes.length > 1 || p.label) {
           ctx.font = '12px system-ui, sans-serif';
           ctx.fillStyle = getComputedStyle(canvas).color;
-          ctx.fillText(p.label + (p.geom && Number.isFinite(p.geom.z) ? `  z = ${p.geom.z.toFixed(2)} mm` : ''), p.x + 8, 16);
+          ctx.fillText(p.label + (p.geom && typeof p.geom.z === 'number' && Number.isFinite(p.geom.z) ? `  z = ${p.geom.z.toFixed(2)} mm` : ''), p.x + 8, 16);
         }
         ctx.restore();
       }
@@ -386,27 +447,57 @@ export class LayerViewer {
     if (this.view && (this.before || this.after)) this.drawScaleBar(canvas.clientHeight);
     canvas.dataset.segments = String(drawn);
     canvas.dataset.scale = this.view ? String(this.view.scale) : '';
-    if (this.bed?.length >= 3) {
-      const xs = this.bed.map((p) => p[0]);
-      const ys = this.bed.map((p) => p[1]);
+    const bed = this.bed;
+    if (bed && bed.length >= 3) {
+      const xs = bed.map((p) => p[0]);
+      const ys = bed.map((p) => p[1]);
       canvas.dataset.bed = `${+(Math.max(...xs) - Math.min(...xs)).toFixed(1)} × ${+(Math.max(...ys) - Math.min(...ys)).toFixed(1)} mm`;
     } else delete canvas.dataset.bed;
     this.renderLegend(range);
+    const label = this.describe(drawn);
+    if (canvas.getAttribute('aria-label') !== label) canvas.setAttribute('aria-label', label);
   }
 
-  /** The whole print's XY extent as a dashed outline, so a layer is seen in its place. */
+  /**
+   * The canvas's text alternative, kept in step with every redraw: which layer is shown (its
+   * number and height), what is drawn and in which colours (the legend), and the keys.
+   * @param {number} segments how many segments the last draw stroked
+   * @returns {string}
+   */
+  describe(segments) {
+    const keys = 'Wheel or +/- to zoom, drag or arrow keys to pan, double-click or 0 to fit the layer, B to see the whole bed.';
+    const g = this.before ?? this.after;
+    if (!g || !this.view) return `Toolpath of the selected layer: nothing loaded yet. ${keys}`;
+    /** @param {LayerMessage | null} l */
+    const z = (l) => (l && typeof l.z === 'number' && Number.isFinite(l.z) ? `z = ${l.z.toFixed(2)} mm` : 'no height');
+    const panes = this.panes();
+    const what = panes.length > 1 ? `before and after side by side (after at ${z(this.after)})` : panes[0].label === 'after over before' ? `the optimized file (at ${z(this.after)}) over the original` : panes[0].label === 'after' ? `the optimized file, at ${z(this.after)}` : 'the file';
+    const colours = { feature: 'feature', speed: 'speed', curvature: 'curvature', 'layer-time': 'layer time' }[this.colorBy] ?? this.colorBy;
+    // The legend's entries: a swatch and its name, or the colour ramp's ends ("12 to 150 mm/s").
+    const legend = [...this.legend.children]
+      .map((li) => [...li.childNodes].map((n) => (n.textContent ?? '').trim()).filter(Boolean).join(li.classList.contains('ramp') ? ' to ' : ' '))
+      .filter(Boolean)
+      .join(', ');
+    return `Layer ${g.index + 1} of ${g.count}, ${z(g)}: ${what}, ${segments.toLocaleString('en-US')} segments drawn, coloured by ${colours}${legend ? ` (${legend})` : ''}. ${keys}`;
+  }
+
+  /**
+   * The whole print's XY extent as a dashed outline, so a layer is seen in its place.
+   * @param {Pane} pane
+   * @param {number} h the canvas height, CSS px
+   */
   drawBounds(pane, h) {
     const b = this.bounds;
     if (!this.view) return;
-    const { ctx } = this;
+    const { ctx, bed } = this;
     const { cx, cy, scale } = this.view;
     const ox = pane.x + pane.w / 2 - cx * scale;
     const oy = h / 2 + cy * scale;
-    if (this.bed?.length >= 3) {
+    if (bed && bed.length >= 3) {
       // The bed: a solid outline and a faint fill.
       ctx.save();
       ctx.beginPath();
-      this.bed.forEach(([x, y], i) => (i ? ctx.lineTo(ox + x * scale, oy - y * scale) : ctx.moveTo(ox + x * scale, oy - y * scale)));
+      bed.forEach(([x, y], i) => (i ? ctx.lineTo(ox + x * scale, oy - y * scale) : ctx.moveTo(ox + x * scale, oy - y * scale)));
       ctx.closePath();
       ctx.fillStyle = 'rgba(128,128,128,0.06)';
       ctx.fill();
@@ -424,14 +515,19 @@ export class LayerViewer {
     ctx.restore();
   }
 
-  /** A scale bar of a round length (1, 2 or 5 × 10ⁿ mm), about 100 px long, bottom left. */
+  /**
+   * A scale bar of a round length (1, 2 or 5 × 10ⁿ mm), about 100 px long, bottom left.
+   * Needs a view.
+   * @param {number} h the canvas height, CSS px
+   */
   drawScaleBar(h) {
     const { ctx } = this;
+    const { scale } = /** @type {View} */ (this.view);
     const dpr = window.devicePixelRatio || 1;
-    const target = 100 / this.view.scale; // mm in 100 px
+    const target = 100 / scale; // mm in 100 px
     const pow = 10 ** Math.floor(Math.log10(target));
     const mm = [1, 2, 5, 10].map((m) => m * pow).filter((v) => v <= target * 1.5).pop() ?? pow;
-    const px = mm * this.view.scale;
+    const px = mm * scale;
     ctx.save();
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
     const color = getComputedStyle(this.canvas).color;
@@ -453,10 +549,18 @@ export class LayerViewer {
     this.canvas.dataset.scaleBar = label;
   }
 
-  /** Strokes one geometry into a pane; returns the number of segments drawn. */
+  /**
+   * Strokes one geometry into a pane; returns the number of segments drawn. Needs a view.
+   * @param {LayerMessage} g
+   * @param {Pane} pane
+   * @param {number} h the canvas height, CSS px
+   * @param {Range | null} range colour by this value range, or by feature when null
+   * @param {boolean} ghost grey, under the other file
+   * @returns {number}
+   */
   drawGeometry(g, pane, h, range, ghost) {
     const { ctx } = this;
-    const { cx, cy, scale } = this.view;
+    const { cx, cy, scale } = /** @type {View} */ (this.view);
     const ox = pane.x + pane.w / 2 - cx * scale;
     const oy = h / 2 + cy * scale;
     const { xy, kind } = g;
@@ -473,6 +577,7 @@ export class LayerViewer {
     } else {
       colors = [null, ...RAMP];
       const k = BUCKETS / (range.hi - range.lo);
+      /** @param {number} v */
       const toBucket = (v) => {
         const b = Math.floor((v - range.lo) * k);
         return 1 + (b < 0 ? 0 : b >= BUCKETS ? BUCKETS - 1 : b);
@@ -480,7 +585,7 @@ export class LayerViewer {
       if (range.key === 'layer-time') {
         // The whole layer in the colour of its print time (short layers cool badly).
         const t = g === this.after ? this.layerTime?.after : this.layerTime?.before;
-        const b = Number.isFinite(t) ? toBucket(t) : -1;
+        const b = typeof t === 'number' && Number.isFinite(t) ? toBucket(t) : -1;
         for (let i = 0; i < n; i++) bucket[i] = kind[i] === 0 ? 0 : b;
       } else {
         const a = g[range.key];
@@ -492,6 +597,12 @@ export class LayerViewer {
     ctx.lineCap = 'round';
     ctx.lineJoin = 'round';
     let drawn = 0;
+    /**
+     * @param {number} b the bucket
+     * @param {string} style
+     * @param {number} lw line width, CSS px
+     * @param {number[]} dash
+     */
     const strokeBucket = (b, style, lw, dash) => {
       ctx.beginPath();
       let px = NaN;
@@ -517,13 +628,19 @@ export class LayerViewer {
       return count;
     };
     if (this.showTravel && !ghost) drawn += strokeBucket(0, 'rgba(140,150,146,0.7)', 0.75, [3, 3]);
-    for (let b = 1; b < colors.length; b++) drawn += strokeBucket(b, colors[b], ghost ? Math.max(1, width * 0.8) : width, []);
+    for (let b = 1; b < colors.length; b++) drawn += strokeBucket(b, /** @type {string} */ (colors[b]), ghost ? Math.max(1, width * 0.8) : width, []);
     ctx.setLineDash([]);
     return drawn;
   }
 
+  /** @param {Range | null} range */
   renderLegend(range) {
     const items = [];
+    /**
+     * @param {string} color
+     * @param {string} label
+     * @param {boolean} [dashed]
+     */
     const swatch = (color, label, dashed) => {
       const li = document.createElement('li');
       const s = document.createElement('span');
@@ -539,6 +656,7 @@ export class LayerViewer {
       for (let k = 1; k < KINDS.length; k++) if (present.has(k)) items.push(swatch(KIND_COLORS[k], KINDS[k]));
     } else {
       const unit = range.key === 'speed' ? 'mm/s' : range.key === 'layer-time' ? 's per layer' : '1/mm';
+      /** @param {number} v */
       const fmt = (v) => (Math.abs(v) >= 10 ? v.toFixed(0) : v.toFixed(2));
       const li = document.createElement('li');
       li.className = 'ramp';
@@ -549,7 +667,7 @@ export class LayerViewer {
       items.push(li);
     }
     if (this.showTravel) items.push(swatch('#9aa4a0', 'travel', true));
-    if (this.bed?.length >= 3) items.push(swatch('rgba(128,128,128,0.8)', `bed ${this.canvas.dataset.bed ?? ''}`, true));
+    if ((this.bed?.length ?? 0) >= 3) items.push(swatch('rgba(128,128,128,0.8)', `bed ${this.canvas.dataset.bed ?? ''}`, true));
     if (this.bounds) items.push(swatch('rgba(128,128,128,0.55)', 'the whole print', true));
     this.legend.replaceChildren(...items);
   }

@@ -1,3 +1,4 @@
+// @ts-check
 // quietpath job worker (module worker).
 //
 // Created by jobs.js as: new Worker('./worker.js', { type: 'module' })
@@ -64,12 +65,28 @@ const PROGRESS_INTERVAL_MS = 50;
 const EXCERPT_MAX = 200;
 const JOBS = ['analyze', 'optimize', 'vtg', 'infill', 'smooth', 'vibration'];
 
+/** @typedef {(...args: any[]) => any} AnyFunction */
+/**
+ * The package's exports, or a Session's methods, by name: the jobs are looked up by name, since
+ * a build may lack some.
+ * @param {object} o
+ */
+const byName = (o) => /** @type {Record<string, AnyFunction | undefined>} */ (o);
+
 // Which jobs this build offers: a Session method or a free function.
 function capabilities() {
-  const proto = qp.Session?.prototype ?? {};
-  return JOBS.filter((j) => typeof qp[j] === 'function' || typeof proto[j] === 'function');
+  const proto = byName(qp.Session?.prototype ?? {});
+  return JOBS.filter((j) => typeof byName(qp)[j] === 'function' || typeof proto[j] === 'function');
 }
 
+/**
+ * A request of the page (the protocol above).
+ * @typedef {{ id: number, type: 'load' | 'analyze', which?: 'input' | 'output', bytes: ArrayBuffer, name?: string, options?: qp.AnalyzeOptions, analyze?: boolean }} LoadRequest
+ * @typedef {{ id: number, type: 'job', job: string, options?: any, target?: 'input' | 'output' }} JobRequest
+ * @typedef {{ id: number, type: 'layer', which: 'before' | 'after', index: number, z?: number | null }} LayerRequest
+ */
+
+/** @type {unknown} */
 let loadError = null;
 const ready = init().then(
   () => {
@@ -79,6 +96,7 @@ const ready = init().then(
     } catch {
       // version() is informational only
     }
+    /** @type {qp.MachineProfile[]} */
     let machines = [];
     try {
       machines = typeof qp.machines === 'function' ? qp.machines() : [];
@@ -92,12 +110,22 @@ const ready = init().then(
   },
 );
 
-/** The sessions: { session: Session, bytes: Uint8Array, options } or null. */
+/**
+ * A file the worker holds: its wasm Session, its bytes and the analyze options it was read with.
+ * @typedef {{ session: qp.Session, bytes: Uint8Array, options: qp.AnalyzeOptions }} Held
+ */
+
+/** @type {{ input: Held | null, output: Held | null }} */
 const sessions = { input: null, output: null };
 
-// Text of 1-based line `line` in `bytes`, or null.
+/**
+ * Text of 1-based line `line` in `bytes`, or null.
+ * @param {Uint8Array | null} bytes
+ * @param {number | null} line
+ * @returns {string | null}
+ */
 function lineExcerpt(bytes, line) {
-  if (!bytes || !Number.isInteger(line) || line < 1) return null;
+  if (!bytes || typeof line !== 'number' || !Number.isInteger(line) || line < 1) return null;
   let start = 0;
   for (let n = 1; n < line; n++) {
     const nl = bytes.indexOf(10, start);
@@ -117,11 +145,20 @@ function lineExcerpt(bytes, line) {
   return text;
 }
 
+/**
+ * @param {unknown} err
+ * @param {'line' | 'column'} key
+ * @returns {number | null}
+ */
 function positionOf(err, key) {
-  const v = err !== null && typeof err === 'object' ? err[key] : undefined;
+  const v = err !== null && typeof err === 'object' ? /** @type {Record<string, unknown>} */ (err)[key] : undefined;
   return typeof v === 'number' && Number.isFinite(v) ? v : null;
 }
 
+/**
+ * @param {unknown} err
+ * @returns {string}
+ */
 function describe(err) {
   if (err instanceof Error) return err.message || err.name;
   if (typeof err === 'string') return err;
@@ -133,8 +170,9 @@ function describe(err) {
 }
 
 // The analyzer's machine-readable error kind (e.g. { kind: 'invalid_number', letter: 'X' }), if any.
+/** @param {unknown} err */
 function plainKind(err) {
-  const k = err !== null && typeof err === 'object' ? err.kind : undefined;
+  const k = err !== null && typeof err === 'object' ? /** @type {{ kind?: unknown }} */ (err).kind : undefined;
   if (k === undefined || k === null) return null;
   try {
     return JSON.parse(JSON.stringify(k));
@@ -143,6 +181,11 @@ function plainKind(err) {
   }
 }
 
+/**
+ * @param {number} id
+ * @param {unknown} err
+ * @param {Uint8Array | null} bytes the file, for the excerpt of the line at fault
+ */
 function postError(id, err, bytes) {
   const line = positionOf(err, 'line');
   const column = positionOf(err, 'column');
@@ -159,10 +202,15 @@ function postError(id, err, bytes) {
   });
 }
 
-// A progress callback for the wasm that posts throttled, increasing fractions.
+/**
+ * A progress callback for the wasm that posts throttled, increasing fractions; `finish()`
+ * posts the last one.
+ * @param {number} id
+ */
 function progressFor(id) {
   let lastFraction = -1;
   let lastTime = 0;
+  /** @param {number} fraction */
   const fn = (fraction) => {
     const now = performance.now();
     if (fraction >= 1 || fraction - lastFraction >= PROGRESS_STEP || now - lastTime >= PROGRESS_INTERVAL_MS) {
@@ -178,6 +226,7 @@ function progressFor(id) {
   return fn;
 }
 
+/** @param {'input' | 'output'} which */
 function dropSession(which) {
   const s = sessions[which];
   sessions[which] = null;
@@ -188,6 +237,7 @@ function dropSession(which) {
   }
 }
 
+/** @param {LoadRequest} msg */
 function handleLoad(msg) {
   const { id, options } = msg;
   const which = msg.which === 'output' ? 'output' : 'input';
@@ -214,6 +264,7 @@ function handleLoad(msg) {
   }
 }
 
+/** @param {JobRequest} msg */
 function handleJob(msg) {
   const { id, job, options } = msg;
   const target = msg.target === 'output' ? 'output' : 'input';
@@ -230,12 +281,14 @@ function handleJob(msg) {
   const t0 = performance.now();
   try {
     let result;
-    if (typeof s.session[job] === 'function') {
-      result = job === 'analyze' ? s.session.analyze(progress) : s.session[job](options ?? {}, progress);
-    } else if (typeof qp[job] === 'function') {
+    const method = byName(s.session)[job];
+    const free = byName(qp)[job];
+    if (typeof method === 'function') {
+      result = job === 'analyze' ? s.session.analyze(progress) : method.call(s.session, options ?? {}, progress);
+    } else if (typeof free === 'function') {
       // The free vtg() takes the analyze options inside its own (a Session has them already).
       const opts = job === 'vtg' && Object.keys(s.options).length && !options?.analyze ? { ...options, analyze: s.options } : options ?? {};
-      result = job === 'analyze' ? qp.analyze(s.bytes, s.options, progress) : qp[job](s.bytes, opts, progress);
+      result = job === 'analyze' ? qp.analyze(s.bytes, s.options, progress) : free(s.bytes, opts, progress);
     } else {
       throw new Error(`${job} is not available in this build`);
     }
@@ -256,9 +309,13 @@ function handleJob(msg) {
   }
 }
 
-// Removes the optimized G-code from a job result and returns it as bytes, or
-// null. Accepts what a serde bridge may produce: Uint8Array (serde_bytes), an
-// array of numbers, or a string; on a plain object or a Map.
+/**
+ * Removes the optimized G-code from a job result and returns it as bytes, or
+ * null. Accepts what a serde bridge may produce: Uint8Array (serde_bytes), an
+ * array of numbers, or a string; on a plain object or a Map.
+ * @param {any} result
+ * @returns {Uint8Array | null}
+ */
 function takeOutput(result) {
   if (!result || typeof result !== 'object') return null;
   let v;
@@ -275,6 +332,7 @@ function takeOutput(result) {
   return null;
 }
 
+/** @param {LayerRequest} msg */
 function handleLayer(msg) {
   const { id, index } = msg;
   const which = msg.which === 'after' ? 'after' : 'before';
@@ -298,14 +356,23 @@ function handleLayer(msg) {
   }
 }
 
-// The layer of `session` whose z is nearest `z`: a binary search over the layers' heights
-// (increasing in a layered print), then the neighbours; `hint` (the same index) wins ties.
-// Returns [index, geometry].
+/**
+ * The layer of `session` whose z is nearest `z`: a binary search over the layers' heights
+ * (increasing in a layered print), then the neighbours; `hint` (the same index) wins ties.
+ * Returns [index, geometry].
+ * @param {qp.Session} session
+ * @param {number} count its number of layers
+ * @param {number} z
+ * @param {number} hint
+ * @returns {[number, qp.LayerGeometry]}
+ */
 function nearestZ(session, count, z, hint) {
+  /** @type {Map<number, qp.LayerGeometry>} */
   const zs = new Map();
+  /** @param {number} i */
   const zAt = (i) => {
     if (!zs.has(i)) zs.set(i, session.layer(i));
-    const v = zs.get(i).z;
+    const v = /** @type {qp.LayerGeometry} */ (zs.get(i)).z;
     return typeof v === 'number' ? v : NaN;
   };
   let lo = 0;
@@ -328,6 +395,7 @@ function nearestZ(session, count, z, hint) {
   return [best, zs.get(best) ?? session.layer(best)];
 }
 
+/** @type {Record<string, (msg: any) => void>} */
 const HANDLERS = { load: handleLoad, job: handleJob, layer: handleLayer, analyze: handleLoad };
 
 // Requests are handled strictly one after another.

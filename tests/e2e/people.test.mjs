@@ -1,7 +1,8 @@
 // Browser tests of the playground as a person meets it (issue 32): the printer picker, input
 // states, the before/after layer after a job, a running job's progress and the list of jobs,
-// readable results, per-layer charts and the phone layout. Same set-up as playground.test.mjs:
-// scripts/serve.mjs, Debian's Chromium through playwright-core, www/pkg built, the corpus in
+// readable results, per-layer charts, the phone layout, the 3-D view and accessibility (text
+// alternatives of the viewer, the 3-D view and the charts; Tab order). Same set-up as
+// playground.test.mjs: scripts/serve.mjs, Debian's Chromium through playwright-core, www/pkg built, the corpus in
 // ../shared/corpus and the native CLI (target/release/quietpath or $QUIETPATH_CLI).
 
 import { test, before, after } from 'node:test';
@@ -406,6 +407,120 @@ test('3-D view: the demo drawn with WebGL, a layer range, orbit, the 5-axis file
   await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
   assert.ok((await inked3d()) > 500, '5-axis file drawn in 3-D');
   await byTestId('view-kind').selectOption('2d');
+  assert.deepEqual(pageErrors, []);
+});
+
+test('accessibility: the viewer, the 3-D view and every chart say what they show, and follow the layer; Tab follows the page', { timeout: JOB_TIMEOUT }, async () => {
+  await page.goto(baseUrl);
+  assert.equal(await settled(), 'ready');
+  const report = await reportJson();
+  const n = report.layers;
+  const label = async (id) => (await byTestId(id).getAttribute('aria-label')) ?? '';
+  const frames = () => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+
+  // The layer viewer: a picture whose name is the layer shown, its height and its colours.
+  assert.equal(await byTestId('viewer').getAttribute('role'), 'img');
+  const showLayer = async (i) => {
+    await byTestId('layer-slider').evaluate((s, v) => {
+      s.value = String(v);
+      s.dispatchEvent(new Event('input', { bubbles: true }));
+    }, i);
+    await page.waitForFunction((v) => (document.querySelector('[data-testid="viewer"]').getAttribute('aria-label') ?? '').startsWith(`Layer ${v + 1} of `), i);
+    await frames();
+    const text = await label('viewer');
+    const z = Number(await byTestId('viewer').getAttribute('data-z'));
+    assert.ok(text.startsWith(`Layer ${i + 1} of ${n}, z = ${z.toFixed(2)} mm: the file, `), text);
+    return { text, z };
+  };
+  const first = await showLayer(0);
+  assert.match(first.text, /[\d,]+ segments drawn, coloured by feature \(.*outer wall.*\)\. Wheel or \+\/- to zoom/);
+  const tenth = await showLayer(9);
+  assert.notEqual(tenth.text, first.text, 'the name follows the layer');
+  await byTestId('color-by').selectOption('speed');
+  await page.waitForFunction(() => /coloured by speed \([\d.]+ to [\d.]+ mm\/s/.test(document.querySelector('[data-testid="viewer"]').getAttribute('aria-label')));
+  await byTestId('color-by').selectOption('feature');
+  await page.waitForFunction(() => /coloured by feature/.test(document.querySelector('[data-testid="viewer"]').getAttribute('aria-label')));
+
+  // Every chart drawn is a picture named by its caption and a summary of its series; a chart
+  // not drawn yet shows its message as text (no picture role).
+  const charts = await page.evaluate(() =>
+    [...document.querySelectorAll('[data-testid^="chart-"]')].map((c) => ({ id: c.dataset.testid, drawn: !!c.querySelector('canvas'), role: c.getAttribute('role'), label: c.getAttribute('aria-label') })),
+  );
+  assert.ok(charts.filter((c) => c.drawn).length >= 3, JSON.stringify(charts));
+  for (const c of charts) {
+    if (c.drawn) assert.equal(c.role, 'img', c.id);
+    else assert.deepEqual([c.role, c.label], [null, null], c.id);
+  }
+  const perLayer = [
+    ['chart-layer-time', 'Print time per layer, s', 'time', 's'],
+    ['chart-layer-energy', 'Energy per layer, J', 'energy', 'J'],
+    ['chart-layer-filament', 'Filament per layer, mm', 'filament', 'mm'],
+  ];
+  for (const [id, caption, series, unit] of perLayer) {
+    const text = await label(id);
+    const re = new RegExp(`^${caption}: ${n} points, layer 1 to ${n}; ${series} from [\\d.,]+ ${unit} at layer \\d+ to [\\d.,]+ ${unit} at layer \\d+\\.$`);
+    assert.match(text, re, id);
+  }
+  // The longest layer the time chart names is the report's.
+  const times = report.layer_list.map((l) => l.time_s);
+  const longest = times.indexOf(Math.max(...times)) + 1;
+  assert.match(await label('chart-layer-time'), new RegExp(` to [\\d.,]+ s at layer ${longest}\\.$`));
+  // Another printer: new per-layer times, a new summary.
+  const timeLabel = await label('chart-layer-time');
+  await byTestId('machine').selectOption('creality-ender3');
+  await page.waitForFunction((t) => document.querySelector('[data-testid="chart-layer-time"]').getAttribute('aria-label') !== t, timeLabel);
+  assert.equal(await settled(), 'ready');
+  await byTestId('machine').selectOption('');
+  assert.equal(await settled(), 'ready');
+
+  // The 3-D view: its name is the layer range, their heights and the colours; it follows the range.
+  await byTestId('view-kind').selectOption('3d');
+  await page.waitForFunction((n) => (document.querySelector('[data-testid="view-3d"]').getAttribute('aria-label') ?? '').startsWith(`The part in 3-D: layers 1 to ${n} of ${n}`), n, { timeout: JOB_TIMEOUT });
+  assert.equal(await byTestId('view-3d').getAttribute('role'), 'img');
+  const whole = await label('view-3d');
+  assert.match(whole, /, z = [\d.]+ to [\d.]+ mm, of the file, [\d,]+ segments, coloured by feature\. Drag to orbit/);
+  await byTestId('layer-from').fill('10');
+  await byTestId('layer-from').dispatchEvent('change');
+  await byTestId('layer-to').fill('12');
+  await byTestId('layer-to').dispatchEvent('change');
+  const range = `The part in 3-D: layers 10 to 12 of ${n}, z = ${tenth.z.toFixed(2)} to `;
+  await page.waitForFunction((r) => (document.querySelector('[data-testid="view-3d"]').getAttribute('aria-label') ?? '').startsWith(r), range);
+  await byTestId('view-kind').selectOption('2d');
+
+  // Tab order follows the page: no positive tabindex, and Tab visits the controls in document order.
+  const positive = await page.evaluate(() => [...document.querySelectorAll('[tabindex]')].filter((e) => e.tabIndex > 0).map((e) => e.outerHTML.slice(0, 100)));
+  assert.deepEqual(positive, []);
+  // A fresh page: Tab starts from the top of the document.
+  await page.goto(baseUrl);
+  assert.equal(await settled(), 'ready');
+  const visited = [];
+  for (let i = 0; i < 200; i++) {
+    await page.keyboard.press('Tab');
+    const at = await page.evaluate(() => {
+      const e = document.activeElement;
+      if (!e || e === document.body) return null;
+      // Where it is on the page: its panel's top (panels side by side share a row).
+      const panel = e.closest('.panel, .stats') ?? e;
+      return {
+        order: [...document.querySelectorAll('*')].indexOf(e),
+        top: panel.getBoundingClientRect().top + window.scrollY,
+        name: e.dataset?.testid || e.id || `${e.tagName.toLowerCase()}${e.getAttribute('name') ? `[${e.getAttribute('name')}]` : ''}`,
+      };
+    });
+    if (!at || (visited.length && at.order === visited[0].order)) break;
+    visited.push(at);
+  }
+  assert.ok(visited.length > 20, `Tab reached ${visited.length} controls: ${visited.map((v) => v.name).join(' ')}`);
+  for (let i = 1; i < visited.length; i++) {
+    const [a, b] = [visited[i - 1], visited[i]];
+    assert.ok(b.order > a.order, `Tab went from ${a.name} back to ${b.name}: ${visited.map((v) => v.name).join(' → ')}`);
+    // The page's grid places panels by area: the document order must be the order they are seen in.
+    assert.ok(b.top >= a.top - 1, `Tab went from ${a.name} (panel at y = ${Math.round(a.top)}) up to ${b.name} (y = ${Math.round(b.top)})`);
+  }
+  const names = visited.map((v) => v.name);
+  const main = ['file', 'demo', 'machine', 'layer-slider', 'color-by', 'show-travel', 'fit', 'view-kind', 'viewer', 'run-optimize', 'run-vtg', 'run-infill', 'run-smooth', 'run-vibration', 'download'];
+  for (const id of main) assert.ok(names.includes(id), `Tab never reaches ${id}: ${names.join(' ')}`);
+  assert.deepEqual(names.filter((x) => main.includes(x)), main, 'the main controls in the order of the page');
   assert.deepEqual(pageErrors, []);
 });
 
