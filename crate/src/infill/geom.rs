@@ -85,9 +85,31 @@ pub fn boundary_dist(r: &Region, p: P2) -> f64 {
     best
 }
 
-/// Whether `p` is inside the region or within `tol` of its boundary.
+/// Whether `p` is inside the region or within `tol` of its boundary. Squared distances, and
+/// the first boundary segment near enough ends the search: this test runs for every link and
+/// chain the search considers.
 pub fn inside_tol(r: &Region, p: P2, tol: f64) -> bool {
-    inside(r, p) || boundary_dist(r, p) <= tol
+    if inside(r, p) {
+        return true;
+    }
+    let tol2 = tol * tol;
+    r.iter().any(|c| {
+        let n = c.len();
+        (0..n).any(|i| seg_dist_sq(p, c[i], c[(i + 1) % n]) <= tol2)
+    })
+}
+
+/// Squared distance from `p` to segment `ab`.
+fn seg_dist_sq(p: P2, a: P2, b: P2) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (ex, ey) = (p[0] - a[0] - t * dx, p[1] - a[1] - t * dy);
+    ex * ex + ey * ey
 }
 
 /// Bounding box `[x0, y0, x1, y1]` of some points (None when empty or not finite).
