@@ -73,18 +73,6 @@ pub fn seg_dist(p: P2, a: P2, b: P2) -> f64 {
     dist(p, [a[0] + t * dx, a[1] + t * dy])
 }
 
-/// Distance from `p` to the region's boundary.
-pub fn boundary_dist(r: &Region, p: P2) -> f64 {
-    let mut best = f64::INFINITY;
-    for c in r {
-        let n = c.len();
-        for i in 0..n {
-            best = best.min(seg_dist(p, c[i], c[(i + 1) % n]));
-        }
-    }
-    best
-}
-
 /// Whether `p` is inside the region or within `tol` of its boundary. Squared distances, and
 /// the first boundary segment near enough ends the search: this test runs for every link and
 /// chain the search considers.
