@@ -30,6 +30,17 @@ pub(crate) fn clip(paths: &[Path], region: &Region) -> Vec<Path> {
         let mut state: Option<bool> = None;
         for w in path.windows(2) {
             let (a, b) = (w[0], w[1]);
+            if grid.beside(a, b) {
+                // Wholly beyond one side of the region's box: outside, and no edge to test
+                // (space-filling curves and spirals cover the box's square or circle).
+                state = Some(false);
+                if piece.len() >= 2 {
+                    out.push(std::mem::take(&mut piece));
+                } else {
+                    piece.clear();
+                }
+                continue;
+            }
             ts.clear();
             ts.push(0.0);
             grid.crossings(a, b, &mut ts);
@@ -72,6 +83,8 @@ pub(crate) fn clip(paths: &[Path], region: &Region) -> Vec<Path> {
 
 /// A region's edges bucketed in a uniform grid of about 64 × 64 cells.
 struct EdgeGrid {
+    /// The region's bounding box `[x0, y0, x1, y1]`.
+    bounds: [f64; 4],
     edges: Vec<(P2, P2)>,
     origin: P2,
     cell: f64,
@@ -87,6 +100,7 @@ impl EdgeGrid {
         let nx = ((b[2] - b[0]) / cell).floor() as usize + 1;
         let ny = ((b[3] - b[1]) / cell).floor() as usize + 1;
         let mut g = EdgeGrid {
+            bounds: b,
             edges: Vec::new(),
             origin: [b[0], b[1]],
             cell,
@@ -109,6 +123,16 @@ impl EdgeGrid {
             }
         }
         Some(g)
+    }
+
+    /// Whether segment `ab` lies wholly beyond one side of the region's box (strictly: a
+    /// segment touching the box may touch the region).
+    fn beside(&self, a: P2, b: P2) -> bool {
+        let [x0, y0, x1, y1] = self.bounds;
+        (a[0] < x0 && b[0] < x0)
+            || (a[0] > x1 && b[0] > x1)
+            || (a[1] < y0 && b[1] < y0)
+            || (a[1] > y1 && b[1] > y1)
     }
 
     fn cell_of(&self, p: P2) -> (usize, usize) {
