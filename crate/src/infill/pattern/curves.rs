@@ -85,12 +85,15 @@ pub(crate) fn clip(paths: &[Path], region: &Region) -> Vec<Path> {
 struct EdgeGrid {
     /// The region's bounding box `[x0, y0, x1, y1]`.
     bounds: [f64; 4],
-    edges: Vec<(P2, P2)>,
     origin: P2,
     cell: f64,
     nx: usize,
     ny: usize,
-    cells: Vec<Vec<u32>>,
+    /// Where each cell's edges start in `items`: cell `i` holds `starts[i]..starts[i + 1]`.
+    starts: Vec<usize>,
+    /// Every cell's edges, cell after cell, endpoints inline: the segment and ray tests read
+    /// one contiguous array instead of a list per cell and an index into the edges.
+    items: Vec<(P2, P2)>,
 }
 
 impl EdgeGrid {
@@ -101,28 +104,47 @@ impl EdgeGrid {
         let ny = ((b[3] - b[1]) / cell).floor() as usize + 1;
         let mut g = EdgeGrid {
             bounds: b,
-            edges: Vec::new(),
             origin: [b[0], b[1]],
             cell,
             nx,
             ny,
-            cells: vec![Vec::new(); nx * ny],
+            starts: vec![0; nx * ny + 1],
+            items: Vec::new(),
         };
+        // Each edge with the cells its box covers, then counted, then placed (edges keep
+        // their order within a cell).
+        let mut placed: Vec<((P2, P2), [usize; 4])> = Vec::new();
         for c in region {
             for i in 0..c.len() {
                 let (p, q) = (c[i], c[(i + 1) % c.len()]);
-                let e = g.edges.len() as u32;
-                g.edges.push((p, q));
                 let (x0, y0) = g.cell_of([p[0].min(q[0]), p[1].min(q[1])]);
                 let (x1, y1) = g.cell_of([p[0].max(q[0]), p[1].max(q[1])]);
-                for y in y0..=y1 {
-                    for x in x0..=x1 {
-                        g.cells[y * nx + x].push(e);
-                    }
-                }
+                placed.push(((p, q), [x0, y0, x1, y1]));
+            }
+        }
+        let covered =
+            |r: [usize; 4]| (r[1]..=r[3]).flat_map(move |y| (r[0]..=r[2]).map(move |x| y * nx + x));
+        for &(_, r) in &placed {
+            covered(r).for_each(|k| g.starts[k + 1] += 1);
+        }
+        for k in 0..nx * ny {
+            g.starts[k + 1] += g.starts[k];
+        }
+        let mut next = g.starts.clone();
+        g.items = vec![([0.0; 2], [0.0; 2]); g.starts[nx * ny]];
+        for &(edge, r) in &placed {
+            for k in covered(r) {
+                g.items[next[k]] = edge;
+                next[k] += 1;
             }
         }
         Some(g)
+    }
+
+    /// The edges of cell `(x, y)`.
+    fn edges_in(&self, x: usize, y: usize) -> &[(P2, P2)] {
+        let k = y * self.nx + x;
+        &self.items[self.starts[k]..self.starts[k + 1]]
     }
 
     /// Whether segment `ab` lies wholly beyond one side of the region's box (strictly: a
@@ -152,8 +174,7 @@ impl EdgeGrid {
         let d = [b[0] - a[0], b[1] - a[1]];
         for y in y0..=y1 {
             for x in x0..=x1 {
-                for &e in &self.cells[y * self.nx + x] {
-                    let (p, q) = self.edges[e as usize];
+                for &(p, q) in self.edges_in(x, y) {
                     let r = [q[0] - p[0], q[1] - p[1]];
                     let den = d[0] * r[1] - d[1] * r[0];
                     if den.abs() < 1e-18 {
@@ -186,8 +207,7 @@ impl EdgeGrid {
                 lo + self.cell
             };
             let lo = if x == 0 { f64::NEG_INFINITY } else { lo };
-            for &e in &self.cells[cy * self.nx + x] {
-                let (a, b) = self.edges[e as usize];
+            for &(a, b) in self.edges_in(x, cy) {
                 if (a[1] > p[1]) != (b[1] > p[1]) {
                     let xc = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
                     // Each crossing counted once: in the cell that holds it.
