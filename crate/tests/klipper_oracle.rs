@@ -13,6 +13,10 @@ use std::process::Command;
 use quietpath::plan::KlipperConfig;
 use quietpath::read::AnalyzeOptions;
 
+#[path = "../../tests/support/oracle_set_up.rs"]
+mod oracle_set_up;
+use oracle_set_up::first_alone;
+
 /// Largest difference allowed in one source line's time, s.
 const TOLERANCE_S: f64 = 1e-6;
 
@@ -32,21 +36,6 @@ fn oracle() -> PathBuf {
         path.display()
     );
     path
-}
-
-/// `run` the oracle for `version`; its first run of each version alone. On first use the
-/// oracle sets itself up (a venv, then a build per Klipper version), and two set-ups at once
-/// fail on a fresh machine (`File exists`); the two versions' tests run in parallel.
-fn first_alone<T>(version: &str, run: impl FnOnce() -> T) -> T {
-    static SET_UP: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
-    let mut set_up = SET_UP.lock().unwrap_or_else(|e| e.into_inner());
-    if set_up.iter().any(|v| v == version) {
-        drop(set_up);
-        return run();
-    }
-    let out = run();
-    set_up.push(version.to_owned());
-    out
 }
 
 /// Klipper's planned time of each source line of `file` (summed over its moves), and the

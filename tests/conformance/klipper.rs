@@ -13,6 +13,10 @@ use quietpath::plan::{JunctionModel, KlipperConfig, KlipperVersion};
 use quietpath::{analyze, AnalyzeOptions};
 use quietpath_conformance::{corpus, corpus_dir, fixtures_dir};
 
+#[path = "../support/oracle_set_up.rs"]
+mod oracle_set_up;
+use oracle_set_up::first_alone;
+
 /// Largest difference on any file, percent.
 const FILE_BAR_PCT: f64 = 0.2;
 /// Largest median difference, percent.
@@ -20,21 +24,6 @@ const MEDIAN_BAR_PCT: f64 = 0.05;
 
 fn shared() -> PathBuf {
     corpus_dir().join("..")
-}
-
-/// `run` the oracle for `version`; its first run of each version alone: the oracle sets
-/// itself up on first use (a venv, a build per version), which is not safe to do twice at
-/// once, and this file's two tests run in parallel.
-fn first_alone<T>(version: &str, run: impl FnOnce() -> T) -> T {
-    static SET_UP: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
-    let mut set_up = SET_UP.lock().unwrap_or_else(|e| e.into_inner());
-    if set_up.iter().any(|v| v == version) {
-        drop(set_up);
-        return run();
-    }
-    let out = run();
-    set_up.push(version.to_owned());
-    out
 }
 
 /// The time Klipper plans for `file` (`time_s` of the oracle's report), or a failure that

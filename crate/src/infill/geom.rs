@@ -63,6 +63,11 @@ pub fn inside(r: &Region, p: P2) -> bool {
 
 /// Distance from `p` to segment `ab`.
 pub fn seg_dist(p: P2, a: P2, b: P2) -> f64 {
+    dist(p, foot(p, a, b))
+}
+
+/// The point of segment `ab` nearest `p`.
+fn foot(p: P2, a: P2, b: P2) -> P2 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let l2 = dx * dx + dy * dy;
     let t = if l2 > 0.0 {
@@ -70,7 +75,7 @@ pub fn seg_dist(p: P2, a: P2, b: P2) -> f64 {
     } else {
         0.0
     };
-    dist(p, [a[0] + t * dx, a[1] + t * dy])
+    [a[0] + t * dx, a[1] + t * dy]
 }
 
 /// Whether `p` is inside the region or within `tol` of its boundary. Squared distances, and
@@ -89,14 +94,8 @@ pub fn inside_tol(r: &Region, p: P2, tol: f64) -> bool {
 
 /// Squared distance from `p` to segment `ab`.
 fn seg_dist_sq(p: P2, a: P2, b: P2) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let l2 = dx * dx + dy * dy;
-    let t = if l2 > 0.0 {
-        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let (ex, ey) = (p[0] - a[0] - t * dx, p[1] - a[1] - t * dy);
+    let f = foot(p, a, b);
+    let (ex, ey) = (p[0] - f[0], p[1] - f[1]);
     ex * ex + ey * ey
 }
 
