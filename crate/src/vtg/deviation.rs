@@ -206,7 +206,11 @@ impl Original<'_> {
             return len;
         }
         let (mut lo, mut hi) = (t, len);
-        while hi - lo > step {
+        // At most 64 halvings: a step of 0 (or below the numbers' resolution) ends there.
+        for _ in 0..64 {
+            if hi - lo <= step {
+                break;
+            }
             let mid = 0.5 * (lo + hi);
             if at(mid) <= accept {
                 lo = mid;
