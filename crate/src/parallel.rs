@@ -45,38 +45,71 @@ where
 {
     #[cfg(not(target_arch = "wasm32"))]
     {
-        use std::sync::atomic::{AtomicUsize, Ordering};
         let threads = threads();
         if threads > 1 && items.len() >= MIN_ITEMS {
             let block = items.len().div_ceil(threads * BLOCKS_PER_THREAD);
             let blocks: Vec<&[T]> = items.chunks(block).collect();
-            let next = AtomicUsize::new(0);
-            let claim = || {
-                let mut done: Vec<(usize, Vec<R>)> = Vec::new();
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(b) = blocks.get(i) else {
-                        return done;
-                    };
-                    done.push((i, f(b)));
-                }
-            };
-            let mut parts: Vec<(usize, Vec<R>)> = std::thread::scope(|scope| {
-                let handles: Vec<_> = (1..threads).map(|_| scope.spawn(claim)).collect();
-                let mut all = claim();
-                for h in handles {
-                    match h.join() {
-                        Ok(r) => all.extend(r),
-                        Err(panic) => std::panic::resume_unwind(panic),
-                    }
-                }
-                all
-            });
-            parts.sort_unstable_by_key(|(i, _)| *i);
-            return parts.into_iter().flat_map(|(_, r)| r).collect();
+            return claimed(blocks.len(), threads, |i| f(blocks[i]))
+                .into_iter()
+                .flatten()
+                .collect();
         }
     }
     f(items)
+}
+
+/// `f` applied to every item, in order, each item a unit of work the threads claim one at a
+/// time: for a few costly items (an infill candidate each), which [`map_chunks`] would run in
+/// place as a short list.
+pub fn map_each<T, R, F>(items: &[T], f: F) -> Vec<R>
+where
+    T: Sync,
+    R: Send,
+    F: Fn(&T) -> R + Sync,
+{
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        let threads = threads().min(items.len());
+        if threads > 1 {
+            return claimed(items.len(), threads, |i| f(&items[i]));
+        }
+    }
+    items.iter().map(f).collect()
+}
+
+/// `work(0..n)` on `threads` scoped threads that claim the next index as they finish one; the
+/// results in index order.
+#[cfg(not(target_arch = "wasm32"))]
+fn claimed<R, W>(n: usize, threads: usize, work: W) -> Vec<R>
+where
+    R: Send,
+    W: Fn(usize) -> R + Sync,
+{
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let next = AtomicUsize::new(0);
+    let claim = || {
+        let mut done: Vec<(usize, R)> = Vec::new();
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            if i >= n {
+                return done;
+            }
+            done.push((i, work(i)));
+        }
+    };
+    let mut parts: Vec<(usize, R)> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (1..threads).map(|_| scope.spawn(claim)).collect();
+        let mut all = claim();
+        for h in handles {
+            match h.join() {
+                Ok(r) => all.extend(r),
+                Err(panic) => std::panic::resume_unwind(panic),
+            }
+        }
+        all
+    });
+    parts.sort_unstable_by_key(|(i, _)| *i);
+    parts.into_iter().map(|(_, r)| r).collect()
 }
 
 /// Runs `a` and `b`, natively on two threads, and returns both results.
@@ -112,5 +145,7 @@ mod tests {
         let few = map_chunks(&items[..3], |c| c.to_vec());
         assert_eq!(few, vec![0, 1, 2]);
         assert_eq!(join(|| 1 + 1, || "two"), (2, "two"));
+        let each = map_each(&items[..5], |x| x + 1);
+        assert_eq!(each, vec![1, 2, 3, 4, 5]);
     }
 }

@@ -17,6 +17,7 @@ pub(crate) mod link;
 pub mod pattern;
 pub(crate) mod program;
 pub(crate) mod region;
+mod rounds;
 mod search;
 pub(crate) mod spacing;
 pub(crate) mod write;

@@ -140,19 +140,17 @@ fn work_items(prog: &Program, by_layer: &[Vec<usize>], clearance: f64) -> Vec<Wo
     for (b, blk) in prog.blocks.iter().enumerate() {
         blocks_of.entry(blk.layer).or_default().push(b);
     }
-    let mut layers: Vec<usize> = blocks_of.keys().copied().collect();
-    layers.sort_unstable();
-    let mut work = Vec::new();
-    for layer in layers {
-        let blocks = blocks_of.remove(&layer).unwrap_or_default();
-        let Some(idx) = by_layer.get(layer) else {
-            continue;
-        };
-        if let Some(w) = work_item(prog, layer, blocks, idx, clearance) {
-            work.push(w);
-        }
-    }
-    work
+    let mut layers: Vec<(usize, Vec<usize>)> = blocks_of.into_iter().collect();
+    layers.sort_unstable_by_key(|l| l.0);
+    // Each layer's region is a few boolean operations on its walls: independent, so one layer
+    // a thread.
+    crate::parallel::map_each(&layers, |(layer, blocks)| {
+        let idx = by_layer.get(*layer)?;
+        work_item(prog, *layer, blocks.clone(), idx, clearance)
+    })
+    .into_iter()
+    .flatten()
+    .collect()
 }
 
 /// Layer `layer` with sparse-infill blocks `blocks` and moves `idx` as a work item, if its
@@ -450,7 +448,7 @@ fn arrange(w: &Work, strokes: Vec<Path>) -> Vec<Path> {
     out
 }
 
-fn score(objective: Objective, w: &super::Weights, c: &Costs, base: &Costs) -> f64 {
+pub(crate) fn score(objective: Objective, w: &super::Weights, c: &Costs, base: &Costs) -> f64 {
     let rel = |a: f64, b: f64| if b > 0.0 { a / b } else { a };
     match objective {
         Objective::Energy => c.total_j,
@@ -462,11 +460,6 @@ fn score(objective: Objective, w: &super::Weights, c: &Costs, base: &Costs) -> f
                 + w.length * rel(c.length_mm, base.length_mm)
         }
     }
-}
-
-/// Key of a part-frame angle for the geometry cache (millidegrees in [0, 360)).
-fn angle_key(beta: f64) -> i64 {
-    (beta.rem_euclid(360.0) * 1000.0).round() as i64 % 360_000
 }
 
 /// [`infill`] with a progress callback (fraction of candidates costed; `false` cancels).
@@ -483,7 +476,7 @@ pub fn infill_with_progress(
     let prep = prepare(input, options)?;
     let base_costs = replay(&prep.prog, &[], None, &prep.base);
     let (rotations, rotations_skipped) = rotations_of(&prep, options)?;
-    let searched = search(&prep, options, &rotations, &base_costs, progress)?;
+    let searched = super::rounds::search(&prep, options, &rotations, &base_costs, progress)?;
     let Some((best_score, bi)) = searched.best else {
         return Err(invalid("no candidate"));
     };
@@ -573,11 +566,8 @@ fn write_chosen(
     base_costs: &Costs,
 ) -> Written {
     let beta = chosen.angle_deg - chosen.rotation_deg;
-    let mut plans: Vec<Vec<Path>> = prep
-        .work
-        .iter()
-        .map(|w| prep.plan_layer(w, chosen.pattern, beta))
-        .collect();
+    let mut plans: Vec<Vec<Path>> =
+        crate::parallel::map_each(&prep.work, |w| prep.plan_layer(w, chosen.pattern, beta));
     let mut layers = None;
     let mut costs = Costs {
         time_s: chosen.time_s,
@@ -715,122 +705,6 @@ fn original_kept(before: &Report, message: String) -> Best {
         saving_pct: 0.0,
         layers: None,
         message: Some(message),
-    }
-}
-
-/// Every (pattern, angle, rotation) costed.
-struct Searched {
-    candidates: Vec<Candidate>,
-    /// Score and index of the best candidate.
-    best: Option<(f64, usize)>,
-    /// Candidates whose geometry repeated an earlier one's: listed with its costs, not replayed.
-    skipped: usize,
-}
-
-/// One pattern's generated strokes, each set once: angles that give the same strokes (any
-/// angle for concentric loops; symmetric patterns) share one entry and one costing per
-/// rotation.
-#[derive(Default)]
-struct Geometries {
-    /// Strokes of each distinct geometry.
-    plans: Vec<Vec<Vec<Path>>>,
-    /// Geometry index of each part-frame angle key.
-    by_key: HashMap<i64, usize>,
-    /// Costs of (geometry, rotation index) already replayed.
-    costed: HashMap<(usize, usize), Costs>,
-}
-
-impl Geometries {
-    /// The geometry index of `pattern` at part-frame angle `beta`, generating it if new.
-    fn index(&mut self, prep: &Prepared<'_>, pattern: Pattern, beta: f64) -> usize {
-        // Concentric loops do not depend on the angle.
-        let key = if pattern == Pattern::Concentric {
-            0
-        } else {
-            angle_key(beta)
-        };
-        if let Some(&i) = self.by_key.get(&key) {
-            return i;
-        }
-        let plans: Vec<Vec<Path>> = prep
-            .work
-            .iter()
-            .map(|w| prep.plan_layer(w, pattern, beta))
-            .collect();
-        let i = match self.plans.iter().position(|p| *p == plans) {
-            Some(i) => i,
-            None => {
-                self.plans.push(plans);
-                self.plans.len() - 1
-            }
-        };
-        self.by_key.insert(key, i);
-        i
-    }
-}
-
-/// Every (pattern, angle, rotation) costed, and the score and index of the best.
-fn search(
-    prep: &Prepared<'_>,
-    options: &InfillOptions,
-    rotations: &[(f64, Option<Rotation>)],
-    base_costs: &Costs,
-    progress: Progress<'_>,
-) -> Result<Searched, Error> {
-    let total = options.patterns.len() * options.angles_deg.len() * rotations.len();
-    let mut done = 0usize;
-    let mut out = Searched {
-        candidates: Vec::with_capacity(total),
-        best: None,
-        skipped: 0,
-    };
-    for &pattern in &options.patterns {
-        let mut geometries = Geometries::default();
-        for &angle in &options.angles_deg {
-            for (ri, (rot_deg, rotation)) in rotations.iter().enumerate() {
-                if !progress(done as f64 / total as f64) {
-                    return Err(Error::new(0, 0, ErrorKind::Cancelled));
-                }
-                done += 1;
-                let g = geometries.index(prep, pattern, angle - rot_deg);
-                let c = match geometries.costed.get(&(g, ri)) {
-                    Some(c) => {
-                        out.skipped += 1;
-                        *c
-                    }
-                    None => {
-                        let refs: Vec<&Vec<Path>> = geometries.plans[g].iter().collect();
-                        let (_, motions) = prep.candidate(&refs, rotation.as_ref());
-                        let c = replay(&prep.prog, &motions, rotation.as_ref(), &prep.base);
-                        geometries.costed.insert((g, ri), c);
-                        c
-                    }
-                };
-                let s = score(options.objective, &options.weights, &c, base_costs);
-                if out.best.is_none_or(|(b, _)| s < b) {
-                    out.best = Some((s, out.candidates.len()));
-                }
-                out.candidates
-                    .push(candidate_of(pattern, angle, *rot_deg, &c));
-            }
-        }
-    }
-    Ok(out)
-}
-
-fn candidate_of(pattern: Pattern, angle_deg: f64, rotation_deg: f64, c: &Costs) -> Candidate {
-    Candidate {
-        pattern,
-        angle_deg,
-        rotation_deg,
-        thesis_j: c.thesis_j,
-        total_j: c.total_j,
-        time_s: c.time_s,
-        length_mm: c.length_mm,
-        filament_mm: c.filament_mm,
-        infill_length_mm: c.infill.l_total_mm,
-        infill_turning_points: c.infill.n_turning,
-        infill_mean_turn_deg: c.infill.mean_turn_deg,
     }
 }
 
