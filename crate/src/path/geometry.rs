@@ -54,7 +54,16 @@ pub struct LayerGeometry {
     /// Curvature at the segment's start: turning angle to the previous printing segment over
     /// the mean of their lengths, 1/mm (0 after a travel and on travels).
     pub curvature: Vec<f32>,
+    /// Tool vectors of a multi-axis file, [`TOOL_FLOATS`] numbers each (vector `i` is
+    /// `tool[6i..6i+6] = [x, y, z, i, j, k]`): the tool tip (mm) and the unit tool vector (tip
+    /// towards the nozzle), both in the workpiece frame. Always empty here: reading rotary axes
+    /// takes a kinematic model, which lives in `orient`, above this module; `orient` fills it
+    /// (`orient::layer_geometries`). Empty for a three-axis file.
+    pub tool: Vec<f32>,
 }
+
+/// Numbers per tool vector in [`LayerGeometry::tool`]: tip x, y, z, then the unit vector.
+pub const TOOL_FLOATS: usize = 6;
 
 fn segment_kind(path: &PrintPath, m: &PathMove) -> SegmentKind {
     use crate::gcode::FeatureKind as F;
