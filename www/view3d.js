@@ -6,7 +6,9 @@
 //
 // Orbit by dragging, pan with the right button (or Shift+drag), zoom with the wheel, two
 // fingers pinch to zoom and drag to orbit. Colours are those of the 2-D viewer (feature,
-// speed, curvature, layer time); travels on demand; "after" over a grey "before".
+// speed, curvature, layer time); travels on demand; "after" over a grey "before". A multi-axis
+// file also gets its tool vectors (LayerGeometry.tool, computed by the crate's orient module in
+// the workpiece frame): short segments from the tool tip up the tool axis, every n-th of them.
 
 import * as THREE from './vendor/three.module.js';
 import { KINDS, KIND_COLORS, RAMP } from './viewer.js';
@@ -16,13 +18,19 @@ import { KINDS, KIND_COLORS, RAMP } from './viewer.js';
  * @typedef {import('./jobs.js').LayerMessage & { time?: number | null }} PartLayer
  */
 /**
- * How to draw: the colouring, travels, the value range of speed, curvature or layer time,
- * and the bed's outline ([[x, y], …] in mm) when known.
- * @typedef {{ colorBy: string, showTravel: boolean, range: { lo: number, hi: number } | null, bed?: number[][] | null }} DrawOptions
+ * How to draw: the colouring, travels, tool vectors (multi-axis files), the value range of
+ * speed, curvature or layer time, and the bed's outline ([[x, y], …] in mm) when known.
+ * @typedef {{ colorBy: string, showTravel: boolean, showTools?: boolean, range: { lo: number, hi: number } | null, bed?: number[][] | null }} DrawOptions
  */
 
 const GHOST = new THREE.Color('#9aa4a0');
 const TRAVEL = new THREE.Color('#8c9692');
+/** Colour of the tool vectors: a magenta none of the feature colours or ramps comes near. */
+export const TOOL_COLOR = '#ff00cc';
+/** Length of a drawn tool vector, mm: long enough to read the tilt, short beside the part. */
+const TOOL_LENGTH_MM = 4;
+/** Most tool vectors drawn: one per extruding move would hide the part, so every n-th. */
+const MAX_TOOL_VECTORS = 2500;
 
 export class PartView {
   /** @param {HTMLCanvasElement} canvas */
@@ -78,6 +86,14 @@ export class PartView {
     };
     if (ghost) add(ghost, true);
     add(layers, false);
+    const tools = opts.showTools ? buildTools(layers) : null;
+    if (tools) {
+      tools.geometry.computeBoundingBox();
+      box.union(/** @type {THREE.Box3} */ (tools.geometry.boundingBox));
+      this.scene.add(tools);
+      this.objects.push(tools);
+    }
+    this.canvas.dataset.toolVectors = String(tools ? tools.geometry.getAttribute('position').count / 2 : 0);
     if (opts.bed && opts.bed.length >= 3) {
       // The bed at z = 0, as an outline.
       const pts = opts.bed.map(([x, y]) => new THREE.Vector3(x, y, 0));
@@ -261,4 +277,44 @@ function build(list, ghost, { colorBy, showTravel, range }) {
   geometry.setAttribute('color', new THREE.BufferAttribute(col, 3));
   const material = new THREE.LineBasicMaterial({ vertexColors: true, transparent: ghost, opacity: ghost ? 0.35 : 1 });
   return new THREE.LineSegments(geometry, material);
+}
+
+/**
+ * Tool vectors available in `list` (LayerGeometry.tool holds six numbers per vector).
+ * @param {PartLayer[]} list
+ * @returns {number}
+ */
+export function toolCount(list) {
+  let n = 0;
+  for (const g of list) n += Math.floor((g.tool?.length ?? 0) / 6);
+  return n;
+}
+
+/**
+ * The tool vectors of `list` as one LineSegments: from each tool tip TOOL_LENGTH_MM along the
+ * unit tool vector, every n-th so that at most MAX_TOOL_VECTORS are drawn; null when there are
+ * none (a three-axis file).
+ * @param {PartLayer[]} list
+ * @returns {THREE.LineSegments<THREE.BufferGeometry, THREE.LineBasicMaterial> | null}
+ */
+function buildTools(list) {
+  const total = toolCount(list);
+  if (total === 0) return null;
+  const stride = Math.ceil(total / MAX_TOOL_VECTORS);
+  const pos = new Float32Array(Math.ceil(total / stride) * 6);
+  let seen = 0;
+  let j = 0;
+  for (const g of list) {
+    const t = g.tool;
+    if (!t) continue;
+    for (let o = 0; o + 6 <= t.length; o += 6, seen++) {
+      if (seen % stride !== 0) continue;
+      const L = TOOL_LENGTH_MM;
+      pos.set([t[o], t[o + 1], t[o + 2], t[o] + L * t[o + 3], t[o + 1] + L * t[o + 4], t[o + 2] + L * t[o + 5]], j * 6);
+      j++;
+    }
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(pos.subarray(0, j * 6), 3));
+  return new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: TOOL_COLOR }));
 }
