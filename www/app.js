@@ -1168,7 +1168,7 @@ const KEYS_3D = 'Drag to orbit, right-drag or Shift+drag to pan, wheel or pinch 
 /**
  * The 3-D canvas's text alternative: which layers of which file, their heights, what is
  * drawn and in which colours, and the keys.
- * @param {{ z: number | null }[]} shown the layers drawn
+ * @param {{ z: number | null, xyz?: Float32Array }[]} shown the layers drawn
  * @param {{ from: number, to: number, count: number, stride: number, which: 'before' | 'after', ghost: boolean }} what
  * @returns {string}
  */
@@ -1178,7 +1178,8 @@ function describe3d(shown, { from, to, count, stride, which, ghost }) {
   const colours = { feature: 'feature', speed: 'speed', curvature: 'curvature', 'layer-time': 'layer time' }[viewer.colorBy] ?? viewer.colorBy;
   return (
     `The part in 3-D: layers ${from + 1} to ${to + 1} of ${count}${stride > 1 ? ` (every ${stride}th)` : ''}${heights}, ` +
-    `of the ${which === 'after' ? 'optimized output' : 'file'}${ghost ? ' over the original in grey' : ''}, ` +
+    `of the ${which === 'after' ? 'optimized output' : 'file'}${ghost ? ' over the original in grey' : ''}` +
+    `${shown.some((g) => g.xyz?.length) ? ' drawn on the workpiece (the tool tip through the rotary axes)' : ''}, ` +
     `${formatCount(Number(canvas3d.dataset.segments))} segments, coloured by ${colours}${viewer.showTravel ? ', travels shown' : ''}${toolsText()}. ${KEYS_3D}`
   );
 }
@@ -1287,7 +1288,10 @@ async function refreshLayers() {
       els.layerSlider.max = String(Math.max(0, count - 1));
       if (Number(els.layerSlider.value) > count - 1) els.layerSlider.value = String(Math.max(0, count - 1));
       els.layerNumber.textContent = `${before.index + 1} / ${count}`;
-      els.layerInfo.textContent = `${isNum(before.z) ? `z = ${before.z.toFixed(2)} mm · ` : ''}${formatCount(before.kind.length)} segments${after ? ` before, ${formatCount(after.kind.length)} after` : ''}`;
+      // A multi-axis file (its layers carry a workpiece-frame path): this view is of the machine
+      // axes, which for a turning table are not where the material goes; the 3-D view is.
+      const machineAxes = before.xyz?.length ? ' · machine X, Y (the 3-D view draws the part)' : '';
+      els.layerInfo.textContent = `${isNum(before.z) ? `z = ${before.z.toFixed(2)} mm · ` : ''}${formatCount(before.kind.length)} segments${after ? ` before, ${formatCount(after.kind.length)} after` : ''}${machineAxes}`;
       els.canvas.dataset.layer = String(before.index);
       els.canvas.dataset.z = isNum(before.z) ? before.z.toFixed(3) : '';
       if (after) els.canvas.dataset.afterZ = isNum(after.z) ? after.z.toFixed(3) : '';

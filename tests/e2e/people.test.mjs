@@ -407,6 +407,7 @@ test('3-D view: the demo drawn with WebGL, a layer range, orbit, the 5-axis file
   assert.equal(await byTestId('view-3d').getAttribute('data-tool-vectors'), '0');
   assert.equal(await byTestId('show-tools').isVisible(), false, 'no tool-vector toggle for the 3-axis demo');
   assert.equal(await toolInk(), 0, 'no pixel of the tool-vector colour in the demo');
+  assert.equal(await byTestId('view-3d').getAttribute('data-tool-offset-mm'), '', 'no tool offset to measure');
   // A layer range: fewer segments.
   await byTestId('layer-from').fill('10');
   await byTestId('layer-from').dispatchEvent('change');
@@ -435,6 +436,11 @@ test('3-D view: the demo drawn with WebGL, a layer range, orbit, the 5-axis file
   const vectors = Number(await byTestId('view-3d').getAttribute('data-tool-vectors'));
   assert.ok(vectors > 100, `tool vectors drawn: ${vectors}`);
   assert.match((await byTestId('view-3d').getAttribute('aria-label')) ?? '', /tool vectors/);
+  // The path is drawn on the workpiece, through the tips the vectors start from: each drawn
+  // vector's base is a drawn path vertex (machine X, Y would put it 27 mm away on average).
+  assert.match((await byTestId('view-3d').getAttribute('aria-label')) ?? '', /drawn on the workpiece/);
+  const offset = Number(await byTestId('view-3d').getAttribute('data-tool-offset-mm'));
+  assert.ok(Number.isFinite(offset) && offset < 1e-3, `tool vectors start on the drawn path: ${offset} mm off`);
   const toolPixels = await toolInk();
   assert.ok(toolPixels > 200, `tool-vector pixels: ${toolPixels}`);
   // The toggle hides them.
@@ -445,6 +451,8 @@ test('3-D view: the demo drawn with WebGL, a layer range, orbit, the 5-axis file
   await byTestId('show-tools').check();
   await page.waitForFunction((n) => document.querySelector('[data-testid="view-3d"]').dataset.toolVectors === String(n), vectors);
   await byTestId('view-kind').selectOption('2d');
+  // The 2-D layer view stays in machine axes, and says so for a multi-axis file.
+  await page.waitForFunction(() => /machine X, Y/.test(document.querySelector('[data-testid="layer-info"]').textContent ?? ''), null, { timeout: JOB_TIMEOUT });
   assert.deepEqual(pageErrors, []);
 });
 
