@@ -1095,8 +1095,13 @@ const canvas3d = /** @type {HTMLCanvasElement} */ ($('view-3d'));
 const range3d = $('range-3d');
 const layerFrom = /** @type {HTMLInputElement} */ ($('layer-from'));
 const layerTo = /** @type {HTMLInputElement} */ ($('layer-to'));
+const showTools = /** @type {HTMLInputElement} */ ($('show-tools'));
+const showToolsLabel = $('show-tools-label');
 const MAX_3D_SEGMENTS = 1_500_000;
 let partView = null; // view3d.js's PartView, made the first time the 3-D view is shown
+/** @type {typeof import('./view3d.js') | null} */
+let view3d = null; // the module, loaded with the first PartView
+let toolsAvailable = false; // whether the layers last drawn in 3-D carry tool vectors (multi-axis)
 const part3d = new Map(); // `${fileToken}:${which}` → (index → geometry), of the current file only
 let part3dRun = 0;
 
@@ -1125,9 +1130,10 @@ async function refresh3d(refit = false) {
   if (viewKind.value !== '3d' || !loaded) return;
   const run = ++part3dRun;
   try {
-    if (!partView) {
-      const { PartView } = await import('./view3d.js');
-      partView = new PartView(canvas3d);
+    if (!partView || !view3d) {
+      view3d = await import('./view3d.js');
+      partView = new view3d.PartView(canvas3d);
+      $('tools-swatch').style.background = view3d.TOOL_COLOR;
     }
     const first = await client.layer('before', 0);
     const count = first.count;
@@ -1145,7 +1151,10 @@ async function refresh3d(refit = false) {
     const ghost = which === 'after' && (mode === 'side' || mode === 'overlay') ? await partLayers('before', from, to, stride, run) : null;
     if (!shown || run !== part3dRun) return;
     const range = viewer.colorBy === 'layer-time' ? { lo: viewer.layerTime?.lo ?? 0, hi: viewer.layerTime?.hi ?? 1 } : rangeOf(shown, viewer.colorBy);
-    partView.setLayers(shown, ghost, { colorBy: viewer.colorBy, showTravel: viewer.showTravel, range, bed: viewer.bed }, refit);
+    // The tool-vector toggle is offered for a multi-axis file only (the crate sends its vectors).
+    toolsAvailable = view3d.toolCount(shown) > 0;
+    showToolsLabel.hidden = !toolsAvailable;
+    partView.setLayers(shown, ghost, { colorBy: viewer.colorBy, showTravel: viewer.showTravel, showTools: showTools.checked, range, bed: viewer.bed }, refit);
     canvas3d.dataset.layers = String(shown.length);
     els.layerInfo.textContent = `3-D: layers ${from + 1}–${to + 1}${stride > 1 ? ` (every ${stride}th, to stay quick)` : ''} of the ${which === 'after' ? 'optimized output' : 'file'} · ${formatCount(Number(canvas3d.dataset.segments))} segments`;
     canvas3d.setAttribute('aria-label', describe3d(shown, { from, to, count, stride, which, ghost: !!ghost }));
@@ -1159,7 +1168,7 @@ const KEYS_3D = 'Drag to orbit, right-drag or Shift+drag to pan, wheel or pinch 
 /**
  * The 3-D canvas's text alternative: which layers of which file, their heights, what is
  * drawn and in which colours, and the keys.
- * @param {{ z: number | null }[]} shown the layers drawn
+ * @param {{ z: number | null, xyz?: Float32Array }[]} shown the layers drawn
  * @param {{ from: number, to: number, count: number, stride: number, which: 'before' | 'after', ghost: boolean }} what
  * @returns {string}
  */
@@ -1169,9 +1178,17 @@ function describe3d(shown, { from, to, count, stride, which, ghost }) {
   const colours = { feature: 'feature', speed: 'speed', curvature: 'curvature', 'layer-time': 'layer time' }[viewer.colorBy] ?? viewer.colorBy;
   return (
     `The part in 3-D: layers ${from + 1} to ${to + 1} of ${count}${stride > 1 ? ` (every ${stride}th)` : ''}${heights}, ` +
-    `of the ${which === 'after' ? 'optimized output' : 'file'}${ghost ? ' over the original in grey' : ''}, ` +
-    `${formatCount(Number(canvas3d.dataset.segments))} segments, coloured by ${colours}${viewer.showTravel ? ', travels shown' : ''}. ${KEYS_3D}`
+    `of the ${which === 'after' ? 'optimized output' : 'file'}${ghost ? ' over the original in grey' : ''}` +
+    `${shown.some((g) => g.xyz?.length) ? ' drawn on the workpiece (the tool tip through the rotary axes)' : ''}, ` +
+    `${formatCount(Number(canvas3d.dataset.segments))} segments, coloured by ${colours}${viewer.showTravel ? ', travels shown' : ''}${toolsText()}. ${KEYS_3D}`
   );
+}
+
+/** The 3-D label's words on the tool vectors of a multi-axis file ('' for a three-axis one). */
+function toolsText() {
+  const n = Number(canvas3d.dataset.toolVectors);
+  if (!toolsAvailable) return '';
+  return n > 0 ? `, ${formatCount(n)} tool vectors (tool axis from the tip) in magenta` : ', tool vectors hidden';
 }
 
 /** Colour range of speed or curvature over the layers (curvature clipped at its 95th percentile). */
@@ -1197,6 +1214,7 @@ function setViewKind(kind) {
   range3d.hidden = !three;
   els.layerSlider.disabled = three;
   els.fit.disabled = three;
+  showToolsLabel.hidden = !three || !toolsAvailable;
   if (three) refresh3d(true);
   else refreshLayers();
 }
@@ -1270,7 +1288,10 @@ async function refreshLayers() {
       els.layerSlider.max = String(Math.max(0, count - 1));
       if (Number(els.layerSlider.value) > count - 1) els.layerSlider.value = String(Math.max(0, count - 1));
       els.layerNumber.textContent = `${before.index + 1} / ${count}`;
-      els.layerInfo.textContent = `${isNum(before.z) ? `z = ${before.z.toFixed(2)} mm · ` : ''}${formatCount(before.kind.length)} segments${after ? ` before, ${formatCount(after.kind.length)} after` : ''}`;
+      // A multi-axis file (its layers carry a workpiece-frame path): this view is of the machine
+      // axes, which for a turning table are not where the material goes; the 3-D view is.
+      const machineAxes = before.xyz?.length ? ' · machine X, Y (the 3-D view draws the part)' : '';
+      els.layerInfo.textContent = `${isNum(before.z) ? `z = ${before.z.toFixed(2)} mm · ` : ''}${formatCount(before.kind.length)} segments${after ? ` before, ${formatCount(after.kind.length)} after` : ''}${machineAxes}`;
       els.canvas.dataset.layer = String(before.index);
       els.canvas.dataset.z = isNum(before.z) ? before.z.toFixed(3) : '';
       if (after) els.canvas.dataset.afterZ = isNum(after.z) ? after.z.toFixed(3) : '';
@@ -1300,6 +1321,9 @@ function resetViewer() {
   els.layerSlider.value = String(Number.isInteger(wanted) && wanted >= 0 ? wanted : 0);
   layerFrom.value = '1';
   layerTo.value = '';
+  // A new file: its own 3-D drawing tells whether it has tool vectors.
+  toolsAvailable = false;
+  showToolsLabel.hidden = true;
   refreshLayers();
   refresh3d(true);
 }
@@ -1822,6 +1846,7 @@ els.showTravel.addEventListener('change', () => {
   refresh3d();
   writeHash();
 });
+showTools.addEventListener('change', () => refresh3d());
 els.viewMode.addEventListener('change', () => {
   viewer.set('mode', els.viewMode.value);
   refresh3d();

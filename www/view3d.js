@@ -6,7 +6,12 @@
 //
 // Orbit by dragging, pan with the right button (or Shift+drag), zoom with the wheel, two
 // fingers pinch to zoom and drag to orbit. Colours are those of the 2-D viewer (feature,
-// speed, curvature, layer time); travels on demand; "after" over a grey "before".
+// speed, curvature, layer time); travels on demand; "after" over a grey "before". A multi-axis
+// file is drawn on its workpiece instead: LayerGeometry.xyz, the tool tip in the workpiece frame
+// (computed by the crate's orient module), a true 3-D path rather than machine X, Y stacked at
+// the layer's height, which for a turning table lies tens of mm from where the material goes.
+// It also gets its tool vectors (LayerGeometry.tool, same frame, same tips): short segments
+// from the tool tip up the tool axis, every n-th of them, each starting on the drawn path.
 
 import * as THREE from './vendor/three.module.js';
 import { KINDS, KIND_COLORS, RAMP } from './viewer.js';
@@ -16,13 +21,19 @@ import { KINDS, KIND_COLORS, RAMP } from './viewer.js';
  * @typedef {import('./jobs.js').LayerMessage & { time?: number | null }} PartLayer
  */
 /**
- * How to draw: the colouring, travels, the value range of speed, curvature or layer time,
- * and the bed's outline ([[x, y], …] in mm) when known.
- * @typedef {{ colorBy: string, showTravel: boolean, range: { lo: number, hi: number } | null, bed?: number[][] | null }} DrawOptions
+ * How to draw: the colouring, travels, tool vectors (multi-axis files), the value range of
+ * speed, curvature or layer time, and the bed's outline ([[x, y], …] in mm) when known.
+ * @typedef {{ colorBy: string, showTravel: boolean, showTools?: boolean, range: { lo: number, hi: number } | null, bed?: number[][] | null }} DrawOptions
  */
 
 const GHOST = new THREE.Color('#9aa4a0');
 const TRAVEL = new THREE.Color('#8c9692');
+/** Colour of the tool vectors: a magenta none of the feature colours or ramps comes near. */
+export const TOOL_COLOR = '#ff00cc';
+/** Length of a drawn tool vector, mm: long enough to read the tilt, short beside the part. */
+const TOOL_LENGTH_MM = 4;
+/** Most tool vectors drawn: one per extruding move would hide the part, so every n-th. */
+const MAX_TOOL_VECTORS = 2500;
 
 export class PartView {
   /** @param {HTMLCanvasElement} canvas */
@@ -46,7 +57,8 @@ export class PartView {
   }
 
   /**
-   * Draws layers: `layers` [{ z, xy, kind, speed, curvature, time }] of the shown file,
+   * Draws layers: `layers` [{ z, xy, kind, speed, curvature, xyz, tool, time }] of the shown
+   * file (through xyz, the workpiece frame, when a multi-axis layer has it),
    * `ghost` the same of the other one (drawn grey) or null; `opts` { colorBy, showTravel,
    * range: { lo, hi } for speed/curvature/layer time }. Keeps the camera unless `refit`.
    * @param {PartLayer[]} layers
@@ -69,15 +81,25 @@ export class PartView {
      */
     const add = (list, isGhost) => {
       const lines = build(list, isGhost, opts);
-      if (!lines) return;
+      if (!lines) return null;
       segments += lines.geometry.getAttribute('position').count / 2;
       lines.geometry.computeBoundingBox();
       box.union(/** @type {THREE.Box3} */ (lines.geometry.boundingBox));
       this.scene.add(lines);
       this.objects.push(lines);
+      return lines;
     };
     if (ghost) add(ghost, true);
-    add(layers, false);
+    const shownLines = add(layers, false);
+    const tools = opts.showTools ? buildTools(layers) : null;
+    this.canvas.dataset.toolOffsetMm = tools && shownLines ? String(toolOffset(positions(shownLines), positions(tools))) : '';
+    if (tools) {
+      tools.geometry.computeBoundingBox();
+      box.union(/** @type {THREE.Box3} */ (tools.geometry.boundingBox));
+      this.scene.add(tools);
+      this.objects.push(tools);
+    }
+    this.canvas.dataset.toolVectors = String(tools ? tools.geometry.getAttribute('position').count / 2 : 0);
     if (opts.bed && opts.bed.length >= 3) {
       // The bed at z = 0, as an outline.
       const pts = opts.bed.map(([x, y]) => new THREE.Vector3(x, y, 0));
@@ -240,6 +262,8 @@ function build(list, ghost, { colorBy, showTravel, range }) {
   for (const g of list) {
     const z = typeof g.z === 'number' && Number.isFinite(g.z) ? g.z : 0;
     const { xy, kind } = g;
+    // A multi-axis layer: its segments on the workpiece, parallel to xy (same kinds, colours).
+    const xyz = g.xyz && g.xyz.length === 6 * kind.length ? g.xyz : null;
     for (let i = 0; i < kind.length; i++) {
       const travel = kind[i] === 0;
       if (travel && !(showTravel && !ghost)) continue;
@@ -251,7 +275,8 @@ function build(list, ghost, { colorBy, showTravel, range }) {
       else if (colorBy === 'layer-time') c = rampAt(g.time);
       else c = kindColors[kind[i]] ?? kindColors[KINDS.length - 1];
       const o = 4 * i;
-      pos.set([xy[o], xy[o + 1], z, xy[o + 2], xy[o + 3], z], j * 6);
+      if (xyz) pos.set(xyz.subarray(6 * i, 6 * i + 6), j * 6);
+      else pos.set([xy[o], xy[o + 1], z, xy[o + 2], xy[o + 3], z], j * 6);
       col.set([c.r, c.g, c.b, c.r, c.g, c.b], j * 6);
       j++;
     }
@@ -261,4 +286,105 @@ function build(list, ghost, { colorBy, showTravel, range }) {
   geometry.setAttribute('color', new THREE.BufferAttribute(col, 3));
   const material = new THREE.LineBasicMaterial({ vertexColors: true, transparent: ghost, opacity: ghost ? 0.35 : 1 });
   return new THREE.LineSegments(geometry, material);
+}
+
+/**
+ * Tool vectors available in `list` (LayerGeometry.tool holds six numbers per vector).
+ * @param {PartLayer[]} list
+ * @returns {number}
+ */
+export function toolCount(list) {
+  let n = 0;
+  for (const g of list) n += Math.floor((g.tool?.length ?? 0) / 6);
+  return n;
+}
+
+/**
+ * The tool vectors of `list` as one LineSegments: from each tool tip TOOL_LENGTH_MM along the
+ * unit tool vector, every n-th so that at most MAX_TOOL_VECTORS are drawn; null when there are
+ * none (a three-axis file).
+ * @param {PartLayer[]} list
+ * @returns {THREE.LineSegments<THREE.BufferGeometry, THREE.LineBasicMaterial> | null}
+ */
+function buildTools(list) {
+  const total = toolCount(list);
+  if (total === 0) return null;
+  const stride = Math.ceil(total / MAX_TOOL_VECTORS);
+  const pos = new Float32Array(Math.ceil(total / stride) * 6);
+  let seen = 0;
+  let j = 0;
+  for (const g of list) {
+    const t = g.tool;
+    if (!t) continue;
+    for (let o = 0; o + 6 <= t.length; o += 6, seen++) {
+      if (seen % stride !== 0) continue;
+      const L = TOOL_LENGTH_MM;
+      pos.set([t[o], t[o + 1], t[o + 2], t[o] + L * t[o + 3], t[o + 1] + L * t[o + 4], t[o + 2] + L * t[o + 5]], j * 6);
+      j++;
+    }
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(pos.subarray(0, j * 6), 3));
+  return new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: TOOL_COLOR }));
+}
+
+/**
+ * The vertex positions of a drawn LineSegments (x, y, z each).
+ * @param {THREE.LineSegments<THREE.BufferGeometry, THREE.LineBasicMaterial> | THREE.Line<THREE.BufferGeometry, THREE.LineBasicMaterial>} lines
+ * @returns {ArrayLike<number>}
+ */
+function positions(lines) {
+  return lines.geometry.getAttribute('position').array;
+}
+
+/** Grid cell of the nearest-vertex search in toolOffset, mm. */
+const OFFSET_CELL_MM = 1;
+/** Most tool vectors without a drawn vertex within a cell whose distance toolOffset searches for. */
+const OFFSET_SLOW_MAX = 50;
+
+/**
+ * How far the drawn tool vectors start from the drawn path, mm: the largest distance from a
+ * vector's base (even vertices of `tools`) to its nearest path vertex (`path`, x, y, z each).
+ * 0 when each vector starts on the path, as the crate's shared tips make it; the canvas shows
+ * it as data-tool-offset-mm, for the tests. One pass over the path: each base is registered in
+ * the 27 grid cells around its own, so a vertex finds the bases within a cell by one lookup. A
+ * base with none (a broken drawing) is measured against every vertex, at most OFFSET_SLOW_MAX
+ * of them, so the result is then a lower bound, already far above a tolerance.
+ * @param {ArrayLike<number>} path
+ * @param {ArrayLike<number>} tools
+ * @returns {number}
+ */
+export function toolOffset(path, tools) {
+  const cell = (/** @type {number} */ v) => Math.floor(v / OFFSET_CELL_MM);
+  const key = (/** @type {number} */ x, /** @type {number} */ y, /** @type {number} */ z) => `${x},${y},${z}`;
+  /** @type {Map<string, number[]>} */
+  const near = new Map();
+  const bases = Math.floor(tools.length / 6);
+  const best = new Float64Array(bases).fill(Infinity);
+  for (let b = 0; b < bases; b++) {
+    const [cx, cy, cz] = [0, 1, 2].map((k) => cell(tools[6 * b + k]));
+    for (let dx = -1; dx <= 1; dx++)
+      for (let dy = -1; dy <= 1; dy++)
+        for (let dz = -1; dz <= 1; dz++) {
+          const k = key(cx + dx, cy + dy, cz + dz);
+          const list = near.get(k);
+          if (list) list.push(b);
+          else near.set(k, [b]);
+        }
+  }
+  const dist = (/** @type {number} */ b, /** @type {number} */ v) =>
+    Math.hypot(path[v] - tools[6 * b], path[v + 1] - tools[6 * b + 1], path[v + 2] - tools[6 * b + 2]);
+  for (let v = 0; v + 2 < path.length; v += 3) {
+    for (const b of near.get(key(cell(path[v]), cell(path[v + 1]), cell(path[v + 2]))) ?? []) best[b] = Math.min(best[b], dist(b, v));
+  }
+  let slow = 0;
+  for (let b = 0; b < bases && slow < OFFSET_SLOW_MAX; b++) {
+    if (best[b] !== Infinity) continue;
+    slow++;
+    for (let v = 0; v + 2 < path.length; v += 3) best[b] = Math.min(best[b], dist(b, v));
+  }
+  let max = 0;
+  // Bases past OFFSET_SLOW_MAX stay unmeasured (Infinity), left out of the lower bound.
+  for (let b = 0; b < bases; b++) if (best[b] !== Infinity) max = Math.max(max, best[b]);
+  return max;
 }

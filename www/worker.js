@@ -36,8 +36,10 @@
 //       session. With a number `z`, the layer nearest that height instead of
 //       `index` (how "after" follows "before": a rewrite may change the count).
 //       → { id, type: 'layer', which, index, count, z, xy, kind, speed,
-//           curvature }   (typed arrays transferred; see types.d.ts
-//           LayerGeometry; count: the session's number of layers)
+//           curvature, xyz, tool }   (typed arrays transferred; see types.d.ts
+//           LayerGeometry; xyz: the segments of a multi-axis file in the
+//           workpiece frame, tool: its tool vectors, both empty otherwise;
+//           count: the session's number of layers)
 //
 // worker → page
 //   { type: 'hello', version, capabilities: string[], machines: MachineProfile[] }
@@ -346,10 +348,10 @@ function handleLayer(msg) {
     let i = Math.max(0, Math.min(count - 1, index | 0));
     let g = null;
     if (count > 0 && typeof msg.z === 'number' && Number.isFinite(msg.z)) [i, g] = nearestZ(s.session, count, msg.z, i);
-    g ??= count > 0 ? s.session.layer(i) : { z: null, xy: new Float32Array(), kind: new Uint8Array(), speed: new Float32Array(), curvature: new Float32Array() };
+    g ??= count > 0 ? s.session.layer(i) : { z: null, xy: new Float32Array(), kind: new Uint8Array(), speed: new Float32Array(), curvature: new Float32Array(), xyz: new Float32Array(), tool: new Float32Array() };
     self.postMessage(
-      { id, type: 'layer', which, index: i, count, z: g.z, xy: g.xy, kind: g.kind, speed: g.speed, curvature: g.curvature },
-      [g.xy.buffer, g.kind.buffer, g.speed.buffer, g.curvature.buffer],
+      { id, type: 'layer', which, index: i, count, z: g.z, xy: g.xy, kind: g.kind, speed: g.speed, curvature: g.curvature, xyz: g.xyz, tool: g.tool },
+      [g.xy.buffer, g.kind.buffer, g.speed.buffer, g.curvature.buffer, g.xyz.buffer, g.tool.buffer],
     );
   } catch (err) {
     postError(id, err, s.bytes);

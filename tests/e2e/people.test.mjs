@@ -370,6 +370,25 @@ async function inked3d(p = page, hash = false) {
   }, hash);
 }
 
+// Pixels of the 3-D canvas within a small distance of the tool-vector colour (the swatch beside
+// the "tool vectors" toggle shows it).
+async function toolInk(p = page) {
+  return p.evaluate(() => {
+    const rgb = getComputedStyle(document.querySelector('[data-testid="tools-swatch"]')).backgroundColor.match(/\d+/g)?.map(Number);
+    if (!rgb || rgb.length < 3) return -1;
+    const c = document.querySelector('[data-testid="view-3d"]');
+    const t = document.createElement('canvas');
+    t.width = c.width;
+    t.height = c.height;
+    const ctx = t.getContext('2d');
+    ctx.drawImage(c, 0, 0);
+    const d = ctx.getImageData(0, 0, t.width, t.height).data;
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - rgb[0]) + Math.abs(d[i + 1] - rgb[1]) + Math.abs(d[i + 2] - rgb[2]) < 60) n++;
+    return n;
+  });
+}
+
 test('3-D view: the demo drawn with WebGL, a layer range, orbit, the 5-axis file', { timeout: JOB_TIMEOUT }, async () => {
   await page.goto(baseUrl);
   assert.equal(await settled(), 'ready');
@@ -384,6 +403,11 @@ test('3-D view: the demo drawn with WebGL, a layer range, orbit, the 5-axis file
   const whole = Number(await byTestId('view-3d').getAttribute('data-segments'));
   const ink = await inked3d();
   assert.ok(ink > 2000, `the WebGL canvas is drawn: ${ink} pixels`);
+  // A three-axis file has no tool vectors: none drawn, no toggle.
+  assert.equal(await byTestId('view-3d').getAttribute('data-tool-vectors'), '0');
+  assert.equal(await byTestId('show-tools').isVisible(), false, 'no tool-vector toggle for the 3-axis demo');
+  assert.equal(await toolInk(), 0, 'no pixel of the tool-vector colour in the demo');
+  assert.equal(await byTestId('view-3d').getAttribute('data-tool-offset-mm'), '', 'no tool offset to measure');
   // A layer range: fewer segments.
   await byTestId('layer-from').fill('10');
   await byTestId('layer-from').dispatchEvent('change');
@@ -406,7 +430,29 @@ test('3-D view: the demo drawn with WebGL, a layer range, orbit, the 5-axis file
   await page.waitForFunction(() => Number(document.querySelector('[data-testid="view-3d"]').dataset.segments) > 0 && document.querySelector('[data-testid="view-3d"]').dataset.layers !== '3', null, { timeout: JOB_TIMEOUT });
   await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
   assert.ok((await inked3d()) > 500, '5-axis file drawn in 3-D');
+  // Its tool vectors (from the crate's kinematic model), on by default, in their own colour.
+  assert.equal(await byTestId('show-tools').isVisible(), true, 'the tool-vector toggle for a 5-axis file');
+  assert.equal(await byTestId('show-tools').isChecked(), true, 'tool vectors on by default');
+  const vectors = Number(await byTestId('view-3d').getAttribute('data-tool-vectors'));
+  assert.ok(vectors > 100, `tool vectors drawn: ${vectors}`);
+  assert.match((await byTestId('view-3d').getAttribute('aria-label')) ?? '', /tool vectors/);
+  // The path is drawn on the workpiece, through the tips the vectors start from: each drawn
+  // vector's base is a drawn path vertex (machine X, Y would put it 27 mm away on average).
+  assert.match((await byTestId('view-3d').getAttribute('aria-label')) ?? '', /drawn on the workpiece/);
+  const offset = Number(await byTestId('view-3d').getAttribute('data-tool-offset-mm'));
+  assert.ok(Number.isFinite(offset) && offset < 1e-3, `tool vectors start on the drawn path: ${offset} mm off`);
+  const toolPixels = await toolInk();
+  assert.ok(toolPixels > 200, `tool-vector pixels: ${toolPixels}`);
+  // The toggle hides them.
+  await byTestId('show-tools').uncheck();
+  await page.waitForFunction(() => document.querySelector('[data-testid="view-3d"]').dataset.toolVectors === '0');
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  assert.ok((await toolInk()) < toolPixels / 20, 'tool vectors hidden by the toggle');
+  await byTestId('show-tools').check();
+  await page.waitForFunction((n) => document.querySelector('[data-testid="view-3d"]').dataset.toolVectors === String(n), vectors);
   await byTestId('view-kind').selectOption('2d');
+  // The 2-D layer view stays in machine axes, and says so for a multi-axis file.
+  await page.waitForFunction(() => /machine X, Y/.test(document.querySelector('[data-testid="layer-info"]').textContent ?? ''), null, { timeout: JOB_TIMEOUT });
   assert.deepEqual(pageErrors, []);
 });
 

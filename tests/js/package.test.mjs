@@ -71,6 +71,8 @@ test('Session: layers to draw, as typed arrays that agree with the report', () =
     assert.equal(g.xy.length, 4 * g.kind.length);
     assert.equal(g.speed.length, g.kind.length);
     assert.equal(g.curvature.length, g.kind.length);
+    assert.ok(g.tool instanceof Float32Array && g.tool.length === 0, 'a 3-axis file has no tool vectors');
+    assert.ok(g.xyz instanceof Float32Array && g.xyz.length === 0, 'nor a workpiece-frame path');
     for (let k = 0; k < g.kind.length; k++) {
       if (g.kind[k] !== 0) extruded += Math.hypot(g.xy[4 * k + 2] - g.xy[4 * k], g.xy[4 * k + 3] - g.xy[4 * k + 1]);
     }
@@ -79,6 +81,25 @@ test('Session: layers to draw, as typed arrays that agree with the report', () =
   // f32 drawing coordinates and arc chords: within 0.1 % of the report's extrusion length.
   assert.ok(Math.abs(extruded - report.extrude_distance_mm) / report.extrude_distance_mm < 1e-3, `${extruded} vs ${report.extrude_distance_mm}`);
   assert.equal(s.layer(1e6).kind.length, 0);
+  s.free();
+});
+
+test('Session: a 5-axis file carries unit tool vectors (tip and direction, workpiece frame)', () => {
+  const s = new node.Session(fs.readFileSync(path.join(corpusDir, 'multiaxis-xyzbc_zhang-ral2021_model1.gcode')));
+  let vectors = 0;
+  for (let i = 0; i < s.layerCount(); i++) {
+    const g = s.layer(i);
+    const t = g.tool;
+    assert.ok(t instanceof Float32Array && t.length % 6 === 0);
+    for (let o = 0; o < t.length; o += 6) assert.ok(Math.abs(Math.hypot(t[o + 3], t[o + 4], t[o + 5]) - 1) < 1e-5);
+    // The path in the workpiece frame, parallel to xy; each tip is an extruding segment's end.
+    assert.equal(g.xyz.length, 6 * g.kind.length);
+    const ends = new Set();
+    for (let k = 0; k < g.kind.length; k++) if (g.kind[k] !== 0) ends.add(`${g.xyz[6 * k + 3]},${g.xyz[6 * k + 4]},${g.xyz[6 * k + 5]}`);
+    for (let o = 0; o < t.length; o += 6) assert.ok(ends.has(`${t[o]},${t[o + 1]},${t[o + 2]}`), `layer ${i}: tip ${t.slice(o, o + 3)} on the path`);
+    vectors += t.length / 6;
+  }
+  assert.ok(vectors > 1000, `${vectors} tool vectors`);
   s.free();
 });
 
@@ -121,7 +142,7 @@ test('TypeScript: declarations compile (tsc --strict) and match real CLI output'
     "  const best: string = ir.best.pattern + ir.candidates[0].total_j + ir.output.length;",
     "  const sv: VibrationResult = s.vibration({ analyze: { machine: 'vtg-ldam-servo' } });",
     "  try { analyze('G1 X1.2.3'); } catch (e) { const err = e as QuietpathError; return err.line ?? 0; }",
-    '  return r.time_s + g.xy.length + fit.k_c + version().length + s.layerCount() + vr.psd.freqs.length + spectrum.length + smoothed.length + sv.steps + sr.corrected + best.length + turning;',
+    '  return r.time_s + g.xy.length + g.xyz.length + g.tool.length + fit.k_c + version().length + s.layerCount() + vr.psd.freqs.length + spectrum.length + smoothed.length + sv.steps + sr.corrected + best.length + turning;',
     '}',
     ...reports.map((json, i) => `export const report${i}: Report = ${json.trim()};`),
     ...typed.map(([t, json], i) => `export const typed${i}: ${t} = ${json};`),

@@ -84,11 +84,7 @@ pub(super) fn run(
 /// Refuses a file whose rotary axes never leave zero: a 3-axis toolpath has a constant tool
 /// vector, and smoothing it would report a success that did nothing.
 fn check_rotary(kin: &Kinematics, moves: &[PathMove]) -> Result<(), Error> {
-    let [r0, r1] = kin.model.rotary_axes();
-    let moved = |p: &crate::machine::Pos| {
-        p.get(r0).is_some_and(|&v| v != 0.0) || p.get(r1).is_some_and(|&v| v != 0.0)
-    };
-    if moves.iter().any(|m| moved(&m.from) || moved(&m.to)) {
+    if program::has_rotary_motion(kin, moves) {
         return Ok(());
     }
     let [first, second] = kin.model.rotary_letters();

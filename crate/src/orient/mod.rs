@@ -24,6 +24,7 @@
 
 pub mod cone;
 pub mod core;
+pub mod drawing;
 pub mod filter;
 pub mod frames;
 pub mod generators;
@@ -39,6 +40,7 @@ use crate::analyze::AnalyzeOptions;
 use crate::error::{Error, ErrorKind, Warning};
 use crate::progress::Progress;
 
+pub use drawing::{layer_geometries, tool_vectors};
 pub use filter::{FilterKind, Window};
 pub use generators::{quarter_torus, square_tube, PartOptions};
 pub use kinematics::{KinematicModel, Kinematics, Pose};

@@ -187,6 +187,15 @@ pub(super) fn runs(
     out
 }
 
+/// Whether a rotary axis of `kin` is off zero anywhere in `moves`: a file whose rotary axes
+/// never leave zero is a three-axis toolpath, whose tool vector is constant.
+pub(super) fn has_rotary_motion(kin: &Kinematics, moves: &[PathMove]) -> bool {
+    let [r0, r1] = kin.model.rotary_axes();
+    let moved =
+        |p: &Pos| p.get(r0).is_some_and(|&v| v != 0.0) || p.get(r1).is_some_and(|&v| v != 0.0);
+    moves.iter().any(|m| moved(&m.from) || moved(&m.to))
+}
+
 /// Pose of a machine position.
 pub(super) fn pose(kin: &Kinematics, pos: &Pos) -> Pose {
     let [r0, r1] = kin.model.rotary_axes();

@@ -17,7 +17,7 @@
 
 mod geometry;
 
-pub use geometry::{LayerGeometry, SegmentKind, ARC_CHORD_DEG};
+pub use geometry::{DrawPoint, LayerGeometry, SegmentKind, ARC_CHORD_DEG, TOOL_FLOATS};
 
 use serde::Serialize;
 

@@ -5,6 +5,7 @@ use wasm_bindgen::prelude::*;
 
 use super::{input_bytes, js_error, options, progress_fn, to_js, JsAnalyzeOptions, JsProgress};
 use crate::analyze::{analyze_with_progress, AnalyzeOptions};
+use crate::orient::{self, SmoothOptions};
 use crate::path::{self, LayerGeometry};
 
 /// A G-code file loaded once: jobs run on it without copying it across the boundary again,
@@ -60,7 +61,8 @@ impl Session {
     }
 
     /// Drawing data of layer `index`: `{ z, xy: Float32Array, kind: Uint8Array,
-    /// speed: Float32Array, curvature: Float32Array }` (see `path::LayerGeometry`).
+    /// speed: Float32Array, curvature: Float32Array, xyz: Float32Array, tool: Float32Array }`
+    /// (see `path::LayerGeometry`).
     #[wasm_bindgen(unchecked_return_type = "LayerGeometry")]
     pub fn layer(&mut self, index: usize) -> Result<JsValue, JsValue> {
         let empty = LayerGeometry::default();
@@ -72,6 +74,8 @@ impl Session {
         set("kind", Uint8Array::from(&g.kind[..]).into())?;
         set("speed", Float32Array::from(&g.speed[..]).into())?;
         set("curvature", Float32Array::from(&g.curvature[..]).into())?;
+        set("xyz", Float32Array::from(&g.xyz[..]).into())?;
+        set("tool", Float32Array::from(&g.tool[..]).into())?;
         Ok(out.into())
     }
 }
@@ -89,9 +93,16 @@ impl Session {
 
     fn layers(&mut self) -> Result<&Vec<LayerGeometry>, JsValue> {
         if self.layers.is_none() {
-            // The move list is large; keep only the compact drawing arrays.
+            // The move list is large; keep only the compact drawing arrays. The workpiece-frame
+            // path and tool vectors of a multi-axis file are read with the smoothing's default
+            // kinematics, as the playground's smooth job reads them.
             let p = path::extract(&self.bytes, &self.options, true).map_err(|e| js_error(&e))?;
-            self.layers = Some((0..p.layers.len()).map(|i| p.layer_geometry(i)).collect());
+            let smooth = SmoothOptions::default();
+            self.layers = Some(orient::layer_geometries(
+                &p,
+                &smooth.kinematics,
+                smooth.coordinates,
+            ));
         }
         Ok(self.layers.get_or_insert_with(Vec::new))
     }

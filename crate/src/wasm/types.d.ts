@@ -193,6 +193,14 @@ export interface LayerGeometry {
   kind: Uint8Array;
   speed: Float32Array;
   curvature: Float32Array;
+  /** A multi-axis file's segments in 3-D, six numbers each (x0, y0, z0, x1, y1, z1, mm),
+   *  parallel to `xy`: the tool tip in the workpiece frame (where the material goes on the part),
+   *  while `xy` holds the machine axes. Empty for a three-axis file. */
+  xyz: Float32Array;
+  /** Tool vectors of a multi-axis file (rotary words), six numbers each: tool tip x, y, z (mm)
+   *  and unit tool vector i, j, k (tip towards the nozzle), both in the workpiece frame, one per
+   *  extruding move. Empty for a three-axis file. */
+  tool: Float32Array;
 }
 /** One calibration row: thesis terms A, B, C, H and the measured energy E (W·ms). */
 export type CalibrationRow = [number, number, number, number, number] | { a: number; b: number; c: number; h: number; e: number };
