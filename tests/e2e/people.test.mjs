@@ -347,9 +347,11 @@ test('phones: two fingers pinch-zoom the layer view', async () => {
   assert.ok(Math.abs(after / before - 3) < 0.01, `pinch from 40 px to 120 px: scale ${before} → ${after}`);
 });
 
-// Pixels of the 3-D canvas that differ from its background colour (the WebGL picture).
-async function inked3d(p = page, hash = false) {
-  return p.evaluate((hash) => {
+// Pixels of the 3-D canvas that differ from its background colour (the WebGL picture), or with
+// `near` ([r, g, b]) those within a small distance of that colour; `hash` returns a hash of
+// where the inked pixels are instead of their count.
+async function inked3d(p = page, hash = false, near = null) {
+  return p.evaluate(({ hash, near }) => {
     const c = document.querySelector('[data-testid="view-3d"]');
     const t = document.createElement('canvas');
     t.width = c.width;
@@ -357,36 +359,27 @@ async function inked3d(p = page, hash = false) {
     const ctx = t.getContext('2d');
     ctx.drawImage(c, 0, 0);
     const d = ctx.getImageData(0, 0, t.width, t.height).data;
-    const bg = [d[0], d[1], d[2]];
+    const ref = near ?? [d[0], d[1], d[2]];
     let n = 0;
     let h = 0;
     for (let i = 0; i < d.length; i += 4) {
-      if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 30) {
+      const off = Math.abs(d[i] - ref[0]) + Math.abs(d[i + 1] - ref[1]) + Math.abs(d[i + 2] - ref[2]);
+      if (near ? off < 60 : off > 30) {
         n++;
         h = (h * 31 + i) | 0;
       }
     }
     return hash ? h : n;
-  }, hash);
+  }, { hash, near });
 }
 
 // Pixels of the 3-D canvas within a small distance of the tool-vector colour (the swatch beside
-// the "tool vectors" toggle shows it).
+// the "tool vectors" toggle shows it); -1 when the swatch has no colour.
 async function toolInk(p = page) {
-  return p.evaluate(() => {
-    const rgb = getComputedStyle(document.querySelector('[data-testid="tools-swatch"]')).backgroundColor.match(/\d+/g)?.map(Number);
-    if (!rgb || rgb.length < 3) return -1;
-    const c = document.querySelector('[data-testid="view-3d"]');
-    const t = document.createElement('canvas');
-    t.width = c.width;
-    t.height = c.height;
-    const ctx = t.getContext('2d');
-    ctx.drawImage(c, 0, 0);
-    const d = ctx.getImageData(0, 0, t.width, t.height).data;
-    let n = 0;
-    for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - rgb[0]) + Math.abs(d[i + 1] - rgb[1]) + Math.abs(d[i + 2] - rgb[2]) < 60) n++;
-    return n;
-  });
+  const rgb = await p.evaluate(() =>
+    getComputedStyle(document.querySelector('[data-testid="tools-swatch"]')).backgroundColor.match(/\d+/g)?.map(Number));
+  if (!rgb || rgb.length < 3) return -1;
+  return inked3d(p, false, rgb.slice(0, 3));
 }
 
 test('3-D view: the demo drawn with WebGL, a layer range, orbit, the 5-axis file', { timeout: JOB_TIMEOUT }, async () => {
