@@ -49,9 +49,10 @@ pub fn tool_vectors(
 
 /// Every layer's drawing data ([`PrintPath::layer_geometry`]) with, for a file whose rotary axes
 /// move, its tool vectors ([`tool_vectors`]) and its segments in the workpiece frame
-/// ([`LayerGeometry::xyz`], through [`workpiece_point`]). A file whose rotary axes never leave
-/// zero (a three-axis print) gets neither: its tool vector is the constant `ẑ` and its machine
-/// X, Y, Z are the workpiece's, and a viewer that finds no vectors knows it is not multi-axis.
+/// ([`LayerGeometry::xyz`]: the tool tip each machine position puts on the workpiece). A file
+/// whose rotary axes never leave zero (a three-axis print) gets neither: its tool vector is the
+/// constant `ẑ` and its machine X, Y, Z are the workpiece's, and a viewer that finds no vectors
+/// knows it is not multi-axis.
 ///
 /// The segments go through the same tips as the vectors, so that a viewer drawing both shows
 /// each vector starting on the path: the machine X, Y of a table-BC file lie tens of mm away
