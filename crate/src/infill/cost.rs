@@ -10,6 +10,8 @@
 //! to the 0.001 mm rounding of the rewritten coordinates (the test suite checks both).
 //! Replaying skips the parser and the machine, so it costs a fraction of an `analyze` pass.
 
+use std::borrow::Cow;
+
 use super::geom::{rotate, P2};
 use super::program::{Mv, Op, Program};
 use crate::analyze::toolpath::ToolpathMetrics;
@@ -147,10 +149,29 @@ fn motion_length(m: &Motion) -> f64 {
     }
 }
 
-/// Replays `prog` with block `b` replaced by `replace[b]` (when `Some`) and the rotation.
-pub(crate) fn replay(
+/// Where a replay's replacement blocks come from: a list made beforehand, or blocks made as
+/// the replay reaches them (one candidate's motions need not all be held at once).
+pub(crate) trait Replacements {
+    /// Whether block `b` is replaced.
+    fn replaced(&self, b: usize) -> bool;
+    /// Block `b`'s replacement (`None`: the block is dropped without one).
+    fn make(&self, b: usize) -> Option<Cow<'_, Replacement>>;
+}
+
+impl Replacements for [Option<Replacement>] {
+    fn replaced(&self, b: usize) -> bool {
+        self.get(b).is_some_and(Option::is_some)
+    }
+
+    fn make(&self, b: usize) -> Option<Cow<'_, Replacement>> {
+        self.get(b)?.as_ref().map(Cow::Borrowed)
+    }
+}
+
+/// Replays `prog` with each block `replace` replaces, and the rotation.
+pub(crate) fn replay<R: Replacements + ?Sized>(
     prog: &Program,
-    replace: &[Option<Replacement>],
+    replace: &R,
     rotation: Option<&Rotation>,
     base: &Baseline,
 ) -> Costs {
@@ -159,9 +180,9 @@ pub(crate) fn replay(
 
 /// [`replay`], also summing `[servo J, s]` of each replaced block's planned moves into
 /// `per_block` (indexed like `prog.blocks`).
-pub(crate) fn replay_blocks(
+pub(crate) fn replay_blocks<R: Replacements + ?Sized>(
     prog: &Program,
-    replace: &[Option<Replacement>],
+    replace: &R,
     rotation: Option<&Rotation>,
     base: &Baseline,
     per_block: Option<&mut Vec<[f64; 2]>>,
@@ -195,7 +216,7 @@ pub(crate) fn replay_blocks(
                     .get(blk.first..blk.end)
                     .map_or(0.0, |ms| ms.iter().map(|m| m.m.extrusion()).sum::<f64>());
                 filament -= orig;
-                if let Some(r) = &replace[b] {
+                if let Some(r) = replace.make(b) {
                     // Turning and length need directions only: positions from the
                     // block's start.
                     let mut at = [0.0f64; 3];
@@ -355,12 +376,12 @@ impl<'a> Replay<'a> {
 }
 
 /// Blocks replaced, as (first move, block index), in file order.
-fn replaced_starts(prog: &Program, replace: &[Option<Replacement>]) -> Vec<(usize, usize)> {
+fn replaced_starts<R: Replacements + ?Sized>(prog: &Program, replace: &R) -> Vec<(usize, usize)> {
     let mut starts: Vec<(usize, usize)> = prog
         .blocks
         .iter()
         .enumerate()
-        .filter(|(b, _)| replace.get(*b).is_some_and(|r| r.is_some()))
+        .filter(|(b, _)| replace.replaced(*b))
         .map(|(b, blk)| (blk.first, b))
         .collect();
     starts.sort_unstable();

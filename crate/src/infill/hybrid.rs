@@ -37,7 +37,7 @@ pub(crate) fn per_layer(
     let original: Vec<Option<Replacement>> = vec![None; prep.prog.blocks.len()];
     replay_blocks(
         &prep.prog,
-        &original,
+        original.as_slice(),
         rotation,
         &prep.base,
         Some(&mut per_block),
@@ -67,7 +67,7 @@ pub(crate) fn per_layer(
             let (_, motions) = prep.candidate(&refs, rotation);
             replay_blocks(
                 &prep.prog,
-                &motions,
+                motions.as_slice(),
                 rotation,
                 &prep.base,
                 Some(&mut per_block),
@@ -93,6 +93,6 @@ pub(crate) fn per_layer(
     }
     let refs: Vec<&Vec<Path>> = plans.iter().collect();
     let (_, motions) = prep.candidate(&refs, rotation);
-    let costs = replay(&prep.prog, &motions, rotation, &prep.base);
+    let costs = replay(&prep.prog, motions.as_slice(), rotation, &prep.base);
     Some((plans, choices, costs))
 }

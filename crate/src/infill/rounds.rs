@@ -107,8 +107,12 @@ impl Geometries {
         let costs = crate::parallel::map_each(&jobs, |&(_, k, ri)| {
             let refs: Vec<&Vec<Path>> = plans[k].iter().collect();
             let rotation = rotations.get(ri).and_then(|r| r.1.as_ref());
-            let (_, motions) = prep.candidate(&refs, rotation);
-            replay(&prep.prog, &motions, rotation, &prep.base)
+            replay(
+                &prep.prog,
+                &prep.lazy(&refs, rotation),
+                rotation,
+                &prep.base,
+            )
         });
         for (&(g, _, ri), c) in jobs.iter().zip(costs) {
             self.costed.insert((g, ri), c);

@@ -8,7 +8,9 @@
 
 use std::collections::HashMap;
 
-use super::cost::{replay, Baseline, Costs, Replacement, Rotation};
+use std::borrow::Cow;
+
+use super::cost::{replay, Baseline, Costs, Replacement, Replacements, Rotation};
 use super::emit::{self, Habit};
 use super::geom::{bbox, path_len, Path, P2};
 use super::program::{self, Program};
@@ -396,40 +398,102 @@ impl Prepared<'_> {
         let n = self.prog.blocks.len();
         let mut texts: Vec<Option<String>> = vec![None; n];
         let mut motions: Vec<Option<Replacement>> = vec![None; n];
-        let tf = |p: P2| rotation.map_or(p, |r| r.apply(p));
-        for (w, plan) in self.work.iter().zip(plans) {
-            // An empty plan keeps the layer's original infill (a per-layer choice, or nothing
-            // generated in its region): never a layer without infill.
-            if plan.is_empty() {
+        for (b, slot) in self.slots(plans).into_iter().enumerate() {
+            let Some((wi, k)) = slot else {
                 continue;
-            }
-            let habit = Habit {
-                e_per_mm: w.e_per_mm,
-                ..self.habit
             };
-            // The plan's groups (one per block) are separated by empty paths.
-            let moved: Vec<Vec<Path>> = plan
-                .split(|s| s.is_empty())
-                .map(|g| {
-                    g.iter()
-                        .map(|s| s.iter().map(|&p| tf(p)).collect())
-                        .collect()
-                })
-                .collect();
-            for (k, &b) in w.blocks.iter().enumerate() {
-                let Some(blk) = self.prog.blocks.get(b) else {
-                    continue;
-                };
-                let p = blk.machine.position();
-                let start = tf([p[axis::X], p[axis::Y]]);
-                let end = tf([blk.end_physical[0], blk.end_physical[1]]);
-                let strokes: &[Path] = moved.get(k).map_or(&[], |g| g.as_slice());
-                let text = emit::block_text(blk, strokes, start, end, &habit);
-                motions[b] = Some(emit::motions(blk, &text, start));
+            if let Some((text, m)) = self.block(wi, plans[wi], k, b, rotation) {
                 texts[b] = Some(text);
+                motions[b] = Some(m);
             }
         }
         (texts, motions)
+    }
+
+    /// The candidate's replacements made one block at a time as a replay reaches them, so
+    /// its motions are never all held at once (a Hilbert candidate's run to gigabytes).
+    pub(crate) fn lazy<'s>(
+        &'s self,
+        plans: &'s [&'s Vec<Path>],
+        rotation: Option<&'s Rotation>,
+    ) -> LazyCandidate<'s> {
+        LazyCandidate {
+            prep: self,
+            slots: self.slots(plans),
+            plans,
+            rotation,
+        }
+    }
+
+    /// For each block of the file, the (work item, group of its plan) that replaces it: every
+    /// block of a work item with a plan. An empty plan keeps the layer's original infill (a
+    /// per-layer choice, or nothing generated in its region): never a layer without infill.
+    fn slots(&self, plans: &[&Vec<Path>]) -> Vec<Option<(usize, usize)>> {
+        let mut slots = vec![None; self.prog.blocks.len()];
+        for (wi, (w, plan)) in self.work.iter().zip(plans).enumerate() {
+            if plan.is_empty() {
+                continue;
+            }
+            for (k, &b) in w.blocks.iter().enumerate() {
+                if let Some(s) = slots.get_mut(b) {
+                    *s = Some((wi, k));
+                }
+            }
+        }
+        slots
+    }
+
+    /// Block `b`'s text and motions: group `k` of work item `wi`'s plan, turned with the part.
+    fn block(
+        &self,
+        wi: usize,
+        plan: &[Path],
+        k: usize,
+        b: usize,
+        rotation: Option<&Rotation>,
+    ) -> Option<(String, Replacement)> {
+        let (w, blk) = (self.work.get(wi)?, self.prog.blocks.get(b)?);
+        let tf = |p: P2| rotation.map_or(p, |r| r.apply(p));
+        let habit = Habit {
+            e_per_mm: w.e_per_mm,
+            ..self.habit
+        };
+        // The plan's groups (one per block) are separated by empty paths.
+        let strokes: Vec<Path> = plan
+            .split(|s| s.is_empty())
+            .nth(k)
+            .unwrap_or(&[])
+            .iter()
+            .map(|s| s.iter().map(|&p| tf(p)).collect())
+            .collect();
+        let p = blk.machine.position();
+        let start = tf([p[axis::X], p[axis::Y]]);
+        let end = tf([blk.end_physical[0], blk.end_physical[1]]);
+        let text = emit::block_text(blk, &strokes, start, end, &habit);
+        let motions = emit::motions(blk, &text, start);
+        Some((text, motions))
+    }
+}
+
+/// A candidate whose blocks are written and parsed back when a replay asks for them
+/// ([`Prepared::lazy`]).
+pub(crate) struct LazyCandidate<'s> {
+    prep: &'s Prepared<'s>,
+    slots: Vec<Option<(usize, usize)>>,
+    plans: &'s [&'s Vec<Path>],
+    rotation: Option<&'s Rotation>,
+}
+
+impl Replacements for LazyCandidate<'_> {
+    fn replaced(&self, b: usize) -> bool {
+        self.slots.get(b).is_some_and(Option::is_some)
+    }
+
+    fn make(&self, b: usize) -> Option<Cow<'_, Replacement>> {
+        let (wi, k) = (*self.slots.get(b)?)?;
+        let plan = self.plans.get(wi)?;
+        let (_, m) = self.prep.block(wi, plan, k, b, self.rotation)?;
+        Some(Cow::Owned(m))
     }
 }
 
@@ -474,7 +538,7 @@ pub fn infill_with_progress(
     progress: Progress<'_>,
 ) -> Result<InfillReport, Error> {
     let prep = prepare(input, options)?;
-    let base_costs = replay(&prep.prog, &[], None, &prep.base);
+    let base_costs = replay(&prep.prog, &[] as &[Option<Replacement>], None, &prep.base);
     let (rotations, rotations_skipped) = rotations_of(&prep, options)?;
     let searched = super::rounds::search(&prep, options, &rotations, &base_costs, progress)?;
     let Some((best_score, bi)) = searched.best else {
@@ -764,7 +828,7 @@ pub(crate) mod tests {
     fn replay_of_the_original_is_analyze() {
         let input = rect(45);
         let prep = prepare(&input, &InfillOptions::default()).expect("prepare");
-        let c = replay(&prep.prog, &[], None, &prep.base);
+        let c = replay(&prep.prog, &[] as &[Option<Replacement>], None, &prep.base);
         let r = &prep.before;
         assert!(
             (c.time_s - r.time_s).abs() < 1e-9 * r.time_s,
