@@ -64,10 +64,9 @@ pub(crate) fn per_layer(
                 .map(|w| prep.plan_layer(w, pattern, beta))
                 .collect();
             let refs: Vec<&Vec<Path>> = plans.iter().collect();
-            let (_, motions) = prep.candidate(&refs, rotation);
             replay_blocks(
                 &prep.prog,
-                motions.as_slice(),
+                &prep.lazy(&refs, rotation),
                 rotation,
                 &prep.base,
                 Some(&mut per_block),
@@ -92,7 +91,11 @@ pub(crate) fn per_layer(
         });
     }
     let refs: Vec<&Vec<Path>> = plans.iter().collect();
-    let (_, motions) = prep.candidate(&refs, rotation);
-    let costs = replay(&prep.prog, motions.as_slice(), rotation, &prep.base);
+    let costs = replay(
+        &prep.prog,
+        &prep.lazy(&refs, rotation),
+        rotation,
+        &prep.base,
+    );
     Some((plans, choices, costs))
 }

@@ -389,25 +389,21 @@ impl Prepared<'_> {
         best.map(|b| arrange(w, b.1)).unwrap_or_default()
     }
 
-    /// The texts and motions of every replaced block for per-work-item strokes.
-    pub(crate) fn candidate(
+    /// The text of every replaced block for per-work-item strokes (what the written file
+    /// gets; a replay makes the motions itself through [`Prepared::lazy`]).
+    pub(crate) fn texts(
         &self,
         plans: &[&Vec<Path>],
         rotation: Option<&Rotation>,
-    ) -> (Vec<Option<String>>, Vec<Option<Replacement>>) {
-        let n = self.prog.blocks.len();
-        let mut texts: Vec<Option<String>> = vec![None; n];
-        let mut motions: Vec<Option<Replacement>> = vec![None; n];
-        for (b, slot) in self.slots(plans).into_iter().enumerate() {
-            let Some((wi, k)) = slot else {
-                continue;
-            };
-            if let Some((text, m)) = self.block(wi, plans[wi], k, b, rotation) {
-                texts[b] = Some(text);
-                motions[b] = Some(m);
-            }
-        }
-        (texts, motions)
+    ) -> Vec<Option<String>> {
+        self.slots(plans)
+            .into_iter()
+            .enumerate()
+            .map(|(b, slot)| {
+                let (wi, k) = slot?;
+                self.block_text(wi, plans.get(wi)?, k, b, rotation)
+            })
+            .collect()
     }
 
     /// The candidate's replacements made one block at a time as a replay reaches them, so
@@ -443,15 +439,15 @@ impl Prepared<'_> {
         slots
     }
 
-    /// Block `b`'s text and motions: group `k` of work item `wi`'s plan, turned with the part.
-    fn block(
+    /// Block `b`'s text: group `k` of work item `wi`'s plan, turned with the part.
+    fn block_text(
         &self,
         wi: usize,
         plan: &[Path],
         k: usize,
         b: usize,
         rotation: Option<&Rotation>,
-    ) -> Option<(String, Replacement)> {
+    ) -> Option<String> {
         let (w, blk) = (self.work.get(wi)?, self.prog.blocks.get(b)?);
         let tf = |p: P2| rotation.map_or(p, |r| r.apply(p));
         let habit = Habit {
@@ -469,9 +465,26 @@ impl Prepared<'_> {
         let p = blk.machine.position();
         let start = tf([p[axis::X], p[axis::Y]]);
         let end = tf([blk.end_physical[0], blk.end_physical[1]]);
-        let text = emit::block_text(blk, &strokes, start, end, &habit);
-        let motions = emit::motions(blk, &text, start);
-        Some((text, motions))
+        Some(emit::block_text(blk, &strokes, start, end, &habit))
+    }
+
+    /// Block `b`'s motions, parsed back from its text ([`Prepared::block_text`]) as the machine
+    /// would run it from the block's start (turned with the part).
+    fn block_motions(
+        &self,
+        wi: usize,
+        plan: &[Path],
+        k: usize,
+        b: usize,
+        rotation: Option<&Rotation>,
+    ) -> Option<Replacement> {
+        let text = self.block_text(wi, plan, k, b, rotation)?;
+        let blk = self.prog.blocks.get(b)?;
+        let p = blk.machine.position();
+        let start = rotation.map_or([p[axis::X], p[axis::Y]], |r| {
+            r.apply([p[axis::X], p[axis::Y]])
+        });
+        Some(emit::motions(blk, &text, start))
     }
 }
 
@@ -492,7 +505,7 @@ impl Replacements for LazyCandidate<'_> {
     fn make(&self, b: usize) -> Option<Cow<'_, Replacement>> {
         let (wi, k) = (*self.slots.get(b)?)?;
         let plan = self.plans.get(wi)?;
-        let (_, m) = self.prep.block(wi, plan, k, b, self.rotation)?;
+        let m = self.prep.block_motions(wi, plan, k, b, self.rotation)?;
         Some(Cow::Owned(m))
     }
 }
@@ -659,7 +672,7 @@ fn write_chosen(
         }
     }
     let refs: Vec<&Vec<Path>> = plans.iter().collect();
-    let (texts, _) = prep.candidate(&refs, rotation);
+    let texts = prep.texts(&refs, rotation);
     let edits = write::edits(prep.input, &prep.prog, &texts, rotation);
     Written {
         output: crate::gcode::apply_edits(prep.input, &edits),
