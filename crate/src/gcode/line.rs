@@ -54,6 +54,17 @@ impl std::fmt::Debug for Params {
 }
 
 impl Params {
+    /// Sets word `letter` (either case) to `value`: for a writer that hands a machine the
+    /// words a line of its text would parse to, without printing and parsing them.
+    #[inline]
+    pub fn set(&mut self, letter: u8, value: f64) {
+        if let Some(i) = slot(letter) {
+            self.present |= 1 << i;
+            self.bare &= !(1 << i);
+            self.values[i] = value;
+        }
+    }
+
     /// Removes every word (values are left in place but no longer visible).
     #[inline]
     pub fn clear(&mut self) {

@@ -10,7 +10,8 @@ use super::cost::Replacement;
 use super::geom::{dist, Path, P2};
 use super::program::{Block, Program};
 use crate::error::Warnings;
-use crate::gcode::number::push_fixed;
+use crate::gcode::number::{push_fixed, rounded};
+#[cfg(test)]
 use crate::gcode::parse_line;
 use crate::machine::{axis, Event, ExtrusionMode, MoveKind};
 use crate::plan::Motion;
@@ -128,10 +129,164 @@ fn r5(v: f64) -> f64 {
     (v * 1e5).round() / 1e5
 }
 
-/// Writes text for a block whose new strokes (machine frame) are `strokes`, from the block's
-/// start to `end` (machine frame), leaving the filament as the original left it.
-struct Writer<'a> {
-    out: String,
+/// Where a block's lines go: text for the written file ([`Text`]), or straight into a copy of
+/// the machine ([`Run`]), which gets the very words the text parses to without printing and
+/// parsing a line (the round trip was a third of an infill search).
+trait Sink {
+    /// `G10` (`on`) or `G11`.
+    fn firmware_retract(&mut self, on: bool);
+    /// `G1 E<e> F<f>`: `e` already on the 0.00001 grid, `f` written as `{:.0}`.
+    fn filament(&mut self, e: f64, f: f64);
+    /// `G1 X<x> Y<y> F<f>`: `x`, `y` on the 0.001 grid, `f` written as `{:.0}`.
+    fn travel(&mut self, to: P2, f: f64);
+    /// `G1 X<x> Y<y> E<e>` and `F<f>` (`{:.0}`) if given.
+    fn extrude(&mut self, to: P2, e: f64, f: Option<f64>);
+    /// `G92 E<e>` (`{:.5}`).
+    fn set_e(&mut self, e: f64);
+    /// `G1 F<f>` (`{:.3}`), the block's last line.
+    fn feed(&mut self, f: f64);
+}
+
+/// The block as G-code text (without a final newline).
+struct Text(String);
+
+impl Sink for Text {
+    fn firmware_retract(&mut self, on: bool) {
+        self.0.push_str(if on { "G10\n" } else { "G11\n" });
+    }
+
+    fn filament(&mut self, e: f64, f: f64) {
+        self.0.push_str("G1 E");
+        push_fixed(&mut self.0, e, 5);
+        let _ = writeln!(self.0, " F{f:.0}");
+    }
+
+    fn travel(&mut self, to: P2, f: f64) {
+        self.0.push_str("G1 X");
+        push_fixed(&mut self.0, to[0], 3);
+        self.0.push_str(" Y");
+        push_fixed(&mut self.0, to[1], 3);
+        let _ = writeln!(self.0, " F{f:.0}");
+    }
+
+    fn extrude(&mut self, to: P2, e: f64, f: Option<f64>) {
+        self.0.push_str("G1 X");
+        push_fixed(&mut self.0, to[0], 3);
+        self.0.push_str(" Y");
+        push_fixed(&mut self.0, to[1], 3);
+        self.0.push_str(" E");
+        push_fixed(&mut self.0, e, 5);
+        if let Some(f) = f {
+            let _ = write!(self.0, " F{f:.0}");
+        }
+        self.0.push('\n');
+    }
+
+    fn set_e(&mut self, e: f64) {
+        let _ = writeln!(self.0, "G92 E{e:.5}");
+    }
+
+    fn feed(&mut self, f: f64) {
+        let _ = write!(self.0, "G1 F{f:.3}");
+    }
+}
+
+/// The block run on a copy of the machine as it stood before it, collecting its motions.
+struct Run {
+    machine: crate::machine::Machine,
+    line_no: u32,
+    warnings: Warnings,
+    motions: Vec<Motion>,
+    /// Where the machine copy believes the nozzle starts, and where it does in the
+    /// candidate's frame (a rotated part starts elsewhere).
+    p0: P2,
+    start: P2,
+    moved: bool,
+    /// The last value written with a formatter other than [`push_fixed`], and what it parses
+    /// to (a block writes one or two such feed rates again and again).
+    parsed: Vec<(u64, usize, f64)>,
+}
+
+impl Run {
+    /// What `{v:.decimals$}` parses back to.
+    fn as_written(&mut self, v: f64, decimals: usize) -> f64 {
+        let key = (v.to_bits(), decimals);
+        if let Some(&(_, _, p)) = self.parsed.iter().find(|p| (p.0, p.1) == key) {
+            return p;
+        }
+        let p = format!("{v:.decimals$}").parse().unwrap_or(v);
+        if self.parsed.len() < 8 {
+            self.parsed.push((key.0, key.1, p));
+        }
+        p
+    }
+
+    fn g(&mut self, number: u16, words: &[(u8, f64)]) {
+        let mut line = crate::gcode::Line {
+            command: crate::gcode::Command::Code(crate::gcode::Code {
+                letter: b'G',
+                number,
+                sub: None,
+            }),
+            ..Default::default()
+        };
+        for &(letter, v) in words {
+            line.params.set(letter, v);
+        }
+        if let Some(Event::Move(m)) = self.machine.apply(self.line_no, &line, &mut self.warnings) {
+            let mut motion = Motion::from(&m);
+            if !self.moved && line.params.has(b'X') {
+                // Every XY line written here names X and Y: the first one's displacement is
+                // from the true start.
+                motion.delta[0] += self.p0[0] - self.start[0];
+                motion.delta[1] += self.p0[1] - self.start[1];
+                self.moved = true;
+            }
+            self.motions.push(motion);
+        }
+    }
+}
+
+impl Sink for Run {
+    fn firmware_retract(&mut self, on: bool) {
+        self.g(if on { 10 } else { 11 }, &[]);
+    }
+
+    fn filament(&mut self, e: f64, f: f64) {
+        let f = self.as_written(f, 0);
+        self.g(1, &[(b'E', e), (b'F', f)]);
+    }
+
+    fn travel(&mut self, to: P2, f: f64) {
+        let f = self.as_written(f, 0);
+        self.g(1, &[(b'X', to[0]), (b'Y', to[1]), (b'F', f)]);
+    }
+
+    fn extrude(&mut self, to: P2, e: f64, f: Option<f64>) {
+        match f {
+            Some(f) => {
+                let f = self.as_written(f, 0);
+                self.g(1, &[(b'X', to[0]), (b'Y', to[1]), (b'E', e), (b'F', f)]);
+            }
+            None => self.g(1, &[(b'X', to[0]), (b'Y', to[1]), (b'E', e)]),
+        }
+    }
+
+    fn set_e(&mut self, e: f64) {
+        let e = self.as_written(e, 5);
+        self.g(92, &[(b'E', e)]);
+    }
+
+    fn feed(&mut self, f: f64) {
+        let f = self.as_written(f, 3);
+        self.g(1, &[(b'F', f)]);
+    }
+}
+
+/// Writes a block whose new strokes (machine frame) are `strokes`, from the block's start to
+/// `end` (machine frame), leaving the filament as the original left it.
+struct Writer<'a, S> {
+    out: S,
     habit: &'a Habit,
     pos: P2,
     retracted: bool,
@@ -139,7 +294,7 @@ struct Writer<'a> {
     e: f64,
 }
 
-impl Writer<'_> {
+impl<S: Sink> Writer<'_, S> {
     fn retract(&mut self, on: bool) {
         if self.retracted == on || (self.habit.retract_mm <= 0.0 && !self.habit.firmware) {
             self.retracted = on;
@@ -147,7 +302,7 @@ impl Writer<'_> {
         }
         self.retracted = on;
         if self.habit.firmware {
-            self.out.push_str(if on { "G10\n" } else { "G11\n" });
+            self.out.firmware_retract(on);
             return;
         }
         let (d, f) = if on {
@@ -161,9 +316,7 @@ impl Writer<'_> {
         } else {
             r5(d)
         };
-        self.out.push_str("G1 E");
-        push_fixed(&mut self.out, v, 5);
-        let _ = writeln!(self.out, " F{f:.0}");
+        self.out.filament(rounded(v, 5), f);
     }
 
     fn travel(&mut self, to: P2) {
@@ -175,11 +328,8 @@ impl Writer<'_> {
         if d >= self.habit.min_travel_mm {
             self.retract(true);
         }
-        self.out.push_str("G1 X");
-        push_fixed(&mut self.out, to[0], 3);
-        self.out.push_str(" Y");
-        push_fixed(&mut self.out, to[1], 3);
-        let _ = writeln!(self.out, " F{:.0}", self.habit.travel_f);
+        self.out
+            .travel([rounded(to[0], 3), rounded(to[1], 3)], self.habit.travel_f);
         self.pos = to;
     }
 
@@ -201,19 +351,40 @@ impl Writer<'_> {
             } else {
                 r5(inc)
             };
-            self.out.push_str("G1 X");
-            push_fixed(&mut self.out, q[0], 3);
-            self.out.push_str(" Y");
-            push_fixed(&mut self.out, q[1], 3);
-            self.out.push_str(" E");
-            push_fixed(&mut self.out, v, 5);
-            if first {
-                let _ = write!(self.out, " F{:.0}", self.habit.print_f);
-                first = false;
-            }
-            self.out.push('\n');
+            let f = first.then_some(self.habit.print_f);
+            first = false;
+            self.out
+                .extrude([rounded(q[0], 3), rounded(q[1], 3)], rounded(v, 5), f);
             self.pos = q;
         }
+    }
+
+    /// Writes the block: its strokes, the way back to `end` and the filament state and
+    /// absolute E the original left behind.
+    fn block(mut self, block: &Block, strokes: &[Path], end: P2) -> S {
+        for s in strokes {
+            self.stroke(s);
+        }
+        if !block.free_end {
+            self.travel(end);
+        }
+        self.retract(block.retracted_end);
+        if self.absolute {
+            self.out.set_e(block.end_logical[3]);
+        }
+        self.out.feed(block.end_feed_mm_s * 60.0);
+        self.out
+    }
+}
+
+fn writer<'a, S: Sink>(block: &Block, out: S, start: P2, habit: &'a Habit) -> Writer<'a, S> {
+    Writer {
+        out,
+        habit,
+        pos: [r3(start[0]), r3(start[1])],
+        retracted: block.retracted_start,
+        absolute: block.machine.extrusion_mode() == ExtrusionMode::Absolute,
+        e: block.machine.logical_position()[axis::E],
     }
 }
 
@@ -227,32 +398,53 @@ pub(crate) fn block_text(
     end: P2,
     habit: &Habit,
 ) -> String {
-    let absolute = block.machine.extrusion_mode() == ExtrusionMode::Absolute;
-    let mut w = Writer {
-        out: String::with_capacity(strokes.iter().map(|s| s.len() * 34).sum::<usize>() + 64),
-        habit,
-        pos: [r3(start[0]), r3(start[1])],
-        retracted: block.retracted_start,
-        absolute,
-        e: block.machine.logical_position()[axis::E],
+    let cap = strokes.iter().map(|s| s.len() * 34).sum::<usize>() + 64;
+    let text = Text(String::with_capacity(cap));
+    writer(block, text, start, habit)
+        .block(block, strokes, end)
+        .0
+}
+
+/// The motions [`block_text`] makes when run from the machine state before `block`, with the
+/// nozzle at `start` (the block's start in the candidate's frame: a rotated part starts
+/// elsewhere than the machine copy believes), and where the nozzle ends: the same, bit for bit,
+/// as parsing the text back ([`motions`]).
+pub(crate) fn block_motions(
+    block: &Block,
+    strokes: &[Path],
+    start: P2,
+    end: P2,
+    habit: &Habit,
+) -> Replacement {
+    let machine = block.machine.clone();
+    let p0 = *machine.position();
+    let run = Run {
+        machine,
+        line_no: block.first_line,
+        warnings: Warnings::default(),
+        motions: Vec::with_capacity(strokes.iter().map(Vec::len).sum::<usize>() + 8),
+        p0: [p0[axis::X], p0[axis::Y]],
+        start: [r3(start[0]), r3(start[1])],
+        moved: false,
+        parsed: Vec::new(),
     };
-    for s in strokes {
-        w.stroke(s);
+    let run = writer(block, run, start, habit).block(block, strokes, end);
+    let p = run.machine.position();
+    let end = if run.moved {
+        [p[axis::X], p[axis::Y]]
+    } else {
+        run.start
+    };
+    Replacement {
+        motions: run.motions,
+        end: [end[0], end[1], p[axis::Z]],
     }
-    if !block.free_end {
-        w.travel(end);
-    }
-    w.retract(block.retracted_end);
-    if absolute {
-        let _ = writeln!(w.out, "G92 E{:.5}", block.end_logical[3]);
-    }
-    let _ = write!(w.out, "G1 F{:.3}", block.end_feed_mm_s * 60.0);
-    w.out
 }
 
 /// The motions `text` makes when run from the machine state before `block`, with the nozzle
 /// at `start` (the block's start in the candidate's frame: a rotated part starts elsewhere
 /// than the machine copy believes), and where the nozzle ends.
+#[cfg(test)]
 pub(crate) fn motions(block: &Block, text: &str, start: P2) -> Replacement {
     let mut machine = block.machine.clone();
     let mut warnings = Warnings::default();
@@ -267,8 +459,6 @@ pub(crate) fn motions(block: &Block, text: &str, start: P2) -> Replacement {
         if let Some(Event::Move(m)) = machine.apply(block.first_line, &line, &mut warnings) {
             let mut motion = Motion::from(&m);
             if !moved && line.params.has(b'X') {
-                // Every XY line written here names X and Y: the first one's displacement is
-                // from the true start.
                 motion.delta[0] += p0[axis::X] - start[0];
                 motion.delta[1] += p0[axis::Y] - start[1];
                 moved = true;

@@ -13,7 +13,7 @@ use std::borrow::Cow;
 use super::cost::{replay, Baseline, Costs, Replacement, Replacements, Rotation};
 use super::emit::{self, Habit};
 use super::geom::{bbox, path_len, Path, P2};
-use super::program::{self, Program};
+use super::program::{self, Block, Program};
 use super::region::{self, LayerRegion};
 use super::spacing::Line;
 use super::{
@@ -449,27 +449,17 @@ impl Prepared<'_> {
         rotation: Option<&Rotation>,
     ) -> Option<String> {
         let (w, blk) = (self.work.get(wi)?, self.prog.blocks.get(b)?);
-        let tf = |p: P2| rotation.map_or(p, |r| r.apply(p));
+        let (strokes, start, end) = block_strokes(blk, plan, k, rotation);
         let habit = Habit {
             e_per_mm: w.e_per_mm,
             ..self.habit
         };
-        // The plan's groups (one per block) are separated by empty paths.
-        let strokes: Vec<Path> = plan
-            .split(|s| s.is_empty())
-            .nth(k)
-            .unwrap_or(&[])
-            .iter()
-            .map(|s| s.iter().map(|&p| tf(p)).collect())
-            .collect();
-        let p = blk.machine.position();
-        let start = tf([p[axis::X], p[axis::Y]]);
-        let end = tf([blk.end_physical[0], blk.end_physical[1]]);
         Some(emit::block_text(blk, &strokes, start, end, &habit))
     }
 
-    /// Block `b`'s motions, parsed back from its text ([`Prepared::block_text`]) as the machine
-    /// would run it from the block's start (turned with the part).
+    /// Block `b`'s motions: group `k` of work item `wi`'s plan, turned with the part, run on
+    /// the machine as it stood before the block (what parsing [`Prepared::block_text`] back
+    /// gives, without the text).
     fn block_motions(
         &self,
         wi: usize,
@@ -478,14 +468,36 @@ impl Prepared<'_> {
         b: usize,
         rotation: Option<&Rotation>,
     ) -> Option<Replacement> {
-        let text = self.block_text(wi, plan, k, b, rotation)?;
-        let blk = self.prog.blocks.get(b)?;
-        let p = blk.machine.position();
-        let start = rotation.map_or([p[axis::X], p[axis::Y]], |r| {
-            r.apply([p[axis::X], p[axis::Y]])
-        });
-        Some(emit::motions(blk, &text, start))
+        let (w, blk) = (self.work.get(wi)?, self.prog.blocks.get(b)?);
+        let (strokes, start, end) = block_strokes(blk, plan, k, rotation);
+        let habit = Habit {
+            e_per_mm: w.e_per_mm,
+            ..self.habit
+        };
+        Some(emit::block_motions(blk, &strokes, start, end, &habit))
     }
+}
+
+/// Group `k` of a plan (groups, one per block, separated by empty paths), its block's start
+/// and end, all turned with the part.
+fn block_strokes(
+    blk: &Block,
+    plan: &[Path],
+    k: usize,
+    rotation: Option<&Rotation>,
+) -> (Vec<Path>, P2, P2) {
+    let tf = |p: P2| rotation.map_or(p, |r| r.apply(p));
+    let strokes: Vec<Path> = plan
+        .split(|s| s.is_empty())
+        .nth(k)
+        .unwrap_or(&[])
+        .iter()
+        .map(|s| s.iter().map(|&p| tf(p)).collect())
+        .collect();
+    let p = blk.machine.position();
+    let start = tf([p[axis::X], p[axis::Y]]);
+    let end = tf([blk.end_physical[0], blk.end_physical[1]]);
+    (strokes, start, end)
 }
 
 /// A candidate whose blocks are written and parsed back when a replay asks for them
@@ -855,5 +867,33 @@ pub(crate) mod tests {
         assert_eq!(prep.work.len(), 25);
         // PrusaSlicer's 20 % of a 0.45 mm line: about 2 mm.
         assert!((prep.spacing - 2.0).abs() < 0.3, "{}", prep.spacing);
+    }
+
+    /// The motions a replay costs a block with are those of its text parsed back, bit for bit:
+    /// every block of the fixture, two patterns, with and without a part rotation.
+    #[test]
+    fn block_motions_are_the_text_parsed_back() {
+        let input = rect(45);
+        let prep = prepare(&input, &InfillOptions::default()).expect("prepare");
+        let turned = prep.rotation(30.0).flatten();
+        assert!(turned.is_some());
+        let mut blocks = 0;
+        for pattern in [Pattern::Rectilinear, Pattern::Hilbert] {
+            for rotation in [None, turned.as_ref()] {
+                for (wi, w) in prep.work.iter().enumerate() {
+                    let plan = prep.plan_layer(w, pattern, 15.0);
+                    for (k, &b) in w.blocks.iter().enumerate() {
+                        let blk = &prep.prog.blocks[b];
+                        let text = prep.block_text(wi, &plan, k, b, rotation).expect("text");
+                        let (_, start, _) = block_strokes(blk, &plan, k, rotation);
+                        let parsed = emit::motions(blk, &text, start);
+                        let direct = prep.block_motions(wi, &plan, k, b, rotation);
+                        assert_eq!(Some(parsed), direct, "block {b}");
+                        blocks += 1;
+                    }
+                }
+            }
+        }
+        assert!(blocks >= 100, "{blocks}");
     }
 }
