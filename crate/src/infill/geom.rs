@@ -93,7 +93,7 @@ pub fn inside_tol(r: &Region, p: P2, tol: f64) -> bool {
 }
 
 /// Squared distance from `p` to segment `ab`.
-fn seg_dist_sq(p: P2, a: P2, b: P2) -> f64 {
+pub(crate) fn seg_dist_sq(p: P2, a: P2, b: P2) -> f64 {
     let f = foot(p, a, b);
     let (ex, ey) = (p[0] - f[0], p[1] - f[1]);
     ex * ex + ey * ey

@@ -8,7 +8,8 @@
 //!   rectilinear does along the boundary) when it is shorter than `connect_max` and stays inside
 //!   the region; otherwise it is a travel.
 
-use super::geom::{dist, inside_tol, Path, Region, P2};
+use super::geom::{dist, Path, Region, P2};
+use super::grid::EdgeGrid;
 
 /// Extruded strokes (polylines), in print order.
 pub(crate) fn link(
@@ -18,6 +19,9 @@ pub(crate) fn link(
     connect_max: f64,
     tol: f64,
 ) -> Vec<Path> {
+    let Some(grid) = EdgeGrid::new(region) else {
+        return Vec::new();
+    };
     let mut strokes: Vec<Path> = Vec::new();
     let mut cur = start;
     // Sweep from the end of the pattern nearer the nozzle.
@@ -42,30 +46,14 @@ pub(crate) fn link(
             if piece.len() < 2 {
                 continue;
             }
-            let closed = piece.len() > 3 && piece.first() == piece.last();
-            if closed {
-                // Start the loop at its vertex nearest the nozzle.
-                piece.pop();
-                let k = (0..piece.len())
-                    .min_by(|&a, &b| dist(piece[a], cur).total_cmp(&dist(piece[b], cur)))
-                    .unwrap_or(0);
-                piece.rotate_left(k);
-                if let Some(&f) = piece.first() {
-                    piece.push(f);
-                }
-            } else if let (Some(&a), Some(&b)) = (piece.first(), piece.last()) {
-                if dist(b, cur) < dist(a, cur) {
-                    piece.reverse();
-                }
-            }
+            face(&mut piece, cur);
             let Some(&head) = piece.first() else { continue };
             let gap = dist(cur, head);
             let connect = open.is_some()
                 && gap <= connect_max
                 && (gap < 1e-9
                     || [0.25, 0.5, 0.75].iter().all(|&t| {
-                        inside_tol(
-                            region,
+                        grid.inside_tol(
                             [
                                 cur[0] + t * (head[0] - cur[0]),
                                 cur[1] + t * (head[1] - cur[1]),
@@ -90,6 +78,26 @@ pub(crate) fn link(
     }
     strokes.extend(open);
     strokes
+}
+
+/// Turns `piece` to start where it is nearest `cur`: a closed loop at its nearest vertex, an
+/// open piece at its nearer end.
+fn face(piece: &mut Path, cur: P2) {
+    let closed = piece.len() > 3 && piece.first() == piece.last();
+    if closed {
+        piece.pop();
+        let k = (0..piece.len())
+            .min_by(|&a, &b| dist(piece[a], cur).total_cmp(&dist(piece[b], cur)))
+            .unwrap_or(0);
+        piece.rotate_left(k);
+        if let Some(&f) = piece.first() {
+            piece.push(f);
+        }
+    } else if let (Some(&a), Some(&b)) = (piece.first(), piece.last()) {
+        if dist(b, cur) < dist(a, cur) {
+            piece.reverse();
+        }
+    }
 }
 
 /// Most chains ordered by nearest neighbour (quadratic); beyond, the generator's order stays.

@@ -12,6 +12,7 @@
 pub(crate) mod cost;
 pub(crate) mod emit;
 pub(crate) mod geom;
+pub(crate) mod grid;
 mod hybrid;
 pub(crate) mod link;
 pub mod pattern;
