@@ -8,7 +8,7 @@ export PATH := $(CURDIR)/node_modules/.bin:$(HOME)/.cargo/bin:$(PATH)
 CORPUS ?= $(CURDIR)/../shared/corpus
 LARGE := $(CORPUS)/curaengine-4.13.0_extruder-idler-x2.5_large.gcode
 
-.PHONY: all setup setup-test pkg serve test typecheck test-rust test-wasm test-js test-fuzz lint cli bench measurements fuzz clean
+.PHONY: all setup setup-test pkg serve test typecheck test-rust test-wasm test-js test-fuzz lint cli bench measurements measure-vtg-w16 fuzz clean
 
 all: pkg cli
 
@@ -81,6 +81,11 @@ bench: cli
 measurements:
 	cargo build --release
 	CORPUS="$(CORPUS)" node scripts/measurements.mjs
+
+## VTG Table 1 and 2 beside the paper's on the W16-style block, sliced with concentric infill
+## (scripts/vtg-w16-tables.sh, docs/measurements/vtg.md; about 4-5 min). W16_HEIGHT=… mm (default 4).
+measure-vtg-w16: cli
+	bash scripts/vtg-w16-tables.sh
 
 ## Short, reproducible (seeded, fixed-count) fuzzing smoke run of every target (make test).
 test-fuzz:
