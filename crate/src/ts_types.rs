@@ -57,13 +57,13 @@ impl TypeVisitor for Collector {
         if self.partial.contains(&name) {
             let _ = write!(
                 text,
-                "export type {name} = Partial<{}>;",
-                T::inline(&self.cfg)
+                "export {}",
+                layout(&format!("type {name} = Partial<{}>;", T::inline(&self.cfg)))
             );
         } else {
-            let _ = write!(text, "export {}", T::decl(&self.cfg));
+            let _ = write!(text, "export {}", layout(&T::decl(&self.cfg)));
         }
-        if self.decls.insert(name.clone(), layout(&text)).is_some() {
+        if self.decls.insert(name.clone(), text).is_some() {
             self.clashes.push(name);
         }
         T::visit_dependencies(self);
@@ -81,22 +81,118 @@ impl Collector {
     }
 }
 
-/// ts-rs writes a declaration's fields flush left with trailing spaces: indent the lines after
-/// the `export type` line and trim the ends, so the file reads (and diffs) like hand-written
-/// TypeScript.
+/// Lays out one ts-rs declaration (one line but for its doc comments) as one member per line,
+/// each object's `{` ending a line and its `}` starting one. wasm-bindgen re-indents the custom
+/// section by exactly that rule (a line ending in `{` opens a level, one starting with `}`
+/// closes it), so ts-rs's `…, last: T, };` would leave every later line one level deeper.
 fn layout(decl: &str) -> String {
-    let mut out = String::with_capacity(decl.len() + 256);
-    let mut body = false;
-    for line in decl.lines() {
-        let line = line.trim_end();
-        if body {
-            out.push_str("  ");
+    let mut out = String::with_capacity(decl.len() * 5 / 4);
+    // Open brackets: `{` breaks lines at its commas, `[` and `<` do not.
+    let mut open: Vec<char> = Vec::new();
+    let depth = |open: &[char]| open.iter().filter(|&&c| c == '{').count();
+    // Ends the line (once: never an empty one) and indents the next.
+    let newline = |out: &mut String, depth: usize| {
+        out.truncate(out.trim_end_matches(' ').len());
+        if !out.ends_with('\n') {
+            out.push('\n');
         }
-        out.push_str(line);
-        out.push('\n');
-        body |= line.starts_with("export ");
+        out.push_str(&"  ".repeat(depth));
+    };
+    let mut chars = decl.chars().peekable();
+    let skip_spaces = |chars: &mut std::iter::Peekable<std::str::Chars<'_>>| {
+        while chars.next_if_eq(&' ').is_some() {}
+    };
+    while let Some(c) = chars.next() {
+        match c {
+            // A doc comment, copied with its lines re-indented.
+            '/' if chars.peek() == Some(&'*') => {
+                out.push('/');
+                let mut prev = '/';
+                for c in chars.by_ref() {
+                    if c == '\n' {
+                        newline(&mut out, depth(&open));
+                    } else {
+                        out.push(c);
+                    }
+                    if prev == '*' && c == '/' {
+                        break;
+                    }
+                    prev = c;
+                }
+            }
+            // A string literal (a tag's value), copied as it is.
+            '"' => {
+                out.push('"');
+                let mut escaped = false;
+                for c in chars.by_ref() {
+                    out.push(c);
+                    if c == '"' && !escaped {
+                        break;
+                    }
+                    escaped = c == '\\' && !escaped;
+                }
+            }
+            '{' => {
+                open.push('{');
+                out.push('{');
+                newline(&mut out, depth(&open));
+                skip_spaces(&mut chars);
+            }
+            '}' => {
+                open.pop();
+                newline(&mut out, depth(&open));
+                out.push('}');
+            }
+            '[' | '<' => {
+                open.push(c);
+                out.push(c);
+            }
+            ']' | '>' => {
+                if open.last() == Some(&if c == ']' { '[' } else { '<' }) {
+                    open.pop();
+                }
+                out.push(c);
+            }
+            ',' if open.last() == Some(&'{') => {
+                out.push(',');
+                skip_spaces(&mut chars);
+                if chars.peek() != Some(&'}') {
+                    newline(&mut out, depth(&open));
+                }
+            }
+            '\n' => {
+                newline(&mut out, depth(&open));
+                skip_spaces(&mut chars);
+            }
+            // No space after the indentation of a new line.
+            ' ' if out.rsplit('\n').next().is_some_and(|l| l.trim().is_empty()) => {}
+            _ => out.push(c),
+        }
     }
+    out.truncate(out.trim_end().len());
+    out.push('\n');
     out
+}
+
+/// Whether wasm-bindgen's re-indentation (see [`layout`]) comes back to the left margin at the
+/// end of `text`, never going below it.
+fn balanced(text: &str) -> bool {
+    let mut level: i64 = 0;
+    for line in text.lines().map(str::trim) {
+        if line.starts_with('*') {
+            continue;
+        }
+        if line.starts_with('}') {
+            level -= 1;
+        }
+        if level < 0 {
+            return false;
+        }
+        if line.ends_with('{') {
+            level += 1;
+        }
+    }
+    level == 0
 }
 
 /// Renders the whole file.
@@ -159,6 +255,9 @@ fn render() -> Result<String, String> {
     for text in c.decls.values() {
         out.push('\n');
         out.push_str(text);
+    }
+    if !balanced(&out) {
+        return Err("the declarations' braces do not balance line by line (see layout())".into());
     }
     Ok(out)
 }

@@ -60,7 +60,8 @@ export type AnalyzeOptions = Partial<{
    * `M205`…), applied before the file, over the profile's limits and the slicer's settings
    * block. Not with `klipper_config` (a Klipper printer's settings are its config).
    */
-  machine_gcode: string | null, }>;
+  machine_gcode: string | null,
+}>;
 
 /**
  * Arcs in the output.
@@ -102,7 +103,8 @@ export type AuxPowers = Partial<{
   /**
    * Constant draw of the electronics while printing, W.
    */
-  electronics_w: number, }>;
+  electronics_w: number,
+}>;
 
 /**
  * `E_aux` by system, J.
@@ -131,7 +133,8 @@ export type AuxReport = {
   /**
    * Electronics, J.
    */
-  electronics_j: number, };
+  electronics_j: number,
+};
 
 /**
  * Modes of one axis.
@@ -148,7 +151,8 @@ export type AxisModes = {
   /**
    * Modes by increasing frequency.
    */
-  modes: Array<Mode>, };
+  modes: Array<Mode>,
+};
 
 /**
  * A ball-screw drive (VTG eq. 1–9).
@@ -241,7 +245,8 @@ export type BallScrew = {
   /**
    * Position loop.
    */
-  servo: ServoLoop, };
+  servo: ServoLoop,
+};
 
 /**
  * A belt drive of a desktop printer, mapped onto the same coordinates.
@@ -310,7 +315,8 @@ export type Belt = {
   /**
    * Stepper (or servo) loop.
    */
-  servo: ServoLoop, };
+  servo: ServoLoop,
+};
 
 /**
  * Axis-aligned bounding box.
@@ -323,12 +329,16 @@ export type Bounds = {
   /**
    * Maximum X, Y, Z, mm.
    */
-  max: [number, number, number], };
+  max: [number, number, number],
+};
 
 /**
  * Why a calibration failed. Rows are 1-based lines of the CSV (or positions in a list).
  */
-export type CalibrationError = { "kind": "empty" } | { "kind": "columns",
+export type CalibrationError = {
+  "kind": "empty"
+} | {
+  "kind": "columns",
   /**
    * Row.
    */
@@ -340,7 +350,9 @@ export type CalibrationError = { "kind": "empty" } | { "kind": "columns",
   /**
    * Fields found.
    */
-  found: number, } | { "kind": "invalid_number",
+  found: number,
+} | {
+  "kind": "invalid_number",
   /**
    * Row.
    */
@@ -352,7 +364,9 @@ export type CalibrationError = { "kind": "empty" } | { "kind": "columns",
   /**
    * The field.
    */
-  text: string, } | { "kind": "out_of_range",
+  text: string,
+} | {
+  "kind": "out_of_range",
   /**
    * Row.
    */
@@ -364,11 +378,15 @@ export type CalibrationError = { "kind": "empty" } | { "kind": "columns",
   /**
    * The value.
    */
-  value: number, } | { "kind": "empty_path",
+  value: number,
+} | {
+  "kind": "empty_path",
   /**
    * Row.
    */
-  row: number, } | { "kind": "gcode",
+  row: number,
+} | {
+  "kind": "gcode",
   /**
    * Row.
    */
@@ -380,7 +398,9 @@ export type CalibrationError = { "kind": "empty" } | { "kind": "columns",
   /**
    * What went wrong.
    */
-  message: string, } | { "kind": "too_few_rows",
+  message: string,
+} | {
+  "kind": "too_few_rows",
   /**
    * Rows needed.
    */
@@ -388,11 +408,14 @@ export type CalibrationError = { "kind": "empty" } | { "kind": "columns",
   /**
    * Rows found.
    */
-  found: number, } | { "kind": "rank_deficient",
+  found: number,
+} | {
+  "kind": "rank_deficient",
   /**
    * Numerical rank.
    */
-  rank: number, };
+  rank: number,
+};
 
 /**
  * The fitted coefficients and the quality of the fit.
@@ -455,7 +478,8 @@ export type CalibrationFit = {
   /**
    * Per-row fit.
    */
-  residuals: Array<Residual>, };
+  residuals: Array<Residual>,
+};
 
 /**
  * Emission figures (VTG eq. 17).
@@ -476,7 +500,8 @@ export type Co2Report = {
   /**
    * From material, g.
    */
-  material_g: number, };
+  material_g: number,
+};
 
 /**
  * A figure before and after, and the relative change.
@@ -493,7 +518,8 @@ export type Comparison = {
   /**
    * `(after − before) / before`, percent (0 when `before` is 0).
    */
-  change_pct: number, };
+  change_pct: number,
+};
 
 /**
  * What the X, Y, Z words of multi-axis G-code are.
@@ -523,7 +549,8 @@ export type Deviation = {
   /**
    * Samples (one per `T_s` while the machine runs a move).
    */
-  samples: number, };
+  samples: number,
+};
 
 /**
  * Deviation of the simulated tool from the programmed path (the paper's Table 2 kinematic
@@ -541,12 +568,17 @@ export type DeviationComparison = {
   /**
    * Mean deviation, mm.
    */
-  mean_mm: Comparison, };
+  mean_mm: Comparison,
+};
 
 /**
  * One axis drive.
  */
-export type Drive = { "type": "ball_screw" } & BallScrew | { "type": "belt" } & Belt;
+export type Drive = {
+  "type": "ball_screw"
+} & BallScrew | {
+  "type": "belt"
+} & Belt;
 
 /**
  * Energy and carbon figures (see [`crate::energy`] for the models, their units and sources).
@@ -609,7 +641,8 @@ export type Energy = {
   /**
    * `co2_g` by source and the factors used.
    */
-  co2: Co2Report, };
+  co2: Co2Report,
+};
 
 /**
  * Settings of the energy models; every field is optional in JSON.
@@ -654,24 +687,34 @@ export type EnergyOptions = Partial<{
   /**
    * Material emission factor, kg CO₂ per kg (default: the material's).
    */
-  material_kg_co2_per_kg: number | null, }>;
+  material_kg_co2_per_kg: number | null,
+}>;
 
 /**
  * What went wrong, independent of where.
  */
-export type ErrorKind = { "kind": "invalid_number",
+export type ErrorKind = {
+  "kind": "invalid_number",
   /**
    * The word letter, upper case.
    */
-  letter: string, } | { "kind": "non_finite_number",
+  letter: string,
+} | {
+  "kind": "non_finite_number",
   /**
    * The word letter, upper case.
    */
-  letter: string, } | { "kind": "unexpected_character",
+  letter: string,
+} | {
+  "kind": "unexpected_character",
   /**
    * The offending character (bytes above 0x7f are shown as U+FFFD).
    */
-  found: string, } | { "kind": "unclosed_comment" } | { "kind": "checksum_mismatch",
+  found: string,
+} | {
+  "kind": "unclosed_comment"
+} | {
+  "kind": "checksum_mismatch",
   /**
    * The checksum written in the line.
    */
@@ -679,27 +722,43 @@ export type ErrorKind = { "kind": "invalid_number",
   /**
    * The checksum computed from the line.
    */
-  computed: number, } | { "kind": "too_many_words",
+  computed: number,
+} | {
+  "kind": "too_many_words",
   /**
    * The limit.
    */
-  max: number, } | { "kind": "duplicate_word",
+  max: number,
+} | {
+  "kind": "duplicate_word",
   /**
    * The repeated letter.
    */
-  letter: string, } | { "kind": "invalid_arc",
+  letter: string,
+} | {
+  "kind": "invalid_arc",
   /**
    * Why.
    */
-  reason: string, } | { "kind": "utf16" } | { "kind": "binary" } | { "kind": "line_too_long",
+  reason: string,
+} | {
+  "kind": "utf16"
+} | {
+  "kind": "binary"
+} | {
+  "kind": "line_too_long",
   /**
    * The limit.
    */
-  max: number, } | { "kind": "invalid_option",
+  max: number,
+} | {
+  "kind": "invalid_option",
   /**
    * Why.
    */
-  reason: string, } | { "kind": "machine_settings",
+  reason: string,
+} | {
+  "kind": "machine_settings",
   /**
    * 1-based line of the settings text.
    */
@@ -707,7 +766,9 @@ export type ErrorKind = { "kind": "invalid_number",
   /**
    * Why, with the line.
    */
-  reason: string, } | { "kind": "no_rotary_motion",
+  reason: string,
+} | {
+  "kind": "no_rotary_motion",
   /**
    * The first rotary axis letter of the kinematic model.
    */
@@ -715,7 +776,10 @@ export type ErrorKind = { "kind": "invalid_number",
   /**
    * The second rotary axis letter.
    */
-  second: string, } | { "kind": "cancelled" };
+  second: string,
+} | {
+  "kind": "cancelled"
+};
 
 /**
  * What [`rewrite_estimates`] changed.
@@ -736,7 +800,8 @@ export type EstimateReport = {
   /**
    * Header comment lines written (earlier quietpath headers are replaced).
    */
-  header_lines: number, };
+  header_lines: number,
+};
 
 /**
  * Extrusion settings used for filament and mass.
@@ -757,7 +822,8 @@ export type ExtrusionInfo = {
   /**
    * Filament density, g/cm³.
    */
-  density_g_cm3: number, };
+  density_g_cm3: number,
+};
 
 /**
  * Extrusion mode for E words.
@@ -788,7 +854,8 @@ export type FanEvent = {
   /**
    * Speed, 0..=1.
    */
-  speed: number, };
+  speed: number,
+};
 
 /**
  * The canonical kind of a printed feature, mapped from every slicer's own names.
@@ -828,7 +895,8 @@ export type FeatureSummary = {
    * Energy of its moves, J: their `E_servo` plus the share of `E_aux` of their time (see
    * [`crate::energy`]).
    */
-  energy_j: number, };
+  energy_j: number,
+};
 
 /**
  * Facts about the input file.
@@ -853,7 +921,8 @@ export type FileInfo = {
   /**
    * The slicer's own print-time estimate written in the file, s.
    */
-  slicer_time_s: number | null, };
+  slicer_time_s: number | null,
+};
 
 /**
  * Which filter smooths the orientation.
@@ -891,7 +960,8 @@ export type FirmwareFigures = {
   /**
    * Segments per second the firmware reads at this file's mean bytes per move line.
    */
-  budget_segments_per_s: number, };
+  budget_segments_per_s: number,
+};
 
 /**
  * Both files against the machine's budget, for the report.
@@ -913,7 +983,8 @@ export type FirmwareReport = {
    * Set when the rewrite's peak segment rate exceeds the budget where the original's did
    * not, or exceeds it by more.
    */
-  warning: string | null, };
+  warning: string | null,
+};
 
 /**
  * How `E_fuse` was computed.
@@ -943,12 +1014,15 @@ export type FuseReport = {
   /**
    * Share of the heater's extra energy that reaches the filament.
    */
-  heater_efficiency: number, };
+  heater_efficiency: number,
+};
 
 /**
  * Which heater a temperature command addresses.
  */
-export type Heater = { "hotend": number } | "bed" | "chamber";
+export type Heater = {
+  "hotend": number
+} | "bed" | "chamber";
 
 /**
  * The chosen result.
@@ -999,7 +1073,8 @@ export type InfillBest = {
    * Why the original was kept, or that a worse candidate was forced; `None` when the
    * written candidate beats the original.
    */
-  message: string | null, };
+  message: string | null,
+};
 
 /**
  * One candidate: the whole file with this pattern, angle and rotation.
@@ -1048,7 +1123,8 @@ export type InfillCandidate = {
   /**
    * Mean turning angle of the new infill, degrees (VTG eq. 26; Fig. 5).
    */
-  infill_mean_turn_deg: number, };
+  infill_mean_turn_deg: number,
+};
 
 /**
  * What was written: a regenerated pattern, or the original file kept as it was.
@@ -1071,7 +1147,8 @@ export type InfillLayerChoice = {
   /**
    * Infill angle, degrees.
    */
-  angle_deg: number, };
+  angle_deg: number,
+};
 
 /**
  * What the method measured from the file.
@@ -1108,7 +1185,8 @@ export type InfillMeasured = {
   /**
    * Retraction length, mm (0: none).
    */
-  retract_mm: number, };
+  retract_mm: number,
+};
 
 /**
  * Options of [`infill`]. Every field is optional in JSON.
@@ -1156,7 +1234,8 @@ export type InfillOptions = Partial<{
    * Rewrite the file's time comments and `M73` lines from the planner when a candidate is
    * written (default true; see [`crate::estimate`]).
    */
-  estimates: boolean, }>;
+  estimates: boolean,
+}>;
 
 /**
  * An infill pattern.
@@ -1195,7 +1274,8 @@ export type InfillReport = {
   /**
    * Rotations skipped (the part would not fit on the bed), degrees.
    */
-  rotations_skipped: Array<number>, };
+  rotations_skipped: Array<number>,
+};
 
 /**
  * Input format of [`smooth`].
@@ -1234,7 +1314,8 @@ export type KinematicLimits = {
   /**
    * Nozzle radius `R_n`, mm.
    */
-  nozzle_radius_mm: number, };
+  nozzle_radius_mm: number,
+};
 
 /**
  * Which machine layout the rotary axes have.
@@ -1260,7 +1341,8 @@ export type Kinematics = Partial<{
   /**
    * `head-ab`: distance from the nozzle tip up to the pivot point the controller programs, mm.
    */
-  pivot_length_mm: number, }>;
+  pivot_length_mm: number,
+}>;
 
 /**
  * The motion settings of a Klipper config. `None`: not in the file (Klipper's default then
@@ -1338,7 +1420,8 @@ export type KlipperConfig = Partial<{
   /**
    * `[firmware_retraction] unretract_speed`, mm/s.
    */
-  unretract_speed: number | null, }>;
+  unretract_speed: number | null,
+}>;
 
 /**
  * What Klipper's version does with `max_accel_to_decel`: older Klipper (v0.12, and the
@@ -1368,12 +1451,18 @@ export type LayerMetrics = {
   /**
    * After.
    */
-  after: ToolpathMetrics, };
+  after: ToolpathMetrics,
+};
 
 /**
  * How the layer count was obtained.
  */
-export type LayerSource = { "method": "markers", "marker": LayerMarkerKind } | { "method": "z_changes" };
+export type LayerSource = {
+  "method": "markers",
+  "marker": LayerMarkerKind
+} | {
+  "method": "z_changes"
+};
 
 /**
  * Totals for one layer.
@@ -1414,7 +1503,8 @@ export type LayerSummary = {
   /**
    * Energy, J: `E_servo` of its moves and dwells plus the share of `E_aux` of its time.
    */
-  energy_j: number, };
+  energy_j: number,
+};
 
 /**
  * Vibration of one layer (the paper's Fig. 9c).
@@ -1439,7 +1529,8 @@ export type LayerVibration = {
   /**
    * RMS of the table's acceleration in the layer, m/s².
    */
-  acceleration_rms: number, };
+  acceleration_rms: number,
+};
 
 /**
  * One limit value with its origin.
@@ -1452,7 +1543,8 @@ export type Limit = {
   /**
    * Where it came from.
    */
-  source: LimitSource, };
+  source: LimitSource,
+};
 
 /**
  * Where a limit's current value came from.
@@ -1526,7 +1618,8 @@ export type Limits = {
    * [`KLIPPER_INSTANT_CORNER_V`](super::junction::KLIPPER_INSTANT_CORNER_V) (and not in the
    * report, which is unchanged for every file that sets no Klipper config).
    */
-  instantaneous_corner_velocity?: Limit | null, };
+  instantaneous_corner_velocity?: Limit | null,
+};
 
 /**
  * The drives of the X and Y axes (Z moves only between layers and is taken as rigid).
@@ -1543,7 +1636,8 @@ export type MachineDynamics = {
   /**
    * Y drive.
    */
-  y: Drive, };
+  y: Drive,
+};
 
 /**
  * The machine a file was planned for.
@@ -1564,7 +1658,8 @@ export type MachineInfo = {
   /**
    * Limits in force at the first printing move, each with where it came from.
    */
-  limits: Limits, };
+  limits: Limits,
+};
 
 /**
  * A machine profile.
@@ -1585,7 +1680,8 @@ export type MachineProfile = {
   /**
    * Motion limits.
    */
-  limits: Limits, };
+  limits: Limits,
+};
 
 /**
  * A filament material with built-in properties.
@@ -1615,7 +1711,8 @@ export type MaterialProperties = {
   /**
    * Cradle-to-gate emission factor of the material, kg CO₂e per kg.
    */
-  co2_kg_per_kg: number, };
+  co2_kg_per_kg: number,
+};
 
 /**
  * Where the material came from.
@@ -1633,7 +1730,8 @@ export type Mode = {
   /**
    * Damping ratio `ζ`.
    */
-  damping_ratio: number, };
+  damping_ratio: number,
+};
 
 /**
  * Where the initial extrusion mode came from.
@@ -1673,7 +1771,8 @@ export type Observation = {
   /**
    * Measured energy, W·ms.
    */
-  e: number, };
+  e: number,
+};
 
 /**
  * Options of [`optimize`]. Every field is optional in JSON.
@@ -1709,7 +1808,8 @@ export type OptimizeOptions = Partial<{
   /**
    * Rewrite the time comments and `M73` lines (default true).
    */
-  estimates: boolean, }>;
+  estimates: boolean,
+}>;
 
 /**
  * Result of [`optimize`].
@@ -1730,7 +1830,8 @@ export type OptimizeReport = {
   /**
    * The estimates written, when asked.
    */
-  estimates: EstimateReport | null, };
+  estimates: EstimateReport | null,
+};
 
 /**
  * One stage's outcome.
@@ -1759,7 +1860,8 @@ export type OptimizeStage = {
   /**
    * Lines before and after the stage.
    */
-  lines: [number, number], };
+  lines: [number, number],
+};
 
 /**
  * Orientation metrics of a set of runs.
@@ -1798,7 +1900,8 @@ export type OrientationMetrics = {
   /**
    * The two rotary axes.
    */
-  rotary: Array<RotaryMetrics>, };
+  rotary: Array<RotaryMetrics>,
+};
 
 /**
  * What the rewrite did to the paths.
@@ -1876,7 +1979,8 @@ export type PathCounts = {
    * (`keyhole`); 0 where the dynamics model found the loops left the machine
    * ringing more than the original (see [`crate::vtg::VtgOptions::dynamics`]).
    */
-  keyholes: number, };
+  keyholes: number,
+};
 
 /**
  * A spectral peak.
@@ -1889,7 +1993,8 @@ export type Peak = {
   /**
    * Power spectral density at the peak.
    */
-  power: number, };
+  power: number,
+};
 
 /**
  * Welch PSD of the table's acceleration (X and Y spectra summed), (m/s²)²/Hz.
@@ -1926,7 +2031,8 @@ export type Psd = {
   /**
    * Highest local maxima, highest first.
    */
-  peaks: Array<Peak>, };
+  peaks: Array<Peak>,
+};
 
 /**
  * Everything `analyze` says about a file.
@@ -2046,7 +2152,8 @@ export type Report = {
   /**
    * Warnings counted beyond the ones listed.
    */
-  warnings_dropped: number, };
+  warnings_dropped: number,
+};
 
 /**
  * One row's fit.
@@ -2067,7 +2174,8 @@ export type Residual = {
   /**
    * `observed − predicted`, W·ms.
    */
-  residual: number, };
+  residual: number,
+};
 
 /**
  * Motion of one rotary axis.
@@ -2104,7 +2212,8 @@ export type RotaryMetrics = {
   /**
    * Root-mean-square angular jerk, °/s³.
    */
-  rms_jerk_deg_s3: number, };
+  rms_jerk_deg_s3: number,
+};
 
 /**
  * The segment budget of the machine a file runs on.
@@ -2128,7 +2237,8 @@ export type SegmentBudget = {
   /**
    * Bytes per second the firmware reads (a 115200-baud serial stream by default).
    */
-  stream_bytes_per_s: number, };
+  stream_bytes_per_s: number,
+};
 
 /**
  * The position loop that drives the motor: torque
@@ -2153,7 +2263,8 @@ export type ServoLoop = {
   /**
    * Acceleration (torque) feed-forward `k_a`, 0..=1.
    */
-  acceleration_feedforward: number, };
+  acceleration_feedforward: number,
+};
 
 /**
  * Which model gives `E_servo`.
@@ -2192,7 +2303,8 @@ export type ServoProfile = Partial<{
   /**
    * Fraction of braking energy the drives return, 0..=1.
    */
-  regeneration: number, }>;
+  regeneration: number,
+}>;
 
 /**
  * The physical model's energy, by kind, J.
@@ -2213,7 +2325,8 @@ export type ServoReport = {
   /**
    * Standby draw of the enabled drives, J.
    */
-  standby_j: number, };
+  standby_j: number,
+};
 
 /**
  * Options of [`smooth`]. Every field is optional in JSON.
@@ -2278,7 +2391,8 @@ export type SmoothOptions = Partial<{
    * Rewrite a G-code file's time comments and `M73` lines from the planner when the file
    * changed (default true; see [`crate::estimate`]).
    */
-  estimates: boolean, }>;
+  estimates: boolean,
+}>;
 
 /**
  * What [`smooth`] did.
@@ -2376,7 +2490,8 @@ export type SmoothReport = {
   /**
    * Warnings met while reading.
    */
-  warnings: Array<Warning>, };
+  warnings: Array<Warning>,
+};
 
 /**
  * Rotary angles per point before and after, decimated to at most [`SERIES_MAX`] points (for a
@@ -2410,12 +2525,17 @@ export type SmoothSeries = {
   /**
    * Angle between the tool vector after and before, degrees.
    */
-  angle_to_original_deg: Array<number>, };
+  angle_to_original_deg: Array<number>,
+};
 
 /**
  * Filter window.
  */
-export type SmoothWindow = { "points": number } | { "millimetres": number };
+export type SmoothWindow = {
+  "points": number
+} | {
+  "millimetres": number
+};
 
 /**
  * Window function applied to each segment.
@@ -2453,7 +2573,8 @@ export type Table1 = {
   /**
    * `mean(e_c)`, mm.
    */
-  mean_chord_error_mm: Comparison, };
+  mean_chord_error_mm: Comparison,
+};
 
 /**
  * The paper's Table 2: kinematic and energy performance before and after.
@@ -2482,7 +2603,8 @@ export type Table2 = {
   /**
    * Print time, s.
    */
-  time_s: Comparison, };
+  time_s: Comparison,
+};
 
 /**
  * A heater target set at some point of the print.
@@ -2507,7 +2629,8 @@ export type TemperatureEvent = {
   /**
    * Whether the printer waits for it.
    */
-  wait: boolean, };
+  wait: boolean,
+};
 
 /**
  * The regression coefficients of thesis eq. 28. Units make `E` come out in W·ms:
@@ -2530,7 +2653,8 @@ export type ThesisCoefficients = {
   /**
    * `k_h`: holding factor (both axes).
    */
-  k_h: number, };
+  k_h: number,
+};
 
 /**
  * The sums `A`, `B`, `C`, `H` over a file, and the coefficients they are weighed with.
@@ -2568,7 +2692,8 @@ export type ThesisReport = {
   /**
    * Seconds X and Y spend coasting (both axes counted).
    */
-  coast_s: number, };
+  coast_s: number,
+};
 
 /**
  * Toolpath metrics of a file or a layer (VTG eq. 24–26, 31).
@@ -2609,7 +2734,8 @@ export type ToolpathMetrics = {
   /**
    * Critical angle δθ used, degrees.
    */
-  critical_angle_deg: number, };
+  critical_angle_deg: number,
+};
 
 /**
  * Options of [`vibration`]. Every field is optional in JSON.
@@ -2652,7 +2778,8 @@ export type VibrationOptions = Partial<{
   /**
    * Spectral peaks reported (default 5).
    */
-  peaks: number, }>;
+  peaks: number,
+}>;
 
 /**
  * Result of [`vibration`].
@@ -2705,7 +2832,8 @@ export type VibrationReport = {
   /**
    * Simulation steps.
    */
-  steps: number, };
+  steps: number,
+};
 
 /**
  * Options of [`vtg`]. Every field is optional in JSON.
@@ -2794,7 +2922,8 @@ export type VtgOptions = Partial<{
    * `v · t_min` wherever the tolerance allows, so the firmware's buffer stays full; 0 joins
    * as far as the tolerance and the turn allow.
    */
-  min_segment_time_ms: number | null, }>;
+  min_segment_time_ms: number | null,
+}>;
 
 /**
  * Everything `vtg` says about a rewrite.
@@ -2849,7 +2978,8 @@ export type VtgReport = {
    * Both files against the machine's segment budget: lines, bytes, short segments, the
    * peak segment rate ([`super::firmware`]); `None` only while the report is assembled.
    */
-  firmware: FirmwareReport | null, };
+  firmware: FirmwareReport | null,
+};
 
 /**
  * A non-fatal problem, reported with its line so the user can look at it.
@@ -2862,7 +2992,8 @@ export type Warning = {
   /**
    * Human-readable message.
    */
-  message: string, };
+  message: string,
+};
 
 /**
  * Weights of [`Objective::Weighted`] (each of energy, time, length relative to the original).
@@ -2879,4 +3010,5 @@ export type Weights = Partial<{
   /**
    * Weight of `length_mm / before`.
    */
-  length: number, }>;
+  length: number,
+}>;
