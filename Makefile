@@ -45,11 +45,14 @@ cli:
 test: setup-test lint typecheck test-rust test-wasm test-js test-fuzz
 
 ## `// @ts-check` on the playground's www/*.js: tsc over the page's modules and app.js (DOM) and
-## over the two workers (worker.js, sw.js: the webworker library). Needs www/pkg and www/vendor.
+## over the two workers (worker.js, sw.js: the webworker library), and over the browser test's
+## stand-in package (tests/e2e/mock-package.js) against the generated report types. Needs
+## www/pkg and www/vendor.
 typecheck: pkg
 	tsc -p www/tsconfig.json
 	tsc -p www/tsconfig.app.json
 	tsc -p www/tsconfig.worker.json
+	tsc -p tests/e2e/tsconfig.json
 
 lint:
 	cargo fmt --all -- --check

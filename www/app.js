@@ -492,14 +492,14 @@ function jobOptions(form) {
       options[input.name] = raw;
     }
   }
-  // OptimizeOptions (types.d.ts): VTG's tolerance inside vtg_options, the infill search as
+  // OptimizeOptions (types.generated.d.ts): VTG's tolerance inside vtg_options, the infill search as
   // an options object (its defaults).
   if (form.dataset.job === 'optimize') {
     if (isNum(options.tolerance_mm)) options.vtg_options = { tolerance_mm: options.tolerance_mm };
     delete options.tolerance_mm;
     if (options.infill === true) options.infill = {};
   }
-  // SmoothOptions.window is { points } or { millimetres } (types.d.ts).
+  // SmoothOptions.window is { points } or { millimetres } (types.generated.d.ts).
   if (form.dataset.job === 'smooth') {
     if (isNum(options.window_mm)) options.window = { millimetres: options.window_mm };
     else if (isNum(options.window)) options.window = { points: Math.round(options.window) };
@@ -996,11 +996,11 @@ function renderCharts(job, r) {
     }
   }
   if (job === 'smooth' && r.series) {
-    // Two shapes: { axes, point, first_before, first_after, second_before, second_after }
-    // (the crate's Series, thinned to ≤ 2000 points) or { b_before, b_after, c_before, c_after }.
+    // The crate's SmoothSeries (thinned to ≤ 2000 points): { axes, point, first_before,
+    // first_after, second_before, second_after }.
     const s = r.series;
     const [ax1, ax2] = Array.isArray(s.axes) && s.axes.length >= 2 ? s.axes : ['B', 'C'];
-    const cols = s.first_before ? [s.first_before, s.first_after, s.second_before, s.second_after] : [s.b_before, s.b_after, s.c_before, s.c_after];
+    const cols = [s.first_before, s.first_after, s.second_before, s.second_after];
     const n = Math.max(...cols.map((a) => (Array.isArray(a) ? a.length : 0)));
     if (n > 0) {
       const x = Array.isArray(s.point) && s.point.length === n ? s.point : Array.from({ length: n }, (_, i) => i);

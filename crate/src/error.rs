@@ -9,6 +9,7 @@ use serde::Serialize;
 
 /// What went wrong, independent of where.
 #[derive(Debug, Clone, PartialEq, thiserror::Error, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(tag = "kind", rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum ErrorKind {
@@ -123,6 +124,7 @@ impl Error {
 
 /// A non-fatal problem, reported with its line so the user can look at it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[cfg_attr(not(target_arch = "wasm32"), derive(serde::Deserialize))]
 pub struct Warning {
     /// 1-based line number (0 for file-level remarks).

@@ -199,6 +199,10 @@ pub mod read;
 pub mod vec3;
 pub mod vtg;
 
+// The TypeScript declarations of the JS boundary's serde types, rendered and checked in a test.
+#[cfg(all(test, not(target_arch = "wasm32")))]
+mod ts_types;
+
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
 

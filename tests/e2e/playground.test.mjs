@@ -487,78 +487,12 @@ for (const [job, file] of [
   });
 }
 
-// The job UI against a package that has every capability of the API contract:
-// a stand-in module re-exports the real package and adds vtg, infill, smooth and
-// vibration returning results of the documented shape (real analyze reports for
-// before/after). Checks the page's side: tables, charts, downloads, the viewer's
+// The job UI against a stand-in package (tests/e2e/mock-package.js): the real package with
+// quick, deterministic vtg, infill, smooth and vibration results of the real shapes (typed with
+// the declarations generated from the Rust types and checked by `make typecheck`), real analyze
+// reports for before/after. Checks the page's side: tables, charts, downloads, the viewer's
 // before/after; the real numbers are checked against the CLI above.
-const MOCK_PACKAGE = `
-import init, * as real from './quietpath.js?real';
-export default init;
-export * from './quietpath.js?real';
-const enc = new TextEncoder();
-// The worker prefers Session methods: route them to the stand-ins below too.
-export class Session extends real.Session {
-  vtg(o, p) { return vtg(this.input(), o, p); }
-  infill(o, p) { return infill(this.input(), o, p); }
-  smooth(o, p) { return smooth(this.input(), o, p); }
-  vibration(o, p) { return vibration(this.input(), o, p); }
-}
-const bytesOf = (input) => (typeof input === 'string' ? enc.encode(input) : new Uint8Array(input));
-function optimized(input, tag) {
-  const a = bytesOf(input);
-  const b = enc.encode('; mock ' + tag + '\\n');
-  const out = new Uint8Array(a.length + b.length);
-  out.set(a);
-  out.set(b, a.length);
-  return out;
-}
-export function vtg(input, options = {}, progress) {
-  progress?.(0.5);
-  const output = optimized(input, 'vtg');
-  const before = real.analyze(bytesOf(input));
-  const after = real.analyze(output);
-  return {
-    tolerance_mm: options.tolerance_mm ?? 0.05, max_deviation_mm: 0.0421, before, after,
-    options_seen: options,
-    table1: { time_s: { before: before.time_s, after: after.time_s, change: 0 } },
-    table2: [{ metric: 'energy_j', before: before.energy.total_j, after: after.energy.total_j }],
-    output,
-  };
-}
-export function infill(input, options = {}) {
-  const output = optimized(input, 'infill');
-  const candidates = [];
-  for (const pattern of ['rectilinear', 'zigzag']) for (const angle_deg of [0, 30, 45, 60, 90])
-    for (const rotation_deg of [0, 90]) candidates.push({ pattern, angle_deg, rotation_deg, thesis_j: 1000 + angle_deg, total_j: 5000 + 10 * Math.sin(angle_deg / 30) + (pattern === 'zigzag' ? 50 : 0) + rotation_deg, time_s: 60, length_mm: 1000 });
-  return { before: real.analyze(bytesOf(input)), after: real.analyze(output), best: { pattern: 'rectilinear', angle_deg: 0, rotation_deg: 0 }, candidates, output };
-}
-export function smooth(input) {
-  const n = 500;
-  const b = Array.from({ length: n }, (_, i) => 20 * Math.sin(i / 20) + (i % 7));
-  return {
-    points: n, corrected: 321, max_angle_to_original_deg: 2.5,
-    before: { max_jerk_deg: 4, mean_step_deg: 1.2 }, after: { max_jerk_deg: 1, mean_step_deg: 0.4 },
-    series: { b_before: b, b_after: b.map((v, i) => 20 * Math.sin(i / 20)), c_before: b.map((v) => v * 2), c_after: b.map((v, i) => 40 * Math.sin(i / 20)) },
-    output: optimized(input, 'smooth'),
-  };
-}
-export function vibration(input, options = {}, progress) {
-  if (options.fs_hz === 999) {
-    // A slow job to cancel.
-    const t0 = Date.now();
-    while (Date.now() - t0 < 10000) progress?.((Date.now() - t0) / 10000);
-  }
-  const after = new TextDecoder().decode(bytesOf(input).subarray(-16)).includes('mock');
-  const freqs = Array.from({ length: 256 }, (_, i) => i * 2);
-  return {
-    natural_frequencies_hz: [41.2, 57.9],
-    deviation_mm: { max: after ? 0.02 : 0.05, min: 0, mean: after ? 0.004 : 0.01 },
-    layers: Array.from({ length: 50 }, (_, i) => ({ layer: i, amplitude: (after ? 0.5 : 1) * (1 + Math.sin(i / 5)) })),
-    psd: { fs_hz: 512, window: 256, freqs, power: freqs.map((f) => (after ? 0.3 : 1) / (1 + Math.abs(f - 41) / 5)), peaks: [{ hz: 41.2, power: 1 }] },
-  };
-}
-`;
+const MOCK_PACKAGE = fs.readFileSync(path.join(repoRoot, 'tests', 'e2e', 'mock-package.js'), 'utf8');
 
 test('the job UI with every capability: tables, charts, downloads, before/after viewer', { timeout: JOB_TIMEOUT }, async () => {
   const tab = await context.newPage();
@@ -619,9 +553,9 @@ test('the job UI with every capability: tables, charts, downloads, before/after 
   await id('run-smooth').click();
   await idle();
   assert.equal(await id('chart-orientation').getAttribute('data-series'), '4');
-  // Human names, not raw keys (issue 32): max_jerk_deg reads "Max jerk", in degrees.
+  // Human names, not raw keys (issue 32): max_angle_change_deg reads "Max angle change", in degrees.
   const smoothRows = await id('compare-table').textContent();
-  assert.ok(smoothRows.includes('Max jerk') && !smoothRows.includes('max jerk deg'), smoothRows);
+  assert.ok(smoothRows.includes('Max angle change') && !smoothRows.includes('max angle change deg'), smoothRows);
   assert.match(smoothRows, /4°/);
 
   // Vibration on the file, then on the optimized output: PSD before and after.

@@ -109,22 +109,40 @@ test('Session: a malformed file fails with a line number (strict)', () => {
   assert.throws(() => s.layerCount(), (e) => e instanceof Error && e.line === 2);
 });
 
+// The report and option types are generated from the Rust types (crate/src/ts_types.rs); this
+// assigns real CLI output to them, so a serde attribute ts-rs reads differently from serde (a
+// field left out, renamed, tagged) fails here. An object literal with a field the type lacks
+// fails too (excess property check), so the check runs both ways.
 test('TypeScript: declarations compile (tsc --strict) and match real CLI output', () => {
   const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'qp-types-'));
-  const reports = [path.join(repoRoot, 'www', 'demo', 'demo.gcode'), path.join(corpusDir, 'prusaslicer-2.7.4_screw_arcfit.gcode')].map((f) =>
+  // A Klipper file with an untimed homing: the report's optional `homing_count`.
+  const klipper = path.join(dir, 'klipper.gcode');
+  fs.writeFileSync(klipper, ';FLAVOR:Klipper\nG1 X10 F600\nG28\nG1 X5 F600\n');
+  // Rows from known coefficients plus noise, for `calibrate --json`.
+  const csv = path.join(dir, 'calibration.csv');
+  fs.writeFileSync(
+    csv,
+    [1, 2, 3, 4, 5, 6, 7, 8].map((x) => [1e4 * x, 3e3 * x * x, x ** 3, 9 - x].concat(1300 * x + 360 * x * x + 70 * x ** 3 + 800 * (9 - x) + (x % 3)).join(',')).join('\n'),
+  );
+  const reports = [path.join(repoRoot, 'www', 'demo', 'demo.gcode'), path.join(corpusDir, 'prusaslicer-2.7.4_screw_arcfit.gcode'), klipper].map((f) =>
     execFileSync(cli, ['analyze', f, '--json'], { encoding: 'utf8', maxBuffer: 64 << 20 }),
   );
+  assert.match(reports[2], /"homing_count": 1/);
   const json = (args) => execFileSync(cli, args, { encoding: 'utf8', maxBuffer: 64 << 20, stdio: ['ignore', 'pipe', 'ignore'] }).trim();
   const typed = [
     ['VibrationReport', json(['vibration', path.join(repoRoot, 'www', 'demo', 'demo.gcode'), '--json'])],
     ['VtgReport', json(['vtg', path.join(repoRoot, 'www', 'demo', 'demo.gcode'), '-o', path.join(dir, 'vtg.gcode'), '--json'])],
     ['InfillReport', json(['infill', path.join(repoRoot, 'www', 'demo', 'demo.gcode'), '-o', path.join(dir, 'infill.gcode'), '--angles', '0:90:90', '--json'])],
     ['SmoothReport', json(['smooth', path.join(corpusDir, 'multiaxis-xyzbc_zhang-ral2021_model1.gcode'), '-o', path.join(dir, 'smooth.gcode'), '--kinematics', 'table-bc', '--json'])],
+    ['InfillReport', json(['infill', path.join(repoRoot, 'www', 'demo', 'demo.gcode'), '-o', path.join(dir, 'infill-layers.gcode'), '--angles', '0:90:90', '--per-layer', '--json'])],
+    ['OptimizeReport', json(['optimize', path.join(repoRoot, 'www', 'demo', 'demo.gcode'), '-o', path.join(dir, 'optimize.gcode'), '--json'])],
+    ['CalibrationFit', json(['calibrate', csv, '--json'])],
+    ['MachineProfile[]', JSON.stringify(node.machines())],
   ];
   const api = path.join(pkgDir, 'web', 'quietpath.js').replaceAll('\\', '/');
   const src = [
-    `import init, { analyze, calibrate, Session, version, vibration, smooth, infill, vtg } from '${api}';`,
-    `import type { Report, AnalyzeOptions, LayerGeometry, CalibrationFit, QuietpathError, VibrationResult, ${typed.map(([t]) => t).join(', ')} } from '${api}';`,
+    `import init, { analyze, calibrate, machines, optimize, Session, version, vibration, smooth, infill, vtg } from '${api}';`,
+    `import type { Report, AnalyzeOptions, LayerGeometry, CalibrationFit, QuietpathError, VibrationResult, MachineProfile, VibrationReport, VtgReport, InfillReport, SmoothReport, OptimizeReport, OptimizeOptions } from '${api}';`,
     'export async function use(bytes: Uint8Array): Promise<number> {',
     '  await init();',
     "  const options: AnalyzeOptions = { strict: true, machine: 'prusa-mk3s', junction_model: 'klipper' };",
@@ -141,8 +159,11 @@ test('TypeScript: declarations compile (tsc --strict) and match real CLI output'
     "  const ir = infill(bytes, { angles_deg: [0, 90], patterns: ['rectilinear', 'hilbert'], objective: 'time' });",
     "  const best: string = ir.best.pattern + ir.candidates[0].total_j + ir.output.length;",
     "  const sv: VibrationResult = s.vibration({ analyze: { machine: 'vtg-ldam-servo' } });",
-    "  try { analyze('G1 X1.2.3'); } catch (e) { const err = e as QuietpathError; return err.line ?? 0; }",
-    '  return r.time_s + g.xy.length + g.xyz.length + g.tool.length + fit.k_c + version().length + s.layerCount() + vr.psd.freqs.length + spectrum.length + smoothed.length + sv.steps + sr.corrected + best.length + turning;',
+    "  const oo: OptimizeOptions = { infill: { per_layer: true }, vtg_options: { tolerance_mm: 0.05 }, arcs: 'off', analyze: { energy: { thesis: { k_c: 70 }, material: 'petg' }, klipper_config: '[printer]\\nmax_accel: 3000\\n' } };",
+    "  const or = optimize(bytes, oo);",
+    "  const profiles: MachineProfile[] = machines();",
+    "  try { analyze('G1 X1.2.3'); } catch (e) { const err = e as QuietpathError; return (err.kind?.kind === 'invalid_number' ? err.kind.letter.length : 0) + (err.line ?? 0); }",
+    '  return r.time_s + g.xy.length + g.xyz.length + g.tool.length + fit.k_c + version().length + s.layerCount() + vr.psd.freqs.length + spectrum.length + smoothed.length + sv.steps + sr.corrected + best.length + turning + or.stages.length + or.output.length + profiles[0].limits.acceleration.value;',
     '}',
     ...reports.map((json, i) => `export const report${i}: Report = ${json.trim()};`),
     ...typed.map(([t, json], i) => `export const typed${i}: ${t} = ${json};`),

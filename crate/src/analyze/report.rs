@@ -10,6 +10,7 @@ pub use crate::read::{LayerSource, LayerSummary};
 
 /// Everything `analyze` says about a file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Report {
     /// quietpath version that made the report.
     pub version: String,
@@ -24,6 +25,7 @@ pub struct Report {
     /// takes depends on the printer, and no file tells. Each stops the toolhead. Absent when
     /// there are none (and on Marlin-style files, where `G28` is timed as a move to 0).
     #[serde(skip_serializing_if = "is_zero")]
+    #[cfg_attr(test, ts(optional, as = "Option<_>"))]
     pub homing_count: u64,
     /// How `time_s` was computed (`planner`: firmware look-ahead with the junction model below).
     pub time_model: String,
@@ -79,6 +81,7 @@ fn is_zero(n: &u64) -> bool {
 
 /// Facts about the input file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct FileInfo {
     /// Size, bytes.
     pub bytes: u64,
@@ -94,6 +97,7 @@ pub struct FileInfo {
 
 /// The machine a file was planned for.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct MachineInfo {
     /// Profile name.
     pub profile: String,
@@ -107,6 +111,7 @@ pub struct MachineInfo {
 
 /// Extrusion settings used for filament and mass.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct ExtrusionInfo {
     /// Mode the file starts in.
     pub mode: ExtrusionMode,
@@ -120,6 +125,7 @@ pub struct ExtrusionInfo {
 
 /// Axis-aligned bounding box.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Bounds {
     /// Minimum X, Y, Z, mm.
     pub min: [f64; 3],
@@ -129,6 +135,7 @@ pub struct Bounds {
 
 /// Totals for one printed feature (as named by the slicer), or for travel.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct FeatureSummary {
     /// Name as the slicer wrote it (`travel` for non-printing moves, `unmarked` when the file
     /// names no features).

@@ -27,6 +27,7 @@ pub const DEFAULT_CRITICAL_ANGLE_DEG: f64 = 30.0;
 
 /// Toolpath metrics of a file or a layer (VTG eq. 24–26, 31).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct ToolpathMetrics {
     /// Printed path length `L_total`, mm (VTG eq. 24).
     pub l_total_mm: f64,

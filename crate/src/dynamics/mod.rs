@@ -41,6 +41,7 @@ pub use welch::{Peak, Window};
 
 /// Options of [`vibration`]. Every field is optional in JSON.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct VibrationOptions {
     /// How the file is read and planned (machine preset, junction model...).
@@ -83,6 +84,7 @@ impl Default for VibrationOptions {
 
 /// Trajectory deviation statistics (VTG eq. 15), mm.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Deviation {
     /// Largest deviation.
     pub max: f64,
@@ -98,6 +100,7 @@ pub struct Deviation {
 
 /// Vibration of one layer (the paper's Fig. 9c).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct LayerVibration {
     /// 0-based layer index.
     pub layer: usize,
@@ -113,6 +116,7 @@ pub struct LayerVibration {
 
 /// Modes of one axis.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct AxisModes {
     /// `x` or `y`.
     pub axis: &'static str,
@@ -124,6 +128,7 @@ pub struct AxisModes {
 
 /// Welch PSD of the table's acceleration (X and Y spectra summed), (m/s²)²/Hz.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Psd {
     /// Sampling rate, Hz.
     pub fs_hz: f64,
@@ -145,6 +150,7 @@ pub struct Psd {
 
 /// Result of [`vibration`].
 #[derive(Debug, Clone, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct VibrationReport {
     /// Machine profile the file was planned with.
     pub machine: String,

@@ -12,6 +12,7 @@ use serde::Serialize;
 
 /// One vibration mode.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Mode {
     /// Undamped natural frequency `ωₙ / 2π`, Hz.
     pub frequency_hz: f64,

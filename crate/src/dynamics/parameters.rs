@@ -36,6 +36,7 @@ pub const STEEL_DENSITY: f64 = 7850.0;
 /// axis against its viscous damping at the commanded speed and `k_a` of the torque that
 /// accelerates its inertia.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(deny_unknown_fields)]
 pub struct ServoLoop {
     /// Position gain `K_p`, N·m/rad (for a stepper: holding torque × rotor teeth).
@@ -64,6 +65,7 @@ impl ServoLoop {
 
 /// A ball-screw drive (VTG eq. 1–9).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(deny_unknown_fields)]
 pub struct BallScrew {
     /// Screw radius `r_s`, m.
@@ -114,6 +116,7 @@ pub struct BallScrew {
 
 /// A belt drive of a desktop printer, mapped onto the same coordinates.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(deny_unknown_fields)]
 pub struct Belt {
     /// Pulley pitch radius (the transmission ratio `i_s`), m.
@@ -152,6 +155,7 @@ pub struct Belt {
 
 /// One axis drive.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case", tag = "type")]
 pub enum Drive {
     /// Ball screw and servo motor.
@@ -162,6 +166,7 @@ pub enum Drive {
 
 /// The drives of the X and Y axes (Z moves only between layers and is taken as rigid).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(deny_unknown_fields)]
 pub struct MachineDynamics {
     /// Short name.

@@ -19,6 +19,8 @@ use serde::{Deserialize, Serialize};
 
 /// Window function applied to each segment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(test, derive(ts_rs::TS))]
+#[cfg_attr(test, ts(rename = "SpectrumWindow"))]
 #[serde(rename_all = "snake_case")]
 pub enum Window {
     /// Hamming, `0.54 − 0.46 cos(2πk/n)` (periodic, scipy's `get_window('hamming', n)`); the
@@ -218,6 +220,7 @@ fn accumulate(
 
 /// A spectral peak.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Peak {
     /// Frequency, Hz.
     pub hz: f64,

@@ -22,6 +22,7 @@ use crate::machine::{FanEvent, Heater, TemperatureEvent};
 
 /// Powers and heat capacities of the auxiliary systems.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct AuxPowers {
     /// Bed heat loss per kelvin above ambient, W/K (0.9: about 32 W holding 60 °C).
@@ -85,6 +86,7 @@ impl AuxPowers {
 
 /// `E_aux` by system, J.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct AuxReport {
     /// Bed holding its targets, J.
     pub bed_j: f64,

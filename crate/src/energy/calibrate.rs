@@ -24,11 +24,13 @@ pub const P: usize = 4;
 
 /// One observation: the terms of a print and its measured energy.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(deny_unknown_fields)]
 pub struct Observation {
     /// Where it came from (1-based line of the CSV, or position in a list), for errors and
     /// residuals.
     #[serde(default)]
+    #[cfg_attr(test, ts(optional, as = "Option<_>"))]
     pub row: usize,
     /// `A`, (mm/s)².
     pub a: f64,
@@ -64,6 +66,7 @@ pub enum CsvRows {
 
 /// Why a calibration failed. Rows are 1-based lines of the CSV (or positions in a list).
 #[derive(Debug, Clone, PartialEq, thiserror::Error, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(tag = "kind", rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum CalibrationError {
@@ -135,6 +138,7 @@ pub enum CalibrationError {
 
 /// One row's fit.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Residual {
     /// Row (as in the input).
     pub row: usize,
@@ -148,6 +152,8 @@ pub struct Residual {
 
 /// The fitted coefficients and the quality of the fit.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
+#[cfg_attr(test, ts(rename = "CalibrationFit"))]
 pub struct Calibration {
     /// `k_a·m_x`, W·ms per (mm/s)².
     pub k_a_mx: f64,

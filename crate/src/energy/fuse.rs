@@ -26,6 +26,7 @@ use serde::{Deserialize, Serialize};
 
 /// A filament material with built-in properties.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "lowercase")]
 pub enum Material {
     /// Polylactic acid (the default).
@@ -39,6 +40,7 @@ pub enum Material {
 
 /// What `E_fuse` and the material part of VTG eq. 17 need to know about a material.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct MaterialProperties {
     /// Mean specific heat from room to printing temperature, J/(g·K).
@@ -134,6 +136,7 @@ impl Material {
 
 /// Where the material came from.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum MaterialSource {
     /// Given in the options.
@@ -160,6 +163,7 @@ pub fn fuse_energy_j(
 
 /// How `E_fuse` was computed.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct FuseReport {
     /// Material.
     pub material: Material,

@@ -54,6 +54,7 @@ pub const SERVO_PRESET: &str = "vtg-ldam-servo";
 
 /// Which model gives `E_servo`.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum ServoModel {
     /// The physical model for the servo preset (`vtg-ldam-servo`), the thesis model otherwise.
@@ -69,6 +70,7 @@ pub enum ServoModel {
 ///
 /// `total_j = servo_j + fuse_j + aux_j` (VTG eq. 16); `co2_g` is VTG eq. 17.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Energy {
     /// X/Y stepper energy by the thesis model (thesis eq. 28), J. Always computed.
     pub thesis_j: f64,
@@ -102,9 +104,12 @@ pub struct Energy {
 
 /// Settings of the energy models; every field is optional in JSON.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct EnergyOptions {
     /// Coefficients of the thesis model (default: the published ones).
+    // In TS any of them may be left out (the struct has serde defaults); the reports carry it whole.
+    #[cfg_attr(test, ts(type = "Partial<ThesisCoefficients>"))]
     pub thesis: ThesisCoefficients,
     /// Model of the X/Y drives.
     pub servo_model: ServoModel,
@@ -113,6 +118,7 @@ pub struct EnergyOptions {
     /// Material (default: the file's `filament_type`, else PLA).
     pub material: Option<Material>,
     /// Properties replacing the material's built-in ones.
+    #[cfg_attr(test, ts(type = "Partial<MaterialProperties> | null"))]
     pub material_properties: Option<MaterialProperties>,
     /// Ambient temperature, °C.
     pub ambient_c: f64,
@@ -172,6 +178,7 @@ impl EnergyOptions {
 
 /// Emission figures (VTG eq. 17).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Co2Report {
     /// Grid factor used, kg CO₂ per kWh.
     pub grid_kg_per_kwh: f64,

@@ -25,6 +25,7 @@ use crate::plan::PlannedMove;
 /// like the VTG paper's printer (1000 × 800 × 350 mm); they are engineering estimates, not
 /// measurements, and should be replaced with the machine's own values.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct ServoProfile {
     /// Moving mass per axis X, Y, kg (print head carriage on X; the gantry, which carries X,
@@ -59,6 +60,7 @@ impl Default for ServoProfile {
 
 /// The physical model's energy, by kind, J.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct ServoReport {
     /// Kinetic energy drawn while accelerating (net of regeneration), J.
     pub kinetic_j: f64,

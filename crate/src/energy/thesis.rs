@@ -37,6 +37,7 @@ pub const HOLD_EPS_MM: f64 = 1e-6;
 /// `k_a_mx`, `k_a_my` in W·ms per (mm/s)², `k_c` in W·ms per mm, `k_h` in W·ms per s (so
 /// `k_h` = 832.7 is 0.83 W of holding power per axis).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct ThesisCoefficients {
     /// `k_a·m_x`: acceleration factor of X.
@@ -118,6 +119,7 @@ pub fn dwell_terms(secs: f64) -> [f64; 4] {
 
 /// The sums `A`, `B`, `C`, `H` over a file, and the coefficients they are weighed with.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct ThesisReport {
     /// `A`: X acceleration/deceleration term (thesis eq. 24), (mm/s)².
     pub a: f64,

@@ -26,6 +26,7 @@ pub const HEADER_PREFIX: &str = "; quietpath ";
 
 /// What [`rewrite_estimates`] changed.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct EstimateReport {
     /// Print time by our planner, s (`analyze`'s `time_s` of the file).
     pub time_s: f64,

@@ -9,6 +9,7 @@ use serde::Serialize;
 /// The family of layer-change marker a file uses. A file is counted by the first family seen,
 /// so a file that writes both `;LAYER_CHANGE` and `;LAYER:n` is not counted twice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum LayerMarkerKind {
     /// PrusaSlicer, SuperSlicer, OrcaSlicer, Bambu, Creality Print: `;LAYER_CHANGE`.
@@ -39,6 +40,7 @@ pub enum Marker<'a> {
 
 /// The canonical kind of a printed feature, mapped from every slicer's own names.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum FeatureKind {
     /// Outer wall / external perimeter.

@@ -32,6 +32,7 @@ pub use search::{infill, infill_with_progress};
 
 /// What the search minimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum Objective {
     /// `total_j` of the whole file (servo + fuse + auxiliary).
@@ -47,6 +48,7 @@ pub enum Objective {
 
 /// Weights of [`Objective::Weighted`] (each of energy, time, length relative to the original).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct Weights {
     /// Weight of `total_j / before`.
@@ -69,6 +71,7 @@ impl Default for Weights {
 
 /// Options of [`infill`]. Every field is optional in JSON.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct InfillOptions {
     /// How the file is read and costed (machine, junction model, energy).
@@ -153,6 +156,8 @@ impl InfillOptions {
 
 /// One candidate: the whole file with this pattern, angle and rotation.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
+#[cfg_attr(test, ts(rename = "InfillCandidate"))]
 pub struct Candidate {
     /// Pattern.
     pub pattern: Pattern,
@@ -180,6 +185,8 @@ pub struct Candidate {
 
 /// A layer's choice in a per-layer (hybrid) result.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
+#[cfg_attr(test, ts(rename = "InfillLayerChoice"))]
 pub struct LayerChoice {
     /// Layer index.
     pub layer: usize,
@@ -192,6 +199,8 @@ pub struct LayerChoice {
 
 /// What was written: a regenerated pattern, or the original file kept as it was.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
+#[cfg_attr(test, ts(rename = "InfillChoice"))]
 #[serde(rename_all = "snake_case")]
 pub enum Choice {
     /// No candidate beat the original on the objective (as `analyze` costs both files): the
@@ -214,6 +223,8 @@ impl Choice {
 
 /// The chosen result.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
+#[cfg_attr(test, ts(rename = "InfillBest"))]
 pub struct Best {
     /// Pattern (the most used one for a per-layer result), or `original` when the input is
     /// kept.
@@ -243,6 +254,8 @@ pub struct Best {
 
 /// What the method measured from the file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
+#[cfg_attr(test, ts(rename = "InfillMeasured"))]
 pub struct Measured {
     /// Rectilinear-equivalent line spacing, mm.
     pub spacing_mm: f64,
@@ -264,6 +277,7 @@ pub struct Measured {
 
 /// Result of [`infill`].
 #[derive(Debug, Clone, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct InfillReport {
     /// `analyze` of the input.
     pub before: Report,

@@ -13,6 +13,7 @@ use crate::gcode::{parse_line, Command, Lines};
 
 /// Extrusion mode for E words.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum ExtrusionMode {
     /// `M82`: E is a position.
@@ -24,6 +25,7 @@ pub enum ExtrusionMode {
 
 /// Where the initial extrusion mode came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum ModeSource {
     /// The file writes `M82`/`M83` (or `G91`) before its first extrusion.

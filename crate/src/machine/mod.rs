@@ -193,6 +193,7 @@ impl Move {
 
 /// Which heater a temperature command addresses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum Heater {
     /// A hotend (`M104`/`M109`), with its tool index.

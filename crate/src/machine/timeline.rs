@@ -7,6 +7,7 @@ use super::Heater;
 
 /// A heater target set at some point of the print.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct TemperatureEvent {
     /// 1-based line.
     pub line: u32,
@@ -22,6 +23,7 @@ pub struct TemperatureEvent {
 
 /// A fan speed set at some point of the print.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct FanEvent {
     /// 1-based line.
     pub line: u32,

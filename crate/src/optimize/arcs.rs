@@ -7,6 +7,7 @@ use crate::plan::JunctionModel;
 
 /// Arcs in the output.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum ArcsMode {
     /// Where the firmware runs them: a file that already has arcs; Marlin (its default

@@ -23,6 +23,7 @@ use stages::Stage;
 
 /// Options of [`optimize`]. Every field is optional in JSON.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct OptimizeOptions {
     /// How the file is read and the machine it runs on; every stage uses these.
@@ -60,6 +61,8 @@ impl Default for OptimizeOptions {
 
 /// One stage's outcome.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
+#[cfg_attr(test, ts(rename = "OptimizeStage"))]
 pub struct StageReport {
     /// `infill`, `vtg` or `estimates`.
     pub stage: String,
@@ -77,6 +80,7 @@ pub struct StageReport {
 
 /// Result of [`optimize`].
 #[derive(Debug, Clone, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct OptimizeReport {
     /// `analyze` of the input.
     pub before: Report,

@@ -22,6 +22,7 @@ use crate::vec3::{self, V3};
 
 /// Which filter smooths the orientation.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "kebab-case")]
 pub enum FilterKind {
     /// Forward-backward moving average (the paper's choice for both parts).
@@ -37,6 +38,8 @@ pub enum FilterKind {
 
 /// Filter window.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
+#[cfg_attr(test, ts(rename = "SmoothWindow"))]
 #[serde(rename_all = "snake_case")]
 pub enum Window {
     /// A number of points.

@@ -35,6 +35,7 @@ use crate::vec3::{self, V3};
 
 /// Which machine layout the rotary axes have.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "kebab-case")]
 pub enum KinematicModel {
     /// Table tilting about Y (B) carrying a turntable about Z (C).
@@ -66,6 +67,7 @@ impl KinematicModel {
 
 /// A kinematic model with its geometry.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct Kinematics {
     /// Machine layout (default `table-bc`).

@@ -32,6 +32,7 @@ pub struct Sample {
 
 /// Motion of one rotary axis.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct RotaryMetrics {
     /// Axis letter.
     pub axis: String,
@@ -53,6 +54,7 @@ pub struct RotaryMetrics {
 
 /// Orientation metrics of a set of runs.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct OrientationMetrics {
     /// Orientation roughness: root mean square of the second difference of the unit tool
     /// vector, `‖T_{m+1} − 2 T_m + T_{m−1}‖`, over the interior points of every run (consecutive

@@ -49,6 +49,7 @@ pub use points::PointVector;
 
 /// Input format of [`smooth`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum InputFormat {
     /// G-code unless the data looks like JSON (`[`) or CSV (a first row of six numbers or an
@@ -65,6 +66,7 @@ pub enum InputFormat {
 
 /// What the X, Y, Z words of multi-axis G-code are.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum Coordinates {
     /// Machine axes: the tool tip in the workpiece frame follows through the kinematic model
@@ -79,6 +81,7 @@ pub enum Coordinates {
 
 /// Options of [`smooth`]. Every field is optional in JSON.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct SmoothOptions {
     /// Kinematic model (default: table-tilting B then rotary C, axes through the origin, as in
@@ -173,6 +176,8 @@ impl SmoothOptions {
 /// Rotary angles per point before and after, decimated to at most [`SERIES_MAX`] points (for a
 /// chart). `first_*` is the tilt axis (`axes[0]`), `second_*` the other.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
+#[cfg_attr(test, ts(rename = "SmoothSeries"))]
 pub struct Series {
     /// Axis letters, e.g. `["B", "C"]`.
     pub axes: Vec<String>,
@@ -195,6 +200,7 @@ pub const SERIES_MAX: usize = 2000;
 
 /// What [`smooth`] did.
 #[derive(Debug, Clone, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct SmoothReport {
     /// Input format that was read.
     pub format: InputFormat,

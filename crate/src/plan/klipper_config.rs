@@ -35,6 +35,7 @@ pub struct KlipperConfigError {
 /// firmware of Creality's K1 family) takes it as an absolute rate; current Klipper (since
 /// 2025-08) ignores it and smooths with `minimum_cruise_ratio` only.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum KlipperVersion {
     /// v0.12 and earlier: `max_accel_to_decel` (default half of `max_accel`).
@@ -47,6 +48,7 @@ pub enum KlipperVersion {
 /// The motion settings of a Klipper config. `None`: not in the file (Klipper's default then
 /// applies, or the profile's where Klipper has none).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct KlipperConfig {
     /// `[printer] kinematics`.

@@ -12,6 +12,7 @@ use crate::gcode::Line;
 
 /// Where a limit's current value came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum LimitSource {
     /// The machine profile (preset or JSON).
@@ -30,6 +31,7 @@ pub enum LimitSource {
 
 /// How junction speeds between consecutive moves are limited.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum JunctionModel {
     /// Marlin's (and Prusa firmware's) classic per-axis jerk, the logic of the thesis's
@@ -43,6 +45,7 @@ pub enum JunctionModel {
 
 /// One limit value with its origin.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Limit {
     /// The value (mm/s, mm/s², mm or a ratio).
     pub value: f64,
@@ -67,6 +70,7 @@ impl Limit {
 
 /// The motion limits in force. Axis arrays are X, Y, Z, E.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Limits {
     /// Maximum feed rate per axis, mm/s (`M203`).
     pub max_feedrate: [Limit; 4],

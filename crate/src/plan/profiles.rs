@@ -7,6 +7,7 @@ use super::limits::{JunctionModel, Limit, Limits};
 
 /// A machine profile.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct MachineProfile {
     /// Short name (`prusa-mk3s`).
     pub name: String,

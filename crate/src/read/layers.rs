@@ -16,6 +16,7 @@ use std::f64::consts::TAU;
 
 /// How the layer count was obtained.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case", tag = "method", content = "marker")]
 pub enum LayerSource {
     /// From the slicer's own layer-change comments.
@@ -26,6 +27,7 @@ pub enum LayerSource {
 
 /// Totals for one layer.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct LayerSummary {
     /// 0-based layer index.
     pub index: u64,

@@ -14,6 +14,7 @@ use crate::plan::{FeedUnits, JunctionModel, Limit, LimitSource, MachineProfile};
 /// Options of `analyze`, and of how every other job reads its input. Every field is optional
 /// in JSON.
 #[derive(Debug, Clone, Default, PartialEq, Deserialize, serde::Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct AnalyzeOptions {
     /// Stop at the first malformed line instead of warning.
@@ -39,6 +40,7 @@ pub struct AnalyzeOptions {
     /// The printer's Klipper config (`printer.cfg`): the file runs on Klipper with these
     /// limits, over the profile's. In JSON, the config's text or its parsed form.
     #[serde(deserialize_with = "klipper_config::text_or_parsed")]
+    #[cfg_attr(test, ts(type = "string | KlipperConfig | null"))]
     pub klipper_config: Option<KlipperConfig>,
     /// How that Klipper reads `max_accel_to_decel` (default: current Klipper).
     pub klipper_version: Option<KlipperVersion>,
@@ -50,6 +52,7 @@ pub struct AnalyzeOptions {
 
 /// Starting extrusion mode, as an option.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(rename_all = "snake_case")]
 pub enum ExtrusionModeOption {
     /// `M82`.

@@ -38,6 +38,7 @@ pub const SERIAL_BYTES_PER_S: f64 = 11_520.0;
 
 /// The segment budget of the machine a file runs on.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct SegmentBudget {
     /// Shortest time a segment may last before the firmware slows it when its buffer runs
     /// low, s (Marlin's `M205 B`; [`MARLIN_MIN_SEGMENT_TIME_S`] by default). On Klipper,
@@ -114,6 +115,7 @@ fn m205_b_us(input: &[u8]) -> Option<f64> {
 
 /// How one file measures against the budget.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct FirmwareFigures {
     /// Lines of the file.
     pub lines: u64,
@@ -133,6 +135,7 @@ pub struct FirmwareFigures {
 
 /// Both files against the machine's budget, for the report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct FirmwareReport {
     /// The budget they are measured against.
     pub budget: SegmentBudget,

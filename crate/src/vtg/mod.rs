@@ -53,6 +53,7 @@ pub use stages::kinematics::KinematicLimits;
 
 /// Options of [`vtg`]. Every field is optional in JSON.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 #[serde(default, deny_unknown_fields)]
 pub struct VtgOptions {
     /// How the file is read and the machine it runs on (as `analyze`).

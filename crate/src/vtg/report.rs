@@ -13,6 +13,7 @@ use crate::path::PrintPath;
 
 /// A figure before and after, and the relative change.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Comparison {
     /// Before VTG.
     pub before: f64,
@@ -40,6 +41,7 @@ impl Comparison {
 
 /// The paper's Table 1: toolpath parameters before and after.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Table1 {
     /// `L_total`, mm.
     pub l_total_mm: Comparison,
@@ -60,6 +62,7 @@ pub struct Table1 {
 /// Deviation of the simulated tool from the programmed path (the paper's Table 2 kinematic
 /// rows), from the dynamics model; filled in when that model is run on both files.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct DeviationComparison {
     /// Largest deviation, mm.
     pub max_mm: Comparison,
@@ -71,6 +74,7 @@ pub struct DeviationComparison {
 
 /// The paper's Table 2: kinematic and energy performance before and after.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct Table2 {
     /// Simulated toolpath deviation (dynamics model); `null` until that model is run.
     pub deviation: Option<DeviationComparison>,
@@ -88,6 +92,7 @@ pub struct Table2 {
 
 /// What the rewrite did to the paths.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct PathCounts {
     /// Extrusion paths with a turn above the critical angle.
     pub candidates: u64,
@@ -136,6 +141,7 @@ pub struct PathCounts {
 
 /// Per-layer toolpath metrics before and after.
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct LayerMetrics {
     /// Layer index.
     pub index: usize,
@@ -147,6 +153,7 @@ pub struct LayerMetrics {
 
 /// Everything `vtg` says about a rewrite.
 #[derive(Debug, Clone, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct VtgReport {
     /// Tolerance asked for, mm.
     pub tolerance_mm: f64,

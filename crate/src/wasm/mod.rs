@@ -20,6 +20,12 @@ use crate::error::Error;
 use crate::plan::profiles::PRESETS;
 use crate::plan::MachineProfile;
 
+// The reports and options, generated from the Rust types (crate/src/ts_types.rs), so that the
+// declarations cannot drift from the JSON.
+#[wasm_bindgen(typescript_custom_section)]
+const GENERATED_TYPES: &str = include_str!("types.generated.d.ts");
+
+// What is not a Rust serde type: typed-array results, callbacks, thrown errors.
 #[wasm_bindgen(typescript_custom_section)]
 const TYPES: &str = include_str!("types.d.ts");
 

@@ -15,6 +15,8 @@ use super::geom::{rotate, Path, Region};
 
 /// An infill pattern.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
+#[cfg_attr(test, ts(rename = "InfillPattern"))]
 #[serde(rename_all = "snake_case")]
 pub enum Pattern {
     /// Parallel lines, turned 90° every layer (PrusaSlicer's and Cura's "lines").

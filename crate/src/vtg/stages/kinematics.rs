@@ -9,6 +9,7 @@ use serde::Serialize;
 
 /// The limits VTG eq. 30 is built from.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
 pub struct KinematicLimits {
     /// Highest feed rate `v_max`, mm/s.
     pub v_max_mm_s: f64,
