@@ -90,48 +90,14 @@ fn layout(decl: &str) -> String {
     // Open brackets: `{` breaks lines at its commas, `[` and `<` do not.
     let mut open: Vec<char> = Vec::new();
     let depth = |open: &[char]| open.iter().filter(|&&c| c == '{').count();
-    // Ends the line (once: never an empty one) and indents the next.
-    let newline = |out: &mut String, depth: usize| {
-        out.truncate(out.trim_end_matches(' ').len());
-        if !out.ends_with('\n') {
-            out.push('\n');
-        }
-        out.push_str(&"  ".repeat(depth));
-    };
     let mut chars = decl.chars().peekable();
     let skip_spaces = |chars: &mut std::iter::Peekable<std::str::Chars<'_>>| {
         while chars.next_if_eq(&' ').is_some() {}
     };
     while let Some(c) = chars.next() {
         match c {
-            // A doc comment, copied with its lines re-indented.
-            '/' if chars.peek() == Some(&'*') => {
-                out.push('/');
-                let mut prev = '/';
-                for c in chars.by_ref() {
-                    if c == '\n' {
-                        newline(&mut out, depth(&open));
-                    } else {
-                        out.push(c);
-                    }
-                    if prev == '*' && c == '/' {
-                        break;
-                    }
-                    prev = c;
-                }
-            }
-            // A string literal (a tag's value), copied as it is.
-            '"' => {
-                out.push('"');
-                let mut escaped = false;
-                for c in chars.by_ref() {
-                    out.push(c);
-                    if c == '"' && !escaped {
-                        break;
-                    }
-                    escaped = c == '\\' && !escaped;
-                }
-            }
+            '/' if chars.peek() == Some(&'*') => copy_comment(&mut chars, &mut out, depth(&open)),
+            '"' => copy_string(&mut chars, &mut out),
             '{' => {
                 open.push('{');
                 out.push('{');
@@ -172,6 +138,49 @@ fn layout(decl: &str) -> String {
     out.truncate(out.trim_end().len());
     out.push('\n');
     out
+}
+
+/// Ends the line (once: never an empty one) and indents the next by `depth` levels.
+fn newline(out: &mut String, depth: usize) {
+    out.truncate(out.trim_end_matches(' ').len());
+    if !out.ends_with('\n') {
+        out.push('\n');
+    }
+    out.push_str(&"  ".repeat(depth));
+}
+
+/// Copies a doc comment whose `/` is already read, its lines re-indented to `depth`.
+fn copy_comment(
+    chars: &mut std::iter::Peekable<std::str::Chars<'_>>,
+    out: &mut String,
+    depth: usize,
+) {
+    out.push('/');
+    let mut prev = '/';
+    for c in chars.by_ref() {
+        if c == '\n' {
+            newline(out, depth);
+        } else {
+            out.push(c);
+        }
+        if prev == '*' && c == '/' {
+            break;
+        }
+        prev = c;
+    }
+}
+
+/// Copies a string literal (a tag's value) whose `"` is already read, as it is.
+fn copy_string(chars: &mut std::iter::Peekable<std::str::Chars<'_>>, out: &mut String) {
+    out.push('"');
+    let mut escaped = false;
+    for c in chars.by_ref() {
+        out.push(c);
+        if c == '"' && !escaped {
+            break;
+        }
+        escaped = c == '\\' && !escaped;
+    }
 }
 
 /// Whether wasm-bindgen's re-indentation (see [`layout`]) comes back to the left margin at the
