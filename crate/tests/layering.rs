@@ -70,8 +70,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ),
 ];
 
-/// Front ends: they may use everything.
-const FRONT_ENDS: &[&str] = &["cli", "wasm"];
+/// Front ends: they may use everything. `ts_types` (test-only) renders the JS boundary's
+/// TypeScript declarations, so it names the report and option types of every layer, as `wasm`.
+const FRONT_ENDS: &[&str] = &["cli", "wasm", "ts_types"];
 
 /// Root helpers may use these (each other, never a layer).
 const HELPER_USES: &[(&str, &[&str])] = &[
