@@ -3,8 +3,8 @@
 //! The file's [`Program`] is replayed through a fresh [`Planner`] and energy
 //! [`Accumulator`] exactly as `analyze` drives them (limits where they change, dwells and
 //! heater waits flushing the queue, temperature and fan events stamped at the start of the next
-//! planned move), with the sparse-infill blocks swapped for the candidate's motions (parsed back
-//! from the candidate's own text, see [`super::emit`]) and, for a part rotation, every move of
+//! planned move), with the sparse-infill blocks swapped for the candidate's motions (its lines
+//! run through a copy of the machine, as its text would be, see [`super::emit`]) and, for a part rotation, every move of
 //! the print turned about the part centre. So a candidate's `time_s`, `thesis_j` and `total_j`
 //! are those `analyze` gives for the written file: exactly without rotation; with a rotation up
 //! to the 0.001 mm rounding of the rewritten coordinates (the test suite checks both).

@@ -1,8 +1,9 @@
 //! G-code for new infill, written with the file's own habits, and the planner's view of it.
 //!
-//! A block's new text is parsed back through a copy of the machine as it stood before the
-//! block, so the motions a candidate is costed with are exactly those `analyze` will read from
-//! the written file (same rounding, same extrusion mode, same firmware retraction).
+//! A block's new lines are run through a copy of the machine as it stood before the block, with
+//! the very words its text parses to, so the motions a candidate is costed with are exactly
+//! those `analyze` will read from the written file (same rounding, same extrusion mode, same
+//! firmware retraction) without printing and parsing the text.
 
 use std::fmt::Write as _;
 

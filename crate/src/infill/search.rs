@@ -1,6 +1,6 @@
-//! The search: every (pattern, infill angle, part rotation) is written as G-code for the
-//! replaced blocks, parsed back and replayed through the planner and energy model for the
-//! whole file ([`super::cost`]); the best by the objective is written out and analysed again.
+//! The search: every (pattern, infill angle, part rotation) is run as G-code for the replaced
+//! blocks through a copy of the machine and replayed through the planner and energy model for
+//! the whole file ([`super::cost`]); the best by the objective is written out and analysed again.
 //!
 //! Infill angles are in the machine frame, as a slicer's `fill_angle`: a part turned by `θ`
 //! with infill at `α` gets the pattern at `α − θ` in the part's own frame, so the generated
@@ -439,6 +439,25 @@ impl Prepared<'_> {
         slots
     }
 
+    /// What block `b` is made from: the block, group `k` of work item `wi`'s plan and the
+    /// block's start and end, turned with the part, and the file's habits at the layer's flow.
+    fn block_parts(
+        &self,
+        wi: usize,
+        plan: &[Path],
+        k: usize,
+        b: usize,
+        rotation: Option<&Rotation>,
+    ) -> Option<(&Block, Vec<Path>, P2, P2, Habit)> {
+        let (w, blk) = (self.work.get(wi)?, self.prog.blocks.get(b)?);
+        let (strokes, start, end) = block_strokes(blk, plan, k, rotation);
+        let habit = Habit {
+            e_per_mm: w.e_per_mm,
+            ..self.habit
+        };
+        Some((blk, strokes, start, end, habit))
+    }
+
     /// Block `b`'s text: group `k` of work item `wi`'s plan, turned with the part.
     fn block_text(
         &self,
@@ -448,12 +467,7 @@ impl Prepared<'_> {
         b: usize,
         rotation: Option<&Rotation>,
     ) -> Option<String> {
-        let (w, blk) = (self.work.get(wi)?, self.prog.blocks.get(b)?);
-        let (strokes, start, end) = block_strokes(blk, plan, k, rotation);
-        let habit = Habit {
-            e_per_mm: w.e_per_mm,
-            ..self.habit
-        };
+        let (blk, strokes, start, end, habit) = self.block_parts(wi, plan, k, b, rotation)?;
         Some(emit::block_text(blk, &strokes, start, end, &habit))
     }
 
@@ -468,12 +482,7 @@ impl Prepared<'_> {
         b: usize,
         rotation: Option<&Rotation>,
     ) -> Option<Replacement> {
-        let (w, blk) = (self.work.get(wi)?, self.prog.blocks.get(b)?);
-        let (strokes, start, end) = block_strokes(blk, plan, k, rotation);
-        let habit = Habit {
-            e_per_mm: w.e_per_mm,
-            ..self.habit
-        };
+        let (blk, strokes, start, end, habit) = self.block_parts(wi, plan, k, b, rotation)?;
         Some(emit::block_motions(blk, &strokes, start, end, &habit))
     }
 }
@@ -500,8 +509,7 @@ fn block_strokes(
     (strokes, start, end)
 }
 
-/// A candidate whose blocks are written and parsed back when a replay asks for them
-/// ([`Prepared::lazy`]).
+/// A candidate whose blocks are made when a replay asks for them ([`Prepared::lazy`]).
 pub(crate) struct LazyCandidate<'s> {
     prep: &'s Prepared<'s>,
     slots: Vec<Option<(usize, usize)>>,
