@@ -389,34 +389,39 @@ fn writer<'a, S: Sink>(block: &Block, out: S, start: P2, habit: &'a Habit) -> Wr
     }
 }
 
-/// The new text of `block` (without a final newline): `strokes` (machine frame), then back to
-/// `end` (machine frame) unless the file travels on from there anyway, with the filament state
-/// and absolute E the original left behind.
-pub(crate) fn block_text(
-    block: &Block,
-    strokes: &[Path],
-    start: P2,
-    end: P2,
-    habit: &Habit,
-) -> String {
-    let cap = strokes.iter().map(|s| s.len() * 34).sum::<usize>() + 64;
+/// One block to write: the block, its new strokes, where it starts and ends (all in the
+/// machine frame, turned with the part) and the file's habits at the layer's flow.
+pub(crate) struct Job<'a> {
+    pub block: &'a Block,
+    pub strokes: Vec<Path>,
+    pub start: P2,
+    pub end: P2,
+    pub habit: Habit,
+}
+
+/// The new text of a block (without a final newline): its strokes, then back to its end
+/// unless the file travels on from there anyway, with the filament state and absolute E the
+/// original left behind.
+pub(crate) fn block_text(job: &Job<'_>) -> String {
+    let cap = job.strokes.iter().map(|s| s.len() * 34).sum::<usize>() + 64;
     let text = Text(String::with_capacity(cap));
-    writer(block, text, start, habit)
-        .block(block, strokes, end)
+    writer(job.block, text, job.start, &job.habit)
+        .block(job.block, &job.strokes, job.end)
         .0
 }
 
-/// The motions [`block_text`] makes when run from the machine state before `block`, with the
-/// nozzle at `start` (the block's start in the candidate's frame: a rotated part starts
-/// elsewhere than the machine copy believes), and where the nozzle ends: the same, bit for bit,
-/// as parsing the text back ([`motions`]).
-pub(crate) fn block_motions(
-    block: &Block,
-    strokes: &[Path],
-    start: P2,
-    end: P2,
-    habit: &Habit,
-) -> Replacement {
+/// The motions [`block_text`] makes when run from the machine state before the block, with the
+/// nozzle at the job's start (in the candidate's frame: a rotated part starts elsewhere than
+/// the machine copy believes), and where the nozzle ends: the same, bit for bit, as parsing the
+/// text back ([`motions`]).
+pub(crate) fn block_motions(job: &Job<'_>) -> Replacement {
+    let Job {
+        block,
+        strokes,
+        start,
+        end,
+        habit,
+    } = job;
     let machine = block.machine.clone();
     let p0 = *machine.position();
     let run = Run {
@@ -429,7 +434,7 @@ pub(crate) fn block_motions(
         moved: false,
         parsed: Vec::new(),
     };
-    let run = writer(block, run, start, habit).block(block, strokes, end);
+    let run = writer(block, run, *start, habit).block(block, strokes, *end);
     let p = run.machine.position();
     let end = if run.moved {
         [p[axis::X], p[axis::Y]]

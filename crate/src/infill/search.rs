@@ -13,7 +13,7 @@ use std::borrow::Cow;
 use super::cost::{replay, Baseline, Costs, Replacement, Replacements, Rotation};
 use super::emit::{self, Habit};
 use super::geom::{bbox, path_len, Path, P2};
-use super::program::{self, Block, Program};
+use super::program::{self, Program};
 use super::region::{self, LayerRegion};
 use super::spacing::Line;
 use super::{
@@ -401,7 +401,8 @@ impl Prepared<'_> {
             .enumerate()
             .map(|(b, slot)| {
                 let (wi, k) = slot?;
-                self.block_text(wi, plans.get(wi)?, k, b, rotation)
+                let job = self.block_job(wi, plans.get(wi)?, k, b, rotation)?;
+                Some(emit::block_text(&job))
             })
             .collect()
     }
@@ -439,74 +440,38 @@ impl Prepared<'_> {
         slots
     }
 
-    /// What block `b` is made from: the block, group `k` of work item `wi`'s plan and the
-    /// block's start and end, turned with the part, and the file's habits at the layer's flow.
-    fn block_parts(
-        &self,
+    /// What block `b` is made from: group `k` of work item `wi`'s plan (groups, one per
+    /// block, separated by empty paths), the block's start and end, all turned with the part,
+    /// and the file's habits at the layer's flow.
+    fn block_job<'s>(
+        &'s self,
         wi: usize,
         plan: &[Path],
         k: usize,
         b: usize,
         rotation: Option<&Rotation>,
-    ) -> Option<(&Block, Vec<Path>, P2, P2, Habit)> {
-        let (w, blk) = (self.work.get(wi)?, self.prog.blocks.get(b)?);
-        let (strokes, start, end) = block_strokes(blk, plan, k, rotation);
-        let habit = Habit {
-            e_per_mm: w.e_per_mm,
-            ..self.habit
-        };
-        Some((blk, strokes, start, end, habit))
+    ) -> Option<emit::Job<'s>> {
+        let (w, block) = (self.work.get(wi)?, self.prog.blocks.get(b)?);
+        let tf = |p: P2| rotation.map_or(p, |r| r.apply(p));
+        let strokes: Vec<Path> = plan
+            .split(|s| s.is_empty())
+            .nth(k)
+            .unwrap_or(&[])
+            .iter()
+            .map(|s| s.iter().map(|&p| tf(p)).collect())
+            .collect();
+        let p = block.machine.position();
+        Some(emit::Job {
+            block,
+            strokes,
+            start: tf([p[axis::X], p[axis::Y]]),
+            end: tf([block.end_physical[0], block.end_physical[1]]),
+            habit: Habit {
+                e_per_mm: w.e_per_mm,
+                ..self.habit
+            },
+        })
     }
-
-    /// Block `b`'s text: group `k` of work item `wi`'s plan, turned with the part.
-    fn block_text(
-        &self,
-        wi: usize,
-        plan: &[Path],
-        k: usize,
-        b: usize,
-        rotation: Option<&Rotation>,
-    ) -> Option<String> {
-        let (blk, strokes, start, end, habit) = self.block_parts(wi, plan, k, b, rotation)?;
-        Some(emit::block_text(blk, &strokes, start, end, &habit))
-    }
-
-    /// Block `b`'s motions: group `k` of work item `wi`'s plan, turned with the part, run on
-    /// the machine as it stood before the block (what parsing [`Prepared::block_text`] back
-    /// gives, without the text).
-    fn block_motions(
-        &self,
-        wi: usize,
-        plan: &[Path],
-        k: usize,
-        b: usize,
-        rotation: Option<&Rotation>,
-    ) -> Option<Replacement> {
-        let (blk, strokes, start, end, habit) = self.block_parts(wi, plan, k, b, rotation)?;
-        Some(emit::block_motions(blk, &strokes, start, end, &habit))
-    }
-}
-
-/// Group `k` of a plan (groups, one per block, separated by empty paths), its block's start
-/// and end, all turned with the part.
-fn block_strokes(
-    blk: &Block,
-    plan: &[Path],
-    k: usize,
-    rotation: Option<&Rotation>,
-) -> (Vec<Path>, P2, P2) {
-    let tf = |p: P2| rotation.map_or(p, |r| r.apply(p));
-    let strokes: Vec<Path> = plan
-        .split(|s| s.is_empty())
-        .nth(k)
-        .unwrap_or(&[])
-        .iter()
-        .map(|s| s.iter().map(|&p| tf(p)).collect())
-        .collect();
-    let p = blk.machine.position();
-    let start = tf([p[axis::X], p[axis::Y]]);
-    let end = tf([blk.end_physical[0], blk.end_physical[1]]);
-    (strokes, start, end)
 }
 
 /// A candidate whose blocks are made when a replay asks for them ([`Prepared::lazy`]).
@@ -525,8 +490,8 @@ impl Replacements for LazyCandidate<'_> {
     fn make(&self, b: usize) -> Option<Cow<'_, Replacement>> {
         let (wi, k) = (*self.slots.get(b)?)?;
         let plan = self.plans.get(wi)?;
-        let m = self.prep.block_motions(wi, plan, k, b, self.rotation)?;
-        Some(Cow::Owned(m))
+        let job = self.prep.block_job(wi, plan, k, b, self.rotation)?;
+        Some(Cow::Owned(emit::block_motions(&job)))
     }
 }
 
@@ -891,12 +856,10 @@ pub(crate) mod tests {
                 for (wi, w) in prep.work.iter().enumerate() {
                     let plan = prep.plan_layer(w, pattern, 15.0);
                     for (k, &b) in w.blocks.iter().enumerate() {
-                        let blk = &prep.prog.blocks[b];
-                        let text = prep.block_text(wi, &plan, k, b, rotation).expect("text");
-                        let (_, start, _) = block_strokes(blk, &plan, k, rotation);
-                        let parsed = emit::motions(blk, &text, start);
-                        let direct = prep.block_motions(wi, &plan, k, b, rotation);
-                        assert_eq!(Some(parsed), direct, "block {b}");
+                        let job = prep.block_job(wi, &plan, k, b, rotation).expect("job");
+                        let text = emit::block_text(&job);
+                        let parsed = emit::motions(job.block, &text, job.start);
+                        assert_eq!(parsed, emit::block_motions(&job), "block {b}");
                         blocks += 1;
                     }
                 }
