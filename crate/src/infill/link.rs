@@ -10,6 +10,7 @@
 
 use super::geom::{dist, Path, Region, P2};
 use super::grid::EdgeGrid;
+use super::nearest::Ends;
 
 /// Extruded strokes (polylines), in print order.
 pub(crate) fn link(
@@ -100,8 +101,9 @@ fn face(piece: &mut Path, cur: P2) {
     }
 }
 
-/// Most chains ordered by nearest neighbour (quadratic); beyond, the generator's order stays.
-const MAX_ORDERED: usize = 2000;
+/// Most chains ordered by nearest neighbour (a grid search, [`Ends`]: about linear); beyond,
+/// the generator's order stays (a hostile-input bound).
+const MAX_ORDERED: usize = 20_000;
 /// Most chains improved by 2-opt (quadratic per pass).
 const MAX_TWO_OPT: usize = 400;
 
@@ -109,27 +111,19 @@ const MAX_TWO_OPT: usize = 400;
 /// short: nearest neighbour choosing each chain's direction, then 2-opt on the chain ends
 /// (reversing a run of chains reverses each of them), as slicers order their infill paths.
 pub(crate) fn order(chains: Vec<Path>, start: P2) -> Vec<Path> {
-    let mut chains: Vec<Path> = chains.into_iter().filter(|c| c.len() >= 2).collect();
+    let chains: Vec<Path> = chains.into_iter().filter(|c| c.len() >= 2).collect();
     if chains.len() > MAX_ORDERED {
         return chains;
     }
-    let ends = |c: &Path| (c[0], c[c.len() - 1]);
+    let mut index = Ends::new(&chains);
+    let mut chains: Vec<Option<Path>> = chains.into_iter().map(Some).collect();
     let mut out: Vec<Path> = Vec::with_capacity(chains.len());
     let mut cur = start;
-    while !chains.is_empty() {
-        let mut best = (f64::INFINITY, 0, false);
-        for (i, c) in chains.iter().enumerate() {
-            let (h, t) = ends(c);
-            let (dh, dt) = (dist(cur, h), dist(cur, t));
-            if dh < best.0 {
-                best = (dh, i, false);
-            }
-            if dt < best.0 {
-                best = (dt, i, true);
-            }
-        }
-        let mut c = chains.swap_remove(best.1);
-        if best.2 {
+    while let Some((k, reversed)) = index.take_nearest(cur) {
+        let Some(mut c) = chains.get_mut(k).and_then(Option::take) else {
+            break;
+        };
+        if reversed {
             c.reverse();
         }
         cur = c[c.len() - 1];

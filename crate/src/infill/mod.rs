@@ -15,6 +15,7 @@ pub(crate) mod geom;
 pub(crate) mod grid;
 mod hybrid;
 pub(crate) mod link;
+mod nearest;
 pub mod pattern;
 pub(crate) mod program;
 pub(crate) mod region;
