@@ -54,17 +54,10 @@ typecheck: pkg
 	tsc -p www/tsconfig.worker.json
 	tsc -p tests/e2e/tsconfig.json
 
-WASM_CLIPPY := cargo clippy -p quietpath --lib --target wasm32-unknown-unknown -- -D warnings
-
 lint:
 	cargo fmt --all -- --check
 	cargo clippy --workspace --all-targets -- -D warnings
-	@# Once, on a fresh target dir after the native run, cargo's wasm32 probe of rustc (run
-	@# through clippy-driver) read diagnostics text as its source and the failure was cached in
-	@# target/.rustc_info.json (CI and a local fresh clone; never on a second run): the probe
-	@# cache is dropped and the lint run again before it counts as a failure.
-	$(WASM_CLIPPY) || { echo "lint: wasm32 clippy again with a fresh rustc probe cache"; \
-	  rm -f target/.rustc_info.json; $(WASM_CLIPPY); }
+	cargo clippy -p quietpath --lib --target wasm32-unknown-unknown -- -D warnings
 	RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 
 # Property tests draw a fixed seed here so CI is reproducible; unset PROPTEST_RNG_SEED locally
