@@ -38,7 +38,10 @@ pub fn finish_rewrite<T: serde::Serialize>(
 
 /// Writes `output` through a temporary file in the same directory and a rename, so an
 /// interrupted run never leaves a half-written file where a complete one is expected. Refuses to
-/// replace `input` unless `force`.
+/// replace `input` unless `force`. A symbolic link is followed (the file it names is
+/// replaced, the link stays), and an output that exists and is not a regular file (`/dev/null`,
+/// a named pipe, a terminal) is written in place: a rename would put a plain file where the
+/// device was, and `-o /dev/null` run as root would break every later program that reads it.
 pub fn write_atomically(
     input: &Path,
     output: &Path,
@@ -51,13 +54,33 @@ pub fn write_atomically(
             output.display()
         ));
     }
-    let dir = output
+    let fail = |e: io::Error| format!("{}: {e}", output.display());
+    match fs::metadata(output) {
+        Ok(meta) if !meta.is_file() && !meta.is_dir() => {
+            let mut w = BufWriter::with_capacity(1 << 20, fs::File::create(output).map_err(fail)?);
+            return body(&mut w).and_then(|()| w.flush()).map_err(fail);
+        }
+        _ => {}
+    }
+    let target = match fs::symlink_metadata(output) {
+        Ok(meta) if meta.file_type().is_symlink() => fs::canonicalize(output).map_err(fail)?,
+        _ => output.to_path_buf(),
+    };
+    replace_through_temporary(&target, body).map_err(fail)
+}
+
+/// Writes `body` to a temporary file beside `target`, then renames it onto `target`.
+fn replace_through_temporary(
+    target: &Path,
+    body: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> io::Result<()> {
+    let dir = target
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let name = output
+    let name = target
         .file_name()
-        .ok_or_else(|| format!("{}: not a file name", output.display()))?;
+        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "not a file name"))?;
     let tmp = dir.join(format!(
         ".{}.{}.tmp",
         name.to_string_lossy(),
@@ -69,12 +92,12 @@ pub fn write_atomically(
         body(&mut w)?;
         w.flush()?;
         w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        fs::rename(&tmp, output)
+        fs::rename(&tmp, target)
     })();
-    result.map_err(|e| {
+    if result.is_err() {
         let _ = fs::remove_file(&tmp);
-        format!("{}: {e}", output.display())
-    })
+    }
+    result
 }
 
 fn same_file(a: &Path, b: &Path) -> bool {
@@ -123,5 +146,78 @@ impl ProgressBar {
         if self.enabled {
             eprint!("\r{}\r", " ".repeat(40));
         }
+    }
+}
+
+#[cfg(all(test, unix))]
+mod tests {
+    use super::*;
+    use std::os::unix::fs::FileTypeExt;
+
+    fn scratch(name: &str) -> std::path::PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("quietpath-output-{name}-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).expect("scratch dir");
+        dir
+    }
+
+    #[test]
+    fn a_link_is_followed_and_kept() {
+        let dir = scratch("link");
+        let (real, link) = (dir.join("real.gcode"), dir.join("link.gcode"));
+        fs::write(&real, "old").expect("write");
+        std::os::unix::fs::symlink(&real, &link).expect("symlink");
+        write_atomically(&dir.join("in.gcode"), &link, false, |w| w.write_all(b"new"))
+            .expect("written");
+        assert!(fs::symlink_metadata(&link)
+            .expect("link")
+            .file_type()
+            .is_symlink());
+        assert_eq!(fs::read(&real).expect("read"), b"new");
+        assert_eq!(
+            fs::read_dir(&dir).expect("dir").count(),
+            2,
+            "no temporary left"
+        );
+        fs::remove_dir_all(&dir).expect("clean");
+    }
+
+    #[test]
+    fn a_named_pipe_is_written_not_replaced() {
+        let dir = scratch("fifo");
+        let fifo = dir.join("out.gcode");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.expect("mkfifo runs").success());
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || fs::read(fifo).expect("read the pipe"))
+        };
+        write_atomically(&dir.join("in.gcode"), &fifo, false, |w| {
+            w.write_all(b"G1 X1\n")
+        })
+        .expect("written");
+        // The type first: had the pipe been renamed over, the reader would wait for ever.
+        assert!(fs::metadata(&fifo).expect("fifo").file_type().is_fifo());
+        assert_eq!(reader.join().expect("reader"), b"G1 X1\n");
+        assert_eq!(
+            fs::read_dir(&dir).expect("dir").count(),
+            1,
+            "no temporary left"
+        );
+        fs::remove_dir_all(&dir).expect("clean");
+    }
+
+    #[test]
+    fn a_regular_file_is_replaced_whole() {
+        let dir = scratch("file");
+        let out = dir.join("out.gcode");
+        fs::write(&out, "a much longer old content").expect("write");
+        write_atomically(&dir.join("in.gcode"), &out, false, |w| w.write_all(b"new"))
+            .expect("written");
+        assert_eq!(fs::read(&out).expect("read"), b"new");
+        let refused = write_atomically(&out, &out, false, |w| w.write_all(b"x"));
+        assert!(refused.is_err_and(|e| e.contains("--force")));
+        fs::remove_dir_all(&dir).expect("clean");
     }
 }
