@@ -2,6 +2,9 @@
 //! spiral (the PrusaSlicer patterns of the thesis, Table 4). Curves are built over the region's
 //! bounding box and clipped to the region with `i_overlay`.
 
+use std::cell::RefCell;
+use std::rc::Rc;
+
 use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::OutlineStyle;
 
@@ -153,6 +156,31 @@ pub(crate) fn hilbert(region: &Region, spacing: f64) -> Vec<Path> {
     if count as usize > MAX_POINTS {
         return Vec::new();
     }
+    let path = HILBERT.with(|last| {
+        let mut last = last.borrow_mut();
+        let key = (n, x0.to_bits(), y0.to_bits(), spacing.to_bits());
+        match last.as_ref() {
+            Some((k, path)) if *k == key => path.clone(),
+            _ => {
+                let path = Rc::new(hilbert_path(n, [x0, y0], spacing));
+                *last = Some((key, path.clone()));
+                path
+            }
+        }
+    });
+    clip(std::slice::from_ref(&*path), region)
+}
+
+thread_local! {
+    /// The last Hilbert curve a thread generated, by (order, anchor, spacing): a search runs
+    /// one angle a thread over every layer, and layers with the same extent (a prism's) get
+    /// the same curve, so it is made once and clipped to each.
+    static HILBERT: RefCell<Option<((u32, u64, u64, u64), Rc<Path>)>> = const { RefCell::new(None) };
+}
+
+/// The Hilbert curve of order `n` with cells `spacing` wide from `origin`, cell centres joined.
+fn hilbert_path(n: u32, origin: P2, spacing: f64) -> Path {
+    let count = 1u64 << (2 * n);
     // Cells in a straight run are one segment: the curve is the same, and the firmware and the
     // cost replay see a third fewer points (a straight step is not a vertex to plan).
     let mut cells: Vec<(u64, u64)> = Vec::with_capacity(count as usize);
@@ -167,16 +195,15 @@ pub(crate) fn hilbert(region: &Region, spacing: f64) -> Vec<Path> {
         }
         cells.push(c);
     }
-    let path: Path = cells
+    cells
         .into_iter()
         .map(|(x, y)| {
             [
-                x0 + (x as f64 + 0.5) * spacing,
-                y0 + (y as f64 + 0.5) * spacing,
+                origin[0] + (x as f64 + 0.5) * spacing,
+                origin[1] + (y as f64 + 0.5) * spacing,
             ]
         })
-        .collect();
-    clip(&[path], region)
+        .collect()
 }
 
 /// The Sierpiński curve over the region's bounding square, anchored on the bed grid: the
