@@ -171,11 +171,14 @@ pub(crate) fn hilbert(region: &Region, spacing: f64) -> Vec<Path> {
     clip(std::slice::from_ref(&*path), region)
 }
 
+/// A generated curve's order, anchor (x, y bits) and spacing (bits).
+type CurveKey = (u32, u64, u64, u64);
+
 thread_local! {
     /// The last Hilbert curve a thread generated, by (order, anchor, spacing): a search runs
     /// one angle a thread over every layer, and layers with the same extent (a prism's) get
     /// the same curve, so it is made once and clipped to each.
-    static HILBERT: RefCell<Option<((u32, u64, u64, u64), Rc<Path>)>> = const { RefCell::new(None) };
+    static HILBERT: RefCell<Option<(CurveKey, Rc<Path>)>> = const { RefCell::new(None) };
 }
 
 /// The Hilbert curve of order `n` with cells `spacing` wide from `origin`, cell centres joined.
