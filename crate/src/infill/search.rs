@@ -535,6 +535,7 @@ pub fn infill_with_progress(
     options: &InfillOptions,
     progress: Progress<'_>,
 ) -> Result<InfillReport, Error> {
+    let _curves = pattern::curves::CurveCacheScope;
     let prep = prepare(input, options)?;
     let base_costs = replay(&prep.prog, &[] as &[Option<Replacement>], None, &prep.base);
     let (rotations, rotations_skipped) = rotations_of(&prep, options)?;

@@ -181,6 +181,17 @@ thread_local! {
     static HILBERT: RefCell<Option<(CurveKey, Rc<Path>)>> = const { RefCell::new(None) };
 }
 
+/// Drops this thread's cached curve when it goes out of scope: the search's own thread (the
+/// only one in wasm, where the worker lives on) does not keep a megabyte-sized curve after it.
+#[derive(Debug)]
+pub(crate) struct CurveCacheScope;
+
+impl Drop for CurveCacheScope {
+    fn drop(&mut self) {
+        HILBERT.with(|last| last.borrow_mut().take());
+    }
+}
+
 /// The Hilbert curve of order `n` with cells `spacing` wide from `origin`, cell centres joined.
 fn hilbert_path(n: u32, origin: P2, spacing: f64) -> Path {
     let count = 1u64 << (2 * n);
@@ -333,6 +344,24 @@ mod tests {
 
     fn square() -> Region {
         vec![vec![[0.0, 0.0], [20.0, 0.0], [20.0, 20.0], [0.0, 20.0]]]
+    }
+
+    #[test]
+    fn the_cached_curve_is_the_one_generated_and_dropped_with_its_scope() {
+        let cached = || HILBERT.with(|c| c.borrow().is_some());
+        let scope = CurveCacheScope;
+        let first = hilbert(&square(), 1.0);
+        assert!(cached());
+        // A region of the same extent with a hole (the same key, so the cached curve) is
+        // clipped afresh: shorter than the square's, and the square's comes back unchanged.
+        let mut holed = square();
+        holed.push(vec![[5.0, 5.0], [5.0, 15.0], [15.0, 15.0], [15.0, 5.0]]);
+        let again: f64 = hilbert(&holed, 1.0).iter().map(|p| path_len(p)).sum();
+        let whole: f64 = first.iter().map(|p| path_len(p)).sum();
+        assert!(again < whole && again > 0.5 * whole, "{again} of {whole}");
+        assert_eq!(hilbert(&square(), 1.0), first);
+        drop(scope);
+        assert!(!cached());
     }
 
     /// A 60 mm square with a bore drawn as a 360-gon, as slicers tessellate holes.
