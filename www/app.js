@@ -729,7 +729,7 @@ function resultLine(job, r) {
     case 'infill': {
       const b = r.best ?? {};
       if (b.pattern === 'original') return `No candidate beats your file: it is kept as it was (${r.candidates?.length ?? '—'} candidates). ${b.message ?? ''}`;
-      return `Best: ${b.pattern ?? '—'} at ${n(b.angle_deg, 1)}°${isNum(b.rotation_deg) ? ` (rotation ${n(b.rotation_deg, 1)}°)` : ''} of ${Array.isArray(r.candidates) ? r.candidates.length : '—'} candidates; energy ${pct(r.after?.energy?.total_j, r.before?.energy?.total_j)}.`;
+      return `Best: ${b.pattern ?? '—'} at ${n(b.angle_deg, 1)}°${isNum(b.rotation_deg) ? ` (rotation ${n(b.rotation_deg, 1)}°)` : ''} of ${Array.isArray(r.candidates) ? r.candidates.length : '—'} candidates${r.candidates_estimated ? ` (${r.candidates_estimated} ruled out as clearly worse on a sample of layers)` : ''}; energy ${pct(r.after?.energy?.total_j, r.before?.energy?.total_j)}.`;
     }
     case 'optimize':
       return (r.stages ?? []).map((s) => `${s.stage}: ${s.applied ? '' : 'not applied, '}${s.message}.`).join(' ');

@@ -125,7 +125,7 @@ export function infill(input, _options = {}) {
       for (const rotation_deg of [0, 90]) {
         const total_j = 5000 + 10 * Math.sin(angle_deg / 30) + (pattern === 'grid' ? 50 : 0) + rotation_deg;
         candidates.push({
-          pattern, angle_deg, rotation_deg, thesis_j: 1000 + angle_deg, total_j, time_s: 60, length_mm: 1000, filament_mm: 300,
+          pattern, estimated: false, angle_deg, rotation_deg, thesis_j: 1000 + angle_deg, total_j, time_s: 60, length_mm: 1000, filament_mm: 300,
           infill_length_mm: 400, infill_turning_points: 80, infill_mean_turn_deg: 120,
         });
       }
@@ -140,6 +140,7 @@ export function infill(input, _options = {}) {
     },
     candidates,
     candidates_skipped: 0,
+    candidates_estimated: 0,
     measured: { spacing_mm: 2, clearance_mm: 0.2, e_per_mm: 0.03, layers_regenerated: 40, blocks: 1, print_feed_mm_s: 60, travel_feed_mm_s: 150, retract_mm: 0.8 },
     rotations_skipped: [],
     output,

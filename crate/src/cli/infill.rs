@@ -43,9 +43,14 @@ pub struct Args {
     /// Rectilinear-equivalent line spacing, mm (default: measured from the file).
     #[arg(long)]
     pub spacing: Option<f64>,
-    /// Write every candidate of every file to this CSV (the DOE table).
+    /// Write every candidate of every file to this CSV (the DOE table; every candidate costed
+    /// on the whole file, as with --exhaustive).
     #[arg(long)]
     pub csv: Option<PathBuf>,
+    /// Cost every candidate on the whole file (by default a candidate whose estimate from every
+    /// 4th layer is over 2 % worse than the best so far is listed with that estimate).
+    #[arg(long)]
+    pub exhaustive: bool,
     /// Allow the output to replace the input file.
     #[arg(long)]
     pub force: bool,
@@ -134,6 +139,7 @@ fn options(args: &Args) -> Result<InfillOptions, String> {
         spacing_mm: args.spacing,
         force_candidate: args.force_candidate,
         estimates: !args.no_estimates,
+        exhaustive: args.exhaustive || args.csv.is_some(),
     })
 }
 
@@ -187,31 +193,39 @@ fn print(
         "  saving {:.1} J ({:.2} %)",
         r.best.saving_j, r.best.saving_pct
     )?;
-    let mut sorted: Vec<_> = r.candidates.iter().collect();
-    sorted.sort_by(|x, y| x.total_j.total_cmp(&y.total_j));
-    writeln!(
-        out,
-        "  {} candidates ({} with the geometry of an earlier one, not costed again) in {secs:.2} s; cheapest:",
-        r.candidates.len(),
-        r.candidates_skipped
-    )?;
-    for c in sorted.iter().take(8) {
-        writeln!(
-            out,
-            "    {:<20} {:>6.1}° {:>6.1}°  thesis {:>9.1} J  total {:>10.1} J  {:>8.1} s",
-            c.pattern.name(),
-            c.angle_deg,
-            c.rotation_deg,
-            c.thesis_j,
-            c.total_j,
-            c.time_s
-        )?;
-    }
+    print_candidates(out, r, secs)?;
     if !r.rotations_skipped.is_empty() {
         writeln!(
             out,
             "  rotations skipped (off the bed): {:?}",
             r.rotations_skipped
+        )?;
+    }
+    Ok(())
+}
+
+/// The candidates' count and the cheapest eight.
+fn print_candidates(out: &mut impl Write, r: &InfillReport, secs: f64) -> std::io::Result<()> {
+    let mut sorted: Vec<_> = r.candidates.iter().collect();
+    sorted.sort_by(|x, y| x.total_j.total_cmp(&y.total_j));
+    writeln!(
+        out,
+        "  {} candidates ({} with the geometry of an earlier one, not costed again; {} ruled out on a sample of layers, estimated) in {secs:.2} s; cheapest:",
+        r.candidates.len(),
+        r.candidates_skipped,
+        r.candidates_estimated
+    )?;
+    for c in sorted.iter().take(8) {
+        writeln!(
+            out,
+            "    {:<20} {:>6.1}° {:>6.1}°  thesis {:>9.1} J  total {:>10.1} J  {:>8.1} s{}",
+            c.pattern.name(),
+            c.angle_deg,
+            c.rotation_deg,
+            c.thesis_j,
+            c.total_j,
+            c.time_s,
+            if c.estimated { "  (estimated)" } else { "" }
         )?;
     }
     Ok(())

@@ -18,6 +18,7 @@ pub(crate) mod link;
 mod nearest;
 pub mod pattern;
 pub(crate) mod program;
+mod racing;
 pub(crate) mod region;
 mod rounds;
 mod search;
@@ -98,6 +99,10 @@ pub struct InfillOptions {
     /// Rewrite the file's time comments and `M73` lines from the planner when a candidate is
     /// written (default true; see [`crate::estimate`]).
     pub estimates: bool,
+    /// Cost every candidate on the whole file (default false: a candidate whose estimate from
+    /// a sample of layers is clearly worse than the best so far is listed with that estimate,
+    /// `estimated: true`, and not costed whole; the DOE table sets it).
+    pub exhaustive: bool,
 }
 
 impl Default for InfillOptions {
@@ -113,6 +118,7 @@ impl Default for InfillOptions {
             spacing_mm: None,
             force_candidate: false,
             estimates: true,
+            exhaustive: false,
         }
     }
 }
@@ -162,6 +168,9 @@ impl InfillOptions {
 pub struct Candidate {
     /// Pattern.
     pub pattern: Pattern,
+    /// Whether the costs are an estimate from a sample of layers (a candidate ruled out as
+    /// clearly worse than the best; never chosen) rather than the whole file's.
+    pub estimated: bool,
     /// Infill angle, degrees (machine frame).
     pub angle_deg: f64,
     /// Part rotation about Z, degrees.
@@ -291,6 +300,8 @@ pub struct InfillReport {
     /// Candidates not costed because their geometry is the same as an earlier one's (a
     /// concentric pattern at another angle, a rotation that gives the same strokes).
     pub candidates_skipped: usize,
+    /// Candidates ruled out on a sample of layers (listed with `estimated: true`).
+    pub candidates_estimated: usize,
     /// What was measured from the file.
     pub measured: Measured,
     /// Rotations skipped (the part would not fit on the bed), degrees.

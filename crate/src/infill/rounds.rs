@@ -6,13 +6,16 @@
 //! symmetric pattern — is costed once per rotation and counted as skipped), the new (geometry,
 //! rotation) pairs are replayed one a thread, and the strokes are dropped. Memory holds one
 //! round's strokes, not a pattern's; the candidates, their order and the best are those a
-//! sequential run gives, bit for bit.
+//! sequential run gives, bit for bit. Before a round is costed whole, its keys may be ruled out
+//! on a sample of layers ([`racing`]), judged against the best of the earlier patterns so that
+//! the outcome does not depend on how many keys a round holds.
 
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 
-use super::cost::{replay, Costs, Rotation};
+use super::cost::{replay, Costs, Replacement, Rotation};
 use super::geom::Path;
+use super::racing::{self, Probe};
 use super::search::{score, Prepared};
 use super::{Candidate, InfillOptions, Pattern};
 use crate::error::{Error, ErrorKind};
@@ -25,6 +28,8 @@ pub(crate) struct Searched {
     pub best: Option<(f64, usize)>,
     /// Candidates whose geometry repeated an earlier one's: listed with its costs, not replayed.
     pub skipped: usize,
+    /// Candidates ruled out on a sample of layers: listed with their estimated costs.
+    pub estimated: usize,
 }
 
 /// Key of a part-frame angle (millidegrees in [0, 360)); every angle of concentric loops,
@@ -61,6 +66,8 @@ struct Geometries {
     by_key: HashMap<i64, usize>,
     fingerprints: Vec<u64>,
     costed: HashMap<(usize, usize), Costs>,
+    /// Estimated costs of the (key, rotation index) pairs ruled out on a sample of layers.
+    estimated: HashMap<(i64, usize), Costs>,
 }
 
 impl Geometries {
@@ -135,27 +142,18 @@ pub(crate) fn search(
         candidates: Vec::with_capacity(total),
         best: None,
         skipped: 0,
+        estimated: 0,
     };
+    let mut race = Race::new(prep, options, rotations, base_costs);
+    let judge = |c: &Costs| score(options.objective, &options.weights, c, base_costs);
     let mut done = 0usize;
     for &pattern in &options.patterns {
-        // (angle, rotation index, key) in the order candidates are listed.
-        let slots: Vec<(f64, usize, i64)> = options
-            .angles_deg
-            .iter()
-            .flat_map(|&a| {
-                rotations
-                    .iter()
-                    .enumerate()
-                    .map(move |(ri, r)| (a, ri, angle_key(pattern, a - r.0)))
-            })
-            .collect();
-        let mut keys: Vec<(i64, f64)> = Vec::new();
-        for &(a, ri, key) in &slots {
-            if !keys.iter().any(|k| k.0 == key) {
-                keys.push((key, a - rotations[ri].0));
-            }
-        }
+        let (slots, keys) = slots_and_keys(options, pattern, rotations);
         let mut geometries = Geometries::default();
+        // Sampling stops for the pattern at its first key that survives it: a pattern that
+        // competes with the best would pay for every sample on top of its whole-file costs.
+        let mut sampling = true;
+        race.start_pattern();
         for round in keys.chunks(per_round) {
             if !progress(done as f64 / total as f64) {
                 return Err(Error::new(0, 0, ErrorKind::Cancelled));
@@ -165,7 +163,15 @@ pub(crate) fn search(
                 .filter(|s| round.iter().any(|k| k.0 == s.2))
                 .map(|s| (s.2, s.1))
                 .collect();
-            geometries.round(prep, pattern, round, &wanted, rotations);
+            let whole = if sampling {
+                race.sample(&mut geometries, pattern, round, &wanted, &judge)
+            } else {
+                round.to_vec()
+            };
+            // A survivor and every key after it are costed whole.
+            sampling &= whole.is_empty();
+            geometries.round(prep, pattern, &whole, &wanted, rotations);
+            race.saw(&geometries, &wanted, &judge);
             done += wanted.len();
         }
         list(
@@ -181,6 +187,149 @@ pub(crate) fn search(
     Ok(out)
 }
 
+/// A pattern's slots, (angle, rotation index, key) in the order candidates are listed, and its
+/// distinct keys with their part-frame angles.
+#[allow(clippy::type_complexity)]
+fn slots_and_keys(
+    options: &InfillOptions,
+    pattern: Pattern,
+    rotations: &[(f64, Option<Rotation>)],
+) -> (Vec<(f64, usize, i64)>, Vec<(i64, f64)>) {
+    let slots: Vec<(f64, usize, i64)> = options
+        .angles_deg
+        .iter()
+        .flat_map(|&a| {
+            rotations
+                .iter()
+                .enumerate()
+                .map(move |(ri, r)| (a, ri, angle_key(pattern, a - r.0)))
+        })
+        .collect();
+    let mut keys: Vec<(i64, f64)> = Vec::new();
+    for &(a, ri, key) in &slots {
+        if !keys.iter().any(|k| k.0 == key) {
+            keys.push((key, a - rotations[ri].0));
+        }
+    }
+    (slots, keys)
+}
+
+/// What ruling candidates out needs: the sample, the original's costs at each rotation, and
+/// the best exact score so far.
+struct Race<'a> {
+    prep: &'a Prepared<'a>,
+    rotations: &'a [(f64, Option<Rotation>)],
+    probe: Option<Probe>,
+    bases: Vec<Costs>,
+    best_exact: Option<f64>,
+    /// The best exact score when the current pattern started.
+    threshold: Option<f64>,
+}
+
+impl<'a> Race<'a> {
+    fn new(
+        prep: &'a Prepared<'a>,
+        options: &InfillOptions,
+        rotations: &'a [(f64, Option<Rotation>)],
+        base_costs: &Costs,
+    ) -> Self {
+        let probe = if options.exhaustive {
+            None
+        } else {
+            Probe::of(prep)
+        };
+        let bases = match probe {
+            Some(_) => crate::parallel::map_each(rotations, |(_, r)| match r {
+                None => *base_costs,
+                Some(r) => replay(
+                    &prep.prog,
+                    &[] as &[Option<Replacement>],
+                    Some(r),
+                    &prep.base,
+                ),
+            }),
+            None => Vec::new(),
+        };
+        Self {
+            prep,
+            rotations,
+            probe,
+            bases,
+            best_exact: None,
+            threshold: None,
+        }
+    }
+
+    /// Estimates the round's keys on the probe's sample of layers and files in `g` those whose
+    /// every wanted rotation is ruled out against the best exact score ([`racing`]); the keys
+    /// left to cost whole (all of them before anything is exact, or without a sample).
+    fn sample(
+        &self,
+        g: &mut Geometries,
+        pattern: Pattern,
+        keys: &[(i64, f64)],
+        wanted: &[(i64, usize)],
+        judge: &dyn Fn(&Costs) -> f64,
+    ) -> Vec<(i64, f64)> {
+        let (Some(probe), Some(_)) = (&self.probe, self.threshold) else {
+            return keys.to_vec();
+        };
+        // One sample per (key, rotation): every angle of concentric loops shares a key.
+        let mut pairs: Vec<(i64, f64, usize)> = Vec::new();
+        for &(key, beta) in keys {
+            for &(k, ri) in wanted {
+                if k == key && !pairs.iter().any(|p| (p.0, p.2) == (key, ri)) {
+                    pairs.push((key, beta, ri));
+                }
+            }
+        }
+        let estimates = crate::parallel::map_each(&pairs, |&(_, beta, ri)| {
+            let rotation = self.rotations.get(ri).and_then(|r| r.1.as_ref());
+            let base = self.bases.get(ri).copied().unwrap_or_default();
+            probe.estimate(self.prep, pattern, beta, rotation, &base)
+        });
+        // In key order up to the first survivor, whatever the round's size: the same
+        // candidates are ruled out on one thread (wasm) as on many.
+        let mut left = Vec::new();
+        for &(key, beta) in keys {
+            let mine: Vec<(usize, &Costs)> = pairs
+                .iter()
+                .zip(&estimates)
+                .filter(|(p, _)| p.0 == key)
+                .map(|(p, c)| (p.2, c))
+                .collect();
+            let out = |c: &&Costs| racing::ruled_out(judge(c), self.threshold);
+            if left.is_empty() && !mine.is_empty() && mine.iter().all(|(_, c)| out(c)) {
+                for (ri, c) in mine {
+                    g.estimated.insert((key, ri), *c);
+                }
+            } else {
+                left.push((key, beta));
+            }
+        }
+        left
+    }
+
+    /// Starts a pattern: its candidates are judged against the best exact score of the
+    /// patterns before it (not of its own earlier rounds, whose size depends on the threads).
+    fn start_pattern(&mut self) {
+        self.threshold = self.best_exact;
+    }
+
+    /// Takes the round's exact costs into the best score so far.
+    fn saw(&mut self, g: &Geometries, wanted: &[(i64, usize)], judge: &dyn Fn(&Costs) -> f64) {
+        for &(key, ri) in wanted {
+            let exact = g.by_key.get(&key).and_then(|&gi| g.costed.get(&(gi, ri)));
+            if let Some(c) = exact {
+                let s = judge(c);
+                if self.best_exact.is_none_or(|b| s < b) {
+                    self.best_exact = Some(s);
+                }
+            }
+        }
+    }
+}
+
 /// Appends a pattern's candidates in slot order, counting repeats and keeping the best.
 fn list(
     out: &mut Searched,
@@ -193,6 +342,13 @@ fn list(
 ) {
     let mut seen: Vec<(usize, usize)> = Vec::new();
     for &(angle, ri, key) in slots {
+        let rotation_deg = rotations[ri].0;
+        if let Some(c) = geometries.estimated.get(&(key, ri)) {
+            out.estimated += 1;
+            out.candidates
+                .push(candidate_of(pattern, angle, rotation_deg, c, true));
+            continue;
+        }
         let Some(&g) = geometries.by_key.get(&key) else {
             continue;
         };
@@ -209,12 +365,19 @@ fn list(
             out.best = Some((s, out.candidates.len()));
         }
         out.candidates
-            .push(candidate_of(pattern, angle, rotations[ri].0, c));
+            .push(candidate_of(pattern, angle, rotation_deg, c, false));
     }
 }
 
-fn candidate_of(pattern: Pattern, angle_deg: f64, rotation_deg: f64, c: &Costs) -> Candidate {
+fn candidate_of(
+    pattern: Pattern,
+    angle_deg: f64,
+    rotation_deg: f64,
+    c: &Costs,
+    estimated: bool,
+) -> Candidate {
     Candidate {
+        estimated,
         pattern,
         angle_deg,
         rotation_deg,

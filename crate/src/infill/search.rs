@@ -587,6 +587,7 @@ pub fn infill_with_progress(
         best,
         candidates: searched.candidates,
         candidates_skipped: searched.skipped,
+        candidates_estimated: searched.estimated,
         measured,
         rotations_skipped,
         output,

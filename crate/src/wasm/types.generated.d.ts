@@ -1085,6 +1085,11 @@ export type InfillCandidate = {
    */
   pattern: InfillPattern,
   /**
+   * Whether the costs are an estimate from a sample of layers (a candidate ruled out as
+   * clearly worse than the best; never chosen) rather than the whole file's.
+   */
+  estimated: boolean,
+  /**
    * Infill angle, degrees (machine frame).
    */
   angle_deg: number,
@@ -1235,6 +1240,12 @@ export type InfillOptions = Partial<{
    * written (default true; see [`crate::estimate`]).
    */
   estimates: boolean,
+  /**
+   * Cost every candidate on the whole file (default false: a candidate whose estimate from
+   * a sample of layers is clearly worse than the best so far is listed with that estimate,
+   * `estimated: true`, and not costed whole; the DOE table sets it).
+   */
+  exhaustive: boolean,
 }>;
 
 /**
@@ -1267,6 +1278,10 @@ export type InfillReport = {
    * concentric pattern at another angle, a rotation that gives the same strokes).
    */
   candidates_skipped: number,
+  /**
+   * Candidates ruled out on a sample of layers (listed with `estimated: true`).
+   */
+  candidates_estimated: number,
   /**
    * What was measured from the file.
    */
