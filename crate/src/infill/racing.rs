@@ -4,13 +4,13 @@
 //! 70 % infill a Hilbert curve doubles the print time and the octagram adds 6 % of energy,
 //! while the best rectilinear angles lie within 1.6 % of each other. Yet a Hilbert candidate
 //! is the costliest to cost (a vertex every cell: 25 times the original file's moves), and was
-//! half of the whole search. So once a candidate has been costed exactly, each new (pattern,
-//! angle) is first generated and replayed on every [`PROBE_EVERY`]-th layer only (the other
-//! layers keep their original infill); its change against the original, scaled up by the
-//! layers' share of the original infill length, estimates the whole. A candidate whose
-//! estimate scores more than [`MARGIN`] worse than the best exact candidate so far is listed
-//! with the estimate (`estimated: true`) and not costed whole; every other is costed whole,
-//! and only exact candidates can be chosen. `InfillOptions::exhaustive` (the CLI's `--csv` DOE
+//! half of the whole search. So after the first pattern, each pattern's angles are first
+//! generated and replayed on every [`PROBE_EVERY`]-th layer only (the other layers keep their
+//! original infill); the change against the original, scaled up by the layers' share of the
+//! original infill length, estimates the whole. A candidate whose estimate scores more than
+//! [`MARGIN`] worse than the best exact candidate of the earlier patterns is listed with the
+//! estimate (`estimated: true`) and not costed whole; a pattern's first angle that survives,
+//! and every angle after it, are costed whole, and only exact candidates can be chosen. `InfillOptions::exhaustive` (the CLI's `--csv` DOE
 //! table and `--exhaustive`) costs every candidate whole.
 
 use super::cost::{replay, Costs, Rotation};
@@ -26,8 +26,8 @@ const MIN_PROBE_LAYERS: usize = 3;
 /// Least share of the original infill length the sample must hold.
 const MIN_PROBE_SHARE: f64 = 0.15;
 /// How much worse than the best exact score an estimate must be to rule its candidate out:
-/// a sample's estimate of a change is good to a fraction of that change, and the candidates it
-/// rules out on real parts are 3 % to 100 % worse.
+/// a sample's estimate of a change is good to a fraction of that change (measured: within a
+/// quarter), and the candidates it rules out on the parts measured are 4 % to 140 % worse.
 pub(crate) const MARGIN: f64 = 0.02;
 
 /// The sampled layers of a search, and how their change scales to the whole.
