@@ -63,10 +63,23 @@ pub fn write_atomically(
         _ => {}
     }
     let target = match fs::symlink_metadata(output) {
-        Ok(meta) if meta.file_type().is_symlink() => fs::canonicalize(output).map_err(fail)?,
+        Ok(meta) if meta.file_type().is_symlink() => link_target(output).map_err(fail)?,
         _ => output.to_path_buf(),
     };
     replace_through_temporary(&target, body).map_err(fail)
+}
+
+/// The file a symbolic link names, whether or not it exists yet (a relative target is taken
+/// from the link's own directory).
+fn link_target(link: &Path) -> io::Result<std::path::PathBuf> {
+    if let Ok(path) = fs::canonicalize(link) {
+        return Ok(path);
+    }
+    let to = fs::read_link(link)?;
+    Ok(match link.parent() {
+        Some(dir) if to.is_relative() => dir.join(to),
+        _ => to,
+    })
 }
 
 /// Writes `body` to a temporary file beside `target`, then renames it onto `target`.
@@ -180,6 +193,21 @@ mod tests {
             2,
             "no temporary left"
         );
+        fs::remove_dir_all(&dir).expect("clean");
+    }
+
+    #[test]
+    fn a_dangling_link_gets_its_file() {
+        let dir = scratch("dangling");
+        let link = dir.join("link.gcode");
+        std::os::unix::fs::symlink("new.gcode", &link).expect("symlink");
+        write_atomically(&dir.join("in.gcode"), &link, false, |w| w.write_all(b"new"))
+            .expect("written");
+        assert!(fs::symlink_metadata(&link)
+            .expect("link")
+            .file_type()
+            .is_symlink());
+        assert_eq!(fs::read(dir.join("new.gcode")).expect("read"), b"new");
         fs::remove_dir_all(&dir).expect("clean");
     }
 
