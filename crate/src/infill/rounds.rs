@@ -233,7 +233,9 @@ impl<'a> Race<'a> {
         rotations: &'a [(f64, Option<Rotation>)],
         base_costs: &Costs,
     ) -> Self {
-        let probe = if options.exhaustive {
+        // One pattern is never sampled (nothing exact comes before it): no sample, and no
+        // replays of the original at every rotation for one.
+        let probe = if options.exhaustive || options.patterns.len() < 2 {
             None
         } else {
             Probe::of(prep)
