@@ -49,19 +49,25 @@ for t in "${targets[@]}"; do
     mkdir -p "fuzz/corpus/$t" "fuzz/artifacts/$t"
     corpus="fuzz/corpus/$t"
     mode=(-max_total_time="$secs")
+    build=()
     if [ -n "${FUZZ_SEED:-}" ]; then
         corpus=$(mktemp -d)
         runs=$(( ${per_second[$t]:-100} * secs ))
         # The time cap only guards a much slower machine; it then runs a prefix of the same
         # sequence.
         mode=(-seed="$FUZZ_SEED" -runs="$runs" -max_total_time=$(( 4 * secs )))
+        # No AddressSanitizer in the seeded smoke run: quietpath forbids unsafe code, so what
+        # it looks for (panics, timeouts, runaway memory) needs none, and the inputs run about
+        # five times faster (all eight targets: 26 s against 127 s). The exploring run
+        # (`make fuzz`) keeps it, for the dependencies' unsafe code.
+        build=(--sanitizer none)
         echo "== fuzz $t: $runs inputs, seed $FUZZ_SEED"
     else
         echo "== fuzz $t for ${secs}s"
     fi
     # -timeout: one input taking longer than 10 s is a bug (quadratic paths on hostile input).
     # -rss_limit_mb: the parser streams; 2 GB means a leak or an unbounded structure.
-    if ! cargo +nightly fuzz run "$t" "$corpus" "fuzz/seeds/$t" -- \
+    if ! cargo +nightly fuzz run "${build[@]}" "$t" "$corpus" "fuzz/seeds/$t" -- \
         "${mode[@]}" -timeout=10 -rss_limit_mb=2048 -dict=fuzz/gcode.dict \
         -print_final_stats=1; then
         echo "!! fuzz target $t failed; reproducer in crate/fuzz/artifacts/$t/" >&2
