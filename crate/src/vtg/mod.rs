@@ -243,12 +243,18 @@ pub fn vtg_with_progress(
         ))
     };
     let first = search::Variant::default();
-    let mut report = attempt(first, before, &mut |f| progress(0.3 + 0.4 * f))?;
+    // The original's simulated deviation does not depend on the rewrite: where there are
+    // threads, it runs beside the first one (on a long print it takes as long).
+    let (original_deviation, report) = crate::parallel::join(
+        || options.dynamics.then(|| printing_deviation(input, options)),
+        || attempt(first, before, &mut |f| progress(0.3 + 0.4 * f)),
+    );
+    let mut report = report?;
     if !progress(0.7) {
         return Err(cancelled());
     }
-    if options.dynamics {
-        report = with_simulated_deviation(input, report, options, &mut |variant, before, f| {
+    if let Some(original) = original_deviation {
+        report = with_simulated_deviation(original, report, options, &mut |variant, before, f| {
             attempt(variant, before, &mut |g| progress(f + 0.05 * g))
         })?;
     }
@@ -294,8 +300,9 @@ fn with_estimates(
     Ok(report)
 }
 
-/// Fills Table 2's deviation rows with the dynamics model, run on the original and on the
-/// rewritten file over printing moves (travels are not rewritten), and closes the loop on it.
+/// Fills Table 2's deviation rows with the dynamics model, run on the rewritten file over
+/// printing moves (travels are not rewritten) and compared with `original`, the original's
+/// (`None`: the model could not run on it), and closes the loop on it.
 ///
 /// VTG eq. 29's speeds (`J_n = A_n f₁`) are meant to keep a rounded corner from exciting the frame
 /// more than the sharp one did, and on nearly every file they do. They are a rule of thumb, though:
@@ -314,21 +321,13 @@ fn with_estimates(
 /// `None` rows when the model cannot run (a print too long to simulate, for instance): the
 /// rest of the report stands without them.
 fn with_simulated_deviation(
-    input: &[u8],
+    original: Option<crate::dynamics::Deviation>,
     first: VtgReport,
     options: &VtgOptions,
     again: &mut dyn FnMut(search::Variant, Report, f64) -> Result<VtgReport, Error>,
 ) -> Result<VtgReport, Error> {
-    let vibration = crate::dynamics::VibrationOptions {
-        analyze: options.analyze.clone(),
-        ..Default::default()
-    };
-    let mean = |bytes: &[u8]| {
-        crate::dynamics::vibration(bytes, &vibration)
-            .ok()
-            .map(|r| r.printing_deviation_mm)
-    };
-    let Some(b) = mean(input) else {
+    let mean = |bytes: &[u8]| printing_deviation(bytes, options);
+    let Some(b) = original else {
         return Ok(first);
     };
     let rows = |a: crate::dynamics::Deviation| report::DeviationComparison {
@@ -362,6 +361,18 @@ fn with_simulated_deviation(
         }
     }
     Ok(best)
+}
+
+/// The dynamics model's deviation over a file's printing moves, `None` when the model cannot
+/// run on it (a print too long to simulate, for instance).
+fn printing_deviation(bytes: &[u8], options: &VtgOptions) -> Option<crate::dynamics::Deviation> {
+    let vibration = crate::dynamics::VibrationOptions {
+        analyze: options.analyze.clone(),
+        ..Default::default()
+    };
+    crate::dynamics::vibration(bytes, &vibration)
+        .ok()
+        .map(|r| r.printing_deviation_mm)
 }
 
 /// How a rewrite's simulated deviation `a` compares with the original's `b`, lower is
