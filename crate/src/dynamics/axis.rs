@@ -12,6 +12,7 @@ use nalgebra::{DMatrix, SVector};
 use super::integrate::discretize;
 use super::lumped::{dof, Coefficients, Mat6, Matrices, Vec6};
 use super::modal::{self, state_matrix, Mode};
+use super::modal_step::ModalStepper;
 use super::parameters::Drive;
 
 /// Simulation state of one axis.
@@ -22,18 +23,27 @@ pub const TABLE: usize = dof::X4;
 pub const TABLE_VELOCITY: usize = 6 + dof::X4;
 
 /// `Φ` and `Γ` of one bucket, as plain column-major arrays (the product below unrolls and
-/// vectorises; it is the simulation's inner loop).
+/// vectorises), and their modal form where it exists (the step the simulation takes).
 #[derive(Debug, Clone)]
 pub struct Stepper {
     phi: [[f64; 12]; 12],
     gamma: [[f64; 12]; 2],
+    modal: Option<ModalStepper>,
 }
 
 impl Stepper {
     /// One period: `x ← Φ x + Γ [v, a]` (commanded velocity at the start, m/s, and
-    /// acceleration over the period, m/s²).
+    /// acceleration over the period, m/s²), with the dense `Φ`.
     #[inline]
     pub fn step(&self, x: &State, v: f64, a: f64) -> State {
+        let mut y: [f64; 12] = (*x).into();
+        self.dense_step(&mut y, v, a);
+        flush_to_zero(&mut y);
+        State::from(y)
+    }
+
+    #[inline]
+    fn dense_step(&self, x: &mut [f64; 12], v: f64, a: f64) {
         let mut y = [0.0f64; 12];
         for (r, yr) in y.iter_mut().enumerate() {
             *yr = self.gamma[0][r] * v + self.gamma[1][r] * a;
@@ -43,15 +53,24 @@ impl Stepper {
                 *yr += p * xc;
             }
         }
-        // A decaying state would otherwise sink into subnormal numbers, which x86 handles a
-        // hundred times slower (a crawl at a vanishing feed rate took minutes); 1e-200 m is
-        // zero for any machine.
-        for yr in &mut y {
-            if yr.abs() < FLUSH_TO_ZERO {
-                *yr = 0.0;
-            }
+        *x = y;
+    }
+
+    /// Whether the bucket steps in modal coordinates.
+    pub fn is_modal(&self) -> bool {
+        self.modal.is_some()
+    }
+}
+
+/// A decaying state would otherwise sink into subnormal numbers, which x86 handles a hundred
+/// times slower (a crawl at a vanishing feed rate took minutes); 1e-200 m is zero for any
+/// machine.
+#[inline]
+fn flush_to_zero(x: &mut [f64; 12]) {
+    for v in x {
+        if v.abs() < FLUSH_TO_ZERO {
+            *v = 0.0;
         }
-        State::from(y)
     }
 }
 
@@ -108,26 +127,38 @@ pub fn stepper(drive: &Drive, position_m: f64, ts: f64) -> Option<Stepper> {
     Some(Stepper {
         phi: core::array::from_fn(|c| core::array::from_fn(|r| d.phi[(r, c)])),
         gamma: core::array::from_fn(|c| core::array::from_fn(|r| d.gamma[(r, c)])),
+        modal: ModalStepper::new(&a, &d.phi, &d.gamma, [TABLE, TABLE_VELOCITY]),
     })
 }
 
-/// State components smaller than this are set to zero after each step (see [`Stepper::step`]).
+/// State components smaller than this are set to zero every few steps (subnormal numbers
+/// would slow the simulation a hundredfold).
 pub const FLUSH_TO_ZERO: f64 = 1e-200;
+/// Steps between two flushes of the state to zero.
+const FLUSH_EVERY: u32 = 16;
 
-/// An axis with its steppers cached per bucket of nut positions.
+/// An axis with its steppers cached per bucket of nut positions, and its state.
 #[derive(Debug)]
 pub struct Axis {
     drive: Drive,
     ts: f64,
     bucket_m: f64,
+    /// `1 / bucket_m`: a product per step instead of a division.
+    per_bucket: f64,
     cache: Vec<Option<Box<Stepper>>>,
+    /// Steps since the state was last flushed to zero ([`flush_to_zero`]).
+    unflushed: u32,
+    /// The bucket whose coordinates `z` is in.
+    current: usize,
+    /// The state: modal coordinates of bucket `current` if it has a modal form, else physical.
+    z: [f64; 12],
 }
 
 impl Axis {
     /// Most buckets per axis.
     pub const MAX_BUCKETS: usize = 4096;
 
-    /// An axis simulated every `ts` seconds, with the stiffness held constant over
+    /// An axis at rest, simulated every `ts` seconds, with the stiffness held constant over
     /// `bucket_m` of travel.
     pub fn new(drive: Drive, ts: f64, bucket_m: f64) -> Self {
         let travel = drive.travel_m();
@@ -137,26 +168,92 @@ impl Axis {
             drive,
             ts,
             bucket_m,
+            per_bucket: 1.0 / bucket_m,
             cache: vec![None; count],
+            unflushed: 0,
+            current: usize::MAX,
+            z: [0.0; 12],
         }
     }
 
-    /// The stepper for the axis at `position_m` (computed on first use), `None` if the model
-    /// cannot be discretised.
-    #[inline]
-    pub fn at(&mut self, position_m: f64) -> Option<&Stepper> {
+    fn bucket(&self, position_m: f64) -> usize {
         let last = self.cache.len() - 1;
-        let idx = if position_m > 0.0 {
-            ((position_m / self.bucket_m) as usize).min(last)
+        if position_m > 0.0 {
+            ((position_m * self.per_bucket) as usize).min(last)
         } else {
             0
-        };
+        }
+    }
+
+    /// The stepper of bucket `idx` (computed on first use), `None` if the model cannot be
+    /// discretised there.
+    fn stepper(&mut self, idx: usize) -> Option<&Stepper> {
         let slot = self.cache.get_mut(idx)?;
         if slot.is_none() {
             let centre = (idx as f64 + 0.5) * self.bucket_m;
             *slot = Some(Box::new(stepper(&self.drive, centre, self.ts)?));
         }
         slot.as_deref()
+    }
+
+    /// The stepper for the axis at `position_m`, `None` if the model cannot be discretised.
+    pub fn at(&mut self, position_m: f64) -> Option<&Stepper> {
+        let idx = self.bucket(position_m);
+        self.stepper(idx)
+    }
+
+    /// One period with the nut at `position_m`: commanded velocity `v` (m/s) at its start and
+    /// acceleration `a` (m/s²) over it. `None` if the model cannot be discretised there.
+    #[inline]
+    pub fn step(&mut self, position_m: f64, v: f64, a: f64) -> Option<()> {
+        let idx = self.bucket(position_m);
+        if idx != self.current {
+            let x = self.state();
+            let modal = self.stepper(idx)?.modal.as_ref();
+            self.z = modal.map_or(x.into(), |m| m.to_modal(&x.into()));
+            self.current = idx;
+        }
+        let st = self.cache.get(idx)?.as_deref()?;
+        match &st.modal {
+            Some(m) => m.step(&mut self.z, v, a),
+            None => st.dense_step(&mut self.z, v, a),
+        }
+        // Every few steps is enough: a state sinks past 1e-200 only slowly, and only a
+        // component that stays subnormal costs time.
+        self.unflushed += 1;
+        if self.unflushed >= FLUSH_EVERY {
+            flush_to_zero(&mut self.z);
+            self.unflushed = 0;
+        }
+        Some(())
+    }
+
+    fn modal(&self) -> Option<&ModalStepper> {
+        self.cache.get(self.current)?.as_deref()?.modal.as_ref()
+    }
+
+    /// The physical state `[q̃, q̃̇]`.
+    pub fn state(&self) -> State {
+        State::from(self.modal().map_or(self.z, |m| m.to_physical(&self.z)))
+    }
+
+    /// The table's deviation from the commanded position, m.
+    #[inline]
+    pub fn table(&self) -> f64 {
+        self.modal()
+            .map_or(self.z[TABLE], |m| m.physical_row(&self.z, 0))
+    }
+
+    /// The table's deviation velocity, m/s.
+    #[inline]
+    pub fn table_velocity(&self) -> f64 {
+        self.modal()
+            .map_or(self.z[TABLE_VELOCITY], |m| m.physical_row(&self.z, 1))
+    }
+
+    /// Brings the axis to rest.
+    pub fn rest(&mut self) {
+        self.z = [0.0; 12];
     }
 }
 
@@ -182,6 +279,39 @@ mod tests {
         for m in lm.iter().chain(&dm) {
             // The screws' (motor mount's and idler's) antisymmetric mode has no damper: ζ = 0.
             assert!(m.damping_ratio >= 0.0 && m.damping_ratio < 1.0, "{m:?}");
+        }
+    }
+
+    #[test]
+    fn modal_steps_follow_the_dense_step_across_buckets() {
+        // Back and forth over several 5 mm buckets with acceleration steps: the modal state
+        // (rebased at every bucket change) stays on the dense step's to rounding.
+        for name in ["ldam-ball-screw", "desktop-belt"] {
+            let machine = MachineDynamics::preset(name).unwrap();
+            let ts = 1e-3;
+            let mut modal = Axis::new(machine.y, ts, 0.005);
+            let mut dense = Axis::new(machine.y, ts, 0.005);
+            let (mut pos, mut v, mut x) = (0.3 * machine.y.travel_m(), 0.0, State::zeros());
+            let (mut largest, mut worst, mut scale) = (0.0f64, 0.0f64, 0.0f64);
+            for k in 0..60_000 {
+                let a = [2.0, 0.0, -2.0, -2.0, 0.0, 2.0][(k / 150) % 6];
+                assert!(modal.at(pos).unwrap().is_modal(), "{name} at {pos}");
+                x = dense.at(pos).unwrap().step(&x, v, a);
+                modal.step(pos, v, a).unwrap();
+                largest = largest.max(x[TABLE].abs());
+                worst = worst.max((modal.table() - x[TABLE]).abs());
+                scale = scale.max(x.amax());
+                let diff = (modal.state() - x).amax();
+                assert!(
+                    diff <= 1e-8 * scale,
+                    "{name} step {k}: {diff} against {scale}"
+                );
+                pos += v * ts + 0.5 * a * ts * ts;
+                v += a * ts;
+            }
+            assert!(largest > 1e-7, "{name}: the table moved {largest} m");
+            assert!(worst <= 1e-8 * largest, "{name}: {worst} against {largest}");
+            eprintln!("{name}: table {largest:e} m, modal against dense {worst:e} m");
         }
     }
 

@@ -23,6 +23,7 @@ pub mod compare;
 pub mod integrate;
 pub mod lumped;
 pub mod modal;
+pub mod modal_step;
 pub mod parameters;
 pub mod simulate;
 pub mod trajectory;

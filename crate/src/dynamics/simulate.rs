@@ -1,7 +1,7 @@
 //! Runs both axes over the sampled trajectory: trajectory deviation (VTG eq. 15), per-layer
 //! statistics and the table's acceleration signal.
 
-use super::axis::{Axis, State, TABLE, TABLE_VELOCITY};
+use super::axis::{Axis, State};
 use super::parameters::MachineDynamics;
 use super::trajectory::{Command, Segment};
 use super::welch::Welch;
@@ -190,18 +190,12 @@ impl Outcome {
 
 /// One step of both axes from the command `prev` to `next`.
 #[inline]
-fn step_axes(
-    axes: &mut [Axis; 2],
-    x: &mut [State; 2],
-    prev: &Command,
-    next: &Command,
-    ts: f64,
-) -> Result<(), Error> {
-    for ax in 0..2 {
+fn step_axes(axes: &mut [Axis; 2], prev: &Command, next: &Command, ts: f64) -> Result<(), Error> {
+    for (ax, axis) in axes.iter_mut().enumerate() {
         let v0 = prev.vel[ax] * 1e-3;
         let a = (next.vel[ax] - prev.vel[ax]) * 1e-3 / ts;
-        let st = axes[ax].at(prev.pos[ax] * 1e-3).ok_or_else(model_error)?;
-        x[ax] = st.step(&x[ax], v0, a);
+        axis.step(prev.pos[ax] * 1e-3, v0, a)
+            .ok_or_else(model_error)?;
     }
     Ok(())
 }
@@ -209,10 +203,15 @@ fn step_axes(
 /// The table's mean acceleration (X, Y, m/s²) over the `dt` since its velocity was `last_v`,
 /// which becomes its velocity now.
 #[inline]
-fn table_acceleration(next: &Command, x: &[State; 2], last_v: &mut [f64; 2], dt: f64) -> [f64; 2] {
+fn table_acceleration(
+    next: &Command,
+    axes: &[Axis; 2],
+    last_v: &mut [f64; 2],
+    dt: f64,
+) -> [f64; 2] {
     let mut acc = [0.0; 2];
-    for ax in 0..2 {
-        let v = next.vel[ax] * 1e-3 + x[ax][TABLE_VELOCITY];
+    for (ax, axis) in axes.iter().enumerate() {
+        let v = next.vel[ax] * 1e-3 + axis.table_velocity();
         acc[ax] = (v - last_v[ax]) / dt;
         last_v[ax] = v;
     }
@@ -275,7 +274,6 @@ pub fn run(
         Axis::new(machine.x, ts, settings.bucket_m),
         Axis::new(machine.y, ts, settings.bucket_m),
     ];
-    let mut x = [State::zeros(); 2];
     let mut out = Outcome::new(layers);
     let mut cursor = Cursor { segs, j: 0 };
     let (mut prev, _) = cursor.at(0.0);
@@ -287,31 +285,31 @@ pub fn run(
     while k < total {
         let t1 = (k + 1) as f64 * ts;
         let (next, seg) = cursor.at(t1);
-        step_axes(&mut axes, &mut x, &prev, &next, ts)?;
+        step_axes(&mut axes, &prev, &next, ts)?;
         k += 1;
         out.steps += 1;
         let layer = seg.and_then(|i| segs.get(i)).map_or(NO_LAYER, |s| s.layer);
         if seg.is_some() {
-            let (dx, dy) = (x[0][TABLE], x[1][TABLE]);
+            let (dx, dy) = (axes[0].table(), axes[1].table());
             let dev = (dx * dx + dy * dy).sqrt() * 1e3;
             let extruding = seg.and_then(|i| segs.get(i)).is_some_and(|s| s.extruding);
             out.add_deviation(dev, [next.pos[0], next.pos[1], t1], extruding, layer);
         }
         since += 1;
         if since >= settings.decimation {
-            let acc = table_acceleration(&next, &x, &mut last_v, since as f64 * ts);
+            let acc = table_acceleration(&next, &axes, &mut last_v, since as f64 * ts);
             welch.push(&acc);
             out.add_acceleration(&acc, layer);
             since = 0;
         }
         let mut jumped = false;
-        if seg.is_none() && x.iter().all(still) {
+        if seg.is_none() && axes.iter().all(|a| still(&a.state())) {
             // At rest and still: jump to the next move (nothing changes meanwhile).
             if let Some(s) = segs.get(cursor.j) {
                 let resume = ((s.start_s / ts).floor() as u64).saturating_sub(1);
                 if resume > k {
                     k = resume;
-                    x = [State::zeros(); 2];
+                    axes.iter_mut().for_each(Axis::rest);
                     last_v = [0.0; 2];
                     since = 0;
                     jumped = true;
