@@ -8,7 +8,7 @@ export PATH := $(CURDIR)/node_modules/.bin:$(HOME)/.cargo/bin:$(PATH)
 CORPUS ?= $(CURDIR)/../shared/corpus
 LARGE := $(CORPUS)/curaengine-4.13.0_extruder-idler-x2.5_large.gcode
 
-.PHONY: all setup setup-test pkg serve test typecheck test-rust test-wasm test-js test-fuzz lint cli bench measurements measure-vtg-w16 fuzz clean
+.PHONY: all setup setup-test pkg wasm-web wasm-node wasm-bundler serve test typecheck test-rust test-wasm test-js test-fuzz lint cli bench measurements measure-vtg-w16 fuzz clean
 
 all: pkg cli
 
@@ -22,9 +22,7 @@ setup-test:
 ## web build into the playground and copy uPlot and three.js (the 3-D view) beside it, each with
 ## its TypeScript declarations for `make typecheck` (a .d.ts beside the .js is what tsc reads).
 pkg: setup
-	wasm-pack build crate --release --target web --out-dir ../pkg/web --out-name quietpath
-	wasm-pack build crate --release --target nodejs --out-dir ../pkg/node --out-name quietpath
-	wasm-pack build crate --release --target bundler --out-dir ../pkg/bundler --out-name quietpath
+	$(MAKE) --no-print-directory --output-sync=target -j3 wasm-web wasm-node wasm-bundler
 	node scripts/package.mjs
 	ln -sfn ../pkg/web www/pkg
 	mkdir -p www/vendor
@@ -32,6 +30,16 @@ pkg: setup
 	cp node_modules/three/build/three.module.js node_modules/three/build/three.core.js www/vendor/
 	cp node_modules/uplot/dist/uPlot.d.ts www/vendor/uPlot.esm.d.ts
 	cp www/types/three.module.d.ts www/vendor/
+
+# The three wasm-pack builds of `pkg`, run side by side: they share one compile (cargo's lock
+# holds the later two until it is done), then each runs wasm-bindgen and wasm-opt, whose -O3
+# pass (npm binaryen, one thread, about 45 s) was most of their time one after another.
+wasm-web:
+	wasm-pack build crate --release --target web --out-dir ../pkg/web --out-name quietpath
+wasm-node:
+	wasm-pack build crate --release --target nodejs --out-dir ../pkg/node --out-name quietpath
+wasm-bundler:
+	wasm-pack build crate --release --target bundler --out-dir ../pkg/bundler --out-name quietpath
 
 ## Build the wasm and serve the playground on http://127.0.0.1:$(PORT)
 serve: pkg
