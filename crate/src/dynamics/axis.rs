@@ -12,7 +12,7 @@ use nalgebra::{DMatrix, SVector};
 use super::integrate::discretize;
 use super::lumped::{dof, Coefficients, Mat6, Matrices, Vec6};
 use super::modal::{self, state_matrix, Mode};
-use super::modal_step::ModalStepper;
+use super::modal_step::{product, ModalStepper};
 use super::parameters::Drive;
 
 /// Simulation state of one axis.
@@ -44,14 +44,9 @@ impl Stepper {
 
     #[inline]
     fn dense_step(&self, x: &mut [f64; 12], v: f64, a: f64) {
-        let mut y = [0.0f64; 12];
+        let mut y = product(&self.phi, x);
         for (r, yr) in y.iter_mut().enumerate() {
-            *yr = self.gamma[0][r] * v + self.gamma[1][r] * a;
-        }
-        for (col, &xc) in self.phi.iter().zip(x.iter()) {
-            for (yr, p) in y.iter_mut().zip(col) {
-                *yr += p * xc;
-            }
+            *yr += self.gamma[0][r] * v + self.gamma[1][r] * a;
         }
         *x = y;
     }

@@ -118,8 +118,8 @@ impl ModalStepper {
     }
 }
 
-/// `m x` for a column-major `m`.
-fn product(m: &[[f64; N]; N], x: &[f64; N]) -> [f64; N] {
+/// `m x` for a column-major `m` (the dense step's product too; it unrolls and vectorises).
+pub(super) fn product(m: &[[f64; N]; N], x: &[f64; N]) -> [f64; N] {
     let mut y = [0.0; N];
     for (col, &xc) in m.iter().zip(x) {
         for (yr, p) in y.iter_mut().zip(col) {
