@@ -175,18 +175,23 @@ mod tests {
         dir
     }
 
+    /// Writes `new` through `link` and checks the link is still a link.
+    fn write_through(dir: &std::path::Path, link: &std::path::Path) {
+        write_atomically(&dir.join("in.gcode"), link, false, |w| w.write_all(b"new"))
+            .expect("written");
+        assert!(fs::symlink_metadata(link)
+            .expect("link")
+            .file_type()
+            .is_symlink());
+    }
+
     #[test]
     fn a_link_is_followed_and_kept() {
         let dir = scratch("link");
         let (real, link) = (dir.join("real.gcode"), dir.join("link.gcode"));
         fs::write(&real, "old").expect("write");
         std::os::unix::fs::symlink(&real, &link).expect("symlink");
-        write_atomically(&dir.join("in.gcode"), &link, false, |w| w.write_all(b"new"))
-            .expect("written");
-        assert!(fs::symlink_metadata(&link)
-            .expect("link")
-            .file_type()
-            .is_symlink());
+        write_through(&dir, &link);
         assert_eq!(fs::read(&real).expect("read"), b"new");
         assert_eq!(
             fs::read_dir(&dir).expect("dir").count(),
@@ -201,12 +206,7 @@ mod tests {
         let dir = scratch("dangling");
         let link = dir.join("link.gcode");
         std::os::unix::fs::symlink("new.gcode", &link).expect("symlink");
-        write_atomically(&dir.join("in.gcode"), &link, false, |w| w.write_all(b"new"))
-            .expect("written");
-        assert!(fs::symlink_metadata(&link)
-            .expect("link")
-            .file_type()
-            .is_symlink());
+        write_through(&dir, &link);
         assert_eq!(fs::read(dir.join("new.gcode")).expect("read"), b"new");
         fs::remove_dir_all(&dir).expect("clean");
     }
