@@ -244,19 +244,15 @@ pub fn vtg_with_progress(
     let first = search::Variant::default();
     // The original's simulated deviation does not depend on the rewrite: where there are
     // threads, it runs beside the first one (on a long print it takes as long).
-    let (original, report) = crate::parallel::join(
-        || {
-            options
-                .dynamics
-                .then(|| original_deviation(input, &path, options))
-        },
+    let (original_deviation, report) = crate::parallel::join(
+        || options.dynamics.then(|| printing_deviation(input, options)),
         || attempt(first, before, &mut |f| progress(0.3 + 0.4 * f)),
     );
     let mut report = report?;
     if !progress(0.7) {
         return Err(cancelled());
     }
-    if let Some(original) = original {
+    if let Some(original) = original_deviation {
         report = with_simulated_deviation(original, report, options, &mut |variant, before, f| {
             attempt(variant, before, &mut |g| progress(f + 0.05 * g))
         })?;
@@ -329,7 +325,7 @@ fn with_simulated_deviation(
     options: &VtgOptions,
     again: &mut dyn FnMut(search::Variant, Report, f64) -> Result<VtgReport, Error>,
 ) -> Result<VtgReport, Error> {
-    let mean = |bytes: &[u8]| printing_deviation(bytes, None, options);
+    let mean = |bytes: &[u8]| printing_deviation(bytes, options);
     let Some(b) = original else {
         return Ok(first);
     };
@@ -367,32 +363,15 @@ fn with_simulated_deviation(
 }
 
 /// The dynamics model's deviation over a file's printing moves, `None` when the model cannot
-/// run on it (a print too long to simulate, for instance). `planned`: the file's path, already
-/// extracted and planned with the same options, which then is not read again.
-fn printing_deviation(
-    bytes: &[u8],
-    planned: Option<&crate::path::PrintPath>,
-    options: &VtgOptions,
-) -> Option<crate::dynamics::Deviation> {
+/// run on it (a print too long to simulate, for instance).
+fn printing_deviation(bytes: &[u8], options: &VtgOptions) -> Option<crate::dynamics::Deviation> {
     let vibration = crate::dynamics::VibrationOptions {
         analyze: options.analyze.clone(),
         ..Default::default()
     };
-    let report = match planned {
-        Some(path) => crate::dynamics::vibration_of_path(path, &vibration, &mut |_| true),
-        None => crate::dynamics::vibration(bytes, &vibration),
-    };
-    report.ok().map(|r| r.printing_deviation_mm)
-}
-
-/// [`printing_deviation`] of the original, from its path when that was planned (it is, when
-/// feeds are limited) rather than read again.
-fn original_deviation(
-    input: &[u8],
-    path: &crate::path::PrintPath,
-    options: &VtgOptions,
-) -> Option<crate::dynamics::Deviation> {
-    printing_deviation(input, options.limit_feed.then_some(path), options)
+    crate::dynamics::vibration(bytes, &vibration)
+        .ok()
+        .map(|r| r.printing_deviation_mm)
 }
 
 /// How a rewrite's simulated deviation `a` compares with the original's `b`, lower is
