@@ -373,17 +373,28 @@ pub fn vibration(data: &[u8]) {
 /// or a typed error. (The dynamics rows are skipped: `vibration` is checked on its own.)
 pub fn vtg(data: &[u8]) {
     use quietpath::vtg::{vtg as run, VtgOptions};
-    let options = VtgOptions {
-        dynamics: false,
-        ..VtgOptions::default()
-    };
-    if let Ok(r) = run(data, &options) {
+    // Lines allowed, so every corner the tolerance allows is rewritten; then the defaults,
+    // which must add no line.
+    for allow_more_lines_pct in [1000.0, 0.0] {
+        let options = VtgOptions {
+            dynamics: false,
+            allow_more_lines_pct,
+            ..VtgOptions::default()
+        };
+        let Ok(r) = run(data, &options) else { continue };
         check_rewritten(data, &r.output, "vtg");
         assert!(
             r.max_deviation_mm.is_finite() && r.max_deviation_mm <= r.tolerance_mm * 1.01 + 1e-9,
             "vtg: deviation {} over tolerance {}",
             r.max_deviation_mm,
             r.tolerance_mm
+        );
+        let lines = |b: &[u8]| b.split(|&c| c == b'\n').count();
+        assert!(
+            allow_more_lines_pct > 0.0 || lines(&r.output) <= lines(data),
+            "vtg: {} lines from {}",
+            lines(&r.output),
+            lines(data)
         );
     }
 }

@@ -80,12 +80,13 @@ fn two_hundred_thousand_layers() {
     let r = quietpath::analyze(&data, &Default::default()).unwrap();
     assert_eq!(r.layers, 200_000);
     run_all("200 000 layers", &data, &EVERY_JOB);
-    // Work in every layer: VTG rounds 8 000 corners.
+    // Work in every layer: VTG rounds 8 000 corners (with the lines they take allowed).
     let squares = square_layers(2_000);
     let v = quietpath::vtg::vtg(
         &squares,
         &quietpath::vtg::VtgOptions {
             dynamics: false,
+            allow_more_lines_pct: 1000.0,
             ..Default::default()
         },
     )

@@ -163,12 +163,15 @@ fn in_place_as_prusaslicer_runs_it() {
         "the first line identifies the slicer"
     );
     assert!(assert_estimates_true(&after) > 100);
-    // The benchy gets no slower and no dearer, and loses most of its sharp corners.
+    // The benchy gets no slower, no dearer and no more lines but the estimates' two header
+    // comments, and loses sharp corners: as many as VTG's line budget pays for (see its
+    // method; with more lines allowed it loses most of them).
     let a = quietpath::analyze(after.as_bytes(), &AnalyzeOptions::default()).unwrap();
     let b = quietpath::analyze(before.as_bytes(), &AnalyzeOptions::default()).unwrap();
     assert!(a.time_s <= b.time_s && a.energy.total_j <= b.energy.total_j);
+    assert!(after.lines().count() <= before.lines().count() + 2);
     let sharp = a.toolpath.n_turning as f64 / b.toolpath.n_turning as f64 - 1.0;
-    assert!(sharp <= -0.6, "sharp corners {:+.1} %", 100.0 * sharp);
+    assert!(sharp <= -0.05, "sharp corners {:+.1} %", 100.0 * sharp);
 }
 
 /// SuperSlicer runs post-processing scripts as PrusaSlicer does; its file drives Klipper and

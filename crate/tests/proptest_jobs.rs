@@ -134,7 +134,11 @@ proptest! {
 
         let vtg = quietpath::vtg::vtg(
             data,
-            &quietpath::vtg::VtgOptions { dynamics: false, ..Default::default() },
+            &quietpath::vtg::VtgOptions {
+                dynamics: false,
+                allow_more_lines_pct: 1000.0,
+                ..Default::default()
+            },
         );
         let vtg = vtg.map_err(|e| TestCaseError::fail(format!("vtg: {e}\n{text}")))?;
         // Each rewritten path writes its E words to 5 decimals from a running total (relative)

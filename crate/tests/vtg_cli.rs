@@ -1,24 +1,41 @@
 //! `quietpath vtg` from outside: output file, JSON report, refusal to overwrite the input.
 #![cfg(not(target_arch = "wasm32"))]
 
-use std::path::Path;
-use std::process::Command;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The thesis square, and a scratch directory named after `tag` for its output.
+fn square(tag: &str) -> (PathBuf, PathBuf) {
+    let input = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures/gcode/prusaslicer-2.5.0_thesis_square.gcode");
+    let dir = std::env::temp_dir().join(format!("quietpath-vtg-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    (input, dir)
+}
+
+/// `quietpath vtg INPUT -o OUT ARGS…`.
+fn vtg(input: &Path, out: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_quietpath"))
+        .arg("vtg")
+        .arg(input)
+        .arg("-o")
+        .arg(out)
+        .args(args)
+        .output()
+        .expect("run quietpath")
+}
 
 #[test]
 fn vtg_writes_the_file_and_reports_json() {
-    let input = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/fixtures/gcode/prusaslicer-2.5.0_thesis_square.gcode");
-    let dir = std::env::temp_dir().join(format!("quietpath-vtg-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
+    let (input, dir) = square("cli");
     let out_path = dir.join("square.vtg.gcode");
-    let out = Command::new(env!("CARGO_BIN_EXE_quietpath"))
-        .arg("vtg")
-        .arg(&input)
-        .arg("-o")
-        .arg(&out_path)
-        .args(["--tolerance", "0.1", "--critical-angle", "30", "--json"])
-        .output()
-        .expect("run quietpath");
+    // Rounding the square's corners adds lines: allowed here (the default is tested below).
+    let args = ["--tolerance", "0.1", "--critical-angle", "30", "--json"];
+    let out = vtg(
+        &input,
+        &out_path,
+        &[&args[..], &["--allow-more-lines", "1000"]].concat(),
+    );
     assert!(
         out.status.success(),
         "{}",
@@ -55,14 +72,17 @@ fn vtg_writes_the_file_and_reports_json() {
         .expect("steps_joined");
     // --no-dynamics skips the simulation (and the closed loop): the same file, deviation rows
     // null.
-    let fast = Command::new(env!("CARGO_BIN_EXE_quietpath"))
-        .arg("vtg")
-        .arg(&input)
-        .arg("-o")
-        .arg(&out_path)
-        .args(["--no-dynamics", "--force", "--json"])
-        .output()
-        .expect("run quietpath");
+    let fast = vtg(
+        &input,
+        &out_path,
+        &[
+            "--no-dynamics",
+            "--force",
+            "--json",
+            "--allow-more-lines",
+            "1000",
+        ],
+    );
     assert!(fast.status.success());
     let fast: serde_json::Value = serde_json::from_slice(&fast.stdout).expect("json");
     assert!(fast["table2"]["deviation"].is_null());
@@ -83,13 +103,33 @@ fn vtg_writes_the_file_and_reports_json() {
     }
 
     // Refuses to overwrite its input without --force.
-    let again = Command::new(env!("CARGO_BIN_EXE_quietpath"))
-        .arg("vtg")
-        .arg(&input)
-        .arg("-o")
-        .arg(&input)
-        .output()
-        .expect("run quietpath");
+    let again = vtg(&input, &input, &[]);
     assert!(!again.status.success());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// By default the file gains no lines: the square's corners would each take several, so they
+/// stay sharp, and the table says why and what to pass to round them.
+#[test]
+fn vtg_adds_no_lines_by_default_and_says_so() {
+    let (input, dir) = square("lines");
+    let out_path = dir.join("square.vtg.gcode");
+    let out = vtg(&input, &out_path, &["--no-dynamics"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines = |b: &[u8]| b.iter().filter(|&&c| c == b'\n').count();
+    let (before, after) = (
+        std::fs::read(&input).expect("input"),
+        std::fs::read(&out_path).expect("output"),
+    );
+    assert!(lines(&after) <= lines(&before));
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains("kept sharp for lines") && table.contains("--allow-more-lines"),
+        "{table}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -100,6 +100,27 @@ enum Cmd {
     },
 }
 
+/// Arcs in a rewritten file (`--arcs`), as [`quietpath::vtg::ArcsMode`].
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum ArcsArg {
+    /// Where the firmware runs them.
+    Auto,
+    /// Always.
+    On,
+    /// Never.
+    Off,
+}
+
+impl From<ArcsArg> for quietpath::vtg::ArcsMode {
+    fn from(a: ArcsArg) -> Self {
+        match a {
+            ArcsArg::Auto => Self::Auto,
+            ArcsArg::On => Self::On,
+            ArcsArg::Off => Self::Off,
+        }
+    }
+}
+
 #[derive(Debug, clap::Args)]
 struct AnalyzeArgs {
     /// Stop at the first malformed line instead of warning.

@@ -11,9 +11,9 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-use quietpath::optimize::{optimize_with_progress, ArcsMode, OptimizeOptions, OptimizeReport};
+use quietpath::optimize::{optimize_with_progress, OptimizeOptions, OptimizeReport};
 
-use super::{output, read, AnalyzeArgs};
+use super::{output, read, AnalyzeArgs, ArcsArg};
 
 /// Arguments of `quietpath optimize`.
 #[derive(Debug, clap::Args)]
@@ -62,13 +62,6 @@ pub struct Args {
     opts: AnalyzeArgs,
 }
 
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum ArcsArg {
-    Auto,
-    On,
-    Off,
-}
-
 /// The options: the config file's, then the flags.
 fn options(args: &Args) -> Result<OptimizeOptions, String> {
     let mut o = match &args.config {
@@ -100,11 +93,7 @@ fn options(args: &Args) -> Result<OptimizeOptions, String> {
         o.vtg_options.dynamics = false;
     }
     if let Some(a) = args.arcs {
-        o.arcs = match a {
-            ArcsArg::Auto => ArcsMode::Auto,
-            ArcsArg::On => ArcsMode::On,
-            ArcsArg::Off => ArcsMode::Off,
-        };
+        o.arcs = a.into();
     }
     Ok(o)
 }

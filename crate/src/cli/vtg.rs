@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use quietpath::vtg::{vtg_with_progress, Comparison, VtgOptions, VtgReport};
 
-use super::{output, read, AnalyzeArgs};
+use super::{output, read, AnalyzeArgs, ArcsArg};
 
 /// Arguments of `quietpath vtg`.
 #[derive(Debug, clap::Args)]
@@ -28,16 +28,24 @@ pub struct Args {
     /// rewrite with faster fillet speeds it asks for when the first one rings more).
     #[arg(long)]
     pub no_dynamics: bool,
-    /// Write runs of new points that lie on a circle as arcs (G2/G3): fewer lines. Needs a
-    /// firmware with arcs enabled (Marlin's ARC_SUPPORT, Klipper's [gcode_arcs]).
-    #[arg(long)]
-    pub arcs: bool,
+    /// Write runs of new points that lie on a circle as arcs (G2/G3): fewer lines. auto:
+    /// where the firmware runs them (the file has arcs already; Marlin, RepRapFirmware and
+    /// Smoothieware flavours; Klipper only with [gcode_arcs] in --klipper-config). `--arcs`
+    /// alone is `on`.
+    #[arg(long, value_enum, value_name = "WHEN", num_args = 0..=1, default_value = "auto", default_missing_value = "on")]
+    pub arcs: ArcsArg,
     /// Print time the rewrite may add to round corners that cost time, percent of the
     /// original's. Only Klipper machines with a high square-corner velocity spend it: they take
     /// sharp corners faster than rounded ones. 0: the print gets no slower and uses no more
     /// energy; 100 rounds every corner the tolerance allows.
     #[arg(long, value_name = "PCT", default_value_t = quietpath::vtg::DEFAULT_ALLOW_SLOWER_PCT)]
     pub allow_slower: f64,
+    /// Lines the rewritten file may have over the original's, percent. Each rounded corner
+    /// takes several lines where the original had one; a printer fed over USB or from SD reads
+    /// only so many a second. 0 (the default): never more lines than the original, the paths
+    /// that do not fit kept as they were.
+    #[arg(long, value_name = "PCT", default_value_t = 0.0)]
+    pub allow_more_lines: f64,
     /// Round corners only on the inside (fillets tangent to the legs) instead of on the racing
     /// line, which eases out by up to the tolerance before a corner for a wider circle.
     #[arg(long)]
@@ -69,8 +77,9 @@ pub fn run(args: Args) -> Result<(), String> {
         critical_angle_deg: args.critical_angle,
         limit_feed: !args.keep_feed,
         dynamics: !args.no_dynamics,
-        arcs: args.arcs,
+        arcs: args.arcs.into(),
         allow_slower_pct: args.allow_slower,
+        allow_more_lines_pct: args.allow_more_lines,
         inside_corners: args.inside_corners,
         estimates: !args.no_estimates,
         min_segment_time_ms: args.min_segment_time,
@@ -97,12 +106,23 @@ fn print(out: &mut impl Write, r: &VtgReport) -> std::io::Result<()> {
         "tolerance {} mm, measured max deviation {:.4} mm, critical angle {}°, K_cr {:.4} /mm",
         r.tolerance_mm, r.max_deviation_mm, r.critical_angle_deg, r.k_cr_per_mm
     )?;
+    if let Some(m) = &r.message {
+        writeln!(out, "{m}")?;
+    }
     let p = &r.paths;
     writeln!(
         out,
         "paths with sharp corners {}, rewritten {}; moves {} -> {}; feed lowered on {} segments",
         p.candidates, p.rewritten, p.replaced_moves, p.written_moves, p.lowered_feed_segments
     )?;
+    if p.kept_for_lines > 0 || p.compacted > 0 {
+        writeln!(
+            out,
+            "line budget: {} paths kept sharp for lines, {} written with arcs to save lines \
+             (--allow-more-lines)",
+            p.kept_for_lines, p.compacted
+        )?;
+    }
     writeln!(
         out,
         "{:<28} {:>14} {:>14} {:>9}",

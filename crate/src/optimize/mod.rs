@@ -7,7 +7,6 @@
 //! The time comments and `M73` lines are then rewritten from the planner's clock
 //! ([`crate::estimate`]), so printers show the time of the toolpath they run.
 
-mod arcs;
 mod stages;
 
 use serde::{Deserialize, Serialize};
@@ -17,8 +16,8 @@ use crate::error::Error;
 use crate::estimate::EstimateReport;
 use crate::infill::InfillOptions;
 use crate::progress::Progress;
+pub use crate::vtg::ArcsMode;
 use crate::vtg::VtgOptions;
-pub use arcs::ArcsMode;
 use stages::Stage;
 
 /// Options of [`optimize`]. Every field is optional in JSON.
@@ -119,10 +118,9 @@ pub fn optimize_with_progress(
     if options.vtg {
         let (a, b) = span.next().copied().unwrap_or((0.0, 1.0));
         let mut p = |f: f64| progress(a + (b - a) * f);
-        let arcs = options.arcs.resolve(input, &before, &options.analyze);
         let vtg = VtgOptions {
             analyze: options.analyze.clone(),
-            arcs,
+            arcs: options.arcs.resolved(input, &before, &options.analyze),
             allow_slower_pct: options.allow_slower_pct,
             // The pipeline writes the estimates once, at its end.
             estimates: false,

@@ -113,7 +113,11 @@ impl Stage {
             pct(turns(&r.after) as f64, turns(&self.report) as f64),
             r.max_deviation_mm,
             r.tolerance_mm,
-            if o.arcs { ", arcs written" } else { "" }
+            if r.paths.arcs_written > 0 {
+                ", arcs written"
+            } else {
+                ""
+            }
         );
         Ok(self.offer("vtg", r.output, r.after, done))
     }

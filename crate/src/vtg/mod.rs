@@ -26,6 +26,7 @@
 //! against the original independently ([`deviation`]) and compared with [`metrics`] (Table 1,
 //! VTG eq. 24–26 and 31) and the analysis (Table 2).
 
+mod arc_support;
 mod block;
 mod corners;
 pub mod deviation;
@@ -46,6 +47,7 @@ use serde::{Deserialize, Serialize};
 use crate::analyze::{AnalyzeOptions, Report};
 use crate::error::{Error, ErrorKind};
 use crate::progress::Progress;
+pub use arc_support::ArcsMode;
 pub use report::{
     Comparison, DeviationComparison, LayerMetrics, PathCounts, Table1, Table2, VtgReport,
 };
@@ -85,10 +87,11 @@ pub struct VtgOptions {
     /// original (default true; it costs about as much as the rewrite itself, more when it
     /// rewrites again). See `with_simulated_deviation`.
     pub dynamics: bool,
-    /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`) to cut the
-    /// line count (default false: the firmware must have arcs enabled, Marlin's `ARC_SUPPORT`
-    /// or Klipper's `[gcode_arcs]`).
-    pub arcs: bool,
+    /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`) to cut the line
+    /// count: `auto` (default) where the firmware runs them ([`ArcsMode::Auto`]: a file that
+    /// already has arcs, Marlin, RepRapFirmware and Smoothieware flavours, Klipper only with
+    /// `[gcode_arcs]` in the printer config given), `on` or `off`.
+    pub arcs: ArcsMode,
     /// Print time the rewrite may add to round corners that cost time, percent of the
     /// original's (default [`DEFAULT_ALLOW_SLOWER_PCT`], the issue's bar). On a machine whose
     /// firmware takes sharp corners faster than any fillet within the tolerance (Klipper with a
@@ -114,6 +117,13 @@ pub struct VtgOptions {
     /// `v · t_min` wherever the tolerance allows, so the firmware's buffer stays full; 0 joins
     /// as far as the tolerance and the turn allow.
     pub min_segment_time_ms: Option<f64>,
+    /// Lines the rewritten file may have over the original's, percent (default 0: never more
+    /// lines). Each rounded corner is walked in several steps where the original had one
+    /// vertex; a firmware fed over a serial link or from an SD card reads only so many lines a
+    /// second, and Marlin slows segments when its planner buffer runs low (see [`firmware`]).
+    /// The rewrites that save lines pay for those that add them, the corners that cost the
+    /// fewest lines first; the paths that do not fit are kept as they were (`kept_for_lines`).
+    pub allow_more_lines_pct: f64,
 }
 
 /// The print time the rewrite may add by default, percent: the issue's bar. More rounds more
@@ -132,11 +142,12 @@ impl Default for VtgOptions {
             nozzle_diameter_mm: 0.4,
             limit_feed: true,
             dynamics: true,
-            arcs: false,
+            arcs: ArcsMode::Auto,
             allow_slower_pct: DEFAULT_ALLOW_SLOWER_PCT,
             inside_corners: false,
             estimates: true,
             min_segment_time_ms: None,
+            allow_more_lines_pct: 0.0,
         }
     }
 }
@@ -172,6 +183,9 @@ impl VtgOptions {
         {
             return bad("min_segment_time_ms must be a number in [0, 1000]");
         }
+        if !(0.0..=1000.0).contains(&self.allow_more_lines_pct) {
+            return bad("allow_more_lines_pct must be a number in [0, 1000]");
+        }
         Ok(())
     }
 }
@@ -203,13 +217,69 @@ pub fn vtg_with_progress(
     if !progress(0.3) {
         return Err(cancelled());
     }
-    let limits = rewrite::limits_for(&path, options);
-    // One rewrite tried as `variant`, analysed and reported.
-    let attempt = |variant: search::Variant, before: Report, progress: Progress<'_>| {
+    // Arcs where the firmware runs them, decided once for every variant tried.
+    let options = &VtgOptions {
+        arcs: options.arcs.resolved(input, &before, &options.analyze),
+        ..options.clone()
+    };
+    let run = Run {
+        input,
+        path: &path,
+        sources: &sources,
+        options,
+        limits: rewrite::limits_for(&path, options),
+    };
+    let attempt = |variant, before, progress: Progress<'_>| run.attempt(variant, before, progress);
+    let first = search::Variant::default();
+    // The original's simulated deviation does not depend on the rewrite: where there are
+    // threads, it runs beside the first one (on a long print it takes as long).
+    let (original_deviation, report) = crate::parallel::join(
+        || options.dynamics.then(|| printing_deviation(input, options)),
+        || attempt(first, before, &mut |f| progress(0.3 + 0.4 * f)),
+    );
+    let mut report = report?;
+    if !progress(0.7) {
+        return Err(cancelled());
+    }
+    if let Some(original) = original_deviation {
+        report = with_simulated_deviation(original, report, options, &mut |variant, before, f| {
+            attempt(variant, before, &mut |g| progress(f + 0.05 * g))
+        })?;
+    }
+    let mut report = with_estimates(input, report, options)?;
+    report.firmware = Some(firmware_report(input, &report.output, &path, options)?);
+    progress(1.0);
+    Ok(report)
+}
+
+/// One file being rewritten: what every whole-file attempt shares.
+struct Run<'a> {
+    input: &'a [u8],
+    path: &'a crate::path::PrintPath,
+    sources: &'a source::Sources,
+    options: &'a VtgOptions,
+    limits: KinematicLimits,
+}
+
+impl Run<'_> {
+    /// One rewrite tried as `variant`, analysed and reported (`before`: the original's analysis).
+    fn attempt(
+        &self,
+        variant: search::Variant,
+        before: Report,
+        progress: Progress<'_>,
+    ) -> Result<VtgReport, Error> {
+        let Run {
+            input,
+            path,
+            sources,
+            options,
+            limits,
+        } = *self;
         let mut step = |f: f64| progress(0.8 * f);
-        let offers = rewrite::offers(input, &path, &sources, options, &limits, variant, &mut step)?;
+        let offers = rewrite::offers(input, path, sources, options, &limits, variant, &mut step)?;
         if !progress(0.8) {
-            return Err(cancelled());
+            return Err(Error::new(0, 0, ErrorKind::Cancelled));
         }
         let (rewritten, measured) = search::within_allowed_time(input, &offers, options, &before)?;
         // The output's metrics streamed, not from a kept move list: rounding corners can
@@ -236,31 +306,11 @@ pub fn vtg_with_progress(
             &limits,
             before,
             after,
-            &path,
+            path,
             after_metrics,
             rewritten,
         ))
-    };
-    let first = search::Variant::default();
-    // The original's simulated deviation does not depend on the rewrite: where there are
-    // threads, it runs beside the first one (on a long print it takes as long).
-    let (original_deviation, report) = crate::parallel::join(
-        || options.dynamics.then(|| printing_deviation(input, options)),
-        || attempt(first, before, &mut |f| progress(0.3 + 0.4 * f)),
-    );
-    let mut report = report?;
-    if !progress(0.7) {
-        return Err(cancelled());
     }
-    if let Some(original) = original_deviation {
-        report = with_simulated_deviation(original, report, options, &mut |variant, before, f| {
-            attempt(variant, before, &mut |g| progress(f + 0.05 * g))
-        })?;
-    }
-    let mut report = with_estimates(input, report, options)?;
-    report.firmware = Some(firmware_report(input, &report.output, &path, options)?);
-    progress(1.0);
-    Ok(report)
 }
 
 /// Both files measured against the machine's segment budget ([`firmware`]), read side by
@@ -279,6 +329,10 @@ fn firmware_report(
     );
     Ok(firmware::FirmwareReport::new(budget, before?, after?))
 }
+
+/// Lines the refreshed time estimates add to the file's header ([`with_estimates`]): its note
+/// and the estimate's own line.
+pub(crate) const ESTIMATE_HEADER_LINES: i64 = 2;
 
 /// The report with its file's time comments and `M73` lines rewritten from the planner
 /// ([`crate::estimate`]) when the toolpath changed and the options ask for it.
@@ -309,13 +363,18 @@ fn with_estimates(
 /// `a_n` and `j_n` sees, and not monotonically (figures in `docs/method/vtg-tuning-notes.md`). So
 /// when the simulated mean deviation does not fall, or the peak deviation rises (the
 /// no-dearer rule holds for both, [`quietness`]), the file is rewritten again with the speeds
-/// starting at each of `Tuning::quieter_scales` in turn, and the quietest rewrite is kept: every variant still passes the no-dearer check path by path, so time and
-/// energy fall as before.
+/// starting at each of `Tuning::quieter_scales` in turn, and the quietest rewrite is kept:
+/// every variant still passes the no-dearer check path by path, so time and energy fall as
+/// before.
 ///
 /// Keyhole loops ([`corners::keyhole`]) are the other thing the model can object to: the
 /// machine no longer stops at the tip of a wedge, but it swings round a loop of a tenth of a
 /// millimetre or so in radius, and on some files that rang more than the stop did. If no scale
 /// brings the mean below the original's with them, the scales are tried again without keyholes.
+///
+/// If even the quietest rewrite raises the mean or the peak deviation over the original's, the
+/// original is handed back unchanged, with a `message` saying so: no file comes back ringing
+/// more than it went in.
 ///
 /// `None` rows when the model cannot run (a print too long to simulate, for instance): the
 /// rest of the report stands without them.
@@ -335,15 +394,20 @@ fn with_simulated_deviation(
         mean_mm: Comparison::new(b.mean, a.mean),
     };
     let mut best = first;
+    if best.paths.rewritten == 0 && best.paths.compacted == 0 {
+        // Nothing rewritten: the file rings as the original does, and no variant would differ.
+        best.table2.deviation = Some(rows(b));
+        return Ok(best);
+    }
     let Some(a) = mean(&best.output) else {
         return Ok(best);
     };
     best.table2.deviation = Some(rows(a));
-    if !options.limit_feed {
-        return Ok(best);
-    }
     let mut best_score = quietness(&b, &a);
-    for (k, variant) in search::quieter_variants().enumerate() {
+    let mut best_a = a;
+    // Faster speeds only where the feed is the VTG eq. 29 one.
+    let variants = search::quieter_variants().filter(|_| options.limit_feed);
+    for (k, variant) in variants.enumerate() {
         if best_score.0 == 0 {
             break;
         }
@@ -357,9 +421,28 @@ fn with_simulated_deviation(
             next.table2.deviation = Some(rows(a));
             best_score = score;
             best = next;
+            best_a = a;
         }
     }
-    Ok(best)
+    if best_a.mean <= b.mean && best_a.max <= b.max {
+        return Ok(best);
+    }
+    // Every rewrite tried rings more than the original: the original is handed back.
+    let mut kept = again(search::Variant::original(), best.before.clone(), 0.95)?;
+    kept.table2.deviation = Some(rows(b));
+    let change = |before: f64, after: f64| {
+        format!(
+            "{:+.1} % ({before:.4} → {after:.4} mm)",
+            (after / before - 1.0) * 100.0
+        )
+    };
+    kept.message = Some(format!(
+        "kept the original: the quietest rewrite tried changed the dynamics model's mean \
+         deviation by {} and its peak by {}, and neither may rise",
+        change(b.mean, best_a.mean),
+        change(b.max, best_a.max)
+    ));
+    Ok(kept)
 }
 
 /// The dynamics model's deviation over a file's printing moves, `None` when the model cannot

@@ -120,6 +120,12 @@ pub struct PathCounts {
     pub paid_from_savings: u64,
     /// Paths like those that the savings could not pay for, kept as they were.
     pub kept_for_time: u64,
+    /// Paths kept as they were because rounding them would add more lines than the file's
+    /// line budget had left (`allow_more_lines_pct`).
+    pub kept_for_lines: u64,
+    /// Paths without sharp corners written with arcs, as their own points lie, for the lines
+    /// they save (only as many as the corners rounded elsewhere need).
+    pub compacted: u64,
     /// Mean speed fluctuation of the interpolation steps, percent (VTG eq. 28).
     pub mean_speed_fluctuation_pct: f64,
     /// The scale the VTG eq. 29 speeds of every rewrite started from: 1, or higher where the
@@ -181,6 +187,9 @@ pub struct VtgReport {
     /// Both files against the machine's segment budget: lines, bytes, short segments, the
     /// peak segment rate ([`super::firmware`]); `None` only while the report is assembled.
     pub firmware: Option<super::firmware::FirmwareReport>,
+    /// Why the original was handed back unchanged, when it was (`None`: the rewrite is the
+    /// output).
+    pub message: Option<String>,
     /// The rewritten G-code.
     #[serde(skip)]
     pub output: Vec<u8>,
@@ -243,6 +252,8 @@ pub(crate) fn build(
             uncapped: rewritten.uncapped_paths,
             paid_from_savings: rewritten.paid_paths,
             kept_for_time: rewritten.kept_for_time,
+            kept_for_lines: rewritten.kept_for_lines,
+            compacted: rewritten.compacted_paths,
             mean_speed_fluctuation_pct: if w.steps > 0 {
                 w.fluctuation_sum / w.steps as f64 * 100.0
             } else {
@@ -260,5 +271,6 @@ pub(crate) fn build(
         after,
         firmware: None,
         output: rewritten.output,
+        message: None,
     }
 }

@@ -78,6 +78,11 @@ pub(crate) struct Tuning {
     /// Largest spread of the feed rates one arc joins (it takes the lowest): more writes longer
     /// arcs, slowing their faster parts.
     pub(crate) arc_feed_spread: f64,
+    /// Share of the tolerance a path without sharp corners may stray from its own points when
+    /// its runs on a circle are written as arcs to save lines (`search::compact`): more
+    /// finds more arcs in coarsely sliced curves. At the default 0.1 mm tolerance, 0.25 is
+    /// ArcWelder's default resolution of 0.05 mm (± 0.025 mm).
+    pub(crate) compact_share: f64,
     // Fit and feed (VTG eq. 29).
     /// Data points per knot span in the first fit: fewer spans fit faster, more need fewer
     /// refinement rounds.
@@ -142,6 +147,7 @@ pub(crate) const TUNING: Tuning = Tuning {
     arc_min_radius_mm: 0.2,
     arc_max_radius_mm: 500.0,
     arc_feed_spread: 1.05,
+    compact_share: 0.25,
     points_per_span: 2.5,
     fit_penalty: 1e-3,
     fit_rounds: 6,

@@ -1969,6 +1969,16 @@ export type PathCounts = {
    */
   kept_for_time: number,
   /**
+   * Paths kept as they were because rounding them would add more lines than the file's
+   * line budget had left (`allow_more_lines_pct`).
+   */
+  kept_for_lines: number,
+  /**
+   * Paths without sharp corners written with arcs, as their own points lie, for the lines
+   * they save (only as many as the corners rounded elsewhere need).
+   */
+  compacted: number,
+  /**
    * Mean speed fluctuation of the interpolation steps, percent (VTG eq. 28).
    */
   mean_speed_fluctuation_pct: number,
@@ -2900,11 +2910,12 @@ export type VtgOptions = Partial<{
    */
   dynamics: boolean,
   /**
-   * Write runs of new points that lie on a circle as arcs (`G2`/`G3`) to cut the
-   * line count (default false: the firmware must have arcs enabled, Marlin's `ARC_SUPPORT`
-   * or Klipper's `[gcode_arcs]`).
+   * Write runs of new points that lie on a circle as arcs (`G2`/`G3`) to cut the line
+   * count: `auto` (default) where the firmware runs them ([`ArcsMode::Auto`]: a file that
+   * already has arcs, Marlin, RepRapFirmware and Smoothieware flavours, Klipper only with
+   * `[gcode_arcs]` in the printer config given), `on` or `off`.
    */
-  arcs: boolean,
+  arcs: ArcsMode,
   /**
    * Print time the rewrite may add to round corners that cost time, percent of the
    * original's (default [`DEFAULT_ALLOW_SLOWER_PCT`], the issue's bar). On a machine whose
@@ -2938,6 +2949,15 @@ export type VtgOptions = Partial<{
    * as far as the tolerance and the turn allow.
    */
   min_segment_time_ms: number | null,
+  /**
+   * Lines the rewritten file may have over the original's, percent (default 0: never more
+   * lines). Each rounded corner is walked in several steps where the original had one
+   * vertex; a firmware fed over a serial link or from an SD card reads only so many lines a
+   * second, and Marlin slows segments when its planner buffer runs low (see [`firmware`]).
+   * The rewrites that save lines pay for those that add them, the corners that cost the
+   * fewest lines first; the paths that do not fit are kept as they were (`kept_for_lines`).
+   */
+  allow_more_lines_pct: number,
 }>;
 
 /**
@@ -2994,6 +3014,11 @@ export type VtgReport = {
    * peak segment rate ([`super::firmware`]); `None` only while the report is assembled.
    */
   firmware: FirmwareReport | null,
+  /**
+   * Why the original was handed back unchanged, when it was (`None`: the rewrite is the
+   * output).
+   */
+  message: string | null,
 };
 
 /**

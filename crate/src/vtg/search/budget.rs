@@ -12,6 +12,15 @@
 //! and dearer ones that round some or all of them too, `Tuning::dearer_speed_shares`, each written
 //! the way that costs least energy and the way that costs least time; buying a dearer one is then
 //! an increment over the free one).
+//!
+//! Lines are the other budget. A printer's firmware reads the file a line at a time, with a
+//! planner buffer of a few blocks and a serial link or SD card that carries only so many lines
+//! a second (see [`crate::vtg::firmware`]); a rounded corner is walked in several steps where
+//! the original had one vertex, so rounding adds lines. The file may gain no more lines than
+//! [`crate::vtg::VtgOptions::allow_more_lines_pct`] allows (none by default): the rewrites that
+//! save lines (a dense curve walked in longer steps, arcs) pay for those that add them, the
+//! ones that remove the most sharp corners per line added first ([`free_within_lines`]), and a
+//! dearer rewrite must fit what is left.
 
 use crate::gcode::Edit;
 use crate::vtg::rewrite::Rewritten;
@@ -30,6 +39,8 @@ pub(crate) struct Outcome {
     pub(crate) dearer: bool,
     /// Sharp corners it removes.
     pub(crate) corners_removed: u64,
+    /// Lines it adds to the file (negative: saves).
+    pub(crate) lines_added: i64,
 }
 
 /// The ways one path can be written.
@@ -112,23 +123,151 @@ struct Step {
     added: [f64; 2],
     corners: u64,
     per_corner: f64,
+    /// Lines it adds over what the path had.
+    lines: i64,
+}
+
+/// The paths whose free rewrite fits the line budget, and the lines left for dearer ones.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct LineChoice {
+    /// Per offer: its free rewrite is written.
+    pub(crate) keep_free: Vec<bool>,
+    /// Lines the dearer rewrites may still add.
+    pub(crate) left: i64,
+}
+
+/// Chooses the free rewrites the file's lines allow: `allowed` more lines than the original
+/// (negative: fewer), plus the lines the rewrites that save them save.
+///
+/// Rewrites that remove corners and add no lines are written, if the lines saved can cover
+/// `-allowed` (else nothing is). Those that add lines are taken by sharp corners removed per
+/// line added, most first (ties in file order), each while it fits: one that does not is
+/// skipped, and smaller ones after it are still tried. Rewrites that only save lines (paths
+/// written with arcs, [`super::compact`]) are drawn on as the others need their lines, the
+/// largest saving first: a path is not changed for lines nothing needs. The firmware cuts an
+/// arc into segments of its own, so such a path can take a little longer or cost a little
+/// more energy than its chords: it is drawn only while the time and energy the rewrites
+/// written so far save cover it.
+pub(crate) fn free_within_lines(offers: &[Offer], allowed: i64) -> LineChoice {
+    let mut keep_free = vec![false; offers.len()];
+    let mut pool = Pool {
+        left: allowed,
+        slack: [0.0, 0.0],
+    };
+    let (mut adding, mut savers) = (Vec::new(), Vec::new());
+    for (k, offer) in offers.iter().enumerate() {
+        let Some(free) = &offer.free else { continue };
+        match (free.corners_removed, free.lines_added) {
+            (0, lines) if lines < 0 => savers.push((k, lines, free.added)),
+            (0, _) => {}
+            (_, lines) if lines <= 0 => {
+                keep_free[k] = true;
+                pool.take(lines, free.added);
+            }
+            (corners, lines) => adding.push((k, lines, corners)),
+        }
+    }
+    savers.sort_by_key(|&(k, lines, _)| (lines, k));
+    let reserve = |savers: &[(usize, i64, [f64; 2])]| -> i64 { savers.iter().map(|s| -s.1).sum() };
+    if !pool.draw(&mut savers, (0, [0.0; 2]), &mut keep_free) {
+        // The savings do not cover the header the estimates add: the file stays as it was.
+        return LineChoice {
+            keep_free: vec![false; offers.len()],
+            left: allowed,
+        };
+    }
+    // Corners per line, compared exactly: a.corners / a.lines > b.corners / b.lines.
+    adding.sort_by(|a, b| {
+        (u128::from(b.2) * a.1 as u128)
+            .cmp(&(u128::from(a.2) * b.1 as u128))
+            .then(a.0.cmp(&b.0))
+    });
+    for (k, lines, _) in adding {
+        if lines > pool.left + reserve(&savers) {
+            continue;
+        }
+        let added = offers[k].free.as_ref().map_or([0.0; 2], |f| f.added);
+        if pool.draw(&mut savers, (lines, added), &mut keep_free) {
+            keep_free[k] = true;
+            pool.take(lines, added);
+        }
+    }
+    LineChoice {
+        keep_free,
+        left: pool.left,
+    }
+}
+
+/// What the free rewrites written so far leave: lines, and the time (s) and motor energy (J)
+/// they save.
+struct Pool {
+    left: i64,
+    slack: [f64; 2],
+}
+
+impl Pool {
+    /// Writes a rewrite that adds `lines` and `added` (time s, energy J).
+    fn take(&mut self, lines: i64, added: [f64; 2]) {
+        self.left = self.left.saturating_sub(lines);
+        self.slack = [self.slack[0] - added[0], self.slack[1] - added[1]];
+    }
+
+    /// Makes room for a rewrite that adds `lines` and `added` (time s, energy J; what it saves
+    /// counts towards the savers' cost): writes savers (path, lines, cost), largest first,
+    /// each if the slack pays for it, until the rewrite fits. Whether it does; if not, nothing
+    /// is written.
+    fn draw(
+        &mut self,
+        savers: &mut Vec<(usize, i64, [f64; 2])>,
+        (lines, added): (i64, [f64; 2]),
+        keep: &mut [bool],
+    ) -> bool {
+        let mut trial = Pool {
+            left: self.left,
+            slack: [self.slack[0] - added[0], self.slack[1] - added[1]],
+        };
+        let mut drawn = Vec::new();
+        for (k, &(_, saved, cost)) in savers.iter().enumerate() {
+            if trial.left >= lines {
+                break;
+            }
+            if cost[0] <= trial.slack[0].max(0.0) && cost[1] <= trial.slack[1].max(0.0) {
+                trial.take(saved, cost);
+                drawn.push(k);
+            }
+        }
+        if trial.left < lines {
+            return false;
+        }
+        for &k in drawn.iter().rev() {
+            let (path, saved, cost) = savers.remove(k);
+            keep[path] = true;
+            self.take(saved, cost);
+        }
+        true
+    }
 }
 
 /// Chooses, for each offer, the dearer outcome to buy (`None`: the free one, or nothing): the
 /// steps that remove the most sharp corners for their cost first, while they fit the budget
 /// (a step that does not fit ends its path's climb; other paths' cheaper steps are still
-/// tried). Ties go to file order, so the choice is the same on any number of threads.
-pub(crate) fn choose(offers: &[Offer], budget: Budget) -> Vec<Option<usize>> {
+/// tried). Ties go to file order, so the choice is the same on any number of threads. A step
+/// climbs from the free rewrite where `lines` kept it, else from the original, and must also
+/// fit the lines left.
+pub(crate) fn choose(offers: &[Offer], budget: Budget, lines: &LineChoice) -> Vec<Option<usize>> {
     let mut choice = vec![None; offers.len()];
     if budget.limits.iter().any(|&b| b.is_nan() || b <= 0.0) {
         return choice;
     }
     let mut steps: Vec<Step> = Vec::new();
     for (path, offer) in offers.iter().enumerate() {
-        let (mut added, mut corners) = offer
+        let (mut added, mut corners, mut lines_added) = offer
             .free
             .as_ref()
-            .map_or(([0.0, 0.0], 0), |f| (f.added, f.corners_removed));
+            .filter(|_| lines.keep_free.get(path).copied().unwrap_or(false))
+            .map_or(([0.0, 0.0], 0, 0), |f| {
+                (f.added, f.corners_removed, f.lines_added)
+            });
         // The lower convex hull of cost against corners, from what the path has for free.
         loop {
             let best = offer
@@ -146,15 +285,18 @@ pub(crate) fn choose(offers: &[Offer], budget: Budget) -> Vec<Option<usize>> {
             let Some((to, d, n, per_corner)) = best else {
                 break;
             };
+            let to_lines = offer.dearer[to].lines_added;
             steps.push(Step {
                 path,
                 to,
                 added: d,
                 corners: n,
                 per_corner,
+                lines: to_lines - lines_added,
             });
             added = offer.dearer[to].added;
             corners += n;
+            lines_added = to_lines;
         }
     }
     // Along one path the steps' cost per corner rises (a convex hull), so in this order each
@@ -166,14 +308,16 @@ pub(crate) fn choose(offers: &[Offer], budget: Budget) -> Vec<Option<usize>> {
             .then(a.corners.cmp(&b.corners))
     });
     let mut left = budget.limits;
+    let mut lines_left = lines.left;
     let mut stopped = vec![false; offers.len()];
     for s in steps {
         if stopped[s.path] {
             continue;
         }
-        if s.added[0] <= left[0] && s.added[1] <= left[1] {
+        if s.added[0] <= left[0] && s.added[1] <= left[1] && s.lines <= lines_left {
             left[0] -= s.added[0];
             left[1] -= s.added[1];
+            lines_left -= s.lines;
             choice[s.path] = Some(s.to);
         } else {
             stopped[s.path] = true;
@@ -193,13 +337,80 @@ mod tests {
             added: [added_s, added_j],
             dearer: added_s > 0.0 || added_j > 0.0,
             corners_removed: corners,
+            lines_added: 0,
         }
+    }
+
+    /// [`choose`] with no limit on lines.
+    fn choose_any_lines(offers: &[Offer], budget: Budget) -> Vec<Option<usize>> {
+        choose(offers, budget, &free_within_lines(offers, i64::MAX / 4))
     }
 
     fn offer(o: Outcome) -> Offer {
         let mut offer = Offer::default();
         offer.push(o);
         offer
+    }
+
+    fn with_lines(mut o: Outcome, lines: i64) -> Outcome {
+        o.lines_added = lines;
+        o
+    }
+
+    #[test]
+    fn lines_saved_pay_for_lines_added_most_corners_per_line_first() {
+        let offers = [
+            offer(with_lines(outcome(0.0, 0.0, 1), -5)), // saves 5 lines
+            offer(with_lines(outcome(0.0, 0.0, 8), 4)),  // 2 corners a line: second
+            offer(with_lines(outcome(0.0, 0.0, 3), 3)),  // 1 a line: no longer fits
+            offer(with_lines(outcome(0.0, 0.0, 3), 1)),  // 3 a line: first
+            offer(with_lines(outcome(0.0, 0.0, 2), 0)),  // adds none
+        ];
+        let chosen = free_within_lines(&offers, 0);
+        assert_eq!(chosen.keep_free, [true, true, false, true, true]);
+        assert_eq!(chosen.left, 0);
+        // One more line allowed: still not the third (3 lines), so one line is left over.
+        assert_eq!(free_within_lines(&offers, 1).left, 1);
+        // The header needs 6 lines and only 5 are saved: nothing is written.
+        let none = free_within_lines(&offers, -6);
+        assert_eq!(none.keep_free, [false; 5]);
+        assert_eq!(none.left, -6);
+        // A dearer way that adds lines is bought only with lines left: time and energy are
+        // plenty, but it adds 3 lines over the free one.
+        let mut dear = offer(with_lines(outcome(-1.0, -1.0, 1), -1));
+        dear.push(with_lines(outcome(-0.9, 0.2, 4), 2));
+        let offers = [dear];
+        let budget = || Budget::new([10.0, 10.0], 0.0, 0.0);
+        let tight = free_within_lines(&offers, 0);
+        assert_eq!((tight.keep_free[0], tight.left), (true, 1));
+        assert_eq!(choose(&offers, budget(), &tight), [None]);
+        assert_eq!(
+            choose(&offers, budget(), &free_within_lines(&offers, 2)),
+            [Some(0)]
+        );
+    }
+
+    #[test]
+    fn paths_that_only_save_lines_are_written_only_as_needed_largest_first() {
+        let saver = |lines| offer(with_lines(outcome(0.0, 0.0, 0), lines));
+        let offers = [
+            saver(-2),
+            offer(with_lines(outcome(0.0, 0.0, 6), 3)),
+            saver(-4),
+            saver(-1),
+        ];
+        // 3 lines needed: the largest saver (4) covers them, one line is left.
+        let chosen = free_within_lines(&offers, 0);
+        assert_eq!(chosen.keep_free, [false, true, true, false]);
+        assert_eq!(chosen.left, 1);
+        // Nothing needs lines: no path is changed for them.
+        assert_eq!(free_within_lines(&offers[2..], 0).keep_free, [false, false]);
+        // More needed than all of them save: the corners stay, and so do the savers.
+        let big = [saver(-2), offer(with_lines(outcome(0.0, 0.0, 6), 8))];
+        assert_eq!(free_within_lines(&big, 0).keep_free, [false, false]);
+        // A rewrite that adds lines and removes no corner is never written.
+        let idle = [saver(-5), offer(with_lines(outcome(-1.0, -1.0, 0), 1))];
+        assert_eq!(free_within_lines(&idle, 0).keep_free, [false, false]);
     }
 
     #[test]
@@ -214,7 +425,7 @@ mod tests {
             offer(outcome(0.5, 0.0, 0)),   // removes nothing: never paid
             offer(outcome(1.0, -20.0, 2)), // saves energy: -0.2 / 2 = -0.1 per corner, first
         ];
-        let chosen = choose(&offers, budget);
+        let chosen = choose_any_lines(&offers, budget);
         // Order: #4 (1 s, -20 J; left 4 s, 70 J), #2 (2 s, 45 J; left 2 s, 25 J), #1 (2 s,
         // 10 J; left 0 s, 15 J), #0 does not fit.
         assert_eq!(chosen, [None, Some(0), Some(0), None, Some(0)]);
@@ -229,7 +440,7 @@ mod tests {
     #[test]
     fn nothing_is_paid_without_savings_in_both_time_and_energy() {
         for saved in [[0.0, 100.0], [10.0, 0.0], [-1.0, 100.0]] {
-            let chosen = choose(
+            let chosen = choose_any_lines(
                 &[offer(outcome(0.001, 0.001, 5))],
                 Budget::new(saved, 0.0, 0.0),
             );
@@ -247,7 +458,7 @@ mod tests {
             offer(outcome(2.0, 0.0, 4)),  // 0.5 s per corner: does not fit after the first
             offer(outcome(1.0, 5.0, 3)),  // 0.33 s per corner: second
         ];
-        assert_eq!(choose(&offers, budget), [Some(0), None, Some(0)]);
+        assert_eq!(choose_any_lines(&offers, budget), [Some(0), None, Some(0)]);
     }
 
     #[test]
@@ -262,15 +473,15 @@ mod tests {
         let weighed = Budget::new([0.0, 0.0], 2.4, 50.0);
         assert_eq!(weighed.seconds_per_joule, TUNING.energy_weight / 50.0);
         // Per corner: 0.2 + 0.2 = 0.4 s or 0.24 - 0.1 = 0.14 s; the other 0.275 s.
-        assert_eq!(choose(&offers, weighed), [Some(1), Some(0)]);
+        assert_eq!(choose_any_lines(&offers, weighed), [Some(1), Some(0)]);
         // Energy not counted: the faster way, and the other path still fits.
         assert_eq!(
-            choose(&offers, Budget::new([0.0, 0.0], 2.4, f64::NAN)),
+            choose_any_lines(&offers, Budget::new([0.0, 0.0], 2.4, f64::NAN)),
             [Some(0), Some(0)]
         );
         // The time allowed still bounds what is bought: the frugal way does not fit in 1.1 s.
         assert_eq!(
-            choose(&offers, Budget::new([0.0, 0.0], 1.1, 50.0)),
+            choose_any_lines(&offers, Budget::new([0.0, 0.0], 1.1, 50.0)),
             [None, Some(0)]
         );
     }
@@ -285,16 +496,16 @@ mod tests {
         // The step over the free rewrite: 2 s for 5 more corners (0.4 s each), before the
         // other path's 0.6 s each; 2.5 s allowed buys only the first.
         assert_eq!(
-            choose(&offers, Budget::new([0.0, 0.0], 2.5, 0.0)),
+            choose_any_lines(&offers, Budget::new([0.0, 0.0], 2.5, 0.0)),
             [Some(0), None]
         );
         assert_eq!(
-            choose(&offers, Budget::new([0.0, 0.0], 5.0, 0.0)),
+            choose_any_lines(&offers, Budget::new([0.0, 0.0], 5.0, 0.0)),
             [Some(0), Some(0)]
         );
         // Nothing allowed: the free rewrite stays.
         assert_eq!(
-            choose(&offers, Budget::new([0.0, 0.0], 0.0, 0.0)),
+            choose_any_lines(&offers, Budget::new([0.0, 0.0], 0.0, 0.0)),
             [None, None]
         );
     }
@@ -313,15 +524,15 @@ mod tests {
         }
         let offers = [o];
         assert_eq!(
-            choose(&offers, Budget::new([0.0, 0.0], 2.0, 0.0)),
+            choose_any_lines(&offers, Budget::new([0.0, 0.0], 2.0, 0.0)),
             [Some(1)]
         );
         assert_eq!(
-            choose(&offers, Budget::new([0.0, 0.0], 4.9, 0.0)),
+            choose_any_lines(&offers, Budget::new([0.0, 0.0], 4.9, 0.0)),
             [Some(1)]
         );
         assert_eq!(
-            choose(&offers, Budget::new([0.0, 0.0], 5.0, 0.0)),
+            choose_any_lines(&offers, Budget::new([0.0, 0.0], 5.0, 0.0)),
             [Some(2)]
         );
     }

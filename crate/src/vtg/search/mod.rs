@@ -24,6 +24,7 @@ use crate::error::Error;
 use smooth::{Settings, SmoothPath, Smoothed};
 
 pub(crate) mod budget;
+mod compact;
 pub(crate) mod rewrite;
 pub(crate) mod smooth;
 
@@ -37,6 +38,18 @@ pub(crate) struct Variant {
     pub(crate) keyholes: bool,
     /// Join the walked steps up to the segment budget ([`Settings::min_segment_s`]).
     pub(crate) thin: bool,
+    /// Rewrite nothing: the original, reported as a rewrite would be ([`Variant::original`]).
+    pub(crate) keep_original: bool,
+}
+
+impl Variant {
+    /// The variant that rewrites nothing, for when no rewrite keeps the no-dearer rule.
+    pub(crate) fn original() -> Self {
+        Variant {
+            keep_original: true,
+            ..Variant::default()
+        }
+    }
 }
 
 impl Default for Variant {
@@ -45,6 +58,7 @@ impl Default for Variant {
             feed_cap_scale: 1.0,
             keyholes: true,
             thin: true,
+            keep_original: false,
         }
     }
 }
@@ -59,6 +73,7 @@ pub(crate) fn quieter_variants() -> impl Iterator<Item = Variant> {
             feed_cap_scale,
             keyholes,
             thin: false,
+            keep_original: false,
         })
     })
 }
@@ -155,11 +170,12 @@ pub(crate) fn within_allowed_time(
     };
     let mut allowed_s = allowed;
     let mean_power_w = before.energy.total_j / before.time_s;
+    let lines = allowed_lines(input, options);
     for _ in 0..TUNING.time_rounds {
         if allowed_s <= 0.0 {
             break;
         }
-        let rewritten = offers.write(input, allowed_s, mean_power_w);
+        let rewritten = offers.write(input, (allowed_s, lines), mean_power_w);
         let after = crate::analyze::analyze(&rewritten.output, &options.analyze)?;
         let added = after.time_s - before.time_s;
         if added <= allowed {
@@ -167,5 +183,19 @@ pub(crate) fn within_allowed_time(
         }
         allowed_s -= TUNING.time_margin * (added - allowed);
     }
-    Ok((offers.write(input, 0.0, mean_power_w), None))
+    Ok((offers.write(input, (0.0, lines), mean_power_w), None))
+}
+
+/// Lines the rewrite may add to `input`: `allow_more_lines_pct` of its lines, less the header
+/// the refreshed time estimates will add where it has estimates (`crate::vtg::ESTIMATE_HEADER_LINES`), so the file as
+/// written keeps to it.
+pub(crate) fn allowed_lines(input: &[u8], options: &VtgOptions) -> i64 {
+    let ends = memchr::memchr_iter(b'\n', input).count();
+    let lines = ends + usize::from(input.last().is_some_and(|&b| b != b'\n'));
+    let header = if options.estimates && crate::estimate::has_estimates(input) {
+        super::ESTIMATE_HEADER_LINES
+    } else {
+        0
+    };
+    (lines as f64 * options.allow_more_lines_pct / 100.0).floor() as i64 - header
 }

@@ -62,6 +62,9 @@ pub(crate) struct Rewritten {
     /// Paths kept as they were because even rounded without caps they plan slower or cost more
     /// motor energy, and the savings elsewhere could not pay for them.
     pub(crate) kept_for_time: u64,
+    /// Paths kept as they were because rounding them would add more lines than the file's
+    /// line budget has left ([`budget::free_within_lines`]).
+    pub(crate) kept_for_lines: u64,
     /// Algorithm 1 statistics.
     pub(crate) walk: WalkStats,
     /// The first scale of the VTG eq. 29 speeds each rewrite was tried with.
@@ -72,6 +75,8 @@ pub(crate) struct Rewritten {
     pub(crate) arcs_written: u64,
     /// Corners turned round keyhole loops.
     pub(crate) keyholes: u64,
+    /// Paths without sharp corners written with arcs to save lines ([`super::compact`]).
+    pub(crate) compacted_paths: u64,
 }
 
 /// The VTG eq. 30 limits for a file: `v_max` from the machine's X/Y feed limits (`M203`), `A_n` the
@@ -128,8 +133,6 @@ pub(crate) fn first_mode_hz(path: &PrintPath) -> f64 {
 #[derive(Debug, Default)]
 pub(crate) struct Offers {
     offers: Vec<Offer>,
-    /// Time (s) and motor energy (J) the free rewrites save.
-    saved: [f64; 2],
     candidate_paths: u64,
     variant: Variant,
 }
@@ -153,7 +156,7 @@ pub(crate) fn offers(
     let sources = &all.moves[..];
     let aligned =
         sources.len() == moves.len() && sources.iter().zip(moves).all(|(s, m)| s.line == m.line);
-    if !aligned {
+    if !aligned || variant.keep_original {
         return Ok(out);
     }
     let budget = crate::vtg::firmware::SegmentBudget::for_file(
@@ -173,8 +176,9 @@ pub(crate) fn offers(
     // The candidates first (cheap), then the paths rewritten in parallel batches: each path is
     // independent, results are merged in file order (the same output on any number of
     // threads), and progress and cancellation are checked between batches.
-    let candidates = candidates(moves, sources, cos_critical);
-    out.candidate_paths = candidates.len() as u64;
+    // Where arcs are written, the paths without sharp corners too: they can save lines.
+    let candidates = candidates(moves, sources, cos_critical, settings.arcs);
+    out.candidate_paths = candidates.iter().filter(|c| c.2).count() as u64;
     let offering = Offering {
         input,
         path,
@@ -189,26 +193,20 @@ pub(crate) fn offers(
         buy_time: options.allow_slower_pct > 0.0 && settings.speed_share_matters(),
     };
     let mut offers: Vec<Offer> = Vec::with_capacity(candidates.len());
-    let mut saved = [0.0f64; 2];
     for (b, batch) in candidates.chunks(BATCH_PATHS).enumerate() {
         if !progress((b * BATCH_PATHS) as f64 / candidates.len().max(1) as f64) {
             return Err(Error::new(0, 0, ErrorKind::Cancelled));
         }
-        // One offer per path, added up here in file order: sums are then the same to the
+        // One offer per path, kept in file order: sums over them are then the same to the
         // last bit as a sequential run's (the wasm build's, which the CLI's JSON must equal).
-        let parts = crate::parallel::map_chunks(batch, |chunk| {
-            chunk.iter().map(|&(i, j)| offering.offer(i, j)).collect()
-        });
-        for offer in parts {
-            if let Some(free) = &offer.free {
-                saved[0] -= free.added[0];
-                saved[1] -= free.added[1];
-            }
-            offers.push(offer);
-        }
+        offers.extend(crate::parallel::map_chunks(batch, |chunk| {
+            chunk
+                .iter()
+                .map(|&(i, j, sharp)| offering.offer(i, j, sharp))
+                .collect()
+        }));
     }
     out.offers = offers;
-    out.saved = saved;
     Ok(out)
 }
 
@@ -240,7 +238,8 @@ fn file_settings(
         classic_jerk_mm_s: (path.junction_model == JunctionModel::ClassicJerk)
             .then(|| xy_jerk(&path.print_limits)),
         feed_cap_scale: variant.feed_cap_scale,
-        arcs: options.arcs,
+        // `vtg` has resolved `auto` by now.
+        arcs: options.arcs == crate::vtg::ArcsMode::On,
         min_speed_share: 1.0,
         keyholes: variant.keyholes,
         klipper_scv_mm_s: (path.junction_model == JunctionModel::Klipper)
@@ -255,13 +254,16 @@ fn file_settings(
     }
 }
 
-/// The paths worth rewriting, as move ranges `i..j`: those with a sharp corner.
+/// The paths worth rewriting, as move ranges `i..j` and whether they have a sharp corner:
+/// those that do, and with `plain` those of at least [`arcs::MIN_SEGMENTS`] moves that do not
+/// (written with arcs, they save lines).
 fn candidates(
     moves: &[PathMove],
     sources: &[MoveSource],
     cos_critical: f64,
-) -> Vec<(usize, usize)> {
-    let mut candidates: Vec<(usize, usize)> = Vec::new();
+    plain: bool,
+) -> Vec<(usize, usize, bool)> {
+    let mut candidates = Vec::new();
     let mut i = 0usize;
     while i < moves.len() {
         let Some(j) = path_end(moves, sources, i) else {
@@ -270,7 +272,9 @@ fn candidates(
         };
         let run = &moves[i..j];
         if run.len() >= 2 && has_sharp_corner(run, cos_critical) {
-            candidates.push((i, j));
+            candidates.push((i, j, true));
+        } else if plain && run.len() >= arcs::MIN_SEGMENTS {
+            candidates.push((i, j, false));
         }
         i = j;
     }
@@ -294,8 +298,9 @@ struct Offering<'a> {
 
 impl Offering<'_> {
     /// The ways of writing moves `i..j`: the free rewrite, and with time to spend the dearer
-    /// variants that round more corners.
-    fn offer(&self, i: usize, j: usize) -> Offer {
+    /// variants that round more corners; a path without a `sharp` corner only with arcs, as
+    /// its original points lie ([`super::compact`]).
+    fn offer(&self, i: usize, j: usize, sharp: bool) -> Offer {
         let (moves, sources) = (&self.path.moves, &self.all.moves[..]);
         let machine = PlanContext {
             limits: self.all.limits_at(i),
@@ -306,6 +311,20 @@ impl Offering<'_> {
                 moves.get(j).map(motion_of),
             ],
         };
+        if !sharp {
+            let settings = machine.settings(&self.settings);
+            let compact = super::compact::compact_path(
+                self.input,
+                &moves[i..j],
+                &sources[i..j],
+                &settings,
+                &machine,
+            );
+            return Offer {
+                free: compact,
+                dearer: Vec::new(),
+            };
+        }
         let write =
             |s: &Settings| rewrite_path(self.input, &moves[i..j], &sources[i..j], s, &machine);
         let base = write(&self.settings).unwrap_or_default();
@@ -333,32 +352,48 @@ impl Offers {
         self.offers.iter().any(|o| !o.dearer.is_empty())
     }
 
-    /// The file with the free rewrites and the dearer ones bought with half of what the free
-    /// ones saved plus `allowed_s` of time, energy weighed at the print's `mean_power_w` where
-    /// time is allowed ([`budget::choose`]).
-    pub(crate) fn write(&self, input: &[u8], allowed_s: f64, mean_power_w: f64) -> Rewritten {
+    /// The file with the free rewrites `allowed_lines` more lines allow ([`budget::free_within_lines`])
+    /// and the dearer ones bought with half of what those saved plus `allowed_s` of time,
+    /// energy weighed at the print's `mean_power_w` where time is allowed ([`budget::choose`]).
+    pub(crate) fn write(
+        &self,
+        input: &[u8],
+        (allowed_s, allowed_lines): (f64, i64),
+        mean_power_w: f64,
+    ) -> Rewritten {
         let mut out = Rewritten {
             candidate_paths: self.candidate_paths,
             feed_cap_scale: self.variant.feed_cap_scale,
             steps_joined: self.variant.thin,
             ..Rewritten::default()
         };
+        let lines = budget::free_within_lines(&self.offers, allowed_lines);
+        let free = |k: usize| self.offers[k].free.as_ref().filter(|_| lines.keep_free[k]);
+        let saved = (0..self.offers.len())
+            .filter_map(free)
+            .fold([0.0, 0.0], |s, f| [s[0] - f.added[0], s[1] - f.added[1]]);
         let choice = budget::choose(
             &self.offers,
-            Budget::new(self.saved, allowed_s, mean_power_w),
+            Budget::new(saved, allowed_s, mean_power_w),
+            &lines,
         );
         let mut edits: Vec<&Edit> = Vec::new();
-        for (offer, chosen) in self.offers.iter().zip(choice) {
+        for (k, (offer, chosen)) in self.offers.iter().zip(choice).enumerate() {
             let written = match chosen {
-                Some(k) => {
+                Some(d) => {
                     out.paid_paths += 1;
-                    offer.dearer.get(k)
+                    offer.dearer.get(d)
                 }
                 None => {
                     if offer.free.is_none() && !offer.dearer.is_empty() {
                         out.kept_for_time += 1;
                     }
-                    offer.free.as_ref()
+                    if offer.free.as_ref().is_some_and(|f| f.corners_removed > 0)
+                        && !lines.keep_free[k]
+                    {
+                        out.kept_for_lines += 1;
+                    }
+                    free(k)
                 }
             };
             if let Some(o) = written {
@@ -399,10 +434,12 @@ impl Rewritten {
         self.uncapped_paths += part.uncapped_paths;
         self.paid_paths += part.paid_paths;
         self.kept_for_time += part.kept_for_time;
+        self.kept_for_lines += part.kept_for_lines;
         self.walk.steps += part.walk.steps;
         self.walk.fluctuation_sum += part.walk.fluctuation_sum;
         self.arcs_written += part.arcs_written;
         self.keyholes += part.keyholes;
+        self.compacted_paths += part.compacted_paths;
     }
 }
 
@@ -465,8 +502,8 @@ fn xy_jerk(limits: &Limits) -> f64 {
 /// The firmware a path runs on: the limits in force where it starts, the junction model, and
 /// the motor energy model; and the moves just before and after the path, which are planned
 /// with it.
-struct PlanContext<'a> {
-    limits: Option<&'a Limits>,
+pub(super) struct PlanContext<'a> {
+    pub(super) limits: Option<&'a Limits>,
     model: JunctionModel,
     energy: &'a Accumulator,
     context: [Option<Motion>; 2],
@@ -506,12 +543,18 @@ impl PlanContext<'_> {
     /// planned from rest to rest, with the moves before and after the path, so what a rewrite
     /// changes at the path's two junctions with the rest of the file is counted too (a short
     /// last step meeting the next move at an angle slows a Klipper machine down there).
-    fn cost(&self, start: [f64; 3], points: &[[f64; 3]], e: &[f64], feed: &[f64]) -> (f64, f64) {
+    pub(super) fn cost(
+        &self,
+        start: [f64; 3],
+        points: &[[f64; 3]],
+        e: &[f64],
+        feed: &[f64],
+    ) -> (f64, f64) {
         self.cost_pieces(start, points, e, &arcs::lines(feed))
     }
 
     /// [`PlanContext::cost`] of the path written as `pieces` (lines and arcs) through `points`.
-    fn cost_pieces(
+    pub(super) fn cost_pieces(
         &self,
         start: [f64; 3],
         points: &[[f64; 3]],
@@ -615,16 +658,16 @@ fn rewrite_path(
 /// An original path as the smoothing reads it: vertices (start point first), filament from
 /// the path start at each vertex in E words, feed per segment, and how the planner ran each
 /// move (as far as it was planned).
-struct Polyline {
-    pts: Vec<[f64; 3]>,
-    e: Vec<f64>,
-    feed: Vec<f64>,
+pub(super) struct Polyline {
+    pub(super) pts: Vec<[f64; 3]>,
+    pub(super) e: Vec<f64>,
+    pub(super) feed: Vec<f64>,
     planned: Vec<Profile>,
 }
 
 impl Polyline {
     /// The path of `run`; `None` where its filament is not a positive, rising total.
-    fn of(run: &[PathMove], src: &[MoveSource]) -> Option<Self> {
+    pub(super) fn of(run: &[PathMove], src: &[MoveSource]) -> Option<Self> {
         let (first, first_src) = (run.first()?, src.first()?);
         let xyz = |p: &crate::machine::Pos| [p[0], p[1], p[2]];
         let mut pts = Vec::with_capacity(run.len() + 1);
@@ -818,8 +861,10 @@ impl Draft<'_> {
         out.max_deviation_mm = out.max_deviation_mm.max(deviation);
         out.walk.steps += smoothed.stats.steps;
         out.walk.fluctuation_sum += smoothed.stats.fluctuation_sum;
+        let edits = edits(src, text);
         Some(Outcome {
-            edits: edits(src, text),
+            lines_added: lines_added(&edits),
+            edits,
             part,
             added,
             dearer,
@@ -830,7 +875,11 @@ impl Draft<'_> {
 
 /// Annotation lines between the original moves (`;WIDTH:`), each with the filament pushed
 /// where it stood (`e`, from the path start): the new block writes them back in place.
-fn notes<'i>(input: &'i [u8], src: &[MoveSource], e: &[f64]) -> Option<Vec<(f64, &'i str)>> {
+pub(super) fn notes<'i>(
+    input: &'i [u8],
+    src: &[MoveSource],
+    e: &[f64],
+) -> Option<Vec<(f64, &'i str)>> {
     let mut notes = Vec::new();
     for (s, &at) in src.iter().zip(e).skip(1) {
         if s.notes.lines > 0 {
@@ -845,7 +894,7 @@ fn notes<'i>(input: &'i [u8], src: &[MoveSource], e: &[f64]) -> Option<Vec<(f64,
 
 /// The edits replacing a path's first line with the new block `text` and deleting its other
 /// lines (with the annotations between them, which the block writes again).
-fn edits(src: &[MoveSource], text: String) -> Vec<Edit> {
+pub(super) fn edits(src: &[MoveSource], text: String) -> Vec<Edit> {
     let mut edits = Vec::with_capacity(src.len());
     if let Some(first) = src.first() {
         edits.push(Edit {
@@ -862,6 +911,17 @@ fn edits(src: &[MoveSource], text: String) -> Vec<Edit> {
     edits
 }
 
+/// Lines `edits` add to the file (negative: remove): each replaces one line with as many as
+/// its text holds, or deletes it.
+pub(super) fn lines_added(edits: &[Edit]) -> i64 {
+    let written: usize = edits
+        .iter()
+        .filter(|e| !e.replacement.is_empty())
+        .map(|e| 1 + e.replacement.iter().filter(|&&b| b == b'\n').count())
+        .sum();
+    written as i64 - edits.len() as i64
+}
+
 /// The written path `all` (start point first; `written` after it) with its runs on a circle as
 /// arcs, if there are any, the firmware cuts them at least as finely as δθ asks, the path with
 /// them stays within the tolerance of the original `orig` both ways (returned: the distance),
@@ -871,6 +931,24 @@ fn with_arcs(
     all: &[[f64; 3]],
     written: &Written,
     lines_cost: (f64, f64),
+    orig: &[[f64; 3]],
+    settings: &Settings,
+    machine: &PlanContext<'_>,
+) -> Option<(Vec<Piece>, f64)> {
+    let fit = TUNING.arc_share * settings.tolerance_mm;
+    let (pieces, d) = fit_arcs((all, &written.feed_mm_s), fit, orig, settings, machine)?;
+    let (s_lines, j_lines) = lines_cost;
+    let (s, j) = machine.cost_pieces(all[0], &written.points, &written.e, &pieces);
+    (s <= s_lines * (1.0 + 1e-9) && j <= j_lines * (1.0 + 1e-9)).then_some((pieces, d))
+}
+
+/// The polyline `all` (feed `feed` per segment) with its runs on a circle within `fit` as
+/// arcs, where there are any, the firmware cuts them at least as finely as δθ asks, and the
+/// path with them stays within the tolerance of the original `orig` both ways (returned: the
+/// distance).
+pub(super) fn fit_arcs(
+    (all, feed): (&[[f64; 3]], &[f64]),
+    fit: f64,
     orig: &[[f64; 3]],
     settings: &Settings,
     machine: &PlanContext<'_>,
@@ -888,7 +966,7 @@ fn with_arcs(
         max_turn_rad: TUNING.step_turn_share * settings.critical_rad,
     };
     let tol = settings.tolerance_mm;
-    let pieces = arcs::pieces(all, &written.feed_mm_s, TUNING.arc_share * tol, &firmware);
+    let pieces = arcs::pieces(all, feed, fit, &firmware);
     if pieces.iter().all(|p| p.arc.is_none()) {
         return None;
     }
@@ -898,12 +976,7 @@ fn with_arcs(
         tol / 10.0,
         tol,
     );
-    if d.is_nan() || d > tol {
-        return None;
-    }
-    let (s_lines, j_lines) = lines_cost;
-    let (s, j) = machine.cost_pieces(all[0], &written.points, &written.e, &pieces);
-    (s <= s_lines * (1.0 + 1e-9) && j <= j_lines * (1.0 + 1e-9)).then_some((pieces, d))
+    (d <= tol).then_some((pieces, d))
 }
 
 /// Turns above the critical angle (cosine `cos_critical`) along the polyline through `pts`.
@@ -941,6 +1014,42 @@ mod tests {
         (at, e)
     }
 
+    /// By default the file gains no lines: a rectangle's corners, each walked in several steps,
+    /// stay sharp and the file comes back as it was; allowed more lines, they are rounded, and
+    /// the file has as many more as it was allowed at most.
+    #[test]
+    fn corners_that_add_lines_stay_sharp_unless_more_lines_are_allowed() {
+        let mut src = String::from("M83\nM204 P1250\nG1 X100 Y100 F6000\nG1 Z0.2\n");
+        for _ in 0..10 {
+            for (x, y) in [(120, 100), (120, 110), (100, 110), (100, 100)] {
+                src.push_str(&format!("G1 X{x} Y{y} E0.5 F3600\n"));
+            }
+        }
+        let run = |allow_more_lines_pct| {
+            let options = crate::vtg::VtgOptions {
+                dynamics: false,
+                allow_more_lines_pct,
+                ..Default::default()
+            };
+            crate::vtg::vtg(src.as_bytes(), &options).expect("vtg")
+        };
+        let lines = |b: &[u8]| b.iter().filter(|&&c| c == b'\n').count();
+        let kept = run(0.0);
+        assert_eq!((kept.paths.rewritten, kept.paths.kept_for_lines), (0, 1));
+        assert_eq!(kept.output, src.as_bytes());
+        let rounded = run(1000.0);
+        assert_eq!(
+            (rounded.paths.rewritten, rounded.paths.kept_for_lines),
+            (1, 0)
+        );
+        let added = lines(&rounded.output) - lines(src.as_bytes());
+        assert!(added > 0 && rounded.table1.n_turning.after == 0.0);
+        // Just enough lines for it (in percent of the file's 44): rounded; one fewer: not.
+        let needed = added as f64 / 44.0 * 100.0;
+        assert_eq!(run(needed).paths.rewritten, 1);
+        assert_eq!(run(needed - 100.0 / 44.0).paths.rewritten, 0);
+    }
+
     #[test]
     fn paths_run_across_width_annotations_and_keep_them_in_place() {
         let mut src = String::from("M83\nM201 X1000 Y1000\nM204 P1250\nM205 X8 Y8\n");
@@ -963,6 +1072,8 @@ mod tests {
         }
         let options = crate::vtg::VtgOptions {
             dynamics: false,
+            // Rounding a rectangle's corners adds lines; the line budget is tested apart.
+            allow_more_lines_pct: 1000.0,
             ..Default::default()
         };
         let r = crate::vtg::vtg(src.as_bytes(), &options).expect("vtg");

@@ -1064,6 +1064,8 @@ mod tests {
         let options = crate::vtg::VtgOptions {
             dynamics: false,
             allow_slower_pct: 10.0,
+            // Rounding a rectangle's corners adds lines; the line budget is tested apart.
+            allow_more_lines_pct: 1000.0,
             ..Default::default()
         };
         let r = crate::vtg::vtg(src.as_bytes(), &options).expect("vtg");
@@ -1097,6 +1099,8 @@ mod tests {
         }
         let options = crate::vtg::VtgOptions {
             dynamics: false,
+            // Rounding a rectangle's corners adds lines; the line budget is tested apart.
+            allow_more_lines_pct: 1000.0,
             ..Default::default()
         };
         let r = crate::vtg::vtg(src.as_bytes(), &options).expect("vtg");

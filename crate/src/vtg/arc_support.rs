@@ -1,4 +1,5 @@
-//! Whether the firmware runs arcs, for VTG's `G2`/`G3` output.
+//! Whether the firmware runs arcs, for VTG's `G2`/`G3` output: where it does, arcs are a
+//! rewrite's cheapest way to stay within the file's line budget.
 
 use serde::{Deserialize, Serialize};
 
@@ -23,6 +24,15 @@ pub enum ArcsMode {
 }
 
 impl ArcsMode {
+    /// [`ArcsMode::resolve`] as `On` or `Off`.
+    pub fn resolved(self, input: &[u8], report: &Report, options: &AnalyzeOptions) -> Self {
+        if self.resolve(input, report, options) {
+            ArcsMode::On
+        } else {
+            ArcsMode::Off
+        }
+    }
+
     /// The decision for `input` (analysed as `report`).
     pub fn resolve(self, input: &[u8], report: &Report, options: &AnalyzeOptions) -> bool {
         match self {
