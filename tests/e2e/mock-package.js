@@ -88,7 +88,7 @@ export function vtg(input, options = {}, progress) {
     limits: { v_max_mm_s: 200, interpolation_period_s: 0.001, chord_tolerance_mm: 0.01, normal_accel_mm_s2: 3000, normal_jerk_mm_s3: 1e5, nozzle_radius_mm: 0.2 },
     paths: {
       candidates: 12, rewritten: 10, replaced_moves: 400, written_moves: 900, above_k_cr_segments: 30, lowered_feed_segments: 5,
-      raised_caps: 2, uncapped: 1, paid_from_savings: 1, kept_for_time: 2, mean_speed_fluctuation_pct: 3.5, feed_cap_scale: 1,
+      raised_caps: 2, uncapped: 1, paid_from_savings: 1, kept_for_time: 2, kept_for_lines: 3, compacted: 4, mean_speed_fluctuation_pct: 3.5, feed_cap_scale: 1,
       steps_joined: true, arcs_written: 0, keyholes: 0,
     },
     table1: {

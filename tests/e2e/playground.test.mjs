@@ -513,14 +513,16 @@ test('the job UI with every capability: tables, charts, downloads, before/after 
 
   // VTG: before/after table, paper tables, download, viewer side by side.
   await id('opt-vtg-tolerance').fill('0.05');
-  await id('opt-vtg-arcs').check();
+  await id('opt-vtg-arcs').selectOption('on');
+  await id('opt-vtg-allow-more-lines').fill('25');
   await id('opt-vtg-inside-corners').check();
   await id('opt-vtg-allow-slower').fill('0.5');
   await id('run-vtg').click();
   await idle();
   const vtgJson = JSON.parse(await id('report-json').textContent());
   assert.equal(vtgJson.tolerance_mm, 0.05);
-  assert.equal(vtgJson.options_seen.arcs, true, 'the arcs box reaches the job');
+  assert.equal(vtgJson.options_seen.arcs, 'on', 'the arcs choice reaches the job');
+  assert.equal(vtgJson.options_seen.allow_more_lines_pct, 25, 'the allow-more-lines field reaches the job');
   assert.equal(vtgJson.options_seen.inside_corners, true, 'the inside-corners box reaches the job');
   assert.equal(vtgJson.options_seen.allow_slower_pct, 0.5, 'the allow-slower field reaches the job');
   assert.ok(!('output' in vtgJson));

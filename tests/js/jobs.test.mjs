@@ -97,11 +97,12 @@ test('vtg inside_corners: wasm equals the CLI, and the output differs from the r
   // and it comes out the same either way).
   const triangle = path.join(repoRoot, 'tests', 'fixtures', 'gcode', 'prusaslicer-2.5.0_thesis_triangle.gcode');
   const out = path.join(tmp, 'vtg-inside.gcode');
-  const fromCli = runCli(['vtg', triangle, '-o', out, '--inside-corners', '--no-dynamics', '--json']);
-  const { report, output } = reportOf(qp.vtg(fs.readFileSync(triangle), { inside_corners: true, dynamics: false }));
+  // Lines allowed: by default the triangle's corners would add lines, and stay sharp.
+  const fromCli = runCli(['vtg', triangle, '-o', out, '--inside-corners', '--no-dynamics', '--allow-more-lines', '1000', '--json']);
+  const { report, output } = reportOf(qp.vtg(fs.readFileSync(triangle), { inside_corners: true, dynamics: false, allow_more_lines_pct: 1000 }));
   assert.deepEqual(report, fromCli);
   assert.ok(Buffer.from(output).equals(fs.readFileSync(out)), 'rewritten file differs from the CLI output');
-  const racing = reportOf(qp.vtg(fs.readFileSync(triangle), { dynamics: false }));
+  const racing = reportOf(qp.vtg(fs.readFileSync(triangle), { dynamics: false, allow_more_lines_pct: 1000 }));
   assert.ok(!Buffer.from(racing.output).equals(Buffer.from(output)), 'inside corners changed nothing');
   assert.ok(racing.report.paths.keyholes < report.paths.keyholes, 'the racing line rounds tips the inside line loops');
   assert.ok(report.max_deviation_mm <= report.tolerance_mm);
