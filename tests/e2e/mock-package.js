@@ -105,6 +105,7 @@ export function vtg(input, options = {}, progress) {
     before,
     after,
     firmware: null,
+    message: null,
     options_seen: options,
     output,
   };
