@@ -105,7 +105,14 @@
 //! for _ in 0..3 {
 //!     gcode.push_str("G1 X20 Y0 E1\nG1 X20 Y20 E1\nG1 X0 Y20 E1\nG1 X0 Y0 E1\n");
 //! }
-//! let options = VtgOptions { tolerance_mm: 0.1, dynamics: false, ..Default::default() };
+//! // Rounding a square's corners takes more lines than its four vertices: allowed here. By
+//! // default the file gains no lines, and corners that would add them stay sharp.
+//! let options = VtgOptions {
+//!     tolerance_mm: 0.1,
+//!     dynamics: false,
+//!     allow_more_lines_pct: 1000.0,
+//!     ..Default::default()
+//! };
 //! let report = vtg(gcode.as_bytes(), &options).unwrap();
 //! assert!(report.max_deviation_mm <= 0.1);
 //! assert!(report.table1.n_turning.after < report.table1.n_turning.before);
