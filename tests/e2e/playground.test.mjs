@@ -539,7 +539,8 @@ test('the job UI with every capability: tables, charts, downloads, before/after 
   assert.equal(await id('view-mode').inputValue(), 'side');
   await tab.waitForFunction(() => /after/.test(document.querySelector('[data-testid="layer-info"]').textContent));
   assert.match(tab.url(), /vtg\.tolerance_mm=0\.05/);
-  assert.match(tab.url(), /vtg\.arcs=1/);
+  assert.match(tab.url(), /vtg\.arcs=on/);
+  assert.match(tab.url(), /vtg\.allow_more_lines_pct=25/);
   assert.match(tab.url(), /vtg\.inside_corners=1/);
   assert.match(tab.url(), /vtg\.allow_slower_pct=0\.5/);
   assert.match(tab.url(), /view=side/);
