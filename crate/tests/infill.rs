@@ -396,11 +396,12 @@ fn no_fixture_gets_a_dearer_file() {
     );
 }
 
-/// Racing (candidates ruled out on every 4th layer) on own parts with bores, thin ribs and a
-/// plain cube: the same best as costing every candidate whole, every candidate it costed
-/// whole the same, every one it ruled out truly worse than the best, and its estimates within
-/// a third of the change the whole file shows (measured: up to a quarter, on the cube's
-/// Archimedean chords; the candidates ruled out here are 3.8 % to 18 % worse than the original).
+/// Racing (candidates ruled out on every 16th and every 4th layer) on own parts with bores,
+/// thin ribs and a plain cube (the ribbed box and the cube are tall enough for both samples):
+/// the same best as costing every candidate whole, every candidate it costed whole the same,
+/// every one it ruled out truly worse than the best, and its estimates within 0.4 of the
+/// change the whole file shows, the error `racing::CHANGE_SHARE` allows for (measured: up to
+/// 0.36, on the cube's Archimedean chords, ruled out on the coarse sample of six layers).
 #[test]
 fn candidates_ruled_out_on_a_sample_are_truly_worse() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/gcode");
@@ -440,7 +441,7 @@ fn candidates_ruled_out_on_a_sample_are_truly_worse() {
                 (r.time_s, w.time_s, before.time_s),
             ] {
                 assert!(
-                    (e - x).abs() <= 0.35 * (x - o).abs() + 1e-9 * o,
+                    (e - x).abs() <= 0.4 * (x - o).abs() + 1e-9 * o,
                     "{what}: estimate {e}, whole {x}, original {o}"
                 );
             }

@@ -175,13 +175,26 @@ pub(crate) fn replay<R: Replacements + ?Sized>(
     rotation: Option<&Rotation>,
     base: &Baseline,
 ) -> Costs {
-    replay_blocks(prog, replace, rotation, base, None)
+    replay_ops(prog, &prog.ops, replace, rotation, base, None)
 }
 
 /// [`replay`], also summing `[servo J, s]` of each replaced block's planned moves into
 /// `per_block` (indexed like `prog.blocks`).
 pub(crate) fn replay_blocks<R: Replacements + ?Sized>(
     prog: &Program,
+    replace: &R,
+    rotation: Option<&Rotation>,
+    base: &Baseline,
+    per_block: Option<&mut Vec<[f64; 2]>>,
+) -> Costs {
+    replay_ops(prog, &prog.ops, replace, rotation, base, per_block)
+}
+
+/// [`replay_blocks`] over `ops`, the program's operations or a subsequence of them (a sample
+/// of its layers, [`super::racing`]).
+pub(crate) fn replay_ops<R: Replacements + ?Sized>(
+    prog: &Program,
+    ops: &[Op],
     replace: &R,
     rotation: Option<&Rotation>,
     base: &Baseline,
@@ -197,7 +210,7 @@ pub(crate) fn replay_blocks<R: Replacements + ?Sized>(
     let mut infill_metrics = crate::analyze::toolpath::MetricsAccumulator::new(
         crate::analyze::toolpath::DEFAULT_CRITICAL_ANGLE_DEG,
     );
-    for op in &prog.ops {
+    for op in ops {
         let Op::Move(i) = op else {
             run.other(op);
             continue;

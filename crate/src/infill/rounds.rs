@@ -214,12 +214,15 @@ fn slots_and_keys(
     (slots, keys)
 }
 
-/// What ruling candidates out needs: the sample, the original's costs at each rotation, and
+/// What ruling candidates out needs: the samples, the original's costs at each rotation, and
 /// the best exact score so far.
 struct Race<'a> {
     prep: &'a Prepared<'a>,
     rotations: &'a [(f64, Option<Rotation>)],
-    probe: Option<Probe>,
+    /// The samples, coarse first ([`racing::COARSE`], [`racing::FINE`]); none for a part too
+    /// thin to sample, and a coarse one only for a tall part.
+    probes: Vec<Probe>,
+    /// The original's whole-file costs at each rotation.
     bases: Vec<Costs>,
     best_exact: Option<f64>,
     /// The best exact score when the current pattern started.
@@ -235,13 +238,18 @@ impl<'a> Race<'a> {
     ) -> Self {
         // One pattern is never sampled (nothing exact comes before it): no sample, and no
         // replays of the original at every rotation for one.
-        let probe = if options.exhaustive || options.patterns.len() < 2 {
+        let fine = if options.exhaustive || options.patterns.len() < 2 {
             None
         } else {
-            Probe::of(prep)
+            Probe::of(prep, racing::FINE, rotations)
         };
-        let bases = match probe {
-            Some(_) => crate::parallel::map_each(rotations, |(_, r)| match r {
+        let mut probes = Vec::new();
+        if let Some(fine) = fine {
+            probes.extend(Probe::of(prep, racing::COARSE, rotations));
+            probes.push(fine);
+        }
+        let bases = match probes.is_empty() {
+            false => crate::parallel::map_each(rotations, |(_, r)| match r {
                 None => *base_costs,
                 Some(r) => replay(
                     &prep.prog,
@@ -250,21 +258,21 @@ impl<'a> Race<'a> {
                     &prep.base,
                 ),
             }),
-            None => Vec::new(),
+            true => Vec::new(),
         };
         Self {
             prep,
             rotations,
-            probe,
+            probes,
             bases,
             best_exact: None,
             threshold: None,
         }
     }
 
-    /// Estimates the round's keys on the probe's sample of layers and files in `g` those whose
-    /// every wanted rotation is ruled out against the best exact score ([`racing`]); the keys
-    /// left to cost whole (all of them before anything is exact, or without a sample).
+    /// Estimates the round's keys on the samples of layers and files in `g` those whose every
+    /// wanted rotation is ruled out against the best exact score ([`racing`]); the keys left
+    /// to cost whole (all of them before anything is exact, or without a sample).
     fn sample(
         &self,
         g: &mut Geometries,
@@ -273,9 +281,9 @@ impl<'a> Race<'a> {
         wanted: &[(i64, usize)],
         judge: &dyn Fn(&Costs) -> f64,
     ) -> Vec<(i64, f64)> {
-        let (Some(probe), Some(_)) = (&self.probe, self.threshold) else {
+        if self.probes.is_empty() || self.threshold.is_none() {
             return keys.to_vec();
-        };
+        }
         // One sample per (key, rotation): every angle of concentric loops shares a key.
         let mut pairs: Vec<(i64, f64, usize)> = Vec::new();
         for &(key, beta) in keys {
@@ -285,31 +293,65 @@ impl<'a> Race<'a> {
                 }
             }
         }
-        let estimates = crate::parallel::map_each(&pairs, |&(_, beta, ri)| {
-            let rotation = self.rotations.get(ri).and_then(|r| r.1.as_ref());
-            let base = self.bases.get(ri).copied().unwrap_or_default();
-            probe.estimate(self.prep, pattern, beta, rotation, &base)
-        });
+        let verdicts = self.verdicts(pattern, &pairs, judge);
         // In key order up to the first survivor, whatever the round's size: the same
         // candidates are ruled out on one thread (wasm) as on many.
         let mut left = Vec::new();
         for &(key, beta) in keys {
-            let mine: Vec<(usize, &Costs)> = pairs
+            let mine: Vec<(usize, &(Costs, bool))> = pairs
                 .iter()
-                .zip(&estimates)
+                .zip(&verdicts)
                 .filter(|(p, _)| p.0 == key)
-                .map(|(p, c)| (p.2, c))
+                .map(|(p, v)| (p.2, v))
                 .collect();
-            let out = |c: &&Costs| racing::ruled_out(judge(c), self.threshold);
-            if left.is_empty() && !mine.is_empty() && mine.iter().all(|(_, c)| out(c)) {
-                for (ri, c) in mine {
-                    g.estimated.insert((key, ri), *c);
+            if left.is_empty() && !mine.is_empty() && mine.iter().all(|(_, v)| v.1) {
+                for (ri, v) in mine {
+                    g.estimated.insert((key, ri), v.0);
                 }
             } else {
                 left.push((key, beta));
             }
         }
         left
+    }
+
+    /// Each pair's estimate and whether it is ruled out: on the coarse sample first, and on
+    /// the next sample for those the coarse one leaves in.
+    fn verdicts(
+        &self,
+        pattern: Pattern,
+        pairs: &[(i64, f64, usize)],
+        judge: &dyn Fn(&Costs) -> f64,
+    ) -> Vec<(Costs, bool)> {
+        let mut verdicts: Vec<Option<(Costs, bool)>> = vec![None; pairs.len()];
+        for (n, probe) in self.probes.iter().enumerate() {
+            let last = n + 1 == self.probes.len();
+            let open: Vec<usize> = (0..pairs.len())
+                .filter(|&i| verdicts[i].is_none())
+                .collect();
+            let estimates = crate::parallel::map_each(&open, |&i| {
+                let (_, beta, ri) = pairs[i];
+                let rotation = self.rotations.get(ri).and_then(|r| r.1.as_ref());
+                let base = self.bases.get(ri).copied().unwrap_or_default();
+                probe.estimate(self.prep, (pattern, beta), (ri, rotation), &base)
+            });
+            for (&i, e) in open.iter().zip(estimates) {
+                let base = self.bases.get(pairs[i].2).copied().unwrap_or_default();
+                let scores = racing::Scores {
+                    estimate: judge(&e.costs),
+                    original: judge(&base),
+                    halves: e.halves.each_ref().map(judge),
+                };
+                let out = racing::ruled_out(&scores, self.threshold, probe.margin);
+                if out || last {
+                    verdicts[i] = Some((e.costs, out));
+                }
+            }
+        }
+        verdicts
+            .into_iter()
+            .map(Option::unwrap_or_default)
+            .collect()
     }
 
     /// Starts a pattern: its candidates are judged against the best exact score of the
