@@ -47,8 +47,8 @@ pub struct Args {
     /// on the whole file, as with --exhaustive).
     #[arg(long)]
     pub csv: Option<PathBuf>,
-    /// Cost every candidate on the whole file (by default a candidate whose estimate from every
-    /// 4th layer is over 2 % worse than the best so far is listed with that estimate).
+    /// Cost every candidate on the whole file (by default a candidate whose estimate from a
+    /// sample of layers is clearly worse than the best so far is listed with that estimate).
     #[arg(long)]
     pub exhaustive: bool,
     /// Allow the output to replace the input file.
