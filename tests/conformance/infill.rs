@@ -210,8 +210,9 @@ fn fixture(name: &str) -> Vec<u8> {
 }
 
 /// The thesis's findings on its DOE geometries (Somade 2023, Table 4, conclusions 2 and 3):
-/// rectilinear infill at 45° costs the most stepper energy and 0°/90° the least; rectilinear
-/// is the cheapest of the five patterns. The first holds on every geometry; the second holds
+/// rectilinear infill at 45° costs the most stepper energy and 0°/90° the least, and the search
+/// saves at least 3 % of it against 45° (the bar); rectilinear is the cheapest of the
+/// five patterns. The first holds on every geometry; the second holds
 /// against Hilbert, Archimedean chords and the octagram spiral, while our concentric loops
 /// (printed as one connected stroke, not as separate loops with a travel and retraction each)
 /// come out level with or below rectilinear on convex shapes — see the README.
@@ -249,6 +250,14 @@ fn thesis_findings_on_its_geometries() {
         assert!(
             rect[1] > rect[0] && rect[1] > rect[2],
             "{shape}: 45° must cost most: {rect:?}"
+        );
+        // The search (least total energy) saves at least 3 % of stepper energy against 45°
+        // rectilinear, the slicer's default (measured: 6.9 % to 15.7 %).
+        assert!(
+            r.best.thesis_j <= 0.97 * rect[1],
+            "{shape}: the search's best {:.0} J against 45° rectilinear {:.0} J",
+            r.best.thesis_j,
+            rect[1]
         );
         for p in [
             Pattern::Hilbert,
