@@ -40,6 +40,10 @@ pub struct Args {
     /// energy; 100 rounds every corner the tolerance allows.
     #[arg(long, value_name = "PCT", default_value_t = quietpath::vtg::DEFAULT_ALLOW_SLOWER_PCT)]
     pub allow_slower: f64,
+    /// Total energy the rewrite may add, percent of the original's. 0 (the default): the time
+    /// --allow-slower allows is spent only while the file uses no more energy than before.
+    #[arg(long, value_name = "PCT", default_value_t = 0.0)]
+    pub allow_more_energy: f64,
     /// Lines the rewritten file may have over the original's, percent. Each rounded corner
     /// takes several lines where the original had one; a printer fed over USB or from SD reads
     /// only so many a second. 0 (the default): never more lines than the original, the paths
@@ -79,6 +83,7 @@ pub fn run(args: Args) -> Result<(), String> {
         dynamics: !args.no_dynamics,
         arcs: args.arcs.into(),
         allow_slower_pct: args.allow_slower,
+        allow_more_energy_pct: args.allow_more_energy,
         allow_more_lines_pct: args.allow_more_lines,
         inside_corners: args.inside_corners,
         estimates: !args.no_estimates,

@@ -97,11 +97,17 @@ pub struct VtgOptions {
     /// firmware takes sharp corners faster than any fillet within the tolerance (Klipper with a
     /// square-corner velocity of 50–100 mm/s) rounding costs time, and motor and standby
     /// energy with it: this buys the corners that remove the most sharp turns for their time
-    /// first, energy weighed in. Where rounding costs nothing
+    /// first, energy weighed in, while the file's energy stays within
+    /// [`VtgOptions::allow_more_energy_pct`]. Where rounding costs nothing
     /// (every Marlin file of the corpus) it changes nothing. 0: the print gets no slower and
     /// uses no more energy, the corners that would cost being paid only out of what the other
     /// rewrites save. 100 rounds every corner the tolerance allows.
     pub allow_slower_pct: f64,
+    /// Total energy the rewrite may add, percent of the original's (default 0: the rewritten
+    /// file uses no more energy than the original). The time [`VtgOptions::allow_slower_pct`]
+    /// allows is spent only while the whole file's energy, as `analyze` measures it, stays
+    /// within this; where it would not, the allowance is cut until it does.
+    pub allow_more_energy_pct: f64,
     /// Round corners only on the inside, with fillets tangent to the legs (default false: where
     /// the path has room, a corner takes the racing line, easing out by up to the tolerance
     /// before it and back after it, round a circle 2.4 times wider at 90°; see
@@ -144,6 +150,7 @@ impl Default for VtgOptions {
             dynamics: true,
             arcs: ArcsMode::Auto,
             allow_slower_pct: DEFAULT_ALLOW_SLOWER_PCT,
+            allow_more_energy_pct: 0.0,
             inside_corners: false,
             estimates: true,
             min_segment_time_ms: None,
@@ -176,6 +183,9 @@ impl VtgOptions {
         }
         if !(0.0..=100.0).contains(&self.allow_slower_pct) {
             return bad("allow_slower_pct must be a number in [0, 100]");
+        }
+        if !(0.0..=100.0).contains(&self.allow_more_energy_pct) {
+            return bad("allow_more_energy_pct must be a number in [0, 100]");
         }
         if !self
             .min_segment_time_ms

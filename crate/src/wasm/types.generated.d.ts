@@ -2922,12 +2922,20 @@ export type VtgOptions = Partial<{
    * firmware takes sharp corners faster than any fillet within the tolerance (Klipper with a
    * square-corner velocity of 50–100 mm/s) rounding costs time, and motor and standby
    * energy with it: this buys the corners that remove the most sharp turns for their time
-   * first, energy weighed in. Where rounding costs nothing
+   * first, energy weighed in, while the file's energy stays within
+   * [`VtgOptions::allow_more_energy_pct`]. Where rounding costs nothing
    * (every Marlin file of the corpus) it changes nothing. 0: the print gets no slower and
    * uses no more energy, the corners that would cost being paid only out of what the other
    * rewrites save. 100 rounds every corner the tolerance allows.
    */
   allow_slower_pct: number,
+  /**
+   * Total energy the rewrite may add, percent of the original's (default 0: the rewritten
+   * file uses no more energy than the original). The time [`VtgOptions::allow_slower_pct`]
+   * allows is spent only while the whole file's energy, as `analyze` measures it, stays
+   * within this; where it would not, the allowance is cut until it does.
+   */
+  allow_more_energy_pct: number,
   /**
    * Round corners only on the inside, with fillets tangent to the legs (default false: where
    * the path has room, a corner takes the racing line, easing out by up to the tolerance

@@ -155,7 +155,10 @@ pub(crate) fn smooth_cut(
 /// The choice counts the time each path adds as planned with its neighbours only; across the
 /// file the firmware's look-ahead adds a little more, so where the whole file comes out slower
 /// than allowed the allowance is cut by the excess and the choice made again (at most
-/// `Tuning::time_rounds` times, then without any allowance).
+/// `Tuning::time_rounds` times, then without any allowance). The time bought also costs
+/// energy (the motors, heaters and electronics run as long as the print does): where the whole
+/// file comes out dearer than `allow_more_energy_pct` allows, the allowance is cut to the time
+/// spent less the excess energy's worth of time at the print's mean power.
 pub(crate) fn within_allowed_time(
     input: &[u8],
     offers: &rewrite::Offers,
@@ -168,20 +171,27 @@ pub(crate) fn within_allowed_time(
     } else {
         0.0
     };
+    let energy_cap = before.energy.total_j * (1.0 + options.allow_more_energy_pct / 100.0);
     let mut allowed_s = allowed;
     let mean_power_w = before.energy.total_j / before.time_s;
     let lines = allowed_lines(input, options);
     for _ in 0..TUNING.time_rounds {
-        if allowed_s <= 0.0 {
+        if allowed_s <= 0.0 || !allowed_s.is_finite() {
             break;
         }
         let rewritten = offers.write(input, (allowed_s, lines), mean_power_w);
         let after = crate::analyze::analyze(&rewritten.output, &options.analyze)?;
         let added = after.time_s - before.time_s;
-        if added <= allowed {
+        let over_j = after.energy.total_j - energy_cap;
+        if added <= allowed && over_j <= 0.0 {
             return Ok((rewritten, Some(after)));
         }
-        allowed_s -= TUNING.time_margin * (added - allowed);
+        if added > allowed {
+            allowed_s -= TUNING.time_margin * (added - allowed);
+        }
+        if over_j > 0.0 {
+            allowed_s = allowed_s.min(added) - TUNING.time_margin * over_j / mean_power_w;
+        }
     }
     Ok((offers.write(input, (0.0, lines), mean_power_w), None))
 }

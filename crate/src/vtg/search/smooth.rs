@@ -1043,13 +1043,9 @@ mod tests {
         assert!(a.points.windows(2).all(|w| w[0] != w[1]) && a.points[0] != pts[0]);
     }
 
-    /// On a Klipper machine whose square-corner velocity takes sharp corners fast (the K1's
-    /// 50 mm/s at 5000 mm/s²), every corner of a square costs time to round; the polygons placed
-    /// for its look-ahead cost about 3.5 ms a corner through the real planner, where a fillet
-    /// fitted and walked cost 5.6 ms and a circle on the racing line 4.5 ms. Bought with the
-    /// time allowed, all 40 corners go.
-    #[test]
-    fn klipper_square_corners_are_bought_as_polygons() {
+    /// Ten layers of a 20 mm square at 200 mm/s on a Klipper machine with a square-corner
+    /// velocity of 50 mm/s: every corner costs time and energy to round.
+    fn klipper_square() -> String {
         let mut src = String::from(
             "SET_VELOCITY_LIMIT ACCEL=5000 ACCEL_TO_DECEL=2500 SQUARE_CORNER_VELOCITY=50\nM83\n",
         );
@@ -1061,9 +1057,48 @@ mod tests {
             }
         }
         src.push_str("G1 X60 Y50 E0.3\n");
+        src
+    }
+
+    /// The same square with time allowed but no more energy (the default): the time is spent
+    /// only while the file's energy does not rise, so fewer corners go than with energy allowed,
+    /// and the energy, as `analyze` measures the written file, is not higher.
+    #[test]
+    fn klipper_square_time_allowance_buys_no_energy_by_default() {
+        let src = klipper_square();
+        let options = |energy_pct: f64| crate::vtg::VtgOptions {
+            dynamics: false,
+            allow_slower_pct: 10.0,
+            allow_more_energy_pct: energy_pct,
+            allow_more_lines_pct: 1000.0,
+            ..Default::default()
+        };
+        let guarded = crate::vtg::vtg(src.as_bytes(), &options(0.0)).expect("vtg");
+        let free = crate::vtg::vtg(src.as_bytes(), &options(10.0)).expect("vtg");
+        let e = &guarded.table2.energy_j;
+        assert!(e.after <= e.before, "{e:?}");
+        assert!(free.table2.energy_j.after > free.table2.energy_j.before);
+        assert!(
+            guarded.table1.n_turning.after > free.table1.n_turning.after,
+            "{:?} {:?}",
+            guarded.table1.n_turning,
+            free.table1.n_turning
+        );
+    }
+
+    /// On a Klipper machine whose square-corner velocity takes sharp corners fast (the K1's
+    /// 50 mm/s at 5000 mm/s²), every corner of a square costs time to round; the polygons placed
+    /// for its look-ahead cost about 3.5 ms a corner through the real planner, where a fillet
+    /// fitted and walked cost 5.6 ms and a circle on the racing line 4.5 ms. Bought with the
+    /// time allowed, all 40 corners go.
+    #[test]
+    fn klipper_square_corners_are_bought_as_polygons() {
+        let src = klipper_square();
         let options = crate::vtg::VtgOptions {
             dynamics: false,
             allow_slower_pct: 10.0,
+            // Every corner here costs time and energy: the energy guard is tested apart.
+            allow_more_energy_pct: 10.0,
             // Rounding a rectangle's corners adds lines; the line budget is tested apart.
             allow_more_lines_pct: 1000.0,
             ..Default::default()
