@@ -168,7 +168,9 @@ pub(crate) fn free_within_lines(offers: &[Offer], allowed: i64) -> LineChoice {
         }
     }
     savers.sort_by_key(|&(k, lines, _)| (lines, k));
-    let reserve = |savers: &[(usize, i64, [f64; 2])]| -> i64 { savers.iter().map(|s| -s.1).sum() };
+    // Lines left plus those the savers not yet drawn would free: drawing a saver moves its
+    // lines from one to the other, so only a rewrite taken changes it.
+    let mut room = savers.iter().fold(pool.left, |r, s| r.saturating_sub(s.1));
     if !pool.draw(&mut savers, (0, [0.0; 2]), &mut keep_free) {
         // The savings do not cover the header the estimates add: the file stays as it was.
         return LineChoice {
@@ -183,13 +185,14 @@ pub(crate) fn free_within_lines(offers: &[Offer], allowed: i64) -> LineChoice {
             .then(a.0.cmp(&b.0))
     });
     for (k, lines, _) in adding {
-        if lines > pool.left + reserve(&savers) {
+        if lines > room {
             continue;
         }
         let added = offers[k].free.as_ref().map_or([0.0; 2], |f| f.added);
         if pool.draw(&mut savers, (lines, added), &mut keep_free) {
             keep_free[k] = true;
             pool.take(lines, added);
+            room = room.saturating_sub(lines);
         }
     }
     LineChoice {
