@@ -109,6 +109,9 @@ pub struct LayerVibration {
     pub z: Option<f64>,
     /// Vibration amplitude: the largest trajectory deviation in the layer, mm.
     pub amplitude: f64,
+    /// The largest deviation while extruding in the layer, mm (0 where it prints nothing): the
+    /// layer's share of the printing peak, which VTG's no-dearer rule holds.
+    pub printing_amplitude: f64,
     /// Mean deviation in the layer, mm.
     pub mean: f64,
     /// RMS of the table's acceleration in the layer, m/s².
@@ -355,6 +358,7 @@ fn layer_vibrations(outcome: &simulate::Outcome, path: &PrintPath) -> Vec<LayerV
             layer: i,
             z: path.layers.get(i).and_then(|l| l.z),
             amplitude: l.deviation.max,
+            printing_amplitude: l.printing_max,
             mean: l.deviation.mean(),
             acceleration_rms: if l.accel_count > 0 {
                 (l.accel_sq / l.accel_count as f64).sqrt()

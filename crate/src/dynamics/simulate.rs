@@ -86,6 +86,8 @@ impl Stats {
 pub struct LayerSums {
     /// Deviation, mm.
     pub deviation: Stats,
+    /// Largest deviation while extruding, mm (0 in a layer that prints nothing).
+    pub printing_max: f64,
     /// Sum of squared acceleration samples, (m/s²)².
     pub accel_sq: f64,
     /// Acceleration samples.
@@ -175,6 +177,9 @@ impl Outcome {
         }
         if let Some(l) = self.layers.get_mut(layer as usize) {
             l.deviation.add(dev);
+            if extruding {
+                l.printing_max = l.printing_max.max(dev);
+            }
         }
     }
 

@@ -239,22 +239,29 @@ pub fn vtg_with_progress(
         options,
         limits: rewrite::limits_for(&path, options),
     };
-    let attempt = |variant, before, progress: Progress<'_>| run.attempt(variant, before, progress);
+    let attempt = |variant, kept: &[bool], before, progress: Progress<'_>| {
+        run.attempt(variant, kept, before, progress)
+    };
     let first = search::Variant::default();
     // The original's simulated deviation does not depend on the rewrite: where there are
     // threads, it runs beside the first one (on a long print it takes as long).
     let (original_deviation, report) = crate::parallel::join(
         || options.dynamics.then(|| printing_deviation(input, options)),
-        || attempt(first, before, &mut |f| progress(0.3 + 0.4 * f)),
+        || attempt(first, &[], before, &mut |f| progress(0.3 + 0.4 * f)),
     );
     let mut report = report?;
     if !progress(0.7) {
         return Err(cancelled());
     }
     if let Some(original) = original_deviation {
-        report = with_simulated_deviation(original, report, options, &mut |variant, before, f| {
-            attempt(variant, before, &mut |g| progress(f + 0.05 * g))
-        })?;
+        report = with_simulated_deviation(
+            original,
+            report,
+            options,
+            &mut |variant, kept, before, f| {
+                attempt(variant, kept, before, &mut |g| progress(f + 0.05 * g))
+            },
+        )?;
     }
     let mut report = with_estimates(input, report, options)?;
     report.firmware = Some(firmware_report(input, &report.output, &path, options)?);
@@ -272,10 +279,12 @@ struct Run<'a> {
 }
 
 impl Run<'_> {
-    /// One rewrite tried as `variant`, analysed and reported (`before`: the original's analysis).
+    /// One rewrite tried as `variant`, the layers `kept` marks left as they are, analysed and
+    /// reported (`before`: the original's analysis).
     fn attempt(
         &self,
         variant: search::Variant,
+        kept: &[bool],
         before: Report,
         progress: Progress<'_>,
     ) -> Result<VtgReport, Error> {
@@ -287,7 +296,14 @@ impl Run<'_> {
             limits,
         } = *self;
         let mut step = |f: f64| progress(0.8 * f);
-        let offers = rewrite::offers(input, path, sources, options, &limits, variant, &mut step)?;
+        let offers = rewrite::offers(
+            input,
+            path,
+            sources,
+            (options, &limits),
+            (variant, kept),
+            &mut step,
+        )?;
         if !progress(0.8) {
             return Err(Error::new(0, 0, ErrorKind::Cancelled));
         }
@@ -382,23 +398,25 @@ fn with_estimates(
 /// millimetre or so in radius, and on some files that rang more than the stop did. If no scale
 /// brings the mean below the original's with them, the scales are tried again without keyholes.
 ///
-/// If even the quietest rewrite raises the mean or the peak deviation over the original's, the
-/// original is handed back unchanged, with a `message` saying so: no file comes back ringing
-/// more than it went in.
+/// Where the quietest rewrite lowers the mean but raises the peak, the layers that ring above
+/// the original's peak are kept as they were ([`keep_peak_layers`]). If even that does not
+/// bring the peak down, or the quietest rewrite raises the mean, the original is handed back
+/// unchanged, with a `message` saying so: no file comes back ringing more than it went in.
 ///
 /// `None` rows when the model cannot run (a print too long to simulate, for instance): the
 /// rest of the report stands without them.
 fn with_simulated_deviation(
-    original: Option<crate::dynamics::Deviation>,
+    original: Option<Simulated>,
     first: VtgReport,
     options: &VtgOptions,
-    again: &mut dyn FnMut(search::Variant, Report, f64) -> Result<VtgReport, Error>,
+    again: &mut Again<'_>,
 ) -> Result<VtgReport, Error> {
-    let mean = |bytes: &[u8]| printing_deviation(bytes, options);
-    let Some(b) = original else {
+    let simulate = |bytes: &[u8]| printing_deviation(bytes, options);
+    let Some(orig) = original else {
         return Ok(first);
     };
-    let rows = |a: crate::dynamics::Deviation| report::DeviationComparison {
+    let b = orig.deviation;
+    let rows = |a: &crate::dynamics::Deviation| report::DeviationComparison {
         max_mm: Comparison::new(b.max, a.max),
         min_mm: Comparison::new(b.min, a.min),
         mean_mm: Comparison::new(b.mean, a.mean),
@@ -406,15 +424,15 @@ fn with_simulated_deviation(
     let mut best = first;
     if best.paths.rewritten == 0 && best.paths.compacted == 0 {
         // Nothing rewritten: the file rings as the original does, and no variant would differ.
-        best.table2.deviation = Some(rows(b));
+        best.table2.deviation = Some(rows(&b));
         return Ok(best);
     }
-    let Some(a) = mean(&best.output) else {
+    let Some(mut best_sim) = simulate(&best.output) else {
         return Ok(best);
     };
-    best.table2.deviation = Some(rows(a));
-    let mut best_score = quietness(&b, &a);
-    let mut best_a = a;
+    best.table2.deviation = Some(rows(&best_sim.deviation));
+    let mut best_score = quietness(&b, &best_sim.deviation);
+    let mut best_variant = search::Variant::default();
     // Faster speeds only where the feed is the VTG eq. 29 one.
     let variants = search::quieter_variants().filter(|_| options.limit_feed);
     for (k, variant) in variants.enumerate() {
@@ -422,49 +440,134 @@ fn with_simulated_deviation(
             break;
         }
         let f = 0.7 + 0.05 * k as f64;
-        let mut next = again(variant, best.before.clone(), f)?;
-        let Some(a) = mean(&next.output) else {
+        let mut next = again(variant, &[], best.before.clone(), f)?;
+        let Some(a) = simulate(&next.output) else {
             break;
         };
-        let score = quietness(&b, &a);
+        let score = quietness(&b, &a.deviation);
         if score < best_score {
-            next.table2.deviation = Some(rows(a));
-            best_score = score;
-            best = next;
-            best_a = a;
+            next.table2.deviation = Some(rows(&a.deviation));
+            (best_score, best, best_sim, best_variant) = (score, next, a, variant);
         }
     }
+    let best_a = best_sim.deviation;
     if best_a.mean <= b.mean && best_a.max <= b.max {
         return Ok(best);
     }
+    if best_a.mean <= b.mean {
+        let before = best.before.clone();
+        if let Some((mut kept, a, layers)) =
+            keep_peak_layers(&orig, best_sim, best_variant, &before, options, again)?
+        {
+            kept.table2.deviation = Some(rows(&a.deviation));
+            kept.message = Some(format!(
+                "kept {} layer(s) as they were: rewritten, they rang above the original's \
+                 peak deviation ({:.4} mm)",
+                layers.len(),
+                b.max
+            ));
+            kept.peak_layers_kept = layers;
+            return Ok(kept);
+        }
+    }
     // Every rewrite tried rings more than the original: the original is handed back.
-    let mut kept = again(search::Variant::original(), best.before.clone(), 0.95)?;
-    kept.table2.deviation = Some(rows(b));
+    let mut kept = again(search::Variant::original(), &[], best.before.clone(), 0.95)?;
+    kept.table2.deviation = Some(rows(&b));
+    kept.message = Some(handed_back(&b, &best_a));
+    Ok(kept)
+}
+
+/// Why the original is handed back: the quietest rewrite's deviation `a` against the
+/// original's `b`.
+fn handed_back(b: &crate::dynamics::Deviation, a: &crate::dynamics::Deviation) -> String {
     let change = |before: f64, after: f64| {
         format!(
             "{:+.1} % ({before:.4} → {after:.4} mm)",
             (after / before - 1.0) * 100.0
         )
     };
-    kept.message = Some(format!(
+    format!(
         "kept the original: the quietest rewrite tried changed the dynamics model's mean \
          deviation by {} and its peak by {}, and neither may rise",
-        change(b.mean, best_a.mean),
-        change(b.max, best_a.max)
-    ));
-    Ok(kept)
+        change(b.mean, a.mean),
+        change(b.max, a.max)
+    )
 }
 
-/// The dynamics model's deviation over a file's printing moves, `None` when the model cannot
-/// run on it (a print too long to simulate, for instance).
-fn printing_deviation(bytes: &[u8], options: &VtgOptions) -> Option<crate::dynamics::Deviation> {
+/// A whole-file rewrite tried again: the variant, the layers kept as they are, the original's
+/// analysis, and where its progress starts.
+type Again<'a> = dyn FnMut(search::Variant, &[bool], Report, f64) -> Result<VtgReport, Error> + 'a;
+
+/// Rounds of [`keep_peak_layers`].
+const PEAK_ROUNDS: usize = 3;
+
+/// The rewrite as `variant` with the layers that ring above the original's peak deviation kept
+/// as they were: each round keeps the layers whose largest printing deviation in `sim` (the
+/// rewrite's) is above the original's peak and above that layer's own in the original, writes
+/// the file again and simulates it, up to [`PEAK_ROUNDS`] times. The rewrite, its simulation
+/// and the layers kept, once neither its mean nor its peak is above the original's;
+/// `None` if no round gets there (the mean rose, or no layer is left to keep).
+fn keep_peak_layers(
+    original: &Simulated,
+    mut sim: Simulated,
+    variant: search::Variant,
+    before: &Report,
+    options: &VtgOptions,
+    again: &mut Again<'_>,
+) -> Result<Option<(VtgReport, Simulated, Vec<usize>)>, Error> {
+    let b = original.deviation;
+    let mut kept = vec![false; original.layer_peaks.len().max(sim.layer_peaks.len())];
+    for _ in 0..PEAK_ROUNDS {
+        let mut more = false;
+        for (l, &peak) in sim.layer_peaks.iter().enumerate() {
+            let was = original.layer_peaks.get(l).copied().unwrap_or(0.0);
+            if peak > b.max && peak > was && !kept[l] {
+                kept[l] = true;
+                more = true;
+            }
+        }
+        if !more {
+            return Ok(None);
+        }
+        let next = again(variant, &kept, before.clone(), 0.95)?;
+        let Some(a) = printing_deviation(&next.output, options) else {
+            return Ok(None);
+        };
+        if a.deviation.mean > b.mean {
+            return Ok(None);
+        }
+        if a.deviation.max <= b.max {
+            let layers = (0..kept.len()).filter(|&l| kept[l]).collect();
+            return Ok(Some((next, a, layers)));
+        }
+        sim = a;
+    }
+    Ok(None)
+}
+
+/// What the dynamics model says of a file: the deviation over its printing moves, and the
+/// largest deviation while printing of each layer (by layer index).
+struct Simulated {
+    deviation: crate::dynamics::Deviation,
+    layer_peaks: Vec<f64>,
+}
+
+/// The dynamics model run on a file, `None` when it cannot run on it (a print too long to
+/// simulate, for instance).
+fn printing_deviation(bytes: &[u8], options: &VtgOptions) -> Option<Simulated> {
     let vibration = crate::dynamics::VibrationOptions {
         analyze: options.analyze.clone(),
         ..Default::default()
     };
-    crate::dynamics::vibration(bytes, &vibration)
-        .ok()
-        .map(|r| r.printing_deviation_mm)
+    let r = crate::dynamics::vibration(bytes, &vibration).ok()?;
+    let mut layer_peaks = vec![0.0; r.layers.iter().map(|l| l.layer + 1).max().unwrap_or(0)];
+    for l in &r.layers {
+        layer_peaks[l.layer] = l.printing_amplitude;
+    }
+    Some(Simulated {
+        deviation: r.printing_deviation_mm,
+        layer_peaks,
+    })
 }
 
 /// How a rewrite's simulated deviation `a` compares with the original's `b`, lower is

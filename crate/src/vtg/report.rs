@@ -187,9 +187,12 @@ pub struct VtgReport {
     /// Both files against the machine's segment budget: lines, bytes, short segments, the
     /// peak segment rate ([`super::firmware`]); `None` only while the report is assembled.
     pub firmware: Option<super::firmware::FirmwareReport>,
-    /// Why the original was handed back unchanged, when it was (`None`: the rewrite is the
-    /// output).
+    /// Why the original was handed back unchanged, or why some layers were kept as they were,
+    /// when either happened (`None`: the rewrite is the output as it is).
     pub message: Option<String>,
+    /// Layers (0-based) kept as they were because, rewritten, they rang above the original's
+    /// peak deviation in the dynamics model (empty: none).
+    pub peak_layers_kept: Vec<usize>,
     /// The rewritten G-code.
     #[serde(skip)]
     pub output: Vec<u8>,
@@ -272,5 +275,6 @@ pub(crate) fn build(
         firmware: None,
         output: rewritten.output,
         message: None,
+        peak_layers_kept: Vec::new(),
     }
 }

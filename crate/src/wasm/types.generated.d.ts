@@ -1538,6 +1538,11 @@ export type LayerVibration = {
    */
   amplitude: number,
   /**
+   * The largest deviation while extruding in the layer, mm (0 where it prints nothing): the
+   * layer's share of the printing peak, which VTG's no-dearer rule holds.
+   */
+  printing_amplitude: number,
+  /**
    * Mean deviation in the layer, mm.
    */
   mean: number,
@@ -3023,10 +3028,15 @@ export type VtgReport = {
    */
   firmware: FirmwareReport | null,
   /**
-   * Why the original was handed back unchanged, when it was (`None`: the rewrite is the
-   * output).
+   * Why the original was handed back unchanged, or why some layers were kept as they were,
+   * when either happened (`None`: the rewrite is the output as it is).
    */
   message: string | null,
+  /**
+   * Layers (0-based) kept as they were because, rewritten, they rang above the original's
+   * peak deviation in the dynamics model (empty: none).
+   */
+  peak_layers_kept: Array<number>,
 };
 
 /**

@@ -143,9 +143,8 @@ pub(crate) fn offers(
     input: &[u8],
     path: &PrintPath,
     all: &Sources,
-    options: &VtgOptions,
-    limits: &KinematicLimits,
-    variant: Variant,
+    (options, limits): (&VtgOptions, &KinematicLimits),
+    (variant, kept_layers): (Variant, &[bool]),
     progress: crate::progress::Progress<'_>,
 ) -> Result<Offers, Error> {
     let mut out = Offers {
@@ -177,7 +176,12 @@ pub(crate) fn offers(
     // independent, results are merged in file order (the same output on any number of
     // threads), and progress and cancellation are checked between batches.
     // Where arcs are written, the paths without sharp corners too: they can save lines.
-    let candidates = candidates(moves, sources, cos_critical, settings.arcs);
+    let mut candidates = candidates(moves, sources, cos_critical, settings.arcs);
+    // Layers kept as they are (where a rewrite rang above the original's peak).
+    candidates.retain(|&(i, _, _)| {
+        let layer = moves.get(i).map_or(u32::MAX, |m| m.layer) as usize;
+        !kept_layers.get(layer).copied().unwrap_or(false)
+    });
     out.candidate_paths = candidates.iter().filter(|c| c.2).count() as u64;
     let offering = Offering {
         input,
