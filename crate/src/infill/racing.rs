@@ -120,20 +120,9 @@ impl Probe {
         let count = (0..n).filter(|&k| picked(k)).count();
         let halves = [0, 1].map(|h| {
             let sampled: Vec<bool> = (0..n).map(|k| half_of(k) == Some(h)).collect();
-            let layers: Vec<usize> = prep
-                .work
-                .iter()
-                .zip(&sampled)
-                .filter(|(_, &s)| s)
-                .map(|(w, _)| w.layer)
-                .collect();
-            let part: f64 = prep
-                .work
-                .iter()
-                .zip(&sampled)
-                .filter(|(_, &s)| s)
-                .map(|(w, _)| w.target_mm)
-                .sum();
+            let chosen = || prep.work.iter().zip(&sampled).filter(|(_, &s)| s);
+            let layers: Vec<usize> = chosen().map(|(w, _)| w.layer).collect();
+            let part: f64 = chosen().map(|(w, _)| w.target_mm).sum();
             let ops = sample_ops(&prep.prog, &layers);
             let none: &[Option<Replacement>] = &[];
             Half {
