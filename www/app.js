@@ -15,6 +15,35 @@ import { LayerViewer } from './viewer.js';
 import { lineChart, clearChart, alignSeries, unionSeries } from './charts.js';
 
 /** @typedef {import('./jobs.js').LayerMessage} LayerMessage */
+/** @typedef {import('./jobs.js').JobError} JobError */
+/** @typedef {import('./pkg/quietpath.js').Report} Report */
+/** @typedef {import('./pkg/quietpath.js').AnalyzeOptions} AnalyzeOptions */
+/** @typedef {import('./pkg/quietpath.js').MachineInfo} MachineInfo */
+/** @typedef {import('./pkg/quietpath.js').MachineProfile} MachineProfile */
+/** @typedef {import('./pkg/quietpath.js').Limit} Limit */
+/** @typedef {import('./pkg/quietpath.js').OptimizeStage} OptimizeStage */
+/** @typedef {import('./pkg/quietpath.js').VibrationReport} VibrationReport */
+/** @typedef {import('./view3d.js').PartView} PartView */
+/** @typedef {import('./view3d.js').PartLayer} PartLayer */
+/**
+ * A job's result as plain JSON (plain()): a VtgReport, InfillReport, OptimizeReport, SmoothReport
+ * or VibrationReport, by the job. The page reads it field by field, defensively and whatever the
+ * job (`r.after?.time_s`, `Array.isArray(r.candidates)`, …), so it is left loose: `any`.
+ * @typedef {Record<string, any>} JobResult
+ */
+/** @typedef {'input' | 'output'} Target the file a job runs on: the loaded one or the output */
+/** @typedef {{ kind: 'load' | 'job', name: string, startedAt: number, posted?: boolean }} Run the run in flight */
+/** @typedef {{ name: string, load: () => Promise<ArrayBuffer> }} Source a file to analyze */
+/** @typedef {{ name: string, report: Report }} Loaded the analyzed file */
+/** @typedef {{ name: string, text: string, key: 'klipper_config' | 'machine_gcode' }} PrinterSettings */
+/**
+ * A row of the before/after table.
+ * @typedef {{ name: string, before: number | null | undefined, after: number | null | undefined, format: (v: number) => string, explain?: string, noChange?: boolean }} CompareRow
+ */
+/**
+ * A job run, kept for the job list.
+ * @typedef {{ id: number, job: string, result: JobResult, target: Target, ms: number, file: string | undefined, bytes: ArrayBuffer | null }} JobEntry
+ */
 
 /**
  * The element with this id: index.html has every one this file asks for.
@@ -73,6 +102,7 @@ const els = {
 
 const DEMO_URL = 'demo/demo.gcode';
 const MAX_WARNINGS_SHOWN = 500;
+/** @type {Record<string, string>} */
 const JOB_NAMES = { optimize: 'optimize', vtg: 'VTG', infill: 'infill search', smooth: 'orientation smoothing', vibration: 'vibration analysis' };
 const LAYER_CACHE = 32;
 
@@ -85,14 +115,22 @@ const KNOWN_FIELDS = new Set([
 
 // ── State ──────────────────────────────────────────────────────────────────
 
+/** @type {Run | null} */
 let current = null; // the run in flight: { kind: 'load'|'job', name, startedAt }
+/** @type {Source | null} */
 let lastSource = null; // { name, load: () => Promise<ArrayBuffer> }
+/** @type {Loaded | null} */
 let loaded = null; // the analyzed file: { name, report }
+/** @type {{ job: string, bytes: ArrayBuffer } | null} */
 let output = null; // the latest optimized G-code: { job, bytes: ArrayBuffer }
+/** @type {{ value: unknown, filename: string } | null} */
 let lastJson = null; // what report-json shows: { value, filename }
+/** @type {Set<string>} */
 let capabilities = new Set();
 let fileToken = 0; // bumps with every new file or output: stale layer data is dropped
+/** @type {Record<string, VibrationReport>} */
 const vibrationRuns = {}; // target → vibration result, for the before/after charts
+/** @type {Record<string, string>} */
 const downloadUrls = {};
 
 const client = new JobClient('./worker.js', {
@@ -112,11 +150,16 @@ const client = new JobClient('./worker.js', {
   },
 });
 
+/** @param {string} text */
 function setStatus(text) {
   els.status.textContent = text;
   els.status.dataset.state = text;
 }
 
+/**
+ * @param {'load' | 'job'} kind
+ * @param {string} name
+ */
 function startRun(kind, name) {
   // A file loaded over a running job: the progress goes back under the file picker.
   if (kind === 'load' && runState.classList.contains('in-job')) placeRunState(null);
@@ -141,6 +184,7 @@ const runFormObserver = new IntersectionObserver((entries) => {
   for (const e of entries) runState.classList.toggle('floating', runState.classList.contains('in-job') && !e.isIntersecting);
 });
 
+/** @param {HTMLFormElement | null} form */
 function placeRunState(form) {
   for (const f of els.actionForms) f.classList.toggle('running', f === form);
   runFormObserver.disconnect();
@@ -152,6 +196,7 @@ function placeRunState(form) {
   runState.classList.toggle('in-job', !!form);
 }
 
+/** @param {string} status */
 function finishRun(status) {
   if (current && status !== 'ready') els.elapsed.textContent = `${formatMs(performance.now() - current.startedAt)} total`;
   if (current?.kind === 'job') placeRunState(null);
@@ -162,11 +207,16 @@ function finishRun(status) {
   updateActions();
 }
 
+/** @param {number} fraction */
 const onProgress = (fraction) => {
   els.progress.value = Math.max(els.progress.value, Math.min(1, fraction));
 };
 
-// A failed request: cancelled (quietly), superseded (ignored) or an error.
+/**
+ * A failed request: cancelled (quietly), superseded (ignored) or an error.
+ * @param {unknown} err
+ * @param {{ keepResults: boolean }} opts
+ */
 function failRun(err, { keepResults }) {
   if (err instanceof Cancelled) {
     if (err.reason === 'superseded') return;
@@ -174,7 +224,7 @@ function failRun(err, { keepResults }) {
     els.elapsed.textContent = '';
     return;
   }
-  showError(err, { keepResults });
+  showError(/** @type {JobError} */ (err), { keepResults });
   finishRun('error');
 }
 
@@ -187,6 +237,7 @@ function failRun(err, { keepResults }) {
 const STORE_MACHINE = 'quietpath.machine';
 const STORE_SETTINGS = 'quietpath.printer-settings';
 const store = {
+  /** @param {string} key */
   get(key) {
     try {
       return localStorage.getItem(key);
@@ -194,6 +245,10 @@ const store = {
       return null; // storage disabled: nothing is remembered
     }
   },
+  /**
+   * @param {string} key
+   * @param {string | null} value
+   */
   set(key, value) {
     try {
       if (value === null) localStorage.removeItem(key);
@@ -203,6 +258,7 @@ const store = {
     }
   },
 };
+/** @type {PrinterSettings | null} */
 let printerSettings = (() => {
   try {
     const v = JSON.parse(store.get(STORE_SETTINGS) ?? 'null');
@@ -215,8 +271,10 @@ let printerSettings = (() => {
 // the file itself sets), a preset name, or 'upload' (the uploaded printer settings).
 let machineChoice = store.get(STORE_MACHINE) ?? '';
 if (machineChoice === 'upload' && !printerSettings) machineChoice = '';
+/** @type {MachineProfile[]} */
 let machines = []; // the package's presets (machines()), from the worker's hello
 
+/** @type {Record<string, string>} */
 const LIMIT_SOURCES = {
   profile: 'the printer preset',
   slicer_settings: "the slicer's settings in the file",
@@ -225,6 +283,7 @@ const LIMIT_SOURCES = {
   command: 'a command in the file (M201…, SET_VELOCITY_LIMIT)',
   option: 'an option of this page',
 };
+/** @type {Record<string, [string, string]>} */
 const LIMIT_NAMES = {
   max_feedrate: ['Top speed per axis (X, Y, Z, E)', 'mm/s'],
   max_acceleration: ['Top acceleration per axis (X, Y, Z, E)', 'mm/s²'],
@@ -242,7 +301,10 @@ const LIMIT_NAMES = {
   instantaneous_corner_velocity: ['Extruder corner velocity (Klipper)', 'mm/s'],
 };
 
-/** Limits the file itself sets (commands or the slicer's settings block). */
+/**
+ * Limits the file itself sets (commands or the slicer's settings block).
+ * @param {Report | undefined} report
+ */
 function fileLimitCount(report) {
   let n = 0;
   for (const v of Object.values(report?.machine?.limits ?? {})) {
@@ -272,12 +334,20 @@ function renderMachinePicker() {
   sel.dataset.fileLimits = String(fromFile);
 }
 
+/**
+ * @param {HTMLInputElement} input
+ * @param {string} message
+ */
 function optionError(input, message) {
   input.setAttribute('aria-invalid', 'true');
   return `${input.closest('label')?.firstChild?.textContent?.trim() || input.name}: ${message}`;
 }
 
-/** A number field against its min/max: the number, '' when empty, or an error message. */
+/**
+ * A number field against its min/max: the number, '' when empty, or an error message.
+ * @param {HTMLInputElement} input
+ * @returns {{ value: number | '', error?: undefined } | { error: string, value?: undefined }}
+ */
 function checkNumber(input) {
   input.removeAttribute('aria-invalid');
   const raw = String(input.value ?? '').trim();
@@ -296,13 +366,14 @@ function checkNumber(input) {
 /** The analyze options of the Options panel and the printer picker: { options, errors }. */
 function readOptions() {
   const form = new FormData(els.optionsForm);
+  /** @type {AnalyzeOptions} */
   const options = {};
   const errors = [];
   if (form.get('strict')) options.strict = true;
   if (machineChoice === 'upload' && printerSettings) options[printerSettings.key] = printerSettings.text;
   else if (machineChoice && machineChoice !== 'upload') options.machine = machineChoice;
-  for (const key of ['filament_diameter_mm', 'density_g_cm3']) {
-    const r = checkNumber(els.optionsForm.elements[key]);
+  for (const key of /** @type {const} */ (['filament_diameter_mm', 'density_g_cm3'])) {
+    const r = checkNumber(/** @type {HTMLFormControlsCollection & Record<string, HTMLInputElement>} */ (els.optionsForm.elements)[key]);
     if (r.error) errors.push(r.error);
     else if (r.value !== '') options[key] = r.value;
   }
@@ -313,11 +384,16 @@ function readOptions() {
   return { options, errors };
 }
 
-// What a file is when it is not G-code text, from its first bytes; null when it may be G-code.
+/**
+ * What a file is when it is not G-code text, from its first bytes; null when it may be G-code.
+ * @param {ArrayBuffer} bytes
+ */
 function notGcode(bytes) {
   const b = new Uint8Array(bytes, 0, Math.min(bytes.byteLength, 65536));
   if (b.length === 0) return 'The file is empty (0 bytes): there is nothing to analyze.';
+  /** @param {...(string | number)} sig */
   const starts = (...sig) => sig.every((v, i) => b[i] === (typeof v === 'string' ? v.charCodeAt(0) : v));
+  /** @type {[(string | number)[], string][]} */
   const kinds = [
     [[0x89, 'P', 'N', 'G'], 'a PNG image'],
     [[0xff, 0xd8, 0xff], 'a JPEG image'],
@@ -339,7 +415,15 @@ function notGcode(bytes) {
 // The printer bed's outline, [[x, y], …] in mm, from the slicer's settings in the file
 // (PrusaSlicer/SuperSlicer `; bed_shape = 0x0,180x0,…`, Orca/Creality `; printable_area = …`) or
 // an uploaded Klipper printer.cfg ([stepper_x]/[stepper_y] position_min/max); null if unknown.
+/**
+ * @param {ArrayBuffer} bytes
+ * @returns {number[][] | null}
+ */
 function bedShape(bytes) {
+  /**
+   * @param {number} a
+   * @param {number} b
+   */
   const text = (a, b) => new TextDecoder('latin1').decode(new Uint8Array(bytes, a, b - a));
   const n = bytes.byteLength;
   const parts = [text(Math.max(0, n - 262144), n), text(0, Math.min(n, 65536))];
@@ -351,8 +435,10 @@ function bedShape(bytes) {
     }
   }
   if (machineChoice === 'upload' && printerSettings?.key === 'klipper_config') {
+    /** @param {string} a */
     const axis = (a) => {
-      const sec = new RegExp(`^\\[stepper_${a}\\]([\\s\\S]*?)(?=^\\[|$(?![\\s\\S]))`, 'm').exec(printerSettings.text)?.[1] ?? '';
+      const sec = new RegExp(`^\\[stepper_${a}\\]([\\s\\S]*?)(?=^\\[|$(?![\\s\\S]))`, 'm').exec(/** @type {PrinterSettings} */ (printerSettings).text)?.[1] ?? '';
+      /** @param {string} k */
       const get = (k) => Number(new RegExp(`^\\s*${k}\\s*[:=]\\s*([-\\d.]+)`, 'm').exec(sec)?.[1]);
       const lo = Number.isFinite(get('position_min')) ? get('position_min') : 0;
       return [lo, get('position_max')];
@@ -364,7 +450,10 @@ function bedShape(bytes) {
   return null;
 }
 
-// A report with no move at all, on a file whose lines do not read as G-code: the reason, or null.
+/**
+ * A report with no move at all, on a file whose lines do not read as G-code: the reason, or null.
+ * @param {Report | null} report
+ */
 function noGcodeIn(report) {
   if (!report || report.moves > 0) return null;
   const warnings = Array.isArray(report.warnings) ? report.warnings : [];
@@ -376,11 +465,12 @@ function noGcodeIn(report) {
   return `No G-code moves found: ${formatCount(unread)} of ${formatCount(lines)} lines could not be read as G-code (line ${first.line}: ${first.message ?? 'unreadable'}). Is this a G-code file?`;
 }
 
+/** @param {Source} source */
 async function run(source) {
   lastSource = source;
   if (current) client.cancel('superseded');
   startRun('load', source.name);
-  const run = current;
+  const run = /** @type {Run} */ (current);
   run.posted = false;
   setStatus('reading');
   els.filename.textContent = source.name;
@@ -452,10 +542,15 @@ function cancel() {
   }
 }
 
+/**
+ * @param {File} file
+ * @returns {Source}
+ */
 function fileSource(file) {
   return { name: file.name, load: () => file.arrayBuffer() };
 }
 
+/** @returns {Source} */
 function demoSource() {
   return {
     name: 'demo.gcode',
@@ -469,8 +564,12 @@ function demoSource() {
 
 // ── Jobs (VTG, infill, smoothing, vibration) ───────────────────────────────
 
-/** Options of an action form: empty fields are left out (the function's defaults). */
+/**
+ * Options of an action form: empty fields are left out (the function's defaults).
+ * @param {HTMLFormElement} form
+ */
 function jobOptions(form) {
+  /** @type {Record<string, unknown>} */
   const options = {};
   for (const input of fieldsOf(form)) {
     if (!input.name || input.name === 'target') continue;
@@ -543,7 +642,7 @@ function fieldsOf(form) {
 function updateActions() {
   const busy = !!current;
   for (const form of els.actionForms) {
-    const job = form.dataset.job;
+    const job = /** @type {string} */ (form.dataset.job); // every action form has data-job
     const button = submitOf(form);
     const note = noteOf(form);
     button.dataset.label ??= button.textContent ?? '';
@@ -559,7 +658,10 @@ function updateActions() {
   els.viewMode.disabled = !output;
 }
 
-/** Number fields of an action form against their min/max: the messages (empty: fine). */
+/**
+ * Number fields of an action form against their min/max: the messages (empty: fine).
+ * @param {HTMLFormElement} form
+ */
 function jobErrors(form) {
   const errors = [];
   for (const input of fieldsOf(form)) {
@@ -575,6 +677,10 @@ function jobErrors(form) {
   return errors;
 }
 
+/**
+ * @param {string} job
+ * @param {HTMLFormElement} form
+ */
 async function runJob(job, form) {
   if (!loaded || current) return;
   const errors = jobErrors(form);
@@ -588,7 +694,8 @@ async function runJob(job, form) {
   const target = job === 'vibration' ? /** @type {'input' | 'output'} */ (targetOf(form).value) : 'input';
   const options = jobOptions(form);
   startRun('job', loaded.name);
-  const run = current;
+  // startRun set `current` (tsc still narrows it to null from the check above).
+  const run = /** @type {Run} */ (/** @type {Run | null} */ (current));
   run.posted = true;
   placeRunState(form);
   setStatus(`running ${job}`);
@@ -620,8 +727,15 @@ function resetOptimized() {
   clearChart(els.chartOrientation, 'Run the orientation smoothing to see the rotary axes.');
 }
 
+/**
+ * @param {string} job
+ * @param {JobResult} result
+ * @param {ArrayBuffer | null} outBytes
+ * @param {Target} target
+ * @param {{ fromList?: boolean }} [opts]
+ */
 function showJobResult(job, result, outBytes, target, { fromList = false } = {}) {
-  showJson(result, `${baseName(loaded.name)}.${job}${target === 'output' ? '.output' : ''}.json`);
+  showJson(result, `${baseName(/** @type {Loaded} */ (loaded).name)}.${job}${target === 'output' ? '.output' : ''}.json`);
   els.resultPanel.hidden = false;
   els.resultJob.textContent = `· ${JOB_NAMES[job]}${target === 'output' ? ' of the optimized output' : ''}`;
   els.resultLine.textContent = resultLine(job, result);
@@ -661,7 +775,7 @@ function showJobResult(job, result, outBytes, target, { fromList = false } = {})
     refresh3d();
   }
   if (job === 'vibration') {
-    vibrationRuns[target] = result;
+    vibrationRuns[target] = /** @type {VibrationReport} */ (result);
     renderCompare(vibrationCompare());
     els.paperTables.replaceChildren();
   } else {
@@ -674,8 +788,16 @@ function showJobResult(job, result, outBytes, target, { fromList = false } = {})
 }
 
 // Every job's result, kept (newest first): its line, its main changes, its JSON and its file.
+/** @type {JobEntry[]} */
 const jobEntries = [];
 
+/**
+ * @param {string} job
+ * @param {JobResult} result
+ * @param {ArrayBuffer | null} outBytes
+ * @param {Target} target
+ * @param {number} ms
+ */
 function addJobEntry(job, result, outBytes, target, ms) {
   const keptOriginal = job === 'infill' && result.best?.pattern === 'original';
   const entry = { id: jobEntries.length + 1, job, result, target, ms, file: loaded?.name, bytes: outBytes && !keptOriginal ? outBytes : null };
@@ -683,8 +805,13 @@ function addJobEntry(job, result, outBytes, target, ms) {
   renderJobList(entry.id);
 }
 
+/** @param {number} activeId */
 function renderJobList(activeId) {
   const list = $('job-list');
+  /**
+   * @param {unknown} a
+   * @param {unknown} b
+   */
   const pct = (a, b) => (isNum(a) && isNum(b) && b !== 0 ? signedPercent(a / b - 1) : null);
   list.replaceChildren(
     ...[...jobEntries].reverse().map((e) => {
@@ -720,8 +847,20 @@ function renderJobList(activeId) {
   $('job-list-panel').hidden = jobEntries.length === 0;
 }
 
+/**
+ * @param {string} job
+ * @param {JobResult} r
+ */
 function resultLine(job, r) {
+  /**
+   * @param {unknown} v
+   * @param {number} [d]
+   */
   const n = (v, d = 3) => (isNum(v) ? String(Math.round(v * 10 ** d) / 10 ** d) : '—');
+  /**
+   * @param {unknown} a
+   * @param {unknown} b
+   */
   const pct = (a, b) => (isNum(a) && isNum(b) && b !== 0 ? signedPercent(a / b - 1) : '—');
   switch (job) {
     case 'vtg':
@@ -733,11 +872,11 @@ function resultLine(job, r) {
       return `Best: ${b.pattern ?? '—'} at ${n(b.angle_deg, 1)}°${isNum(b.rotation_deg) ? ` (rotation ${n(b.rotation_deg, 1)}°)` : ''} of ${Array.isArray(r.candidates) ? r.candidates.length : '—'} candidates${r.candidates_estimated ? ` (${r.candidates_estimated} ruled out as clearly worse on a sample of layers)` : ''}; energy ${pct(r.after?.energy?.total_j, r.before?.energy?.total_j)}.`;
     }
     case 'optimize':
-      return (r.stages ?? []).map((s) => `${s.stage}: ${s.applied ? '' : 'not applied, '}${s.message}.`).join(' ');
+      return (r.stages ?? []).map((/** @type {OptimizeStage} */ s) => `${s.stage}: ${s.applied ? '' : 'not applied, '}${s.message}.`).join(' ');
     case 'smooth':
       return `${formatCount(r.points)} points, ${formatCount(r.corrected)} corrected; the smoothed orientation stays within ${n(r.max_angle_to_original_deg, 2)}° of the original.`;
     case 'vibration': {
-      const f = Array.isArray(r.natural_frequencies_hz) ? r.natural_frequencies_hz.map((v) => `${n(v, 1)} Hz`).join(', ') : '—';
+      const f = Array.isArray(r.natural_frequencies_hz) ? r.natural_frequencies_hz.map((/** @type {number} */ v) => `${n(v, 1)} Hz`).join(', ') : '—';
       return `Natural frequencies ${f}; deviation max ${n(r.deviation_mm?.max, 4)} mm, mean ${n(r.deviation_mm?.mean, 4)} mm.`;
     }
     default:
@@ -747,6 +886,7 @@ function resultLine(job, r) {
 
 // Every metric the page shows by its key: [name, unit, one-line explanation]. The names of the
 // VTG paper's Tables 1 and 2 where they come from it (docs/method/ says how each is computed).
+/** @type {Record<string, [string, string, string]>} */
 const METRICS = {
   time_s: ['Print time', 's', 'How long the printer takes, planned with its accelerations and cornering.'],
   planned_time_s: ['Print time (planned)', 's', 'How long the printer takes, planned with its accelerations and cornering.'],
@@ -784,17 +924,22 @@ const METRICS = {
   max_tip_deviation_mm: ['Largest nozzle-tip change', 'mm', 'Farthest the smoothed orientation moves the nozzle tip.'],
 };
 
-/** [name, unit, explanation] of a key, with a readable fallback for keys not in METRICS. */
+/**
+ * [name, unit, explanation] of a key, with a readable fallback for keys not in METRICS.
+ * @param {string} key
+ * @returns {[string, string, string]}
+ */
 function metricInfo(key) {
   if (METRICS[key]) return METRICS[key];
   const m = /_(mm|s|g|j|deg|hz|pct|mm3|c|w|kwh)$/.exec(key);
+  /** @type {Record<string, string>} */
   const units = { mm: 'mm', s: 's', g: 'g', j: 'J', deg: '°', hz: 'Hz', pct: '%', mm3: 'mm³', c: '°C', w: 'W', kwh: 'kWh' };
   const base = (m ? key.slice(0, -m[0].length) : key).replaceAll('_', ' ');
   return [base.charAt(0).toUpperCase() + base.slice(1), m ? units[m[1]] : '', ''];
 }
 
 // Rows of the before/after table, in the order of the VTG paper's Tables 1 and 2.
-/** @type {[string, (r: any) => number | undefined, (v: number) => string, string][]} */
+/** @type {[string, (r: Report) => number | undefined, (v: number) => string, string][]} */
 const REPORT_METRICS = [
   ['Print time', (r) => r.time_s, formatDuration, METRICS.time_s[2]],
   ['Energy', (r) => r.energy?.total_j, formatEnergy, METRICS.total_j[2]],
@@ -807,10 +952,17 @@ const REPORT_METRICS = [
   ['Mean chord error', (r) => r.toolpath?.mean_chord_error_mm, (v) => `${v.toFixed(4)} mm`, METRICS.mean_chord_error_mm[2]],
 ];
 
+/**
+ * @param {JobResult} result
+ * @param {string} job
+ * @returns {CompareRow[]}
+ */
 function compareRows(result, job) {
   const { before, after } = result;
   if (!before || !after) return [];
+  /** @param {JobResult} r */
   const isReport = (r) => isNum(r.time_s) || isNum(r.energy?.total_j);
+  /** @type {CompareRow[]} */
   const rows = [];
   if (isReport(before) && isReport(after)) {
     for (const [name, get, format, explain] of REPORT_METRICS) {
@@ -840,29 +992,42 @@ function compareRows(result, job) {
   return rows;
 }
 
+/** @returns {CompareRow[]} */
 function vibrationCompare() {
   const b = vibrationRuns.input;
   const a = vibrationRuns.output;
+  /**
+   * @param {VibrationReport | undefined} r
+   * @param {'amplitude' | 'acceleration_rms'} key
+   */
   const meanOf = (r, key) => {
     const v = Array.isArray(r?.layers) ? r.layers.map((l) => l[key]).filter(isNum) : [];
     return v.length ? v.reduce((x, y) => x + y, 0) / v.length : null;
   };
+  /** @param {VibrationReport | undefined} r */
   const mean = (r) => meanOf(r, 'amplitude');
+  /** @param {VibrationReport | undefined} r */
   const peak = (r) => {
     const p = r?.psd?.peaks?.[0];
     return p ? p.hz : null;
   };
+  /** @param {number} v */
   const mm = (v) => `${v.toFixed(4)} mm`;
   return [
     { name: 'Deviation (max)', before: b?.deviation_mm?.max, after: a?.deviation_mm?.max, format: mm, explain: 'Farthest vibration pushes the nozzle off its path.' },
     { name: 'Deviation (mean)', before: b?.deviation_mm?.mean, after: a?.deviation_mm?.mean, format: mm, explain: 'How far vibration pushes the nozzle off its path, on average.' },
     { name: 'Mean layer amplitude', before: mean(b), after: mean(a), format: mm, explain: 'Vibration amplitude of a layer, averaged over the layers.' },
-    { name: 'Mean layer acceleration RMS', before: meanOf(b, 'acceleration_rms'), after: meanOf(a, 'acceleration_rms'), format: (v) => `${fmt2.format(v)} m/s²`, explain: 'How hard the head shakes (root mean square acceleration), averaged over the layers.' },
-    { name: 'Strongest PSD peak', before: peak(b), after: peak(a), format: (v) => `${fmt1.format(v)} Hz`, noChange: true, explain: 'Frequency at which the machine shakes most (peak of the power spectrum).' },
+    { name: 'Mean layer acceleration RMS', before: meanOf(b, 'acceleration_rms'), after: meanOf(a, 'acceleration_rms'), format: (/** @type {number} */ v) => `${fmt2.format(v)} m/s²`, explain: 'How hard the head shakes (root mean square acceleration), averaged over the layers.' },
+    { name: 'Strongest PSD peak', before: peak(b), after: peak(a), format: (/** @type {number} */ v) => `${fmt1.format(v)} Hz`, noChange: true, explain: 'Frequency at which the machine shakes most (peak of the power spectrum).' },
   ].filter((r) => isNum(r.before) || isNum(r.after));
 }
 
+/** @param {CompareRow[]} rows */
 function renderCompare(rows) {
+  /**
+   * @param {number | null | undefined} v
+   * @param {(v: number) => string} format
+   */
   const cell = (v, format) => el('td', { class: 'num', text: isNum(v) ? format(v) : '—' });
   els.compareTable.tBodies[0].replaceChildren(
     ...rows.map((r) => {
@@ -875,7 +1040,11 @@ function renderCompare(rows) {
   );
 }
 
-/** Rows of a paper table in whatever shape the result gives it. */
+/**
+ * Rows of a paper table in whatever shape the result gives it.
+ * @param {unknown} t
+ * @returns {Record<string, unknown>[]}
+ */
 function tableRows(t) {
   if (Array.isArray(t)) return t.map((r) => (r && typeof r === 'object' ? r : { value: r }));
   if (t && typeof t === 'object') {
@@ -884,13 +1053,16 @@ function tableRows(t) {
   return [];
 }
 
+/** @typedef {{ key: string, name: string, unit: string, explain: string | undefined, before: unknown, after: unknown, change: unknown }} PaperRow */
+
 /**
  * A paper table's { before, after, change_pct } rows, nested groups flattened: [{ key, name, before, after, change }].
  * @param {any} t
  * @param {string | null} [prefix]
- * @returns {{ key: string, name: string, unit: string, explain: string, before: any, after: any, change: any }[]}
+ * @returns {PaperRow[]}
  */
 function paperRows(t, prefix = null) {
+  /** @type {PaperRow[]} */
   const rows = [];
   if (!t || typeof t !== 'object' || Array.isArray(t)) return rows;
   for (const [k, v] of Object.entries(t)) {
@@ -904,13 +1076,19 @@ function paperRows(t, prefix = null) {
   return rows;
 }
 
+/** @param {JobResult} result */
 function renderPaperTables(result) {
   const tables = Object.keys(result).filter((k) => /^table\d+$/.test(k));
+  /** @type {Record<string, string>} */
   const titles = { table1: 'VTG paper, Table 1: the toolpath', table2: 'VTG paper, Table 2: vibration, energy and time' };
   els.paperTables.replaceChildren(
     ...tables.map((k) => {
       const flat = paperRows(result[k]);
       if (flat.length) {
+        /**
+         * @param {PaperRow} r
+         * @param {unknown} v
+         */
         const value = (r, v) => (isNum(v) ? formatByKey(r.key, v) : '—');
         return el(
           'div',
@@ -963,9 +1141,14 @@ function renderPaperTables(result) {
   );
 }
 
+/**
+ * @param {string} job
+ * @param {JobResult} r
+ */
 function renderCharts(job, r) {
   if (job === 'infill' && Array.isArray(r.candidates) && r.candidates.length) {
     // Best rotation for each (pattern, angle): one line per pattern.
+    /** @type {Map<string, Map<number, number>>} */
     const byPattern = new Map();
     for (const c of r.candidates) {
       if (!isNum(c.angle_deg) || !isNum(c.total_j)) continue;
@@ -975,7 +1158,7 @@ function renderCharts(job, r) {
     }
     const list = [...byPattern].map(([pattern, m]) => {
       const x = [...m.keys()].sort((a, b) => a - b);
-      return { label: String(pattern), x, y: x.map((a) => m.get(a)) };
+      return { label: String(pattern), x, y: x.map((a) => /** @type {number} */ (m.get(a))) };
     });
     if (list.length) {
       const u = unionSeries(list);
@@ -983,13 +1166,13 @@ function renderCharts(job, r) {
     }
   }
   if (job === 'vibration') {
-    const runs = ['input', 'output'].filter((t) => vibrationRuns[t]?.psd?.freqs?.length);
+    const runs = /** @type {Target[]} */ (['input', 'output']).filter((t) => vibrationRuns[t]?.psd?.freqs?.length);
     if (runs.length) {
       const list = runs.map((t) => ({ label: t === 'input' ? 'before' : 'after', x: vibrationRuns[t].psd.freqs, y: vibrationRuns[t].psd.power }));
       const a = alignSeries(list);
       lineChart(els.chartPsd, { x: a.x, xLabel: 'frequency, Hz', yLabel: 'power', logY: true, points: false, series: list.map((s, i) => ({ label: s.label, values: a.values[i] })) });
     }
-    const layerRuns = ['input', 'output'].filter((t) => Array.isArray(vibrationRuns[t]?.layers) && vibrationRuns[t].layers.length);
+    const layerRuns = /** @type {Target[]} */ (['input', 'output']).filter((t) => Array.isArray(vibrationRuns[t]?.layers) && vibrationRuns[t].layers.length);
     if (layerRuns.length) {
       const list = layerRuns.map((t) => ({ label: t === 'input' ? 'before' : 'after', x: vibrationRuns[t].layers.map((l, i) => (isNum(l.layer) ? l.layer : i)), y: vibrationRuns[t].layers.map((l) => l.amplitude) }));
       const u = unionSeries(list);
@@ -1005,6 +1188,7 @@ function renderCharts(job, r) {
     const n = Math.max(...cols.map((a) => (Array.isArray(a) ? a.length : 0)));
     if (n > 0) {
       const x = Array.isArray(s.point) && s.point.length === n ? s.point : Array.from({ length: n }, (_, i) => i);
+      /** @param {unknown} a */
       const pad = (a) => (Array.isArray(a) ? (a.length === n ? a : [...a, ...new Array(Math.max(0, n - a.length)).fill(null)].slice(0, n)) : new Array(n).fill(null));
       lineChart(els.chartOrientation, {
         x,
@@ -1026,8 +1210,10 @@ function renderCharts(job, r) {
 
 // Time, energy and filament of every layer (the report's layer_list); a click shows that
 // layer in the viewer (the viewer's layer at the same height).
+/** @param {Report} report */
 function renderLayerCharts(report) {
   const list = Array.isArray(report.layer_list) ? report.layer_list : [];
+  /** @type {[string, 'time_s' | 'energy_j' | 'filament_mm', string][]} */
   const ids = [
     ['chart-layer-time', 'time_s', 'time, s'],
     ['chart-layer-energy', 'energy_j', 'energy, J'],
@@ -1040,6 +1226,7 @@ function renderLayerCharts(report) {
     return;
   }
   const x = list.map((l, i) => (isNum(l.index) ? l.index : i) + 1);
+  /** @param {number} i */
   const pick = (i) => showLayerAt(i, list[i]?.z);
   for (const [id, key, label] of ids) {
     lineChart($(id), { x, xLabel: 'layer', yLabel: label, height: 200, points: list.length <= 60, series: [{ label, values: list.map((l) => (isNum(l[key]) ? l[key] : null)) }], onPick: pick });
@@ -1055,13 +1242,19 @@ function renderLayerCharts(report) {
   updateLayerTime();
 }
 
+/** @type {{ z: number | null, t: number }[]} */
 let layerTimes = []; // [{ z, t }] of the loaded file, for the 'layer time' colouring
 
-/** The time of the report layer nearest height z. */
+/**
+ * The time of the report layer nearest height z.
+ * @param {unknown} z
+ * @returns {number | null}
+ */
 function layerTimeAt(z) {
   if (!isNum(z) || layerTimes.length === 0) return null;
+  /** @type {{ z: number | null, t: number } | null} */
   let best = null;
-  for (const l of layerTimes) if (isNum(l.z) && isNum(l.t) && (!best || Math.abs(l.z - z) < Math.abs(best.z - z))) best = l;
+  for (const l of layerTimes) if (isNum(l.z) && isNum(l.t) && (!best || Math.abs(l.z - z) < Math.abs(/** @type {number} */ (best.z) - z))) best = l; // best: a layer with a number z
   return best ? best.t : null;
 }
 
@@ -1076,7 +1269,11 @@ function updateLayerTime() {
   viewer.requestDraw();
 }
 
-/** Shows the viewer's layer at height z (a report layer's), else the layer numbered i. */
+/**
+ * Shows the viewer's layer at height z (a report layer's), else the layer numbered i.
+ * @param {number} i
+ * @param {number | null | undefined} z
+ */
 async function showLayerAt(i, z) {
   try {
     const g = await getLayer('before', i, isNum(z) ? z : null);
@@ -1099,19 +1296,29 @@ const layerTo = /** @type {HTMLInputElement} */ ($('layer-to'));
 const showTools = /** @type {HTMLInputElement} */ ($('show-tools'));
 const showToolsLabel = $('show-tools-label');
 const MAX_3D_SEGMENTS = 1_500_000;
+/** @type {PartView | null} */
 let partView = null; // view3d.js's PartView, made the first time the 3-D view is shown
 /** @type {typeof import('./view3d.js') | null} */
 let view3d = null; // the module, loaded with the first PartView
 let toolsAvailable = false; // whether the layers last drawn in 3-D carry tool vectors (multi-axis)
+/** @type {Map<string, Map<number, LayerMessage>>} */
 const part3d = new Map(); // `${fileToken}:${which}` → (index → geometry), of the current file only
 let part3dRun = 0;
 
-/** Layers from..to (0-based) of `which`, every `stride`-th, fetched once per file. */
+/**
+ * Layers from..to (0-based) of `which`, every `stride`-th, fetched once per file.
+ * @param {'before' | 'after'} which
+ * @param {number} from
+ * @param {number} to
+ * @param {number} stride
+ * @param {number} run
+ * @returns {Promise<PartLayer[] | null>}
+ */
 async function partLayers(which, from, to, stride, run) {
   const key = `${fileToken}:${which}`;
   for (const k of part3d.keys()) if (!k.startsWith(`${fileToken}:`)) part3d.delete(k);
   if (!part3d.has(key)) part3d.set(key, new Map());
-  const cache = part3d.get(key);
+  const cache = /** @type {Map<number, LayerMessage>} */ (part3d.get(key)); // set just above
   const out = [];
   for (let i = from; i <= to; i += stride) {
     if (run !== part3dRun) return null;
@@ -1192,12 +1399,16 @@ function toolsText() {
   return n > 0 ? `, ${formatCount(n)} tool vectors (tool axis from the tip) in magenta` : ', tool vectors hidden';
 }
 
-/** Colour range of speed or curvature over the layers (curvature clipped at its 95th percentile). */
+/**
+ * Colour range of speed or curvature over the layers (curvature clipped at its 95th percentile).
+ * @param {PartLayer[]} layers
+ * @param {string} key
+ */
 function rangeOf(layers, key) {
   if (key !== 'speed' && key !== 'curvature') return null;
   const values = [];
   for (const g of layers) {
-    const a = g[key];
+    const a = g[/** @type {'speed' | 'curvature'} */ (key)];
     const step = Math.max(1, Math.floor(a.length / 500));
     for (let i = 0; i < a.length; i += step) if (g.kind[i] !== 0 && Number.isFinite(a[i])) values.push(a[i]);
   }
@@ -1208,6 +1419,7 @@ function rangeOf(layers, key) {
   return { lo, hi: hi > lo ? hi : lo + 1 };
 }
 
+/** @param {string} kind */
 function setViewKind(kind) {
   const three = kind === '3d';
   els.canvas.hidden = three;
@@ -1234,6 +1446,7 @@ const viewer = new LayerViewer(els.canvas, els.legend, {
       : '';
   },
 });
+/** @type {Map<string, LayerMessage>} */
 const layerCache = new Map(); // `${token}:${which}:${index}` → geometry
 const layerCounts = { before: 0, after: 0 };
 let layerLoading = false;
@@ -1250,13 +1463,13 @@ let layerWanted = false;
  */
 async function getLayer(which, index, z = null) {
   const key = `${fileToken}:${which}:${isNum(z) ? `z${z}` : index}`;
-  if (layerCache.has(key)) return layerCache.get(key);
+  if (layerCache.has(key)) return /** @type {LayerMessage} */ (layerCache.get(key));
   // The first layer of a file makes the worker read the whole toolpath (seconds on 34 MB).
   if (layerCounts[which] === 0) els.layerInfo.textContent = `reading the ${which === 'after' ? 'optimized ' : ''}toolpath…`;
   const g = await client.layer(which, index, isNum(z) ? z : null);
   layerCounts[which] = g.count;
   layerCache.set(key, g);
-  if (layerCache.size > LAYER_CACHE) layerCache.delete(layerCache.keys().next().value);
+  if (layerCache.size > LAYER_CACHE) layerCache.delete(/** @type {string} */ (layerCache.keys().next().value)); // size > 0: a first key
   return g;
 }
 
@@ -1382,6 +1595,15 @@ function readHash() {
 
 // ── Rendering ──────────────────────────────────────────────────────────────
 
+/**
+ * A new element with attributes (`class` and `text` set className and textContent; null or
+ * undefined ones are left out) and children (nodes, or text; null and undefined left out).
+ * @template {keyof HTMLElementTagNameMap} K
+ * @param {K} tag
+ * @param {Record<string, string | null | undefined>} [attrs]
+ * @param {...(Node | string | null | undefined)} children
+ * @returns {HTMLElementTagNameMap[K]}
+ */
 function el(tag, attrs = {}, ...children) {
   const node = document.createElement(tag);
   for (const [k, v] of Object.entries(attrs)) {
@@ -1399,15 +1621,18 @@ function el(tag, attrs = {}, ...children) {
 
 /** @type {(v: unknown) => v is number} */
 const isNum = (v) => typeof v === 'number' && Number.isFinite(v);
+/** @param {number} digits */
 const nf = (digits) => new Intl.NumberFormat('en-US', { maximumFractionDigits: digits, minimumFractionDigits: digits });
 const fmt0 = nf(0);
 const fmt1 = nf(1);
 const fmt2 = nf(2);
 
+/** @param {number} ms */
 function formatMs(ms) {
   return ms < 10 ? `${fmt2.format(ms)} ms` : `${fmt0.format(ms)} ms`;
 }
 
+/** @param {unknown} s */
 function formatDuration(s) {
   if (!isNum(s)) return '—';
   if (s < 60) return `${fmt1.format(s)} s`;
@@ -1418,6 +1643,7 @@ function formatDuration(s) {
   return h > 0 ? `${h} h ${m} min ${sec} s` : `${m} min ${sec} s`;
 }
 
+/** @param {unknown} mm */
 function formatLength(mm) {
   if (!isNum(mm)) return '—';
   if (Math.abs(mm) >= 1000) return `${fmt2.format(mm / 1000)} m`;
@@ -1426,10 +1652,12 @@ function formatLength(mm) {
   return `${fmt1.format(mm)} mm`;
 }
 
+/** @param {unknown} n */
 function formatCount(n) {
   return isNum(n) ? fmt0.format(n) : '—';
 }
 
+/** @param {unknown} n */
 function formatBytes(n) {
   if (!isNum(n)) return '—';
   if (n >= 1024 * 1024) return `${fmt2.format(n / (1024 * 1024))} MiB`;
@@ -1437,6 +1665,7 @@ function formatBytes(n) {
   return `${fmt0.format(n)} B`;
 }
 
+/** @param {unknown} v */
 function formatScalar(v) {
   if (v === null || v === undefined) return '—';
   if (isNum(v)) return Number.isInteger(v) ? fmt0.format(v) : String(Math.round(v * 1e4) / 1e4);
@@ -1446,6 +1675,10 @@ function formatScalar(v) {
 
 // JSON.stringify that survives Map, BigInt and typed arrays (the API returns spectra as
 // Float64Array): the JSON shown and downloaded is the CLI's.
+/**
+ * @param {unknown} value
+ * @param {number} [space]
+ */
 function toJson(value, space) {
   return JSON.stringify(
     value,
@@ -1459,10 +1692,18 @@ function toJson(value, space) {
   );
 }
 
+/**
+ * The value as plain JSON data (typed arrays as arrays, Maps as objects). Typed as the value:
+ * the report types are JSON-shaped already (a job's result is loose anyway: JobResult).
+ * @template T
+ * @param {T} value
+ * @returns {T}
+ */
 function plain(value) {
   return JSON.parse(toJson(value) ?? 'null');
 }
 
+/** @param {unknown} j */
 function formatEnergy(j) {
   if (!isNum(j)) return '—';
   if (Math.abs(j) >= 3.6e5) return `${fmt2.format(j / 3.6e6)} kWh`;
@@ -1470,6 +1711,7 @@ function formatEnergy(j) {
   return `${fmt1.format(j)} J`;
 }
 
+/** @param {number} x */
 function signedPercent(x) {
   const text = fmt1.format(Math.abs(x) * 100);
   // A change that rounds to nothing has no sign ("0.0 %", not "−0.0 %").
@@ -1477,6 +1719,11 @@ function signedPercent(x) {
   return `${x >= 0 ? '+' : '−'}${text} %`;
 }
 
+/**
+ * @param {Report} r
+ * @param {string} name
+ * @param {number} ms
+ */
 function summaryRows(r, name, ms) {
   const file = r.file ?? {};
   const extrusion = r.extrusion ?? {};
@@ -1508,7 +1755,10 @@ function summaryRows(r, name, ms) {
   return rows;
 }
 
-/** What the file was timed as, in words: the printer, its cornering model and why. */
+/**
+ * What the file was timed as, in words: the printer, its cornering model and why.
+ * @param {MachineInfo} m
+ */
 function timedAs(m) {
   const preset = machines.find((p) => p.name === m.profile);
   const junction = { classic_jerk: 'classic jerk cornering', junction_deviation: 'junction-deviation cornering', klipper: "Klipper's square-corner cornering" }[m.junction_model] ?? String(m.junction_model).replaceAll('_', ' ');
@@ -1516,16 +1766,20 @@ function timedAs(m) {
   return `${preset?.description ?? m.profile}${settings} · ${junction} · chosen because: ${m.reason}`;
 }
 
-/** The planner's limits, each with its value, unit and where it came from. */
+/**
+ * The planner's limits, each with its value, unit and where it came from.
+ * @param {Report} r
+ */
 function renderLimits(r) {
   const box = $('machine-limits');
   const limits = r.machine?.limits ?? {};
+  /** @param {Limit} l */
   const source = (l) => (l.source === 'profile' ? `the ${r.machine.profile} preset` : LIMIT_SOURCES[l.source] ?? String(l.source).replaceAll('_', ' '));
   const rows = Object.entries(limits)
     .filter(([, v]) => v !== null && v !== undefined)
     .map(([k, v]) => {
       const [name, unit] = LIMIT_NAMES[k] ?? [k.replaceAll('_', ' '), ''];
-      const list = Array.isArray(v) ? v : [v];
+      const list = /** @type {Limit[]} */ (Array.isArray(v) ? v : [v]); // null ones filtered out above
       const value = `${list.map((l) => formatScalar(l?.value)).join(' / ')}${unit ? ` ${unit}` : ''}`;
       const from = [...new Set(list.map(source))].join('; ');
       return el('tr', { 'data-limit': k }, el('th', { scope: 'row', text: name }), el('td', {}, value, el('small', { class: 'explain', text: `from ${from}` })));
@@ -1536,6 +1790,7 @@ function renderLimits(r) {
   box.hidden = rows.length === 0;
 }
 
+/** @param {Report} r */
 function renderStats(r) {
   const warnings = Array.isArray(r.warnings) ? r.warnings.length : 0;
   const cards = [
@@ -1552,6 +1807,7 @@ function renderStats(r) {
   );
 }
 
+/** @type {Record<string, string>} */
 const SUMMARY_EXPLAIN = {
   'Print time': METRICS.time_s[2],
   'Slicer estimate': "The slicer's own estimate written in the file, and how far ours is from it.",
@@ -1566,6 +1822,11 @@ const SUMMARY_EXPLAIN = {
   Bounds: 'Size of the printed part: width × depth × height.',
 };
 
+/**
+ * @param {Report} r
+ * @param {string} name
+ * @param {number} ms
+ */
 function renderSummary(r, name, ms) {
   const tbody = els.summary.tBodies[0];
   tbody.replaceChildren(
@@ -1580,6 +1841,7 @@ function renderSummary(r, name, ms) {
   );
 }
 
+/** @param {Report} r */
 function renderFeatures(r) {
   const features = Array.isArray(r.features) ? r.features : [];
   const tbody = els.features.tBodies[0];
@@ -1604,6 +1866,7 @@ function renderFeatures(r) {
   els.featuresEmpty.hidden = features.length !== 0;
 }
 
+/** @param {Report} r */
 function renderWarnings(r) {
   const warnings = Array.isArray(r.warnings) ? r.warnings : [];
   els.warningsCount.textContent = formatCount(warnings.length);
@@ -1623,7 +1886,11 @@ function renderWarnings(r) {
   els.warningsEmpty.hidden = warnings.length !== 0;
 }
 
-// A scalar, formatted by the unit its key names (`_mm`, `_s`, `_g`, …).
+/**
+ * A scalar, formatted by the unit its key names (`_mm`, `_s`, `_g`, …).
+ * @param {string} key
+ * @param {unknown} v
+ */
 function formatByKey(key, v) {
   if (!isNum(v)) return formatScalar(v);
   // Compound units first: `_mm_s` is a speed, not a duration.
@@ -1647,7 +1914,13 @@ function formatByKey(key, v) {
   return formatScalar(v);
 }
 
-// Generic rendering of anything we don't have a dedicated view for yet.
+/**
+ * Generic rendering of anything we don't have a dedicated view for yet.
+ * @param {unknown} v
+ * @param {number} [depth]
+ * @param {string} [key]
+ * @returns {Node}
+ */
 function renderValue(v, depth = 0, key = '') {
   if (v === null || typeof v !== 'object') return document.createTextNode(formatByKey(key, v));
   if (Array.isArray(v)) {
@@ -1674,6 +1947,7 @@ function renderValue(v, depth = 0, key = '') {
   );
 }
 
+/** @param {Report} r */
 function renderExtra(r) {
   const extra = Object.entries(r).filter(([k]) => !KNOWN_FIELDS.has(k));
   els.extra.replaceChildren(
@@ -1682,6 +1956,11 @@ function renderExtra(r) {
   els.extraPanel.hidden = extra.length === 0;
 }
 
+/**
+ * @param {Report} rawReport
+ * @param {string} name
+ * @param {number} ms
+ */
 function showReport(rawReport, name, ms) {
   const report = plain(rawReport);
   renderStats(report);
@@ -1698,7 +1977,11 @@ function showReport(rawReport, name, ms) {
   hideError();
 }
 
-/** Shows `value` as the latest report JSON (and what "Download report JSON" saves). */
+/**
+ * Shows `value` as the latest report JSON (and what "Download report JSON" saves).
+ * @param {unknown} value
+ * @param {string} filename
+ */
 function showJson(value, filename) {
   lastJson = { value, filename };
   els.reportJson.textContent = toJson(value, 2);
@@ -1739,10 +2022,16 @@ function hideError() {
   delete els.error.dataset.line;
 }
 
+/** @param {string | undefined} name */
 function baseName(name) {
   return String(name ?? '').replace(/\.[^.]*$/, '') || 'quietpath';
 }
 
+/**
+ * @param {string} key
+ * @param {Blob} blob
+ * @param {string} filename
+ */
 function saveBlob(key, blob, filename) {
   if (downloadUrls[key]) URL.revokeObjectURL(downloadUrls[key]);
   downloadUrls[key] = URL.createObjectURL(blob);
@@ -1782,12 +2071,14 @@ function showPrinterSettingsName() {
   $('printer-settings-clear').hidden = !printerSettings;
 }
 
+/** @param {string} choice */
 function setMachine(choice) {
   machineChoice = choice;
   store.set(STORE_MACHINE, choice || null);
   renderMachinePicker();
 }
 
+/** @param {File | null} file */
 async function setPrinterSettings(file) {
   if (file) {
     const text = await file.text();
@@ -1824,7 +2115,7 @@ els.optionsForm.addEventListener('change', () => {
 for (const form of els.actionForms) {
   form.addEventListener('submit', (e) => {
     e.preventDefault();
-    runJob(form.dataset.job, form);
+    runJob(/** @type {string} */ (form.dataset.job), form); // every action form has data-job
   });
   form.addEventListener('change', () => {
     updateActions();
@@ -1857,6 +2148,7 @@ els.fit.addEventListener('click', () => viewer.fit());
 window.addEventListener('hashchange', readHash);
 
 let dragDepth = 0;
+/** @param {DragEvent} e */
 const hasFiles = (e) => Array.from(e.dataTransfer?.types ?? []).includes('Files');
 window.addEventListener('dragenter', (e) => {
   if (!hasFiles(e)) return;
