@@ -248,8 +248,10 @@ impl<'a> Race<'a> {
             probes.extend(Probe::of(prep, racing::COARSE, rotations));
             probes.push(fine);
         }
-        let bases = match probes.is_empty() {
-            false => crate::parallel::map_each(rotations, |(_, r)| match r {
+        let bases = if probes.is_empty() {
+            Vec::new()
+        } else {
+            crate::parallel::map_each(rotations, |(_, r)| match r {
                 None => *base_costs,
                 Some(r) => replay(
                     &prep.prog,
@@ -257,8 +259,7 @@ impl<'a> Race<'a> {
                     Some(r),
                     &prep.base,
                 ),
-            }),
-            true => Vec::new(),
+            })
         };
         Self {
             prep,
