@@ -59,6 +59,11 @@ pub struct Args {
     /// allows.
     #[arg(long, value_name = "MS")]
     pub min_segment_time: Option<f64>,
+    /// Write and simulate every quieter variant the dynamics model asks for whole, instead of
+    /// racing them on every eighth layer first (files of 512 kB and 64 layers or more). Slower;
+    /// the choice is checked on the whole file either way.
+    #[arg(long)]
+    pub exhaustive: bool,
     /// Leave the file's time comments and M73 lines as the slicer wrote them.
     #[arg(long)]
     pub no_estimates: bool,
@@ -88,6 +93,7 @@ pub fn run(args: Args) -> Result<(), String> {
         inside_corners: args.inside_corners,
         estimates: !args.no_estimates,
         min_segment_time_ms: args.min_segment_time,
+        exhaustive: args.exhaustive,
         ..VtgOptions::default()
     };
     let mut bar = output::ProgressBar::for_input(input.len());

@@ -25,6 +25,7 @@ pub mod lumped;
 pub mod modal;
 pub mod modal_step;
 pub mod parameters;
+mod sampled;
 pub mod simulate;
 pub mod trajectory;
 pub mod welch;
@@ -38,6 +39,7 @@ use crate::progress::Progress;
 pub use compare::{compare, VibrationComparison};
 pub use modal::Mode;
 pub use parameters::{Drive, MachineDynamics};
+pub use sampled::printing_deviation_in_layers;
 pub use welch::{Peak, Window};
 
 /// Options of [`vibration`]. Every field is optional in JSON.
@@ -253,21 +255,14 @@ pub fn vibration_of_path(
 ) -> Result<VibrationReport, Error> {
     options.validate()?;
     let machine = options.machine_dynamics(&path.profile.name)?;
-    let segs = trajectory::segments(path)
-        .ok_or_else(|| invalid("the path has no planned timing (extract it with plan = true)"))?;
-    let ts = options.ts_ms * 1e-3;
-    let decimation = ((1.0 / (options.fs_hz * ts)).round() as u64).max(1);
-    let fs = 1.0 / (decimation as f64 * ts);
+    let segs = planned_segments(path)?;
+    let (settings, fs) = simulation_settings(options);
     let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
     let outcome = simulate::run(
         &segs,
         path.layers.len(),
         &machine,
-        simulate::Settings {
-            ts,
-            decimation,
-            bucket_m: options.bucket_mm * 1e-3,
-        },
+        settings,
         &mut welch,
         progress,
     )?;
@@ -287,20 +282,8 @@ pub fn vibration_of_path(
         natural_frequencies_hz: all.iter().map(|m| m.frequency_hz).collect(),
         damping_ratios: all.iter().map(|m| m.damping_ratio).collect(),
         axes,
-        deviation_mm: Deviation {
-            max: d.max,
-            min: d.min_or_zero(),
-            mean: d.mean(),
-            max_at: outcome.max_at,
-            samples: d.count,
-        },
-        printing_deviation_mm: Deviation {
-            max: outcome.printing.max,
-            min: outcome.printing.min_or_zero(),
-            mean: outcome.printing.mean(),
-            max_at: outcome.printing_max_at,
-            samples: outcome.printing.count,
-        },
+        deviation_mm: Deviation::of(d, outcome.max_at),
+        printing_deviation_mm: Deviation::of(&outcome.printing, outcome.printing_max_at),
         layers,
         psd: Psd {
             fs_hz: fs,
@@ -315,6 +298,37 @@ pub fn vibration_of_path(
         simulated_s: outcome.simulated_s,
         steps: outcome.steps,
     })
+}
+
+/// The commanded trajectory of a planned path, an error where it has no timing.
+pub(crate) fn planned_segments(path: &PrintPath) -> Result<Vec<trajectory::Segment>, Error> {
+    trajectory::segments(path)
+        .ok_or_else(|| invalid("the path has no planned timing (extract it with plan = true)"))
+}
+
+/// The simulation's settings for `options`, and the accelerometer rate they give, Hz.
+pub(crate) fn simulation_settings(options: &VibrationOptions) -> (simulate::Settings, f64) {
+    let ts = options.ts_ms * 1e-3;
+    let decimation = ((1.0 / (options.fs_hz * ts)).round() as u64).max(1);
+    let settings = simulate::Settings {
+        ts,
+        decimation,
+        bucket_m: options.bucket_mm * 1e-3,
+    };
+    (settings, 1.0 / (decimation as f64 * ts))
+}
+
+impl Deviation {
+    /// The figures of running statistics `stats` (mm), the largest at `max_at`.
+    pub(crate) fn of(stats: &simulate::Stats, max_at: [f64; 3]) -> Self {
+        Deviation {
+            max: stats.max,
+            min: stats.min_or_zero(),
+            mean: stats.mean(),
+            max_at,
+            samples: stats.count,
+        }
+    }
 }
 
 /// The modes of each axis in the middle of the printed area.

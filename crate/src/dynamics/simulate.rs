@@ -62,6 +62,14 @@ impl Stats {
         self.max = self.max.max(v);
     }
 
+    /// Both runs' samples as one: `other`'s added to these.
+    pub fn merge(&mut self, other: &Stats) {
+        self.count += other.count;
+        self.sum += other.sum;
+        self.min = self.min.min(other.min);
+        self.max = self.max.max(other.max);
+    }
+
     /// Mean (0 without samples).
     pub fn mean(&self) -> f64 {
         if self.count > 0 {

@@ -150,3 +150,20 @@ mod properties {
         }
     }
 }
+
+#[test]
+fn layers_sampled_ring_as_in_the_whole_run_when_the_machine_settles_between() {
+    let options = VibrationOptions::default();
+    let whole = vibration(SQUARE, &options).unwrap();
+    let all = printing_deviation_in_layers(SQUARE, &options, &[true, true]).unwrap();
+    let p = whole.printing_deviation_mm;
+    assert_eq!((all.max, all.min, all.samples), (p.max, p.min, p.samples));
+    assert_eq!(all.max_at, p.max_at);
+    assert!((all.mean - p.mean).abs() <= 1e-12 * p.mean, "{all:?} {p:?}");
+    // The second layer starts after a 10 s dwell: from rest in the whole run too.
+    let second = printing_deviation_in_layers(SQUARE, &options, &[false, true]).unwrap();
+    assert_eq!(second.max, whole.layers[1].printing_amplitude);
+    assert!(second.samples > 0 && second.samples < all.samples);
+    let none = printing_deviation_in_layers(SQUARE, &options, &[]).unwrap();
+    assert_eq!(none.samples, 0);
+}

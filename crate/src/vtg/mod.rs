@@ -28,6 +28,7 @@
 
 mod arc_support;
 mod block;
+mod closed_loop;
 mod corners;
 pub mod deviation;
 pub mod firmware;
@@ -85,7 +86,7 @@ pub struct VtgOptions {
     /// Run the dynamics model ([`crate::dynamics`]) on both files for the deviation rows of
     /// Table 2, and rewrite again with faster VTG eq. 29 speeds if the rewrite rings more than the
     /// original (default true; it costs about as much as the rewrite itself, more when it
-    /// rewrites again). See `with_simulated_deviation`.
+    /// rewrites again). See `closed_loop::with_simulated_deviation`.
     pub dynamics: bool,
     /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`) to cut the line
     /// count: `auto` (default) where the firmware runs them ([`ArcsMode::Auto`]: a file that
@@ -130,6 +131,12 @@ pub struct VtgOptions {
     /// The rewrites that save lines pay for those that add them, the corners that cost the
     /// fewest lines first; the paths that do not fit are kept as they were (`kept_for_lines`).
     pub allow_more_lines_pct: f64,
+    /// Where the dynamics model asks for quieter whole-file variants, write and simulate each
+    /// whole (default false: on a file of 512 kB and 64 layers or more they race on every
+    /// eighth layer first, and only the one that rings least there is written whole; the
+    /// verdict is the whole file's either way). Slower on large files; the corpus files give
+    /// the same output both ways.
+    pub exhaustive: bool,
 }
 
 /// The print time the rewrite may add by default, percent: the issue's bar. More rounds more
@@ -155,6 +162,7 @@ impl Default for VtgOptions {
             estimates: true,
             min_segment_time_ms: None,
             allow_more_lines_pct: 0.0,
+            exhaustive: false,
         }
     }
 }
@@ -246,7 +254,11 @@ pub fn vtg_with_progress(
     // The original's simulated deviation does not depend on the rewrite: where there are
     // threads, it runs beside the first one (on a long print it takes as long).
     let (original_deviation, report) = crate::parallel::join(
-        || options.dynamics.then(|| printing_deviation(input, options)),
+        || {
+            options
+                .dynamics
+                .then(|| closed_loop::printing_deviation(input, options))
+        },
         || attempt(first, &[], before, &mut |f| progress(0.3 + 0.4 * f)),
     );
     let mut report = report?;
@@ -254,7 +266,8 @@ pub fn vtg_with_progress(
         return Err(cancelled());
     }
     if let Some(original) = original_deviation {
-        report = with_simulated_deviation(
+        report = closed_loop::with_simulated_deviation(
+            input,
             original,
             report,
             options,
@@ -377,205 +390,6 @@ fn with_estimates(
         }
     }
     Ok(report)
-}
-
-/// Fills Table 2's deviation rows with the dynamics model, run on the rewritten file over
-/// printing moves (travels are not rewritten) and compared with `original`, the original's
-/// (`None`: the model could not run on it), and closes the loop on it.
-///
-/// VTG eq. 29's speeds (`J_n = A_n f₁`) are meant to keep a rounded corner from exciting the frame
-/// more than the sharp one did, and on nearly every file they do. They are a rule of thumb, though:
-/// the ringing a corner leaves depends on how its timing falls against the modes, which no bound on
-/// `a_n` and `j_n` sees, and not monotonically (figures in `docs/method/vtg-tuning-notes.md`). So
-/// when the simulated mean deviation does not fall, or the peak deviation rises (the
-/// no-dearer rule holds for both, [`quietness`]), the file is rewritten again with the speeds
-/// starting at each of `Tuning::quieter_scales` in turn, and the quietest rewrite is kept:
-/// every variant still passes the no-dearer check path by path, so time and energy fall as
-/// before.
-///
-/// Keyhole loops ([`corners::keyhole`]) are the other thing the model can object to: the
-/// machine no longer stops at the tip of a wedge, but it swings round a loop of a tenth of a
-/// millimetre or so in radius, and on some files that rang more than the stop did. If no scale
-/// brings the mean below the original's with them, the scales are tried again without keyholes.
-///
-/// Where the quietest rewrite lowers the mean but raises the peak, the layers that ring above
-/// the original's peak are kept as they were ([`keep_peak_layers`]). If even that does not
-/// bring the peak down, or the quietest rewrite raises the mean, the original is handed back
-/// unchanged, with a `message` saying so: no file comes back ringing more than it went in.
-///
-/// `None` rows when the model cannot run (a print too long to simulate, for instance): the
-/// rest of the report stands without them.
-fn with_simulated_deviation(
-    original: Option<Simulated>,
-    first: VtgReport,
-    options: &VtgOptions,
-    again: &mut Again<'_>,
-) -> Result<VtgReport, Error> {
-    let simulate = |bytes: &[u8]| printing_deviation(bytes, options);
-    let Some(orig) = original else {
-        return Ok(first);
-    };
-    let b = orig.deviation;
-    let rows = |a: &crate::dynamics::Deviation| report::DeviationComparison {
-        max_mm: Comparison::new(b.max, a.max),
-        min_mm: Comparison::new(b.min, a.min),
-        mean_mm: Comparison::new(b.mean, a.mean),
-    };
-    let mut best = first;
-    if best.paths.rewritten == 0 && best.paths.compacted == 0 {
-        // Nothing rewritten: the file rings as the original does, and no variant would differ.
-        best.table2.deviation = Some(rows(&b));
-        return Ok(best);
-    }
-    let Some(mut best_sim) = simulate(&best.output) else {
-        return Ok(best);
-    };
-    best.table2.deviation = Some(rows(&best_sim.deviation));
-    let mut best_score = quietness(&b, &best_sim.deviation);
-    let mut best_variant = search::Variant::default();
-    // Faster speeds only where the feed is the VTG eq. 29 one.
-    let variants = search::quieter_variants().filter(|_| options.limit_feed);
-    for (k, variant) in variants.enumerate() {
-        if best_score.0 == 0 {
-            break;
-        }
-        let f = 0.7 + 0.05 * k as f64;
-        let mut next = again(variant, &[], best.before.clone(), f)?;
-        let Some(a) = simulate(&next.output) else {
-            break;
-        };
-        let score = quietness(&b, &a.deviation);
-        if score < best_score {
-            next.table2.deviation = Some(rows(&a.deviation));
-            (best_score, best, best_sim, best_variant) = (score, next, a, variant);
-        }
-    }
-    let best_a = best_sim.deviation;
-    if best_a.mean <= b.mean && best_a.max <= b.max {
-        return Ok(best);
-    }
-    if best_a.mean <= b.mean {
-        let before = best.before.clone();
-        if let Some((mut kept, a, layers)) =
-            keep_peak_layers(&orig, best_sim, best_variant, &before, options, again)?
-        {
-            kept.table2.deviation = Some(rows(&a.deviation));
-            kept.message = Some(format!(
-                "kept {} layer(s) as they were: rewritten, they rang above the original's \
-                 peak deviation ({:.4} mm)",
-                layers.len(),
-                b.max
-            ));
-            kept.peak_layers_kept = layers;
-            return Ok(kept);
-        }
-    }
-    // Every rewrite tried rings more than the original: the original is handed back.
-    let mut kept = again(search::Variant::original(), &[], best.before.clone(), 0.95)?;
-    kept.table2.deviation = Some(rows(&b));
-    kept.message = Some(handed_back(&b, &best_a));
-    Ok(kept)
-}
-
-/// Why the original is handed back: the quietest rewrite's deviation `a` against the
-/// original's `b`.
-fn handed_back(b: &crate::dynamics::Deviation, a: &crate::dynamics::Deviation) -> String {
-    let change = |before: f64, after: f64| {
-        format!(
-            "{:+.1} % ({before:.4} → {after:.4} mm)",
-            (after / before - 1.0) * 100.0
-        )
-    };
-    format!(
-        "kept the original: the quietest rewrite tried changed the dynamics model's mean \
-         deviation by {} and its peak by {}, and neither may rise",
-        change(b.mean, a.mean),
-        change(b.max, a.max)
-    )
-}
-
-/// A whole-file rewrite tried again: the variant, the layers kept as they are, the original's
-/// analysis, and where its progress starts.
-type Again<'a> = dyn FnMut(search::Variant, &[bool], Report, f64) -> Result<VtgReport, Error> + 'a;
-
-/// Rounds of [`keep_peak_layers`].
-const PEAK_ROUNDS: usize = 3;
-
-/// The rewrite as `variant` with the layers that ring above the original's peak deviation kept
-/// as they were: each round keeps the layers whose largest printing deviation in `sim` (the
-/// rewrite's) is above the original's peak and above that layer's own in the original, writes
-/// the file again and simulates it, up to [`PEAK_ROUNDS`] times. The rewrite, its simulation
-/// and the layers kept, once neither its mean nor its peak is above the original's;
-/// `None` if no round gets there (the mean rose, or no layer is left to keep).
-fn keep_peak_layers(
-    original: &Simulated,
-    mut sim: Simulated,
-    variant: search::Variant,
-    before: &Report,
-    options: &VtgOptions,
-    again: &mut Again<'_>,
-) -> Result<Option<(VtgReport, Simulated, Vec<usize>)>, Error> {
-    let b = original.deviation;
-    let mut kept = vec![false; original.layer_peaks.len().max(sim.layer_peaks.len())];
-    for _ in 0..PEAK_ROUNDS {
-        let mut more = false;
-        for (l, &peak) in sim.layer_peaks.iter().enumerate() {
-            let was = original.layer_peaks.get(l).copied().unwrap_or(0.0);
-            if peak > b.max && peak > was && !kept[l] {
-                kept[l] = true;
-                more = true;
-            }
-        }
-        if !more {
-            return Ok(None);
-        }
-        let next = again(variant, &kept, before.clone(), 0.95)?;
-        let Some(a) = printing_deviation(&next.output, options) else {
-            return Ok(None);
-        };
-        if a.deviation.mean > b.mean {
-            return Ok(None);
-        }
-        if a.deviation.max <= b.max {
-            let layers = (0..kept.len()).filter(|&l| kept[l]).collect();
-            return Ok(Some((next, a, layers)));
-        }
-        sim = a;
-    }
-    Ok(None)
-}
-
-/// What the dynamics model says of a file: the deviation over its printing moves, and the
-/// largest deviation while printing of each layer (by layer index).
-struct Simulated {
-    deviation: crate::dynamics::Deviation,
-    layer_peaks: Vec<f64>,
-}
-
-/// The dynamics model run on a file, `None` when it cannot run on it (a print too long to
-/// simulate, for instance).
-fn printing_deviation(bytes: &[u8], options: &VtgOptions) -> Option<Simulated> {
-    let vibration = crate::dynamics::VibrationOptions {
-        analyze: options.analyze.clone(),
-        ..Default::default()
-    };
-    let r = crate::dynamics::vibration(bytes, &vibration).ok()?;
-    let mut layer_peaks = vec![0.0; r.layers.iter().map(|l| l.layer + 1).max().unwrap_or(0)];
-    for l in &r.layers {
-        layer_peaks[l.layer] = l.printing_amplitude;
-    }
-    Some(Simulated {
-        deviation: r.printing_deviation_mm,
-        layer_peaks,
-    })
-}
-
-/// How a rewrite's simulated deviation `a` compares with the original's `b`, lower is
-/// quieter: first how many of the two figures the no-dearer rule checks rose (the mean, and
-/// the peak: VTG Table 2's max row, which the paper's VTG lowers by 19 %), then the mean.
-fn quietness(b: &crate::dynamics::Deviation, a: &crate::dynamics::Deviation) -> (u8, f64) {
-    let rose = u8::from(a.mean >= b.mean) + u8::from(a.max > b.max);
-    (rose, a.mean)
 }
 
 #[cfg(test)]

@@ -2911,7 +2911,7 @@ export type VtgOptions = Partial<{
    * Run the dynamics model ([`crate::dynamics`]) on both files for the deviation rows of
    * Table 2, and rewrite again with faster VTG eq. 29 speeds if the rewrite rings more than the
    * original (default true; it costs about as much as the rewrite itself, more when it
-   * rewrites again). See `with_simulated_deviation`.
+   * rewrites again). See `closed_loop::with_simulated_deviation`.
    */
   dynamics: boolean,
   /**
@@ -2971,6 +2971,14 @@ export type VtgOptions = Partial<{
    * fewest lines first; the paths that do not fit are kept as they were (`kept_for_lines`).
    */
   allow_more_lines_pct: number,
+  /**
+   * Where the dynamics model asks for quieter whole-file variants, write and simulate each
+   * whole (default false: on a file of 512 kB and 64 layers or more they race on every
+   * eighth layer first, and only the one that rings least there is written whole; the
+   * verdict is the whole file's either way). Slower on large files; the corpus files give
+   * the same output both ways.
+   */
+  exhaustive: boolean,
 }>;
 
 /**

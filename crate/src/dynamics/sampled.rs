@@ -1,0 +1,49 @@
+//! The dynamics model over a sample of a file's layers, for optimisers that compare variants
+//! of a large file before writing one whole.
+
+use super::simulate::{self, Outcome, Stats};
+use super::trajectory::Segment;
+use super::{planned_segments, simulation_settings, welch, Deviation, VibrationOptions};
+use crate::error::Error;
+
+/// The deviation over the printing moves of the layers `layers` marks (by layer index), each
+/// run of a layer's moves simulated from rest. The ringing a layer inherits from the one
+/// before is small beside what its own corners excite, and from rest the runs are independent:
+/// they are simulated side by side where there are threads, and a sample of an eighth of the
+/// layers costs about an eighth of [`super::vibration`] (which runs the whole print in one).
+/// Where the machine settles between the layers anyway (a long dwell), a layer rings exactly
+/// as in the whole run.
+pub fn printing_deviation_in_layers(
+    input: &[u8],
+    options: &VibrationOptions,
+    layers: &[bool],
+) -> Result<Deviation, Error> {
+    options.validate()?;
+    let path = crate::path::extract(input, &options.analyze, true)?;
+    let machine = options.machine_dynamics(&path.profile.name)?;
+    let segs = planned_segments(&path)?;
+    let sampled = |s: &Segment| layers.get(s.layer as usize).copied().unwrap_or(false);
+    let runs: Vec<&[Segment]> = segs
+        .chunk_by(|a, b| a.layer == b.layer)
+        .filter(|run| run.first().is_some_and(sampled))
+        .collect();
+    let (settings, fs) = simulation_settings(options);
+    let outcomes = crate::parallel::map_each(&runs, |run| {
+        let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
+        simulate::run(run, 0, &machine, settings, &mut welch, &mut |_| true)
+    });
+    let mut printing = Stats::default();
+    let mut max_at = [0.0; 3];
+    for outcome in outcomes {
+        let Outcome {
+            printing: p,
+            printing_max_at,
+            ..
+        } = outcome?;
+        if p.count > 0 && (printing.count == 0 || p.max > printing.max) {
+            max_at = printing_max_at;
+        }
+        printing.merge(&p);
+    }
+    Ok(Deviation::of(&printing, max_at))
+}
