@@ -239,11 +239,14 @@ pub fn vibration_with_progress(
     progress: Progress<'_>,
 ) -> Result<VibrationReport, Error> {
     options.validate()?;
-    let path = crate::path::extract(input, &options.analyze, true)?;
+    let mut path = crate::path::extract(input, &options.analyze, true)?;
     if !progress(0.1) {
         return Err(Error::new(0, 0, ErrorKind::Cancelled));
     }
-    vibration_of_path(&path, options, &mut |f| progress(0.1 + 0.9 * f))
+    let segs = planned_segments(&path)?;
+    // The moves are done with once their trajectory is built (a 34 MB file's take 300 MB).
+    path.moves = Vec::new();
+    simulated(&segs, &path, options, &mut |f| progress(0.1 + 0.9 * f))
 }
 
 /// Simulates an already extracted, planned path (for optimisers that compare their output's
@@ -254,12 +257,22 @@ pub fn vibration_of_path(
     progress: Progress<'_>,
 ) -> Result<VibrationReport, Error> {
     options.validate()?;
-    let machine = options.machine_dynamics(&path.profile.name)?;
     let segs = planned_segments(path)?;
+    simulated(&segs, path, options, progress)
+}
+
+/// The report of the trajectory `segs` of `path` (whose moves are not read again).
+fn simulated(
+    segs: &[trajectory::Segment],
+    path: &PrintPath,
+    options: &VibrationOptions,
+    progress: Progress<'_>,
+) -> Result<VibrationReport, Error> {
+    let machine = options.machine_dynamics(&path.profile.name)?;
     let (settings, fs) = simulation_settings(options);
     let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
     let outcome = simulate::run(
-        &segs,
+        segs,
         path.layers.len(),
         &machine,
         settings,
@@ -267,7 +280,7 @@ pub fn vibration_of_path(
         progress,
     )?;
 
-    let axes = axis_modes(&segs, &machine);
+    let axes = axis_modes(segs, &machine);
     let mut all: Vec<Mode> = axes.iter().flat_map(|a| a.modes.iter().copied()).collect();
     all.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
 
@@ -301,9 +314,13 @@ pub fn vibration_of_path(
 }
 
 /// The commanded trajectory of a planned path, an error where it has no timing.
-pub(crate) fn planned_segments(path: &PrintPath) -> Result<Vec<trajectory::Segment>, Error> {
-    trajectory::segments(path)
-        .ok_or_else(|| invalid("the path has no planned timing (extract it with plan = true)"))
+fn planned_segments(path: &PrintPath) -> Result<Vec<trajectory::Segment>, Error> {
+    trajectory::segments(path).ok_or_else(untimed)
+}
+
+/// The error for a path extracted without the planner's timing.
+fn untimed() -> Error {
+    invalid("the path has no planned timing (extract it with plan = true)")
 }
 
 /// The simulation's settings for `options`, and the accelerometer rate they give, Hz.

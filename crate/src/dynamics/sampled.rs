@@ -2,8 +2,8 @@
 //! of a large file before writing one whole.
 
 use super::simulate::{self, Outcome, Stats};
-use super::trajectory::Segment;
-use super::{planned_segments, simulation_settings, welch, Deviation, VibrationOptions};
+use super::trajectory::{self, Segment};
+use super::{simulation_settings, untimed, welch, Deviation, VibrationOptions};
 use crate::error::Error;
 
 /// The deviation over the printing moves of the layers `layers` marks (by layer index), each
@@ -21,12 +21,10 @@ pub fn printing_deviation_in_layers(
     options.validate()?;
     let path = crate::path::extract(input, &options.analyze, true)?;
     let machine = options.machine_dynamics(&path.profile.name)?;
-    let segs = planned_segments(&path)?;
-    let sampled = |s: &Segment| layers.get(s.layer as usize).copied().unwrap_or(false);
-    let runs: Vec<&[Segment]> = segs
-        .chunk_by(|a, b| a.layer == b.layer)
-        .filter(|run| run.first().is_some_and(sampled))
-        .collect();
+    let sampled = |layer: u32| layers.get(layer as usize).copied().unwrap_or(false);
+    let segs = trajectory::segments_where(&path, |m| sampled(m.layer)).ok_or_else(untimed)?;
+    drop(path);
+    let runs: Vec<&[Segment]> = segs.chunk_by(|a, b| a.layer == b.layer).collect();
     let (settings, fs) = simulation_settings(options);
     let outcomes = crate::parallel::map_each(&runs, |run| {
         let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);

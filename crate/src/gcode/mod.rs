@@ -68,6 +68,20 @@ where
     Ok(())
 }
 
+/// Lines of `input` that start with a `G` command: about as many as the moves a reader will
+/// find, for sizing a list of them up front. A list grown by doubling as it goes ends up with
+/// up to twice the room it needs (a 34 MB file's 1.09 million moves took 704 MB of list for
+/// 367 MB of moves), and copies itself at each step. Lines that start otherwise (`N12 G1`,
+/// indented) are not counted: the list then grows as before.
+pub fn command_lines(input: &[u8]) -> usize {
+    let starts_g = |b: Option<&u8>| matches!(b, Some(b'G' | b'g'));
+    let first = usize::from(starts_g(input.first()));
+    first
+        + memchr::memchr_iter(b'\n', input)
+            .filter(|&i| starts_g(input.get(i + 1)))
+            .count()
+}
+
 /// Rejects inputs that are not G-code text at all (UTF-16). Binary noise is left to the line
 /// parser, which reports it line by line.
 pub fn check_encoding(input: &[u8]) -> Result<(), Error> {
@@ -75,4 +89,15 @@ pub fn check_encoding(input: &[u8]) -> Result<(), Error> {
         return Err(Error::new(1, 1, ErrorKind::Utf16));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn command_lines_counts_lines_that_start_with_g() {
+        let text = b"G28\n; G1 in a comment\nG1 X1\ng1 x2\n  G1 X3\nN12 G1 X4\nM104 S200\nG92 E0";
+        assert_eq!(super::command_lines(text), 4);
+        assert_eq!(super::command_lines(b""), 0);
+        assert_eq!(super::command_lines(b"\n\n"), 0);
+    }
 }

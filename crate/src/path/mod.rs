@@ -317,7 +317,6 @@ pub fn walk(
 }
 
 /// [`MoveSink`] keeping every move (for [`extract`]).
-#[derive(Default)]
 struct Collect {
     moves: Vec<PathMove>,
     layer_pairs: Vec<(u32, u32)>,
@@ -347,7 +346,11 @@ impl MoveSink for Collect {
 /// commands applied where they appear, dwells and heater waits flushing the queue as firmware
 /// does). [`walk`] reads the same moves without keeping them.
 pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<PrintPath, Error> {
-    let mut kept = Collect::default();
+    let expected = crate::gcode::command_lines(input);
+    let mut kept = Collect {
+        moves: Vec::with_capacity(expected),
+        layer_pairs: Vec::with_capacity(expected),
+    };
     let walked = walk(input, options, plan, &mut kept)?;
     let Collect {
         mut moves,

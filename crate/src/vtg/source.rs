@@ -162,7 +162,7 @@ pub fn move_sources(input: &[u8], options: &AnalyzeOptions) -> Result<Sources, E
     let mut reader = Reader::new(input, options)?;
     let mut fold = Read {
         sources: Sources {
-            moves: Vec::new(),
+            moves: Vec::with_capacity(crate::gcode::command_lines(input)),
             limits: vec![(0, reader.limits.clone())],
         },
         notes: Notes::default(),
