@@ -122,15 +122,18 @@ fn quietest(
     }
     match race_sample(input.len(), orig.layer_peaks.len()).filter(|_| !options.exhaustive) {
         Some(sample) => raced(input, first, orig, &sample, options, again),
-        None => every_variant(first, search::quieter_variants(), orig, options, again),
+        None => {
+            let variants = (search::quieter_variants(), 0.7, 0.04);
+            every_variant(first, variants, orig, options, again)
+        }
     }
 }
 
 /// Each of `variants` written whole and simulated in turn, until one keeps the no-dearer rule;
-/// the quietest of them and `best` kept.
+/// the quietest of them and `best` kept. Progress runs from `from`, `step` a variant.
 fn every_variant(
     mut best: Tried,
-    variants: impl IntoIterator<Item = search::Variant>,
+    (variants, from, step): (impl IntoIterator<Item = search::Variant>, f64, f64),
     orig: &Simulated,
     options: &VtgOptions,
     again: &mut Again<'_>,
@@ -141,7 +144,7 @@ fn every_variant(
         if best_score.0 == 0 {
             break;
         }
-        let f = 0.7 + 0.05 * k as f64;
+        let f = from + step * k as f64;
         let report = again(variant, &[], best.report.before.clone(), f)?;
         let Some(sim) = printing_deviation(&report.output, options) else {
             break;
@@ -226,13 +229,8 @@ fn raced(
             break;
         }
     }
-    every_variant(
-        first,
-        lead.1.into_iter().chain(untold),
-        orig,
-        options,
-        again,
-    )
+    let whole = (lead.1.into_iter().chain(untold), 0.88, 0.01);
+    every_variant(first, whole, orig, options, again)
 }
 
 /// Why the original is handed back: the quietest rewrite's deviation `a` against the
