@@ -173,7 +173,8 @@ const RACE_MIN_BYTES: usize = 512 << 10;
 const RACE_STRIDE: usize = 8;
 
 /// The layers a file of `bytes` bytes and `layers` layers races its variants on ([`raced`]),
-/// `None` where it is small enough to try each whole or has too few layers to sample.
+/// `None` where it is small enough to try each whole or would have fewer than eight layers
+/// in the sample.
 fn race_sample(bytes: usize, layers: usize) -> Option<Vec<bool>> {
     (bytes >= RACE_MIN_BYTES && layers >= 8 * RACE_STRIDE).then(|| {
         (0..layers)
