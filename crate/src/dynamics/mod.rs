@@ -324,7 +324,7 @@ fn untimed() -> Error {
 }
 
 /// The simulation's settings for `options`, and the accelerometer rate they give, Hz.
-pub(crate) fn simulation_settings(options: &VibrationOptions) -> (simulate::Settings, f64) {
+fn simulation_settings(options: &VibrationOptions) -> (simulate::Settings, f64) {
     let ts = options.ts_ms * 1e-3;
     let decimation = ((1.0 / (options.fs_hz * ts)).round() as u64).max(1);
     let settings = simulate::Settings {
@@ -337,7 +337,7 @@ pub(crate) fn simulation_settings(options: &VibrationOptions) -> (simulate::Sett
 
 impl Deviation {
     /// The figures of running statistics `stats` (mm), the largest at `max_at`.
-    pub(crate) fn of(stats: &simulate::Stats, max_at: [f64; 3]) -> Self {
+    fn of(stats: &simulate::Stats, max_at: [f64; 3]) -> Self {
         Deviation {
             max: stats.max,
             min: stats.min_or_zero(),
