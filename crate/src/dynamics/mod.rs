@@ -239,14 +239,16 @@ pub fn vibration_with_progress(
     progress: Progress<'_>,
 ) -> Result<VibrationReport, Error> {
     options.validate()?;
-    let mut path = crate::path::extract(input, &options.analyze, true)?;
+    let (segs, file) = trajectory::all_segments_of_file(input, &options.analyze)?;
+    let segs = segs.ok_or_else(untimed)?;
     if !progress(0.1) {
         return Err(Error::new(0, 0, ErrorKind::Cancelled));
     }
-    let segs = planned_segments(&path)?;
-    // The moves are done with once their trajectory is built (a 34 MB file's take 300 MB).
-    path.moves = Vec::new();
-    simulated(&segs, &path, options, &mut |f| progress(0.1 + 0.9 * f))
+    let of = Simulated {
+        layers: &file.layers,
+        machine: &file.profile.name,
+    };
+    simulated(&segs, of, options, &mut |f| progress(0.1 + 0.9 * f))
 }
 
 /// Simulates an already extracted, planned path (for optimisers that compare their output's
@@ -258,22 +260,35 @@ pub fn vibration_of_path(
 ) -> Result<VibrationReport, Error> {
     options.validate()?;
     let segs = planned_segments(path)?;
-    simulated(&segs, path, options, progress)
+    let of = Simulated {
+        layers: &path.layers,
+        machine: &path.profile.name,
+    };
+    simulated(&segs, of, options, progress)
 }
 
-/// The report of the trajectory `segs` of `path` (whose moves are not read again).
+/// What the simulation's report says of the file besides its trajectory.
+#[derive(Clone, Copy)]
+struct Simulated<'a> {
+    /// Its layers (their heights).
+    layers: &'a [crate::path::PathLayer],
+    /// The machine preset it was planned with.
+    machine: &'a str,
+}
+
+/// The report of the trajectory `segs` of the file `of`.
 fn simulated(
     segs: &[trajectory::Segment],
-    path: &PrintPath,
+    of: Simulated<'_>,
     options: &VibrationOptions,
     progress: Progress<'_>,
 ) -> Result<VibrationReport, Error> {
-    let machine = options.machine_dynamics(&path.profile.name)?;
+    let machine = options.machine_dynamics(of.machine)?;
     let (settings, fs) = simulation_settings(options);
     let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
     let outcome = simulate::run(
         segs,
-        path.layers.len(),
+        of.layers.len(),
         &machine,
         settings,
         &mut welch,
@@ -287,9 +302,9 @@ fn simulated(
     let spectrum = welch.finish();
     let peaks = welch::peaks(&spectrum.freqs, &spectrum.power, options.peaks);
     let d = &outcome.deviation;
-    let layers = layer_vibrations(&outcome, path);
+    let layers = layer_vibrations(&outcome, of.layers);
     Ok(VibrationReport {
-        machine: path.profile.name.clone(),
+        machine: of.machine.to_string(),
         dynamics: machine.name.clone(),
         ts_ms: options.ts_ms,
         natural_frequencies_hz: all.iter().map(|m| m.frequency_hz).collect(),
@@ -379,7 +394,10 @@ fn axis_modes(segs: &[trajectory::Segment], machine: &MachineDynamics) -> Vec<Ax
 }
 
 /// The vibration of each layer with samples.
-fn layer_vibrations(outcome: &simulate::Outcome, path: &PrintPath) -> Vec<LayerVibration> {
+fn layer_vibrations(
+    outcome: &simulate::Outcome,
+    layers: &[crate::path::PathLayer],
+) -> Vec<LayerVibration> {
     outcome
         .layers
         .iter()
@@ -387,7 +405,7 @@ fn layer_vibrations(outcome: &simulate::Outcome, path: &PrintPath) -> Vec<LayerV
         .filter(|(_, l)| l.deviation.count > 0)
         .map(|(i, l)| LayerVibration {
             layer: i,
-            z: path.layers.get(i).and_then(|l| l.z),
+            z: layers.get(i).and_then(|l| l.z),
             amplitude: l.deviation.max,
             printing_amplitude: l.printing_max,
             mean: l.deviation.mean(),

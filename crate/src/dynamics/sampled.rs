@@ -19,11 +19,10 @@ pub fn printing_deviation_in_layers(
     layers: &[bool],
 ) -> Result<Deviation, Error> {
     options.validate()?;
-    let path = crate::path::extract(input, &options.analyze, true)?;
-    let machine = options.machine_dynamics(&path.profile.name)?;
     let sampled = |layer: u32| layers.get(layer as usize).copied().unwrap_or(false);
-    let segs = trajectory::segments_where(&path, |m| sampled(m.layer)).ok_or_else(untimed)?;
-    drop(path);
+    let (segs, file) = trajectory::segments_of_file(input, &options.analyze, sampled)?;
+    let segs = segs.ok_or_else(untimed)?;
+    let machine = options.machine_dynamics(&file.profile.name)?;
     let runs: Vec<&[Segment]> = segs.chunk_by(|a, b| a.layer == b.layer).collect();
     let (settings, fs) = simulation_settings(options);
     let outcomes = crate::parallel::map_each(&runs, |run| {

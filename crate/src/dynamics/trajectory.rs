@@ -124,63 +124,151 @@ fn geometry(m: &PathMove) -> Geometry {
 
 /// The timed trajectory of a planned path, or `None` if the path has no planner timing.
 pub fn segments(path: &PrintPath) -> Option<Vec<Segment>> {
-    timeline(path, |_| true, path.moves.len())
+    from_path(path, |_| true, path.moves.len())
 }
 
-/// The segments of [`segments`] whose moves `keep` accepts, on the whole path's timeline: the
-/// trajectory of a sample of the layers without building the rest (a 34 MB file's whole
-/// trajectory takes 190 MB).
-pub fn segments_where(path: &PrintPath, keep: impl Fn(&PathMove) -> bool) -> Option<Vec<Segment>> {
-    timeline(path, keep, 0)
+/// The segments of [`segments`] on the layers `keep` accepts (by layer index), on the whole
+/// path's timeline: the trajectory of a sample of the layers without building the rest (a 34 MB
+/// file's whole trajectory takes 190 MB).
+pub fn segments_where(path: &PrintPath, keep: impl Fn(u32) -> bool) -> Option<Vec<Segment>> {
+    from_path(path, keep, 0)
 }
 
 /// [`segments_where`], its list made with room for `capacity` segments.
-fn timeline(
+fn from_path(
     path: &PrintPath,
-    keep: impl Fn(&PathMove) -> bool,
+    keep: impl Fn(u32) -> bool,
     capacity: usize,
 ) -> Option<Vec<Segment>> {
-    let mut out: Vec<Segment> = Vec::with_capacity(capacity);
-    // The last segment on the timeline, kept or not: an arc starts at its exit speed.
-    let mut last: Option<Segment> = None;
-    let mut cursor = 0.0f64; // end of the last segment on our timeline
-    let mut planned_end = 0.0f64; // end of the last move on the planner's timeline
+    let mut timeline = Timeline::new(xy_feed_limit(&path.print_limits), keep, capacity);
     for m in &path.moves {
-        let t = m.timing?;
-        let duration = t.duration_s;
-        if !duration.is_finite() || !t.start_s.is_finite() {
-            continue;
+        timeline.push(m, m.timing?, (m.layer, m.layer));
+    }
+    Some(timeline.finish(true))
+}
+
+/// The trajectory of `input` read and planned as [`crate::path::extract`] would, on the layers
+/// `keep` accepts, built as the planner times each move: the file's moves are never all held
+/// (a 34 MB file's take 370 MB beside its 190 MB trajectory). `None` in the first place where
+/// a move has no timing; the second is what the walk learnt of the file (its layers and
+/// machine).
+pub fn segments_of_file(
+    input: &[u8],
+    options: &crate::analyze::AnalyzeOptions,
+    keep: impl Fn(u32) -> bool,
+) -> Result<(Option<Vec<Segment>>, crate::path::Walked), crate::error::Error> {
+    streamed(input, options, keep, 0)
+}
+
+/// [`segments_of_file`] on every layer, its list made with room for a segment per `G` line:
+/// grown by doubling, a 34 MB file's list would take 370 MB (in wasm, whose memory never
+/// shrinks, for good).
+pub fn all_segments_of_file(
+    input: &[u8],
+    options: &crate::analyze::AnalyzeOptions,
+) -> Result<(Option<Vec<Segment>>, crate::path::Walked), crate::error::Error> {
+    streamed(input, options, |_| true, crate::gcode::command_lines(input))
+}
+
+/// [`segments_of_file`], its list made with room for `capacity` segments.
+fn streamed(
+    input: &[u8],
+    options: &crate::analyze::AnalyzeOptions,
+    keep: impl Fn(u32) -> bool,
+    capacity: usize,
+) -> Result<(Option<Vec<Segment>>, crate::path::Walked), crate::error::Error> {
+    let mut sink = Streamed {
+        timeline: Timeline::new(f64::NAN, keep, capacity),
+        xy_feed_limit: f64::NAN,
+        latched: false,
+        waiting: std::collections::VecDeque::new(),
+        early: Vec::new(),
+        untimed: false,
+    };
+    let walked = crate::path::walk(input, options, true, &mut sink)?;
+    while let Some(w) = sink.waiting.pop_front() {
+        sink.done(w);
+    }
+    if !sink.latched {
+        // No extruding move: the limits of the whole file's end are the ones in force.
+        sink.latch(xy_feed_limit(&walked.print_limits));
+    }
+    let by_markers = matches!(walked.layer_source, crate::read::LayerSource::Markers(_));
+    let segments = (!sink.untimed).then(|| sink.timeline.finish(by_markers));
+    Ok((segments, walked))
+}
+
+/// The lower of the X and Y feed limits, mm/s: an arc's direction turns, so both bound it.
+fn xy_feed_limit(limits: &crate::plan::Limits) -> f64 {
+    let f = &limits.max_feedrate;
+    f[axis::X].value.min(f[axis::Y].value)
+}
+
+/// The trajectory built one timed move at a time, in file order.
+struct Timeline<K> {
+    out: Vec<Segment>,
+    /// Each kept segment's layer by counting (its `layer` holds the marker's) until the file
+    /// says which it uses.
+    counted: Vec<u32>,
+    /// The last segment on the timeline, kept or not: an arc starts at its exit speed.
+    last: Option<Segment>,
+    /// End of the last segment on our timeline.
+    cursor: f64,
+    /// End of the last move on the planner's timeline.
+    planned_end: f64,
+    /// [`xy_feed_limit`] of the limits in force when printing (arcs' feed cap).
+    xy_feed_limit: f64,
+    keep: K,
+}
+
+impl<K: Fn(u32) -> bool> Timeline<K> {
+    fn new(xy_feed_limit: f64, keep: K, capacity: usize) -> Self {
+        Timeline {
+            out: Vec::with_capacity(capacity),
+            counted: Vec::with_capacity(capacity),
+            last: None,
+            cursor: 0.0,
+            planned_end: 0.0,
+            xy_feed_limit,
+            keep,
         }
+    }
+
+    /// Move `m`, timed `t`, on layers `layers` (by marker, by counting).
+    fn push(&mut self, m: &PathMove, t: crate::path::MoveTiming, layers: (u32, u32)) {
+        if !t.duration_s.is_finite() || !t.start_s.is_finite() {
+            return;
+        }
+        let cursor = self.cursor;
         let (start, profile) = if matches!(m.kind, MoveKind::Arc(_)) {
             // The planner times an arc as straight firmware segments; the simulation follows the
             // true arc with one trapezoid, starting where the previous move ended.
-            let entry = last
+            let entry = self
+                .last
                 .as_ref()
                 .filter(|s| (s.end_s() - cursor).abs() < 1e-12)
                 .map_or(0.0, |s| s.profile.exit);
-            let a = t.profile.acceleration;
-            // The requested feed within the machine's X/Y speed limits (an arc's direction
-            // turns, so the lower of the two bounds it).
-            let limits = &path.print_limits.max_feedrate;
-            let axis_max = limits[axis::X].value.min(limits[axis::Y].value);
+            // The requested feed within the machine's X/Y speed limits.
+            let axis_max = self.xy_feed_limit;
             let feed = if axis_max > 0.0 {
                 m.feed_mm_s.min(axis_max)
             } else {
                 m.feed_mm_s
             };
             let cruise = feed.max(t.profile.peak);
+            let a = t.profile.acceleration;
             (
                 cursor,
                 Profile::new(m.length_mm, entry, cruise, t.profile.exit, a),
             )
         } else {
-            let gap = (t.start_s - planned_end).max(0.0);
+            let gap = (t.start_s - self.planned_end).max(0.0);
             (cursor + gap, t.profile)
         };
-        planned_end = planned_end.max(t.start_s + duration);
+        self.planned_end = self.planned_end.max(t.start_s + t.duration_s);
         let duration = profile.duration();
         if !(duration.is_finite() && duration > 0.0) {
-            continue;
+            return;
         }
         let seg = Segment {
             start_s: start,
@@ -189,16 +277,111 @@ fn timeline(
             from: [m.from[axis::X], m.from[axis::Y]],
             to: [m.to[axis::X], m.to[axis::Y]],
             geometry: geometry(m),
-            layer: m.layer,
+            layer: layers.0,
             extruding: m.is_extruding(),
         };
-        cursor = seg.end_s();
-        if keep(m) {
-            out.push(seg);
+        self.cursor = seg.end_s();
+        if (self.keep)(layers.0) || (self.keep)(layers.1) {
+            self.out.push(seg);
+            self.counted.push(layers.1);
         }
-        last = Some(seg);
+        self.last = Some(seg);
     }
-    Some(out)
+
+    /// The kept segments, each on its layer by marker (`by_markers`) or by counting.
+    fn finish(self, by_markers: bool) -> Vec<Segment> {
+        let Timeline {
+            mut out,
+            counted,
+            keep,
+            ..
+        } = self;
+        if !by_markers {
+            for (s, &layer) in out.iter_mut().zip(&counted) {
+                s.layer = layer;
+            }
+        }
+        out.retain(|s| keep(s.layer));
+        out
+    }
+}
+
+/// A move read, waiting for the planner's last word on its timing.
+type Waiting = (usize, PathMove, Option<crate::path::MoveTiming>, (u32, u32));
+
+/// The [`crate::path::MoveSink`] of [`segments_of_file`]: each move goes on the timeline once
+/// the planner has timed it and moved past it (an arc is timed in several calls). Until the
+/// first extruding move, whose limits cap the arcs' feeds, timed moves wait in `early`.
+struct Streamed<K> {
+    timeline: Timeline<K>,
+    /// [`xy_feed_limit`] of the limits in force now.
+    xy_feed_limit: f64,
+    /// Whether the printing limits are known (the first extruding move was read).
+    latched: bool,
+    waiting: std::collections::VecDeque<Waiting>,
+    early: Vec<Waiting>,
+    /// Whether a move was left without timing.
+    untimed: bool,
+}
+
+impl<K: Fn(u32) -> bool> Streamed<K> {
+    /// Move `w`'s timing is final.
+    fn done(&mut self, w: Waiting) {
+        if !self.latched {
+            self.early.push(w);
+            return;
+        }
+        match w.2 {
+            Some(t) => self.timeline.push(&w.1, t, w.3),
+            None => self.untimed = true,
+        }
+    }
+
+    /// The printing limits are known: the arcs' feed cap is `limit`.
+    fn latch(&mut self, limit: f64) {
+        self.latched = true;
+        self.timeline.xy_feed_limit = limit;
+        for w in std::mem::take(&mut self.early) {
+            self.done(w);
+        }
+    }
+}
+
+impl<K: Fn(u32) -> bool> crate::path::MoveSink for Streamed<K> {
+    fn moved(
+        &mut self,
+        index: usize,
+        m: PathMove,
+        layers: (u32, u32),
+        _: &[crate::path::PathFeature],
+    ) {
+        if !self.latched && m.is_extruding() {
+            self.latch(self.xy_feed_limit);
+        }
+        self.waiting.push_back((index, m, None, layers));
+    }
+
+    fn timed(&mut self, pm: &crate::plan::PlannedMove) {
+        let tag = pm.tag as usize;
+        while self.waiting.front().is_some_and(|w| w.0 < tag) {
+            if let Some(w) = self.waiting.pop_front() {
+                self.done(w);
+            }
+        }
+        if let Some(w) = self.waiting.front_mut().filter(|w| w.0 == tag) {
+            let end = pm.start_s + pm.duration();
+            let start_s = w.2.map_or(pm.start_s, |t| t.start_s);
+            w.2 = Some(crate::path::MoveTiming {
+                start_s,
+                duration_s: end - start_s,
+                profile: pm.profile,
+            });
+        }
+    }
+
+    fn limits(&mut self, limits: &crate::plan::Limits) {
+        self.xy_feed_limit = xy_feed_limit(limits);
+    }
 }
 
 #[cfg(test)]
@@ -229,7 +412,7 @@ mod tests {
         let second: Vec<Segment> = whole.iter().copied().filter(|s| s.layer == 1).collect();
         assert_eq!(second.len(), 2);
         assert!(second[0].profile.entry > 0.0, "{:?}", second[0].profile);
-        assert_eq!(segments_where(&path, |m| m.layer == 1).unwrap(), second);
+        assert_eq!(segments_where(&path, |layer| layer == 1).unwrap(), second);
     }
 
     #[test]
@@ -245,5 +428,31 @@ mod tests {
         );
         let mid = arc.command(0.5 * arc.duration_s);
         assert!((mid.pos[0].hypot(mid.pos[1]) - 10.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn an_arc_before_the_first_extrusion_waits_for_the_printing_limits() {
+        // A travel arc whose feed the printing limits cap (M203 X40 before the first extrusion,
+        // raised after it), layers by counting (no markers), one move never timed apart.
+        let g = b"G21\nG90\nM83\nM203 X400 Y400\nG1 X10 Y0 F6000\nG3 X0 Y10 I-10 J0 F6000\n\
+M203 X40 Y300\nG1 Z0.2 F600\nG1 X10 Y10 E1 F3000\nM203 X400\nG2 X20 Y0 I10 J0 E1 F6000\n\
+G1 Z0.4\nG1 X0 Y0 E1\nG4 P200\nG1 X5 Y5 E1\n";
+        let options = Default::default();
+        let path = crate::path::extract(g, &options, true).unwrap();
+        assert_eq!(path.print_limits.max_feedrate[axis::X].value, 40.0);
+        let whole = segments(&path).unwrap();
+        let (streamed, walked) = segments_of_file(g, &options, |_| true).unwrap();
+        assert_eq!(streamed.as_ref(), Some(&whole));
+        assert_eq!(walked.moves, path.moves.len());
+        // The first arc's 100 mm/s feed is capped by the printing limit (40 mm/s, below the
+        // planner's own peak on its firmware segments), not by the 400 mm/s in force there.
+        assert!(whole[1].profile.peak < 50.0, "{:?}", whole[1].profile);
+        let second = |layer: u32| layer == 1;
+        let sample = segments_where(&path, second).unwrap();
+        assert!(!sample.is_empty() && sample.iter().all(|s| s.layer == 1));
+        assert_eq!(
+            segments_of_file(g, &options, second).unwrap().0,
+            Some(sample)
+        );
     }
 }

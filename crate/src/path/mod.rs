@@ -150,6 +150,9 @@ pub trait MoveSink {
     /// The planner has timed move `pm.tag` (only when planning; several calls for the segments
     /// of one arc).
     fn timed(&mut self, _pm: &PlannedMove) {}
+    /// The limits in force changed (and once before the first move, with the file's starting
+    /// limits).
+    fn limits(&mut self, _limits: &Limits) {}
 }
 
 /// What [`walk`] learns of a file besides its moves.
@@ -216,6 +219,7 @@ impl<S: MoveSink> Fold for Walk<'_, S> {
         if let Some(planner) = &mut self.planner {
             *planner.limits_mut() = limits.clone();
         }
+        self.sink.limits(limits);
     }
 
     fn event(&mut self, _: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
@@ -269,6 +273,7 @@ pub fn walk(
     sink: &mut impl MoveSink,
 ) -> Result<Walked, Error> {
     let mut reader = Reader::new(input, options)?;
+    sink.limits(&reader.setup.limits);
     let mut fold = Walk {
         sink,
         planner: plan.then(|| Planner::new(reader.setup.limits.clone(), reader.setup.model)),
