@@ -186,3 +186,26 @@ fn the_trajectory_built_as_the_planner_times_each_move_is_the_one_from_the_kept_
         assert!(streamed == sample, "{}: the samples differ", file.name);
     }
 }
+
+#[test]
+fn the_simulation_run_as_the_planner_times_each_move_is_the_one_run_on_the_kept_moves() {
+    // Every corpus file but the 34 MB one (the run above covers its trajectory): the streamed
+    // run keeps one segment where the list-fed one holds them all, and must give the same report.
+    let options = VibrationOptions::default();
+    for file in quietpath_conformance::corpus() {
+        if file.bytes > 10 << 20 {
+            continue;
+        }
+        let input = file.read();
+        let streamed = vibration(&input, &options).expect("vibration");
+        let path = quietpath::path::extract(&input, &options.analyze, true).expect("extract");
+        let listed = quietpath::dynamics::vibration_of_path(&path, &options, &mut |_| true)
+            .expect("vibration_of_path");
+        let json = |r| serde_json::to_string(r).expect("json");
+        assert!(
+            json(&streamed) == json(&listed),
+            "{}: the reports differ",
+            file.name
+        );
+    }
+}

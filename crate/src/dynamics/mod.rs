@@ -27,6 +27,8 @@ pub mod modal_step;
 pub mod parameters;
 mod sampled;
 pub mod simulate;
+mod stream;
+mod timeline;
 pub mod trajectory;
 pub mod welch;
 
@@ -239,16 +241,21 @@ pub fn vibration_with_progress(
     progress: Progress<'_>,
 ) -> Result<VibrationReport, Error> {
     options.validate()?;
-    let (segs, file) = trajectory::all_segments_of_file(input, &options.analyze)?;
-    let segs = segs.ok_or_else(untimed)?;
-    if !progress(0.1) {
-        return Err(Error::new(0, 0, ErrorKind::Cancelled));
+    let (settings, fs) = simulation_settings(options);
+    let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
+    let dynamics_for = |name: &str| options.machine_dynamics(name);
+    let sim = stream::Simulating::new(dynamics_for, (settings, &mut welch), input, progress);
+    let (sim, timed, file) = timeline::of_file(input, &options.analyze, sim)?;
+    if !timed {
+        return Err(untimed());
     }
+    let by_markers = matches!(file.layer_source, crate::read::LayerSource::Markers(_));
+    let (outcome, bounds, machine) = sim.finish(file.layers.len(), by_markers)?;
     let of = Simulated {
         layers: &file.layers,
         machine: &file.profile.name,
     };
-    simulated(&segs, of, options, &mut |f| progress(0.1 + 0.9 * f))
+    Ok(report(outcome, welch, (bounds, &machine), of, options))
 }
 
 /// Simulates an already extracted, planned path (for optimisers that compare their output's
@@ -286,16 +293,22 @@ fn simulated(
     let machine = options.machine_dynamics(of.machine)?;
     let (settings, fs) = simulation_settings(options);
     let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
-    let outcome = simulate::run(
-        segs,
-        of.layers.len(),
-        &machine,
-        settings,
-        &mut welch,
-        progress,
-    )?;
+    let layers = of.layers.len();
+    let outcome = simulate::run(segs, layers, &machine, settings, &mut welch, progress)?;
+    let bounds = trajectory::Bounds::of(segs);
+    Ok(report(outcome, welch, (bounds, &machine), of, options))
+}
 
-    let axes = axis_modes(segs, &machine);
+/// The report of a simulation's `outcome` and spectrum (`welch`) on a trajectory within
+/// `bounds`, of `machine`.
+fn report(
+    outcome: simulate::Outcome,
+    welch: welch::Welch,
+    (bounds, machine): (trajectory::Bounds, &MachineDynamics),
+    of: Simulated<'_>,
+    options: &VibrationOptions,
+) -> VibrationReport {
+    let axes = axis_modes(bounds, machine);
     let mut all: Vec<Mode> = axes.iter().flat_map(|a| a.modes.iter().copied()).collect();
     all.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
 
@@ -303,7 +316,7 @@ fn simulated(
     let peaks = welch::peaks(&spectrum.freqs, &spectrum.power, options.peaks);
     let d = &outcome.deviation;
     let layers = layer_vibrations(&outcome, of.layers);
-    Ok(VibrationReport {
+    VibrationReport {
         machine: of.machine.to_string(),
         dynamics: machine.name.clone(),
         ts_ms: options.ts_ms,
@@ -314,7 +327,7 @@ fn simulated(
         printing_deviation_mm: Deviation::of(&outcome.printing, outcome.printing_max_at),
         layers,
         psd: Psd {
-            fs_hz: fs,
+            fs_hz: simulation_settings(options).1,
             window: spectrum.segment_len,
             window_kind: options.window_kind,
             overlap: spectrum.segment_len / 2,
@@ -325,7 +338,7 @@ fn simulated(
         },
         simulated_s: outcome.simulated_s,
         steps: outcome.steps,
-    })
+    }
 }
 
 /// The commanded trajectory of a planned path, an error where it has no timing.
@@ -364,16 +377,8 @@ impl Deviation {
 }
 
 /// The modes of each axis in the middle of the printed area.
-fn axis_modes(segs: &[trajectory::Segment], machine: &MachineDynamics) -> Vec<AxisModes> {
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for s in segs {
-        for p in [s.from, s.to] {
-            for ax in 0..2 {
-                lo[ax] = lo[ax].min(p[ax]);
-                hi[ax] = hi[ax].max(p[ax]);
-            }
-        }
-    }
+fn axis_modes(bounds: trajectory::Bounds, machine: &MachineDynamics) -> Vec<AxisModes> {
+    let trajectory::Bounds { lo, hi } = bounds;
     let mid = |ax: usize| {
         let m = 0.5 * (lo[ax] + hi[ax]);
         if m.is_finite() {

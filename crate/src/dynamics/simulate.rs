@@ -6,7 +6,6 @@ use super::parameters::MachineDynamics;
 use super::trajectory::{Command, Segment};
 use super::welch::Welch;
 use crate::error::{Error, ErrorKind};
-use crate::path::NO_LAYER;
 use crate::progress::Progress;
 
 /// Most simulation steps one run may take (about 55 hours of motion at 1 ms).
@@ -17,15 +16,13 @@ pub const MAX_STEPS: f64 = 2e8;
 pub const STEPS_PER_MOVE: f64 = 2000.0;
 /// The step budget of even the smallest file (about 5.5 hours of motion at 1 ms).
 pub const MIN_STEP_BUDGET: f64 = 2e7;
-/// Steps between two progress callbacks.
-const PROGRESS_STEPS: u64 = 1 << 20;
 /// Deviations (m) and deviation velocities (m/s) below which a resting machine is taken as
 /// still: 1 nm, and the speed of a 1 nm vibration at 1.6 kHz. Some modes are all but undamped
 /// (the idler's), so waiting for exact zero could take minutes of simulated rest.
 const STILL_M: f64 = 1e-9;
 const STILL_M_S: f64 = 1e-5;
 
-fn still(x: &State) -> bool {
+pub(super) fn still(x: &State) -> bool {
     x.iter().take(6).all(|v| v.abs() < STILL_M) && x.iter().skip(6).all(|v| v.abs() < STILL_M_S)
 }
 
@@ -102,6 +99,24 @@ pub struct LayerSums {
     pub accel_count: u64,
 }
 
+impl LayerSums {
+    /// A deviation sample `dev` (mm), taken while extruding or not.
+    #[inline]
+    pub(super) fn add_deviation(&mut self, dev: f64, extruding: bool) {
+        self.deviation.add(dev);
+        if extruding {
+            self.printing_max = self.printing_max.max(dev);
+        }
+    }
+
+    /// An acceleration sample of the table (X, Y, m/s²).
+    #[inline]
+    pub(super) fn add_acceleration(&mut self, acc: &[f64; 2]) {
+        self.accel_sq += acc[0] * acc[0] + acc[1] * acc[1];
+        self.accel_count += 1;
+    }
+}
+
 /// What a simulation gives.
 #[derive(Debug, Clone)]
 pub struct Outcome {
@@ -132,33 +147,9 @@ pub struct Settings {
     pub bucket_m: f64,
 }
 
-struct Cursor<'a> {
-    segs: &'a [Segment],
-    j: usize,
-}
-
-impl Cursor<'_> {
-    /// Command at `t` (non-decreasing between calls) and the index of the segment it is in.
-    fn at(&mut self, t: f64) -> (Command, Option<usize>) {
-        while self.j < self.segs.len() && self.segs[self.j].end_s() <= t {
-            self.j += 1;
-        }
-        match self.segs.get(self.j) {
-            Some(s) if t >= s.start_s => (s.command(t - s.start_s), Some(self.j)),
-            _ => {
-                let pos = match self.j.checked_sub(1).and_then(|i| self.segs.get(i)) {
-                    Some(prev) => prev.to,
-                    None => self.segs.first().map_or([0.0; 2], |s| s.from),
-                };
-                (Command { pos, vel: [0.0; 2] }, None)
-            }
-        }
-    }
-}
-
 impl Outcome {
     /// Nothing simulated yet, over `layers` layers.
-    fn new(layers: usize) -> Self {
+    pub(super) fn new(layers: usize) -> Self {
         Outcome {
             deviation: Stats::default(),
             max_at: [0.0; 3],
@@ -172,7 +163,7 @@ impl Outcome {
 
     /// A deviation sample `dev` (mm) at X, Y (mm) and time `at`, in layer `layer`.
     #[inline]
-    fn add_deviation(&mut self, dev: f64, at: [f64; 3], extruding: bool, layer: u32) {
+    pub(super) fn add_deviation(&mut self, dev: f64, at: [f64; 3], extruding: bool, layer: u32) {
         if dev > self.deviation.max || self.deviation.count == 0 {
             self.max_at = at;
         }
@@ -184,26 +175,27 @@ impl Outcome {
             self.printing.add(dev);
         }
         if let Some(l) = self.layers.get_mut(layer as usize) {
-            l.deviation.add(dev);
-            if extruding {
-                l.printing_max = l.printing_max.max(dev);
-            }
+            l.add_deviation(dev, extruding);
         }
     }
 
     /// An acceleration sample of the table (X, Y, m/s²) in layer `layer`.
     #[inline]
-    fn add_acceleration(&mut self, acc: &[f64; 2], layer: u32) {
+    pub(super) fn add_acceleration(&mut self, acc: &[f64; 2], layer: u32) {
         if let Some(l) = self.layers.get_mut(layer as usize) {
-            l.accel_sq += acc[0] * acc[0] + acc[1] * acc[1];
-            l.accel_count += 1;
+            l.add_acceleration(acc);
         }
     }
 }
 
 /// One step of both axes from the command `prev` to `next`.
 #[inline]
-fn step_axes(axes: &mut [Axis; 2], prev: &Command, next: &Command, ts: f64) -> Result<(), Error> {
+pub(super) fn step_axes(
+    axes: &mut [Axis; 2],
+    prev: &Command,
+    next: &Command,
+    ts: f64,
+) -> Result<(), Error> {
     for (ax, axis) in axes.iter_mut().enumerate() {
         let v0 = prev.vel[ax] * 1e-3;
         let a = (next.vel[ax] - prev.vel[ax]) * 1e-3 / ts;
@@ -216,7 +208,7 @@ fn step_axes(axes: &mut [Axis; 2], prev: &Command, next: &Command, ts: f64) -> R
 /// The table's mean acceleration (X, Y, m/s²) over the `dt` since its velocity was `last_v`,
 /// which becomes its velocity now.
 #[inline]
-fn table_acceleration(
+pub(super) fn table_acceleration(
     next: &Command,
     axes: &[Axis; 2],
     last_v: &mut [f64; 2],
@@ -245,7 +237,7 @@ fn step_budget(segs: &[Segment], ts: f64) -> Result<(u64, f64), Error> {
     Ok(((end / ts).ceil() as u64, budget))
 }
 
-fn too_long() -> Error {
+pub(super) fn too_long() -> Error {
     Error::new(
         0,
         0,
@@ -256,7 +248,7 @@ fn too_long() -> Error {
     )
 }
 
-fn cancelled() -> Error {
+pub(super) fn cancelled() -> Error {
     Error::new(0, 0, ErrorKind::Cancelled)
 }
 
@@ -281,72 +273,11 @@ pub fn run(
     welch: &mut Welch,
     progress: Progress<'_>,
 ) -> Result<Outcome, Error> {
-    let ts = settings.ts;
-    let (total, budget) = step_budget(segs, ts)?;
-    let mut axes = [
-        Axis::new(machine.x, ts, settings.bucket_m),
-        Axis::new(machine.y, ts, settings.bucket_m),
-    ];
-    let mut out = Outcome::new(layers);
-    let mut cursor = Cursor { segs, j: 0 };
-    let (mut prev, _) = cursor.at(0.0);
-    // Table velocity (m/s) at the last acceleration sample, and steps since.
-    let mut last_v = [0.0f64; 2];
-    let mut since = 0u64;
-    let mut k = 0u64;
-    let mut next_progress = PROGRESS_STEPS;
-    while k < total {
-        let t1 = (k + 1) as f64 * ts;
-        let (next, seg) = cursor.at(t1);
-        step_axes(&mut axes, &prev, &next, ts)?;
-        k += 1;
-        out.steps += 1;
-        let layer = seg.and_then(|i| segs.get(i)).map_or(NO_LAYER, |s| s.layer);
-        if seg.is_some() {
-            let (dx, dy) = (axes[0].table(), axes[1].table());
-            let dev = (dx * dx + dy * dy).sqrt() * 1e3;
-            let extruding = seg.and_then(|i| segs.get(i)).is_some_and(|s| s.extruding);
-            out.add_deviation(dev, [next.pos[0], next.pos[1], t1], extruding, layer);
-        }
-        since += 1;
-        if since >= settings.decimation {
-            let acc = table_acceleration(&next, &axes, &mut last_v, since as f64 * ts);
-            welch.push(&acc);
-            out.add_acceleration(&acc, layer);
-            since = 0;
-        }
-        let mut jumped = false;
-        if seg.is_none() && axes.iter().all(|a| still(&a.state())) {
-            // At rest and still: jump to the next move (nothing changes meanwhile).
-            if let Some(s) = segs.get(cursor.j) {
-                let resume = ((s.start_s / ts).floor() as u64).saturating_sub(1);
-                if resume > k {
-                    k = resume;
-                    axes.iter_mut().for_each(Axis::rest);
-                    last_v = [0.0; 2];
-                    since = 0;
-                    jumped = true;
-                }
-            } else {
-                break;
-            }
-        }
-        if out.steps as f64 > 2.0 * budget {
-            // Rests that never settle (an undamped mode excited): still bounded.
-            return Err(too_long());
-        }
-        if k >= next_progress {
-            next_progress = k + PROGRESS_STEPS;
-            if !progress(k as f64 / total.max(1) as f64) {
-                return Err(cancelled());
-            }
-        }
-        prev = if jumped {
-            cursor.at(k as f64 * ts).0
-        } else {
-            next
-        };
+    let (total, _) = step_budget(segs, settings.ts)?;
+    let sizes = (Some(layers), segs.len(), Some(total));
+    let mut stream = super::stream::Stream::new(machine, settings, welch, sizes);
+    for s in segs {
+        stream.push(*s, s.layer, progress)?;
     }
-    out.simulated_s = out.steps as f64 * ts;
-    Ok(out)
+    Ok(stream.finish(progress)?.0)
 }

@@ -17,7 +17,7 @@ use crate::plan::Profile;
 
 /// Where the path goes.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Geometry {
+pub(super) enum Geometry {
     /// No X/Y motion (Z-only, extruder-only moves).
     Still,
     /// A straight line: start and X/Y change per mm of path.
@@ -45,7 +45,7 @@ pub struct Segment {
     pub from: [f64; 2],
     /// End X, Y, mm.
     pub to: [f64; 2],
-    geometry: Geometry,
+    pub(super) geometry: Geometry,
     /// Layer index (or `path::NO_LAYER`).
     pub layer: u32,
     /// Whether the move lays down material.
@@ -101,7 +101,7 @@ impl Segment {
     }
 }
 
-fn geometry(m: &PathMove) -> Geometry {
+pub(super) fn geometry(m: &PathMove) -> Geometry {
     let dx = m.to[axis::X] - m.from[axis::X];
     let dy = m.to[axis::Y] - m.from[axis::Y];
     let len = m.length_mm;
@@ -124,27 +124,14 @@ fn geometry(m: &PathMove) -> Geometry {
 
 /// The timed trajectory of a planned path, or `None` if the path has no planner timing.
 pub fn segments(path: &PrintPath) -> Option<Vec<Segment>> {
-    from_path(path, |_| true, path.moves.len())
+    super::timeline::from_path(path, |_| true, path.moves.len())
 }
 
 /// The segments of [`segments`] on the layers `keep` accepts (by layer index), on the whole
 /// path's timeline: the trajectory of a sample of the layers without building the rest (a 34 MB
 /// file's whole trajectory takes 190 MB).
 pub fn segments_where(path: &PrintPath, keep: impl Fn(u32) -> bool) -> Option<Vec<Segment>> {
-    from_path(path, keep, 0)
-}
-
-/// [`segments_where`], its list made with room for `capacity` segments.
-fn from_path(
-    path: &PrintPath,
-    keep: impl Fn(u32) -> bool,
-    capacity: usize,
-) -> Option<Vec<Segment>> {
-    let mut timeline = Timeline::new(xy_feed_limit(&path.print_limits), keep, capacity);
-    for m in &path.moves {
-        timeline.push(m, m.timing?, (m.layer, m.layer));
-    }
-    Some(timeline.finish(true))
+    super::timeline::from_path(path, keep, 0)
 }
 
 /// The trajectory of `input` read and planned as [`crate::path::extract`] would, on the layers
@@ -157,230 +144,43 @@ pub fn segments_of_file(
     options: &crate::analyze::AnalyzeOptions,
     keep: impl Fn(u32) -> bool,
 ) -> Result<(Option<Vec<Segment>>, crate::path::Walked), crate::error::Error> {
-    streamed(input, options, keep, 0)
+    super::timeline::kept_of_file(input, options, keep, 0)
 }
 
-/// [`segments_of_file`] on every layer, its list made with room for a segment per `G` line:
-/// grown by doubling, a 34 MB file's list would take 370 MB (in wasm, whose memory never
-/// shrinks, for good).
-pub fn all_segments_of_file(
-    input: &[u8],
-    options: &crate::analyze::AnalyzeOptions,
-) -> Result<(Option<Vec<Segment>>, crate::path::Walked), crate::error::Error> {
-    streamed(input, options, |_| true, crate::gcode::command_lines(input))
+/// Lowest and highest X and Y of a trajectory's segments, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bounds {
+    /// Lowest X, Y.
+    pub lo: [f64; 2],
+    /// Highest X, Y.
+    pub hi: [f64; 2],
 }
 
-/// [`segments_of_file`], its list made with room for `capacity` segments.
-fn streamed(
-    input: &[u8],
-    options: &crate::analyze::AnalyzeOptions,
-    keep: impl Fn(u32) -> bool,
-    capacity: usize,
-) -> Result<(Option<Vec<Segment>>, crate::path::Walked), crate::error::Error> {
-    let mut sink = Streamed {
-        timeline: Timeline::new(f64::NAN, keep, capacity),
-        xy_feed_limit: f64::NAN,
-        latched: false,
-        waiting: std::collections::VecDeque::new(),
-        early: Vec::new(),
-        untimed: false,
-    };
-    let walked = crate::path::walk(input, options, true, &mut sink)?;
-    while let Some(w) = sink.waiting.pop_front() {
-        sink.done(w);
-    }
-    if !sink.latched {
-        // No extruding move: the limits of the whole file's end are the ones in force.
-        sink.latch(xy_feed_limit(&walked.print_limits));
-    }
-    let by_markers = matches!(walked.layer_source, crate::read::LayerSource::Markers(_));
-    let segments = (!sink.untimed).then(|| sink.timeline.finish(by_markers));
-    Ok((segments, walked))
-}
-
-/// The lower of the X and Y feed limits, mm/s: an arc's direction turns, so both bound it.
-fn xy_feed_limit(limits: &crate::plan::Limits) -> f64 {
-    let f = &limits.max_feedrate;
-    f[axis::X].value.min(f[axis::Y].value)
-}
-
-/// The trajectory built one timed move at a time, in file order.
-struct Timeline<K> {
-    out: Vec<Segment>,
-    /// Each kept segment's layer by counting (its `layer` holds the marker's) until the file
-    /// says which it uses.
-    counted: Vec<u32>,
-    /// The last segment on the timeline, kept or not: an arc starts at its exit speed.
-    last: Option<Segment>,
-    /// End of the last segment on our timeline.
-    cursor: f64,
-    /// End of the last move on the planner's timeline.
-    planned_end: f64,
-    /// [`xy_feed_limit`] of the limits in force when printing (arcs' feed cap).
-    xy_feed_limit: f64,
-    keep: K,
-}
-
-impl<K: Fn(u32) -> bool> Timeline<K> {
-    fn new(xy_feed_limit: f64, keep: K, capacity: usize) -> Self {
-        Timeline {
-            out: Vec::with_capacity(capacity),
-            counted: Vec::with_capacity(capacity),
-            last: None,
-            cursor: 0.0,
-            planned_end: 0.0,
-            xy_feed_limit,
-            keep,
+impl Default for Bounds {
+    fn default() -> Self {
+        Bounds {
+            lo: [f64::INFINITY; 2],
+            hi: [f64::NEG_INFINITY; 2],
         }
     }
+}
 
-    /// Move `m`, timed `t`, on layers `layers` (by marker, by counting).
-    fn push(&mut self, m: &PathMove, t: crate::path::MoveTiming, layers: (u32, u32)) {
-        if !t.duration_s.is_finite() || !t.start_s.is_finite() {
-            return;
-        }
-        let cursor = self.cursor;
-        let (start, profile) = if matches!(m.kind, MoveKind::Arc(_)) {
-            // The planner times an arc as straight firmware segments; the simulation follows the
-            // true arc with one trapezoid, starting where the previous move ended.
-            let entry = self
-                .last
-                .as_ref()
-                .filter(|s| (s.end_s() - cursor).abs() < 1e-12)
-                .map_or(0.0, |s| s.profile.exit);
-            // The requested feed within the machine's X/Y speed limits.
-            let axis_max = self.xy_feed_limit;
-            let feed = if axis_max > 0.0 {
-                m.feed_mm_s.min(axis_max)
-            } else {
-                m.feed_mm_s
-            };
-            let cruise = feed.max(t.profile.peak);
-            let a = t.profile.acceleration;
-            (
-                cursor,
-                Profile::new(m.length_mm, entry, cruise, t.profile.exit, a),
-            )
-        } else {
-            let gap = (t.start_s - self.planned_end).max(0.0);
-            (cursor + gap, t.profile)
-        };
-        self.planned_end = self.planned_end.max(t.start_s + t.duration_s);
-        let duration = profile.duration();
-        if !(duration.is_finite() && duration > 0.0) {
-            return;
-        }
-        let seg = Segment {
-            start_s: start,
-            duration_s: duration,
-            profile,
-            from: [m.from[axis::X], m.from[axis::Y]],
-            to: [m.to[axis::X], m.to[axis::Y]],
-            geometry: geometry(m),
-            layer: layers.0,
-            extruding: m.is_extruding(),
-        };
-        self.cursor = seg.end_s();
-        if (self.keep)(layers.0) || (self.keep)(layers.1) {
-            self.out.push(seg);
-            self.counted.push(layers.1);
-        }
-        self.last = Some(seg);
+impl Bounds {
+    /// The bounds of `segs`.
+    pub fn of(segs: &[Segment]) -> Self {
+        let mut b = Bounds::default();
+        segs.iter().for_each(|s| b.add(s));
+        b
     }
 
-    /// The kept segments, each on its layer by marker (`by_markers`) or by counting.
-    fn finish(self, by_markers: bool) -> Vec<Segment> {
-        let Timeline {
-            mut out,
-            counted,
-            keep,
-            ..
-        } = self;
-        if !by_markers {
-            for (s, &layer) in out.iter_mut().zip(&counted) {
-                s.layer = layer;
+    /// Widened to hold `s`'s ends.
+    pub fn add(&mut self, s: &Segment) {
+        for p in [s.from, s.to] {
+            for (ax, &v) in p.iter().enumerate() {
+                self.lo[ax] = self.lo[ax].min(v);
+                self.hi[ax] = self.hi[ax].max(v);
             }
         }
-        out.retain(|s| keep(s.layer));
-        out
-    }
-}
-
-/// A move read, waiting for the planner's last word on its timing.
-type Waiting = (usize, PathMove, Option<crate::path::MoveTiming>, (u32, u32));
-
-/// The [`crate::path::MoveSink`] of [`segments_of_file`]: each move goes on the timeline once
-/// the planner has timed it and moved past it (an arc is timed in several calls). Until the
-/// first extruding move, whose limits cap the arcs' feeds, timed moves wait in `early`.
-struct Streamed<K> {
-    timeline: Timeline<K>,
-    /// [`xy_feed_limit`] of the limits in force now.
-    xy_feed_limit: f64,
-    /// Whether the printing limits are known (the first extruding move was read).
-    latched: bool,
-    waiting: std::collections::VecDeque<Waiting>,
-    early: Vec<Waiting>,
-    /// Whether a move was left without timing.
-    untimed: bool,
-}
-
-impl<K: Fn(u32) -> bool> Streamed<K> {
-    /// Move `w`'s timing is final.
-    fn done(&mut self, w: Waiting) {
-        if !self.latched {
-            self.early.push(w);
-            return;
-        }
-        match w.2 {
-            Some(t) => self.timeline.push(&w.1, t, w.3),
-            None => self.untimed = true,
-        }
-    }
-
-    /// The printing limits are known: the arcs' feed cap is `limit`.
-    fn latch(&mut self, limit: f64) {
-        self.latched = true;
-        self.timeline.xy_feed_limit = limit;
-        for w in std::mem::take(&mut self.early) {
-            self.done(w);
-        }
-    }
-}
-
-impl<K: Fn(u32) -> bool> crate::path::MoveSink for Streamed<K> {
-    fn moved(
-        &mut self,
-        index: usize,
-        m: PathMove,
-        layers: (u32, u32),
-        _: &[crate::path::PathFeature],
-    ) {
-        if !self.latched && m.is_extruding() {
-            self.latch(self.xy_feed_limit);
-        }
-        self.waiting.push_back((index, m, None, layers));
-    }
-
-    fn timed(&mut self, pm: &crate::plan::PlannedMove) {
-        let tag = pm.tag as usize;
-        while self.waiting.front().is_some_and(|w| w.0 < tag) {
-            if let Some(w) = self.waiting.pop_front() {
-                self.done(w);
-            }
-        }
-        if let Some(w) = self.waiting.front_mut().filter(|w| w.0 == tag) {
-            let end = pm.start_s + pm.duration();
-            let start_s = w.2.map_or(pm.start_s, |t| t.start_s);
-            w.2 = Some(crate::path::MoveTiming {
-                start_s,
-                duration_s: end - start_s,
-                profile: pm.profile,
-            });
-        }
-    }
-
-    fn limits(&mut self, limits: &crate::plan::Limits) {
-        self.xy_feed_limit = xy_feed_limit(limits);
     }
 }
 

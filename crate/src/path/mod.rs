@@ -153,6 +153,8 @@ pub trait MoveSink {
     /// The limits in force changed (and once before the first move, with the file's starting
     /// limits).
     fn limits(&mut self, _limits: &Limits) {}
+    /// The machine the file is read for, once, before the first move.
+    fn machine(&mut self, _profile: &MachineProfile) {}
 }
 
 /// What [`walk`] learns of a file besides its moves.
@@ -273,6 +275,7 @@ pub fn walk(
     sink: &mut impl MoveSink,
 ) -> Result<Walked, Error> {
     let mut reader = Reader::new(input, options)?;
+    sink.machine(&reader.setup.profile);
     sink.limits(&reader.setup.limits);
     let mut fold = Walk {
         sink,

@@ -1,0 +1,409 @@
+//! The simulation fed its trajectory one segment at a time, in time order.
+//!
+//! [`super::simulate::run`] feeds it a list; [`super::trajectory::stream_file`] feeds it each
+//! move as the planner times it, so that a file's whole trajectory (190 MB for a 34 MB file)
+//! is never held. A step is taken as soon as the segments known decide it: the command at a
+//! time `t` depends only on the first segment ending after `t`, so every step before the end
+//! of the last segment pushed can be taken. [`Stream::finish`] takes the rest.
+
+use std::collections::VecDeque;
+
+use super::axis::Axis;
+use super::parameters::MachineDynamics;
+use super::simulate::{
+    cancelled, step_axes, still, table_acceleration, too_long, LayerSums, Outcome, Settings,
+    MAX_STEPS, MIN_STEP_BUDGET, STEPS_PER_MOVE,
+};
+use super::timeline::Emit;
+use super::trajectory::{Bounds, Command, Segment};
+use super::welch::Welch;
+use crate::error::Error;
+use crate::path::NO_LAYER;
+use crate::plan::MachineProfile;
+use crate::progress::Progress;
+
+/// Steps between two progress callbacks.
+const PROGRESS_STEPS: u64 = 1 << 20;
+
+/// One run of both axes, fed its segments in time order.
+pub struct Stream<'w> {
+    axes: [Axis; 2],
+    settings: Settings,
+    welch: &'w mut Welch,
+    out: Outcome,
+    /// Per-layer sums by the layer each segment has by counting, where the file's layers are
+    /// not yet known to come from its markers (`None`: the segments' own layers are final).
+    counted: Option<Vec<LayerSums>>,
+    /// Whether the per-layer sums grow to the layers met (their count is known only at the end).
+    grow: bool,
+    /// The segments from the one before the cursor's on, each with its counted layer; `base`
+    /// is the index of the first.
+    window: VecDeque<(Segment, u32)>,
+    base: usize,
+    /// Segments pushed.
+    pushed: usize,
+    /// The cursor: the segment the last command fell in, or the next one.
+    j: usize,
+    /// Where the first segment starts.
+    first_from: [f64; 2],
+    /// End of the last segment pushed, s.
+    end_s: f64,
+    /// The last command.
+    prev: Command,
+    /// Table velocity (m/s) at the last acceleration sample, and steps since.
+    last_v: [f64; 2],
+    since: u64,
+    /// Steps taken or skipped.
+    k: u64,
+    /// Motion time pushed, s (what the run costs: rests are skipped).
+    motion_s: f64,
+    /// The step budget of the most segments the run can have: an upper bound of the final one.
+    most_steps: f64,
+    /// Steps to the end when known up front (progress is reported only then).
+    total: Option<u64>,
+    next_progress: u64,
+}
+
+impl<'w> Stream<'w> {
+    /// A run of `machine` at `settings` with at most `max_segments` segments. `layers`: the
+    /// per-layer sums' count, or `None` to grow them to the layers met and keep sums by counted
+    /// layer too (see [`Stream::finish_layers`]). `total`: the steps to the end, when known.
+    pub fn new(
+        machine: &MachineDynamics,
+        settings: Settings,
+        welch: &'w mut Welch,
+        (layers, max_segments, total): (Option<usize>, usize, Option<u64>),
+    ) -> Self {
+        let ts = settings.ts;
+        Stream {
+            axes: [
+                Axis::new(machine.x, ts, settings.bucket_m),
+                Axis::new(machine.y, ts, settings.bucket_m),
+            ],
+            settings,
+            welch,
+            out: Outcome::new(layers.unwrap_or(0)),
+            counted: layers.is_none().then(Vec::new),
+            grow: layers.is_none(),
+            window: VecDeque::new(),
+            base: 0,
+            pushed: 0,
+            j: 0,
+            first_from: [0.0; 2],
+            end_s: 0.0,
+            prev: Command::default(),
+            last_v: [0.0; 2],
+            since: 0,
+            k: 0,
+            motion_s: 0.0,
+            most_steps: budget(max_segments),
+            total,
+            next_progress: PROGRESS_STEPS,
+        }
+    }
+
+    /// The next segment on the timeline (`counted`: its layer by counting), and every step its
+    /// end decides.
+    pub fn push(
+        &mut self,
+        seg: Segment,
+        counted: u32,
+        progress: Progress<'_>,
+    ) -> Result<(), Error> {
+        self.motion_s += seg.duration_s;
+        // Motion beyond the largest budget the run can have: refused now, as the whole list's
+        // run would refuse it before its first step.
+        if self.motion_s / self.settings.ts > self.most_steps {
+            return Err(too_long());
+        }
+        if self.pushed == 0 {
+            self.first_from = seg.from;
+        }
+        self.end_s = seg.end_s();
+        self.make_room(seg.layer, counted);
+        self.window.push_back((seg, counted));
+        self.pushed += 1;
+        if self.pushed == 1 {
+            self.prev = self.at(0.0).0;
+        }
+        self.advance(None, self.end_s, progress)
+    }
+
+    /// The run's outcome once every segment is pushed: the checks a whole list's run makes
+    /// first, then the steps to the end.
+    pub fn finish(
+        mut self,
+        progress: Progress<'_>,
+    ) -> Result<(Outcome, Option<Vec<LayerSums>>), Error> {
+        let ts = self.settings.ts;
+        let steps = self.motion_s / ts;
+        let budget = budget(self.pushed);
+        let end = self.end_s;
+        if steps.is_nan() || steps > budget || !end.is_finite() || end / ts > u64::MAX as f64 / 2.0
+        {
+            return Err(too_long());
+        }
+        self.most_steps = budget;
+        let total = (end / ts).ceil() as u64;
+        self.advance(Some(total), f64::INFINITY, progress)?;
+        self.out.simulated_s = self.out.steps as f64 * ts;
+        Ok((self.out, self.counted))
+    }
+
+    /// The segment of index `i`, if in the window.
+    fn get(&self, i: usize) -> Option<&(Segment, u32)> {
+        i.checked_sub(self.base).and_then(|w| self.window.get(w))
+    }
+
+    /// Command at `t` (non-decreasing between calls) and the index of the segment it is in.
+    #[inline]
+    fn at(&mut self, t: f64) -> (Command, Option<usize>) {
+        while self.j < self.pushed && self.get(self.j).is_some_and(|s| s.0.end_s() <= t) {
+            self.j += 1;
+        }
+        // Only the segment before the cursor's is needed again.
+        while self.base + 1 < self.j {
+            self.window.pop_front();
+            self.base += 1;
+        }
+        match self.get(self.j) {
+            Some((s, _)) if t >= s.start_s => (s.command(t - s.start_s), Some(self.j)),
+            _ => {
+                let pos = match self.j.checked_sub(1).and_then(|i| self.get(i)) {
+                    Some((prev, _)) => prev.to,
+                    None => self.first_from,
+                };
+                (Command { pos, vel: [0.0; 2] }, None)
+            }
+        }
+    }
+
+    /// Steps while `k < total` (when given) and their time is before `horizon`.
+    fn advance(
+        &mut self,
+        total: Option<u64>,
+        horizon: f64,
+        progress: Progress<'_>,
+    ) -> Result<(), Error> {
+        let ts = self.settings.ts;
+        while total.is_none_or(|n| self.k < n) {
+            let t1 = (self.k + 1) as f64 * ts;
+            if t1 >= horizon {
+                break;
+            }
+            let (next, seg) = self.at(t1);
+            if !self.step(next, seg, t1)? {
+                break;
+            }
+            if self.out.steps as f64 > 2.0 * self.most_steps {
+                // Rests that never settle (an undamped mode excited): still bounded.
+                return Err(too_long());
+            }
+            if let Some(n) = self.total.filter(|_| self.k >= self.next_progress) {
+                self.next_progress = self.k + PROGRESS_STEPS;
+                if !progress(self.k as f64 / n.max(1) as f64) {
+                    return Err(cancelled());
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// One step to the command `next` at `t1`, in segment `seg`; `false` where the machine is
+    /// at rest and still with no segment to come.
+    #[inline]
+    fn step(&mut self, next: Command, seg: Option<usize>, t1: f64) -> Result<bool, Error> {
+        let ts = self.settings.ts;
+        step_axes(&mut self.axes, &self.prev, &next, ts)?;
+        self.k += 1;
+        self.out.steps += 1;
+        let here = seg
+            .and_then(|i| self.get(i))
+            .map(|(s, c)| (s.layer, *c, s.extruding));
+        let (layer, counted) = here.map_or((NO_LAYER, NO_LAYER), |h| (h.0, h.1));
+        if let Some((_, _, extruding)) = here {
+            let (dx, dy) = (self.axes[0].table(), self.axes[1].table());
+            let dev = (dx * dx + dy * dy).sqrt() * 1e3;
+            self.out
+                .add_deviation(dev, [next.pos[0], next.pos[1], t1], extruding, layer);
+            if let Some(l) = self
+                .counted
+                .as_mut()
+                .and_then(|c| c.get_mut(counted as usize))
+            {
+                l.add_deviation(dev, extruding);
+            }
+        }
+        self.since += 1;
+        if self.since >= self.settings.decimation {
+            let dt = self.since as f64 * ts;
+            let acc = table_acceleration(&next, &self.axes, &mut self.last_v, dt);
+            self.welch.push(&acc);
+            self.out.add_acceleration(&acc, layer);
+            if let Some(l) = self
+                .counted
+                .as_mut()
+                .and_then(|c| c.get_mut(counted as usize))
+            {
+                l.add_acceleration(&acc);
+            }
+            self.since = 0;
+        }
+        let mut jumped = false;
+        if seg.is_none() && self.axes.iter().all(|a| still(&a.state())) {
+            // At rest and still: jump to the next move (nothing changes meanwhile).
+            let Some(s) = self.get(self.j).map(|s| s.0) else {
+                return Ok(false);
+            };
+            let resume = ((s.start_s / ts).floor() as u64).saturating_sub(1);
+            if resume > self.k {
+                self.k = resume;
+                self.axes.iter_mut().for_each(Axis::rest);
+                self.last_v = [0.0; 2];
+                self.since = 0;
+                jumped = true;
+            }
+        }
+        self.prev = if jumped {
+            self.at(self.k as f64 * ts).0
+        } else {
+            next
+        };
+        Ok(true)
+    }
+
+    /// Per-layer sums up to `layer` (and `counted`) where they grow to the layers met: made
+    /// as each segment comes, so that the steps find them.
+    fn make_room(&mut self, layer: u32, counted: u32) {
+        if !self.grow {
+            return;
+        }
+        let need = |l: u32| if l == NO_LAYER { 0 } else { l as usize + 1 };
+        if self.out.layers.len() < need(layer) {
+            self.out.layers.resize(need(layer), LayerSums::default());
+        }
+        if let Some(c) = self.counted.as_mut().filter(|c| c.len() < need(counted)) {
+            c.resize(need(counted), LayerSums::default());
+        }
+    }
+}
+
+/// The most steps a run of `segments` segments may take (about 5.5 hours of motion at 1 ms at
+/// least, 55 hours at most).
+fn budget(segments: usize) -> f64 {
+    (STEPS_PER_MOVE * segments as f64).clamp(MIN_STEP_BUDGET, MAX_STEPS)
+}
+
+/// The per-layer sums of a streamed run, `layers` of them, by marker (`by_markers`: the
+/// outcome's own) or by counting.
+fn finish_layers(
+    out: &mut Outcome,
+    counted: Option<Vec<LayerSums>>,
+    layers: usize,
+    by_markers: bool,
+) {
+    if let Some(c) = counted.filter(|_| !by_markers) {
+        out.layers = c;
+    }
+    out.layers.resize(layers, LayerSums::default());
+}
+
+/// The [`Emit`] that runs a simulation on a file's segments as the planner times them
+/// ([`super::timeline::of_file`]): the machine's dynamics are known from the file's machine,
+/// before its first move. Progress runs with the segments read (of about `expected`).
+pub(super) struct Simulating<'w, 'p, F> {
+    dynamics_for: Option<F>,
+    settings: Settings,
+    welch: Option<&'w mut Welch>,
+    stream: Option<Stream<'w>>,
+    machine: Option<MachineDynamics>,
+    max_segments: usize,
+    expected: usize,
+    pushed: usize,
+    bounds: Bounds,
+    error: Option<Error>,
+    progress: Progress<'p>,
+}
+
+impl<'w, 'p, F: FnOnce(&str) -> Result<MachineDynamics, Error>> Simulating<'w, 'p, F> {
+    /// A simulation at `settings` into `welch` of `input`, its machine's dynamics from
+    /// `dynamics_for` (given the machine preset's name).
+    pub(super) fn new(
+        dynamics_for: F,
+        (settings, welch): (Settings, &'w mut Welch),
+        input: &[u8],
+        progress: Progress<'p>,
+    ) -> Self {
+        // A move per line at most.
+        let max_segments = memchr::memchr_iter(b'\n', input).count() + 1;
+        Simulating {
+            dynamics_for: Some(dynamics_for),
+            settings,
+            welch: Some(welch),
+            stream: None,
+            machine: None,
+            max_segments,
+            expected: crate::gcode::command_lines(input).max(1),
+            pushed: 0,
+            bounds: Bounds::default(),
+            error: None,
+            progress,
+        }
+    }
+
+    /// The run's outcome (its per-layer sums, `layers` of them, by marker where `by_markers`),
+    /// the trajectory's bounds and the machine's dynamics.
+    pub(super) fn finish(
+        self,
+        layers: usize,
+        by_markers: bool,
+    ) -> Result<(Outcome, Bounds, MachineDynamics), Error> {
+        if let Some(e) = self.error {
+            return Err(e);
+        }
+        let (Some(stream), Some(machine)) = (self.stream, self.machine) else {
+            return Err(cancelled());
+        };
+        // Read to the end: the rest is a few steps.
+        if !(self.progress)(0.95) {
+            return Err(cancelled());
+        }
+        let (mut out, counted) = stream.finish(self.progress)?;
+        finish_layers(&mut out, counted, layers, by_markers);
+        Ok((out, self.bounds, machine))
+    }
+}
+
+impl<F: FnOnce(&str) -> Result<MachineDynamics, Error>> Emit for Simulating<'_, '_, F> {
+    fn emit(&mut self, seg: Segment, counted: u32) {
+        let Some(stream) = self.stream.as_mut().filter(|_| self.error.is_none()) else {
+            return;
+        };
+        self.bounds.add(&seg);
+        if let Err(e) = stream.push(seg, counted, &mut |_| true) {
+            self.error = Some(e);
+        }
+        self.pushed += 1;
+        if self.pushed % 4096 == 0 {
+            let done = self.pushed as f64 / self.expected as f64;
+            if !(self.progress)(0.95 * done.min(1.0)) {
+                self.error = Some(cancelled());
+            }
+        }
+    }
+
+    fn machine(&mut self, profile: &MachineProfile) {
+        let (Some(dynamics_for), Some(welch)) = (self.dynamics_for.take(), self.welch.take())
+        else {
+            return;
+        };
+        match dynamics_for(&profile.name) {
+            Ok(machine) => {
+                let sizes = (None, self.max_segments, None);
+                self.stream = Some(Stream::new(&machine, self.settings, welch, sizes));
+                self.machine = Some(machine);
+            }
+            Err(e) => self.error = Some(e),
+        }
+    }
+}
