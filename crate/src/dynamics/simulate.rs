@@ -229,12 +229,31 @@ fn step_budget(segs: &[Segment], ts: f64) -> Result<(u64, f64), Error> {
     let end = segs.last().map_or(0.0, |s| s.end_s());
     // Motion time bounds the work (rests are skipped once the machine is still).
     let motion: f64 = segs.iter().map(|s| s.duration_s).sum();
-    let steps = motion / ts;
-    let budget = (STEPS_PER_MOVE * segs.len() as f64).clamp(MIN_STEP_BUDGET, MAX_STEPS);
-    if steps.is_nan() || steps > budget || !end.is_finite() || end / ts > u64::MAX as f64 / 2.0 {
+    steps_to_end(motion, segs.len(), end, ts)
+}
+
+/// Steps to `end_s` at period `ts` for a trajectory of `segments` segments and `motion_s` of
+/// motion, and the most steps its run may take ([`budget`]); an error if its motion would take
+/// more.
+pub(super) fn steps_to_end(
+    motion_s: f64,
+    segments: usize,
+    end_s: f64,
+    ts: f64,
+) -> Result<(u64, f64), Error> {
+    let steps = motion_s / ts;
+    let budget = budget(segments);
+    if steps.is_nan() || steps > budget || !end_s.is_finite() || end_s / ts > u64::MAX as f64 / 2.0
+    {
         return Err(too_long());
     }
-    Ok(((end / ts).ceil() as u64, budget))
+    Ok(((end_s / ts).ceil() as u64, budget))
+}
+
+/// The most steps a run of `segments` segments may take (about 5.5 hours of motion at 1 ms at
+/// least, 55 hours at most).
+pub(super) fn budget(segments: usize) -> f64 {
+    (STEPS_PER_MOVE * segments as f64).clamp(MIN_STEP_BUDGET, MAX_STEPS)
 }
 
 pub(super) fn too_long() -> Error {

@@ -1,7 +1,7 @@
 //! The simulation fed its trajectory one segment at a time, in time order.
 //!
-//! [`super::simulate::run`] feeds it a list; [`super::trajectory::stream_file`] feeds it each
-//! move as the planner times it, so that a file's whole trajectory (190 MB for a 34 MB file)
+//! [`super::simulate::run`] feeds it a list; [`super::timeline::of_file`], with [`Simulating`],
+//! each move as the planner times it, so that a file's whole trajectory (190 MB for a 34 MB file)
 //! is never held. A step is taken as soon as the segments known decide it: the command at a
 //! time `t` depends only on the first segment ending after `t`, so every step before the end
 //! of the last segment pushed can be taken. [`Stream::finish`] takes the rest.
@@ -11,8 +11,8 @@ use std::collections::VecDeque;
 use super::axis::Axis;
 use super::parameters::MachineDynamics;
 use super::simulate::{
-    cancelled, step_axes, still, table_acceleration, too_long, LayerSums, Outcome, Settings,
-    MAX_STEPS, MIN_STEP_BUDGET, STEPS_PER_MOVE,
+    budget, cancelled, step_axes, steps_to_end, still, table_acceleration, too_long, LayerSums,
+    Outcome, Settings,
 };
 use super::timeline::Emit;
 use super::trajectory::{Bounds, Command, Segment};
@@ -32,10 +32,9 @@ pub struct Stream<'w> {
     welch: &'w mut Welch,
     out: Outcome,
     /// Per-layer sums by the layer each segment has by counting, where the file's layers are
-    /// not yet known to come from its markers (`None`: the segments' own layers are final).
+    /// not yet known to come from its markers and their count is known only at the end (`None`:
+    /// the segments' own layers are final, the sums' count fixed).
     counted: Option<Vec<LayerSums>>,
-    /// Whether the per-layer sums grow to the layers met (their count is known only at the end).
-    grow: bool,
     /// The segments from the one before the cursor's on, each with its counted layer; `base`
     /// is the index of the first.
     window: VecDeque<(Segment, u32)>,
@@ -84,7 +83,6 @@ impl<'w> Stream<'w> {
             welch,
             out: Outcome::new(layers.unwrap_or(0)),
             counted: layers.is_none().then(Vec::new),
-            grow: layers.is_none(),
             window: VecDeque::new(),
             base: 0,
             pushed: 0,
@@ -136,15 +134,8 @@ impl<'w> Stream<'w> {
         progress: Progress<'_>,
     ) -> Result<(Outcome, Option<Vec<LayerSums>>), Error> {
         let ts = self.settings.ts;
-        let steps = self.motion_s / ts;
-        let budget = budget(self.pushed);
-        let end = self.end_s;
-        if steps.is_nan() || steps > budget || !end.is_finite() || end / ts > u64::MAX as f64 / 2.0
-        {
-            return Err(too_long());
-        }
+        let (total, budget) = steps_to_end(self.motion_s, self.pushed, self.end_s, ts)?;
         self.most_steps = budget;
-        let total = (end / ts).ceil() as u64;
         self.advance(Some(total), f64::INFINITY, progress)?;
         self.out.simulated_s = self.out.steps as f64 * ts;
         Ok((self.out, self.counted))
@@ -275,7 +266,7 @@ impl<'w> Stream<'w> {
     /// Per-layer sums up to `layer` (and `counted`) where they grow to the layers met: made
     /// as each segment comes, so that the steps find them.
     fn make_room(&mut self, layer: u32, counted: u32) {
-        if !self.grow {
+        if self.counted.is_none() {
             return;
         }
         let need = |l: u32| if l == NO_LAYER { 0 } else { l as usize + 1 };
@@ -286,12 +277,6 @@ impl<'w> Stream<'w> {
             c.resize(need(counted), LayerSums::default());
         }
     }
-}
-
-/// The most steps a run of `segments` segments may take (about 5.5 hours of motion at 1 ms at
-/// least, 55 hours at most).
-fn budget(segments: usize) -> f64 {
-    (STEPS_PER_MOVE * segments as f64).clamp(MIN_STEP_BUDGET, MAX_STEPS)
 }
 
 /// The per-layer sums of a streamed run, `layers` of them, by marker (`by_markers`: the
@@ -361,6 +346,8 @@ impl<'w, 'p, F: FnOnce(&str) -> Result<MachineDynamics, Error>> Simulating<'w, '
         if let Some(e) = self.error {
             return Err(e);
         }
+        // `path::walk` tells the machine before the first move: no stream only where the walk
+        // stopped before reading.
         let (Some(stream), Some(machine)) = (self.stream, self.machine) else {
             return Err(cancelled());
         };
