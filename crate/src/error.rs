@@ -98,6 +98,13 @@ pub enum ErrorKind {
         /// The second rotary axis letter.
         second: char,
     },
+    /// Data handed between the two halves of an analysis run apart (the playground's two
+    /// workers) was cut short or garbled.
+    #[error("analysis data between workers is damaged: {reason}")]
+    Transfer {
+        /// Why.
+        reason: &'static str,
+    },
     /// The job was cancelled by the caller.
     #[error("cancelled")]
     Cancelled,

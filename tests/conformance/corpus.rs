@@ -329,3 +329,36 @@ fn the_slicer_is_recognised() {
         assert!(got.starts_with(slicer), "{name}: slicer {got:?}");
     }
 }
+
+/// The playground plans a file in a second worker, with the moves and results passed as
+/// bytes: the report must be `analyze`'s to the bit on every file (arcs, dwells, Klipper
+/// limits, temperature and fan events, 5-axis moves), and with a Klipper config applied.
+#[test]
+fn analyze_with_the_timing_side_apart_gives_the_same_report() {
+    use quietpath::analyze::apart::{read_apart, report_apart, TimingApart};
+    let klipper = AnalyzeOptions {
+        machine: Some("voron-klipper".into()),
+        ..AnalyzeOptions::default()
+    };
+    for f in corpus() {
+        let input = f.read();
+        for options in [AnalyzeOptions::default(), klipper.clone()] {
+            let mut timing = TimingApart::new();
+            let mut batches = 0;
+            let side = read_apart(&input, &options, &mut |_| true, &mut |batch| {
+                batches += 1;
+                timing.feed(batch).unwrap();
+            })
+            .unwrap();
+            let report = report_apart(&input, &options, side, &timing.finish().unwrap()).unwrap();
+            let whole = analyze(&input, &options).unwrap();
+            assert_eq!(
+                serde_json::to_string(&report).unwrap(),
+                serde_json::to_string(&whole).unwrap(),
+                "{}",
+                f.name
+            );
+            assert!(batches >= 1, "{}", f.name);
+        }
+    }
+}

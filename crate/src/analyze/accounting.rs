@@ -182,8 +182,12 @@ impl Accounts {
         }
     }
 
-    /// Adds the timing side's per-feature and per-layer times and energies.
-    pub fn merge(&mut self, timing: &TimeBook, layers: &mut LayerTracker) {
+    /// Adds the timing side's per-feature and per-layer times and energies, and gives its
+    /// energy model the material the file names.
+    pub fn merge(&mut self, timing: &mut TimeBook, layers: &mut LayerTracker) {
+        if let Some(m) = self.material {
+            timing.energy.set_material_from_file(m);
+        }
         for (i, (t, e)) in timing.feature_time.iter().enumerate() {
             if let Some(f) = self.features.get_mut(i) {
                 f.time_s += t;
@@ -256,10 +260,10 @@ pub struct Timing {
 pub struct TimeBook {
     pub energy: Accumulator,
     /// (time, energy) per feature slot.
-    feature_time: Vec<(f64, f64)>,
-    travel_time: (f64, f64),
+    pub(super) feature_time: Vec<(f64, f64)>,
+    pub(super) travel_time: (f64, f64),
     /// (time, energy) per layer: by markers, by Z.
-    layer_time: [Vec<(f64, f64)>; 2],
+    pub(super) layer_time: [Vec<(f64, f64)>; 2],
     /// (sequence, slot, layers) of moves not yet finalised.
     tags: VecDeque<(u64, u32, (u32, u32))>,
     pending: VecDeque<(u64, Pending)>,
@@ -281,19 +285,9 @@ fn add(v: &mut Vec<(f64, f64)>, i: u32, t: f64, e: f64) {
 
 impl Timing {
     pub fn new(planner: Planner, energy: Accumulator) -> Self {
-        let book = TimeBook {
-            energy,
-            feature_time: Vec::new(),
-            travel_time: (0.0, 0.0),
-            layer_time: [Vec::new(), Vec::new()],
-            tags: VecDeque::new(),
-            pending: VecDeque::new(),
-            temperatures: Vec::new(),
-            fans: Vec::new(),
-        };
         Self {
             planner,
-            book,
+            book: TimeBook::new(energy),
             moves: 0,
         }
     }
@@ -353,6 +347,20 @@ impl Timing {
 }
 
 impl TimeBook {
+    /// An empty book.
+    pub fn new(energy: Accumulator) -> Self {
+        TimeBook {
+            energy,
+            feature_time: Vec::new(),
+            travel_time: (0.0, 0.0),
+            layer_time: [Vec::new(), Vec::new()],
+            tags: VecDeque::new(),
+            pending: VecDeque::new(),
+            temperatures: Vec::new(),
+            fans: Vec::new(),
+        }
+    }
+
     fn planned(&mut self, pm: &PlannedMove) {
         let joules = self.energy.planned(pm);
         self.stamp_until(pm.tag, pm.start_s);

@@ -2,19 +2,20 @@
 //! filament, layers, features, temperatures, fans and energy (from [`crate::energy`]).
 
 mod accounting;
+pub mod apart;
 mod pipeline;
 pub mod report;
 pub mod toolpath;
+mod wire;
 
-use crate::energy::Accumulator;
 use crate::error::{Error, ErrorKind};
 use crate::gcode::{Line, RawLine, SlicerInfo};
 use crate::machine::{axis, Event, Machine};
-use crate::plan::{Limits, Planner};
+use crate::plan::Limits;
 use crate::progress::Progress;
 pub use crate::read::{prescan, AnalyzeOptions, ExtrusionModeOption};
 use crate::read::{At, Flow, Fold, Reader, Setup};
-use accounting::{Accounts, TimeBook, TimeMsg, Timing};
+use accounting::{Accounts, TimeBook, TimeMsg};
 pub use report::*;
 
 /// Default filament diameter when the file does not declare one, mm.
@@ -98,13 +99,7 @@ pub fn analyze_with_progress(
     progress: Progress<'_>,
 ) -> Result<Report, Error> {
     let mut reader = Reader::new(input, options)?;
-    let mut timing = Timing::new(
-        Planner::new(reader.setup.limits.clone(), reader.setup.model),
-        Accumulator::new(
-            &options.energy.clone().unwrap_or_default(),
-            &reader.setup.profile.name,
-        ),
-    );
+    let mut timing = wire::TimingSetup::of(&reader, options).timing();
     let mut info = SlicerInfo::default();
     let mut acc = Accounts::new();
     pipeline::run(input.len(), &mut timing, |to_timing| {
@@ -120,22 +115,28 @@ pub fn analyze_with_progress(
     })?;
     timing.finish();
     progress(1.0);
-    acc.merge(&timing.book, &mut reader.layers);
-    if let Some(m) = acc.material {
-        timing.book.energy.set_material_from_file(m);
-    }
-    Ok(report(input, options, reader, acc, timing, info))
+    let time_s = timing.planner.elapsed_s();
+    Ok(report(
+        input,
+        options,
+        reader,
+        acc,
+        (time_s, timing.book),
+        info,
+    ))
 }
 
-/// The report of a file read into `reader`, `acc` and `timing`.
+/// The report of a file read into `reader` and `acc`, from the timing side's planned time and
+/// book.
 fn report(
     input: &[u8],
     options: &AnalyzeOptions,
-    reader: Reader,
-    acc: Accounts,
-    timing: Timing,
+    mut reader: Reader,
+    mut acc: Accounts,
+    (time_s, mut book): (f64, TimeBook),
     info: SlicerInfo,
 ) -> Report {
+    acc.merge(&mut book, &mut reader.layers);
     let Accounts {
         totals,
         mut features,
@@ -143,7 +144,6 @@ fn report(
         toolpath,
         ..
     } = acc;
-    let (time_s, Timing { book, .. }) = (timing.planner.elapsed_s(), timing);
     let TimeBook {
         energy: energy_acc,
         temperatures,

@@ -256,6 +256,40 @@ impl Accumulator {
         }
     }
 
+    /// The running sums (thesis terms, accelerating and coasting time, the physical servo
+    /// energies), for carrying an accumulation from one wasm instance to another: the
+    /// playground plans a file in a second worker and sends these back.
+    pub fn running_sums(&self) -> [f64; 10] {
+        let [a, b, c, h] = self.terms;
+        let s = &self.servo;
+        [
+            a,
+            b,
+            c,
+            h,
+            self.accel_decel_s,
+            self.coast_s,
+            s.kinetic_j,
+            s.friction_j,
+            s.copper_j,
+            s.standby_j,
+        ]
+    }
+
+    /// Sets the running sums to those [`running_sums`](Self::running_sums) gave.
+    pub fn set_running_sums(&mut self, sums: [f64; 10]) {
+        let [a, b, c, h, accel_decel_s, coast_s, kinetic_j, friction_j, copper_j, standby_j] = sums;
+        self.terms = [a, b, c, h];
+        self.accel_decel_s = accel_decel_s;
+        self.coast_s = coast_s;
+        self.servo = ServoReport {
+            kinetic_j,
+            friction_j,
+            copper_j,
+            standby_j,
+        };
+    }
+
     /// The material the file names in its comments (`filament_type`), used unless the
     /// options name one.
     pub fn set_material_from_file(&mut self, material: Material) {

@@ -778,6 +778,12 @@ export type ErrorKind = {
    */
   second: string,
 } | {
+  "kind": "transfer",
+  /**
+   * Why.
+   */
+  reason: string,
+} | {
   "kind": "cancelled"
 };
 
