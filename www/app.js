@@ -516,6 +516,7 @@ async function run(source) {
     renderMachinePicker();
     showReport(msg.report, source.name, msg.ms);
     els.elapsed.dataset.totalMs = String(msg.totalMs);
+    els.elapsed.dataset.workers = String(msg.workers ?? 1);
     finishRun('ready');
     resetViewer();
   } catch (err) {

@@ -217,12 +217,12 @@ export class JobClient {
 
   /**
    * Loads a file (the new input session) and analyzes it.
-   * Anything in flight is cancelled first. Resolves to { report, ms, totalMs }.
+   * Anything in flight is cancelled first. Resolves to { report, ms, totalMs, workers }.
    * @param {ArrayBuffer} bytes the file (transferred to the worker)
    * @param {string} name
    * @param {AnalyzeOptions} options
    * @param {(fraction: number) => void} [onProgress]
-   * @returns {Promise<{ report: Report, ms: number, totalMs: number }>}
+   * @returns {Promise<{ report: Report, ms: number, totalMs: number, workers?: number }>}
    */
   async load(bytes, name, options, onProgress) {
     this.cancel('superseded');

@@ -21,6 +21,7 @@ const SHELL = [
   'viewer.js',
   'charts.js',
   'worker.js',
+  'timing-worker.js',
   'style.css',
   'favicon.svg',
   'vendor/uPlot.esm.js',

@@ -19,9 +19,11 @@
 //       it) with analyze `options` ({ strict?, filament_diameter_mm?, … }).
 //       Creating the input session drops the output session.
 //       With analyze !== false (the default for 'input'), runs analyze().
-//       → { id, type: 'result', report?, ms?, totalMs }
+//       → { id, type: 'result', report?, ms?, totalMs, workers? }
 //         report: the analysis report (same JSON as the CLI's --json), only
-//         when analyzed; ms: analyze() wall time; totalMs: the whole request.
+//         when analyzed; ms: analyze() wall time; totalMs: the whole request;
+//         workers: 2 when a large file's moves were planned in timing-worker.js
+//         while this worker read it (as the CLI plans on a second thread), else 1.
 //   { id, type: 'job', job: 'vtg'|'infill'|'smooth'|'vibration'|'analyze',
 //     options, target?: 'input'|'output' }
 //       Runs the capability on a session (default 'input'), as a Session
@@ -111,6 +113,63 @@ const ready = init().then(
     loadError = err;
   },
 );
+
+// ── The timing worker ──────────────────────────────────────────────────────
+// analyze of a large file reads it here while timing-worker.js plans its moves, as the CLI
+// plans on a second thread (a worker has one): same report, less wall time.
+const APART_MIN_BYTES = 1 << 20;
+/** @type {Worker | null} */
+let timingWorker = null;
+let timingRun = 0;
+/** Whether the timing worker is there and loaded (false: analyze here alone). */
+const timingUp = ready.then(
+  () =>
+    new Promise((resolve) => {
+      if (loadError || typeof Worker !== 'function' || typeof qp.TimingApart !== 'function') return resolve(false);
+      try {
+        timingWorker = new Worker(new URL('./timing-worker.js', import.meta.url), { type: 'module' });
+      } catch {
+        return resolve(false);
+      }
+      timingWorker.onmessage = (e) => resolve(e.data?.type === 'ready');
+      timingWorker.onerror = () => resolve(false);
+    }),
+);
+
+/**
+ * analyze with the timing side in the timing worker: this worker reads and sends it the
+ * batches, then joins its results. Falls back to analyze here if that worker fails.
+ * @param {qp.Session} session
+ * @param {(fraction: number) => void} progress
+ * @returns {Promise<{ report: qp.Report, workers: number }>}
+ */
+async function analyzeApart(session, progress) {
+  const helper = /** @type {Worker} */ (timingWorker);
+  const run = ++timingRun;
+  /** @type {Promise<Uint8Array>} */
+  const results = new Promise((resolve, reject) => {
+    helper.onmessage = (e) => {
+      const m = e.data;
+      if (m?.run !== run) return;
+      if (m.type === 'timing') resolve(new Uint8Array(m.bytes));
+      else reject(new Error(m.message ?? 'the timing worker failed'));
+    };
+    helper.onerror = (e) => reject(new Error(e.message || 'the timing worker failed'));
+  });
+  helper.postMessage({ type: 'begin', run });
+  const read = session.readApart(progress, (batch) => helper.postMessage({ type: 'batch', run, bytes: batch.buffer }, [batch.buffer]));
+  helper.postMessage({ type: 'finish', run });
+  try {
+    return { report: session.reportApart(read, await results), workers: 2 };
+  } catch (err) {
+    console.warn(`analyzing without the timing worker: ${describe(err)}`);
+    timingWorker = null;
+    helper.terminate();
+    return { report: session.analyze(progress), workers: 1 };
+  } finally {
+    read.free();
+  }
+}
 
 /**
  * A file the worker holds: its wasm Session, its bytes and the analyze options it was read with.
@@ -240,7 +299,7 @@ function dropSession(which) {
 }
 
 /** @param {LoadRequest} msg */
-function handleLoad(msg) {
+async function handleLoad(msg) {
   const { id, options } = msg;
   const which = msg.which === 'output' ? 'output' : 'input';
   const t0 = performance.now();
@@ -256,11 +315,12 @@ function handleLoad(msg) {
       return;
     }
     const progress = progressFor(id);
+    const apart = bytes.length >= APART_MIN_BYTES && navigator.hardwareConcurrency > 1 && (await timingUp) && timingWorker !== null;
     const a0 = performance.now();
-    const report = session.analyze(progress);
+    const { report, workers } = apart ? await analyzeApart(session, progress) : { report: session.analyze(progress), workers: 1 };
     const ms = performance.now() - a0;
     progress.finish();
-    self.postMessage({ id, type: 'result', report, ms, totalMs: performance.now() - t0 });
+    self.postMessage({ id, type: 'result', report, ms, totalMs: performance.now() - t0, workers });
   } catch (err) {
     postError(id, err, bytes);
   }
@@ -397,7 +457,7 @@ function nearestZ(session, count, z, hint) {
   return [best, zs.get(best) ?? session.layer(best)];
 }
 
-/** @type {Record<string, (msg: any) => void>} */
+/** @type {Record<string, (msg: any) => void | Promise<void>>} */
 const HANDLERS = { load: handleLoad, job: handleJob, layer: handleLayer, analyze: handleLoad };
 
 // Requests are handled strictly one after another.
@@ -422,7 +482,7 @@ self.onmessage = (event) => {
         });
         return;
       }
-      handler(msg);
+      await handler(msg);
     })
     .catch((err) => {
       self.postMessage({ id: msg.id, type: 'error', message: describe(err), line: null, column: null, excerpt: null, kind: null, fatal: true });

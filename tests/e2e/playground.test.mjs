@@ -607,8 +607,10 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
   await page.goto(baseUrl);
   await waitForStatus('ready', 'demo.gcode');
   // Best of 11 on both sides, the native and the browser runs taken in turn: the machine is
-  // shared, and a burst of load elsewhere then slows both sides alike instead of one. (The
-  // margin is narrow: 1.6–2.0× measured here, the worker on one thread against the CLI's two.)
+  // shared, and a burst of load elsewhere then slows both sides alike instead of one. The CLI
+  // plans on a second thread while it reads; the worker hands the planning to a second worker
+  // (timing-worker.js). On one worker the ratio was 1.3–2.1× (2.12× failed a CI run on a
+  // machine whose two cores let the CLI's threads overlap well).
   const RUNS = 11;
   const native = [];
   const browser = [];
@@ -635,6 +637,7 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
     const ms = Number(await byTestId('elapsed').getAttribute('data-ms'));
     const totalMs = Number(await byTestId('elapsed').getAttribute('data-total-ms'));
     browser.push({ ms, totalMs, pageMs: Date.now() - t0 });
+    assert.equal(await byTestId('elapsed').getAttribute('data-workers'), '2', 'the moves were not planned in the timing worker');
     // The worker then reads the toolpath for the viewer: let it finish before the next native
     // run, which would otherwise share the cores with it.
     await page.waitForFunction(() => /segments/.test(document.querySelector('[data-testid="layer-info"]').textContent), null, { timeout: JOB_TIMEOUT });
@@ -652,8 +655,8 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
   t.diagnostic(`native CLI (process wall time, best of ${RUNS}): ${nativeMs.toFixed(0)} ms`);
   t.diagnostic(`worker, best of ${RUNS}: analyze ${best.ms.toFixed(0)} ms, load request (copy into wasm + analyze) ${best.totalMs.toFixed(0)} ms, page (pick to ready) ${best.pageMs} ms`);
   t.diagnostic(`ratio (worker analyze / CLI): ${(best.ms / nativeMs).toFixed(2)}×, with the copy into wasm ${(best.totalMs / nativeMs).toFixed(2)}×`);
-  // The requirement: analyze in the worker within 2× of the native CLI (which reads the file
-  // and runs the planner on a second thread; the worker runs on one).
+  // The requirement: analyze in the worker within 2× of the native CLI (both read the file
+  // on one thread and plan its moves on another).
   assert.ok(best.ms <= 2 * nativeMs, `worker analyze ${best.ms.toFixed(0)} ms > 2 × CLI ${nativeMs.toFixed(0)} ms`);
   const report = await reportJson();
   assert.deepEqual(report, runCli('analyze', file).json, 'the worker report differs from the CLI');

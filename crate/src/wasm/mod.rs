@@ -4,9 +4,11 @@
 //! parsed by the JS engine), so a report from the browser, Node and the CLI is identical.
 //! Errors become JS `Error` objects carrying `line`, `column` and `kind` properties.
 
+mod apart;
 mod jobs;
 mod session;
 
+pub use apart::{ReadApart, TimingApart};
 pub use jobs::{infill, smooth, vibration, vtg};
 pub use session::Session;
 
