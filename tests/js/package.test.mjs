@@ -103,6 +103,33 @@ test('Session: a 5-axis file carries unit tool vectors (tip and direction, workp
   s.free();
 });
 
+test('Session: analyze with the timing side apart (readApart → TimingApart → reportApart) gives analyze\'s report', () => {
+  // What the playground does in two workers, here in one: the batches and the results cross
+  // as bytes, so the report must be the same to the bit. An arc-welded file (G2/G3 moves) and
+  // a Klipper-driven one (limits set in the file); the second with a user's machine profile.
+  for (const [name, options] of [
+    ['prusaslicer-2.7.4_screw_arcfit.gcode', {}],
+    ['superslicer-2.3.56_klipper_arcwelder.gcode', { machine: 'voron-klipper' }],
+  ]) {
+    const s = new node.Session(fs.readFileSync(path.join(corpusDir, name)), options);
+    const timing = new node.TimingApart();
+    let batches = 0;
+    const read = s.readApart(undefined, (batch) => {
+      assert.ok(batch instanceof Uint8Array && batch.byteOffset === 0 && batch.byteLength === batch.buffer.byteLength, 'a batch is a whole, transferable buffer');
+      batches++;
+      timing.feed(batch);
+    });
+    const report = s.reportApart(read, timing.finish());
+    assert.ok(batches >= 1, name);
+    assert.deepEqual(report, s.analyze(), name);
+    assert.throws(() => s.reportApart(read, new Uint8Array()), /reported already/);
+    assert.throws(() => new node.TimingApart().feed(new Uint8Array([0, 1, 2])), (e) => e instanceof Error && e.kind.kind === 'transfer');
+    read.free();
+    timing.free();
+    s.free();
+  }
+});
+
 test('Session: a malformed file fails with a line number (strict)', () => {
   const s = new node.Session('G1 X1\nG1 Y1.2.3\n', { strict: true });
   assert.throws(() => s.analyze(), (e) => e instanceof Error && e.line === 2 && e.kind.kind === 'invalid_number');
