@@ -742,6 +742,37 @@ test('a crashing worker is reported and replaced', async () => {
   await tab.close();
 });
 
+test('without its timing worker, a large file is analyzed in one worker, with the same report', { timeout: JOB_TIMEOUT }, async () => {
+  // timing-worker.js cannot load (a server or cache that lacks it): the job worker plans the
+  // moves itself.
+  // A context of its own, without the service worker (which would answer from its cache). A
+  // worker's own requests are not routed, so the job worker is served asking for a file the
+  // server does not have.
+  const ctx = await browser.newContext({ serviceWorkers: 'block' });
+  let served = 0;
+  await ctx.route('**/worker.js', async (route) => {
+    const real = await route.fetch();
+    const text = await real.text();
+    assert.ok(text.includes("'./timing-worker.js'"));
+    served++;
+    await route.fulfill({ response: real, body: text.replace("'./timing-worker.js'", "'./no-such-timing-worker.js'") });
+  });
+  const tab = await ctx.newPage();
+  tab.setDefaultTimeout(STEP_TIMEOUT);
+  await tab.goto(baseUrl);
+  await tab.waitForFunction(() => document.querySelector('[data-testid="status"]').textContent === 'ready');
+  const file = path.join(corpusDir, BENCHY);
+  assert.ok(fs.statSync(file).size >= 1 << 20, 'the file is large enough to be analyzed in two workers');
+  await tab.locator('[data-testid="file"]').setInputFiles(file);
+  await tab.waitForFunction((n) => document.querySelector('[data-testid="filename"]').textContent === n && ['ready', 'error'].includes(document.querySelector('[data-testid="status"]').textContent), BENCHY, { timeout: JOB_TIMEOUT });
+  assert.equal(await tab.locator('[data-testid="status"]').textContent(), 'ready');
+  assert.equal(await tab.locator('[data-testid="elapsed"]').getAttribute('data-workers'), '1');
+  const report = JSON.parse(await tab.locator('[data-testid="report-json"]').textContent());
+  assert.deepEqual(report, runCli('analyze', file).json, 'the one-worker report differs from the CLI');
+  assert.ok(served >= 1, 'the job worker was not the one served here');
+  await ctx.close();
+});
+
 test('once loaded, the playground works offline', { timeout: JOB_TIMEOUT }, async () => {
   const ctx = await browser.newContext({ viewport: { width: 1280, height: 900 } });
   ctx.on('request', (req) => requests.push(req.url()));
