@@ -9,7 +9,7 @@
 
 use super::accounting::{Accounts, TimeMsg, Timing};
 use super::wire::{self, TimingSetup, WireMsg};
-use super::{report, Report, Tally, PROGRESS_STEP};
+use super::{report, Report, Tally};
 use crate::energy::Accumulator;
 use crate::error::{Error, ErrorKind};
 use crate::gcode::SlicerInfo;
@@ -52,14 +52,7 @@ pub fn read_apart(
             batch.clear();
         }
     };
-    let mut tally = Tally {
-        acc: &mut acc,
-        info: &mut info,
-        to_timing: &mut to_timing,
-        progress,
-        input_len: input.len(),
-        next_progress: PROGRESS_STEP,
-    };
+    let mut tally = Tally::new(&mut acc, &mut info, &mut to_timing, progress, input.len());
     reader.read(input, &mut tally)?;
     if !batch.is_empty() {
         send(&batch);

@@ -41,6 +41,26 @@ struct Tally<'a> {
     next_progress: usize,
 }
 
+impl<'a> Tally<'a> {
+    /// A tally of a file of `input_len` bytes that hands the timing side its messages.
+    fn new(
+        acc: &'a mut Accounts,
+        info: &'a mut SlicerInfo,
+        to_timing: &'a mut dyn FnMut(TimeMsg),
+        progress: Progress<'a>,
+        input_len: usize,
+    ) -> Self {
+        Tally {
+            acc,
+            info,
+            to_timing,
+            progress,
+            input_len,
+            next_progress: PROGRESS_STEP,
+        }
+    }
+}
+
 impl Fold for Tally<'_> {
     fn line(&mut self, raw: &RawLine<'_>, _: Option<&Line<'_>>) -> Result<Flow, Error> {
         self.acc.totals.lines += 1;
@@ -103,14 +123,7 @@ pub fn analyze_with_progress(
     let mut info = SlicerInfo::default();
     let mut acc = Accounts::new();
     pipeline::run(input.len(), &mut timing, |to_timing| {
-        let mut tally = Tally {
-            acc: &mut acc,
-            info: &mut info,
-            to_timing,
-            progress: &mut *progress,
-            input_len: input.len(),
-            next_progress: PROGRESS_STEP,
-        };
+        let mut tally = Tally::new(&mut acc, &mut info, to_timing, &mut *progress, input.len());
         reader.read(input, &mut tally)
     })?;
     timing.finish();
