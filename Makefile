@@ -86,6 +86,7 @@ bench: cli
 	target/release/quietpath bench "$(LARGE)"
 	cargo bench -p quietpath --bench parse
 	cargo test --release -p quietpath-conformance --test infill -- --ignored --nocapture
+	cargo test --release -p quietpath-conformance --test vtg -- --ignored --nocapture
 
 ## The generated tables in docs/measurements/generated/ (analyze, vtg, infill, smooth on every
 ## corpus file and fixture, from the CLI's --json; a few minutes). CORPUS=… for another corpus folder.

@@ -200,7 +200,7 @@ export function vibration(input, options = {}, progress) {
     natural_frequencies_hz: [41.2, 57.9], damping_ratios: [0.05, 0.05],
     axes: [{ axis: 'x', position_mm: 100, modes: [{ frequency_hz: 41.2, damping_ratio: 0.05 }] }],
     deviation_mm: deviation, printing_deviation_mm: deviation,
-    layers: Array.from({ length: 50 }, (_, i) => ({ layer: i, z: 0.2 * (i + 1), amplitude: (after ? 0.5 : 1) * (1 + Math.sin(i / 5)), printing_amplitude: (after ? 0.4 : 0.8) * (1 + Math.sin(i / 5)), mean: 0.5, acceleration_rms: 1 })),
+    layers: Array.from({ length: 50 }, (_, i) => ({ layer: i, z: 0.2 * (i + 1), amplitude: (after ? 0.5 : 1) * (1 + Math.sin(i / 5)), printing_amplitude: (after ? 0.4 : 0.8) * (1 + Math.sin(i / 5)), printing_mean: 0.4, printing_samples: 1000, mean: 0.5, acceleration_rms: 1 })),
     psd: {
       fs_hz: 512, window: 256, window_kind: 'hamming', overlap: 128, segments: 8,
       freqs, power: freqs.map((f) => (after ? 0.3 : 1) / (1 + Math.abs(f - 41) / 5)), peaks: [{ hz: 41.2, power: 1 }],

@@ -116,6 +116,11 @@ pub struct LayerVibration {
     /// The largest deviation while extruding in the layer, mm (0 where it prints nothing): the
     /// layer's share of the printing peak, which VTG's no-dearer rule holds.
     pub printing_amplitude: f64,
+    /// Mean deviation while extruding in the layer, mm (0 where it prints nothing).
+    pub printing_mean: f64,
+    /// Samples taken while extruding in the layer (one per `T_s`): the weight of its
+    /// `printing_mean` in the file's.
+    pub printing_samples: u64,
     /// Mean deviation in the layer, mm.
     pub mean: f64,
     /// RMS of the table's acceleration in the layer, m/s².
@@ -412,7 +417,9 @@ fn layer_vibrations(
             layer: i,
             z: layers.get(i).and_then(|l| l.z),
             amplitude: l.deviation.max,
-            printing_amplitude: l.printing_max,
+            printing_amplitude: l.printing.max,
+            printing_mean: l.printing.mean(),
+            printing_samples: l.printing.count,
             mean: l.deviation.mean(),
             acceleration_rms: if l.accel_count > 0 {
                 (l.accel_sq / l.accel_count as f64).sqrt()

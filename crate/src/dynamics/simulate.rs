@@ -91,8 +91,8 @@ impl Stats {
 pub struct LayerSums {
     /// Deviation, mm.
     pub deviation: Stats,
-    /// Largest deviation while extruding, mm (0 in a layer that prints nothing).
-    pub printing_max: f64,
+    /// Deviation while extruding, mm (no samples in a layer that prints nothing).
+    pub printing: Stats,
     /// Sum of squared acceleration samples, (m/s²)².
     pub accel_sq: f64,
     /// Acceleration samples.
@@ -105,7 +105,7 @@ impl LayerSums {
     pub(super) fn add_deviation(&mut self, dev: f64, extruding: bool) {
         self.deviation.add(dev);
         if extruding {
-            self.printing_max = self.printing_max.max(dev);
+            self.printing.add(dev);
         }
     }
 

@@ -1,7 +1,7 @@
 //! The dynamics model's loop over a rewrite (VTG Table 2's deviation rows): the whole file
 //! rewritten again with quieter variants where the first rewrite rings more than the original,
-//! layers kept as they were where only their peak rose, and the original handed back where no
-//! rewrite keeps the no-dearer rule.
+//! layers kept as they were where they ring more than the original did, and the original handed
+//! back where no rewrite keeps the no-dearer rule.
 
 use super::report::{self, Comparison, VtgReport};
 use super::{search, VtgOptions};
@@ -30,10 +30,10 @@ use crate::error::Error;
 /// On a large file the variants race on a sample of its layers first ([`raced`]), and only the
 /// one that rings least there is written whole.
 ///
-/// Where the quietest rewrite lowers the mean but raises the peak, the layers that ring above
-/// the original's peak are kept as they were ([`keep_peak_layers`]). If even that does not
-/// bring the peak down, or the quietest rewrite raises the mean, the original is handed back
-/// unchanged, with a `message` saying so: no file comes back ringing more than it went in.
+/// Where the quietest rewrite still raises the mean or the peak, the layers that ring above the
+/// original's peak, and those that raise the mean most, are kept as they were
+/// ([`keep_ringing_layers`]). If even that does not bring both down, the original is handed
+/// back unchanged, with a `message` saying so: no file comes back ringing more than it went in.
 ///
 /// `None` rows when the model cannot run (a print too long to simulate, for instance): the
 /// rest of the report stands without them.
@@ -48,11 +48,7 @@ pub(super) fn with_simulated_deviation(
         return Ok(first);
     };
     let b = orig.deviation;
-    let rows = |a: &Deviation| report::DeviationComparison {
-        max_mm: Comparison::new(b.max, a.max),
-        min_mm: Comparison::new(b.min, a.min),
-        mean_mm: Comparison::new(b.mean, a.mean),
-    };
+    let rows = |a: &Deviation| deviation_rows(&b, a);
     let mut first = first;
     if first.paths.rewritten == 0 && first.paths.compacted == 0 {
         // Nothing rewritten: the file rings as the original does, and no variant would differ.
@@ -67,37 +63,80 @@ pub(super) fn with_simulated_deviation(
         sim,
         variant: search::Variant::default(),
     };
-    let Tried {
-        report: mut best,
-        sim: best_sim,
-        variant: best_variant,
-    } = quietest(input, first, &orig, options, again)?;
-    best.table2.deviation = Some(rows(&best_sim.deviation));
-    let best_a = best_sim.deviation;
+    let mut best = quietest(input, first, &orig, options, again)?;
+    let best_a = best.sim.deviation;
+    best.report.table2.deviation = Some(rows(&best_a));
     if best_a.mean <= b.mean && best_a.max <= b.max {
-        return Ok(best);
+        return Ok(best.report);
     }
-    if best_a.mean <= b.mean {
-        let before = best.before.clone();
-        if let Some((mut kept, a, layers)) =
-            keep_peak_layers(&orig, best_sim, best_variant, &before, options, again)?
-        {
-            kept.table2.deviation = Some(rows(&a.deviation));
-            kept.message = Some(format!(
-                "kept {} layer(s) as they were: rewritten, they rang above the original's \
-                 peak deviation ({:.4} mm)",
-                layers.len(),
-                b.max
-            ));
-            kept.peak_layers_kept = layers;
-            return Ok(kept);
-        }
+    let before = best.report.before.clone();
+    if let Some(kept) = with_layers_kept(&orig, &best, &before, options, again)? {
+        return Ok(kept);
     }
     // Every rewrite tried rings more than the original: the original is handed back.
-    let mut kept = again(search::Variant::original(), &[], best.before.clone(), 0.95)?;
+    let mut kept = again(search::Variant::original(), &[], before, 0.95)?;
     kept.table2.deviation = Some(rows(&b));
     kept.message = Some(handed_back(&b, &best_a));
     Ok(kept)
+}
+
+/// `tried` written again with the layers that ring more than the original's kept as they were
+/// ([`keep_ringing_layers`]), its deviation rows and message filled; `None` where that does
+/// not keep the no-dearer rule.
+fn with_layers_kept(
+    orig: &Simulated,
+    tried: &Tried,
+    before: &Report,
+    options: &VtgOptions,
+    again: &mut Again<'_>,
+) -> Result<Option<VtgReport>, Error> {
+    let b = orig.deviation;
+    let Some(LayersKept {
+        report: mut kept,
+        sim: a,
+        layers,
+        why,
+    }) = keep_ringing_layers(
+        orig,
+        tried.sim.clone(),
+        tried.variant,
+        before,
+        options,
+        again,
+    )?
+    else {
+        return Ok(None);
+    };
+    kept.table2.deviation = Some(deviation_rows(&b, &a.deviation));
+    let mut reasons = Vec::new();
+    if why.peak > 0 {
+        reasons.push(format!(
+            "{} rang above the original's peak deviation ({:.4} mm)",
+            why.peak, b.max
+        ));
+    }
+    if why.mean > 0 {
+        reasons.push(format!(
+            "{} raised its mean deviation ({:.4} mm) most",
+            why.mean, b.mean
+        ));
+    }
+    kept.message = Some(format!(
+        "kept {} layer(s) as they were: rewritten, {}",
+        layers.len(),
+        reasons.join(", and ")
+    ));
+    kept.peak_layers_kept = layers;
+    Ok(Some(kept))
+}
+
+/// Table 2's deviation rows: the original's `b` beside the rewrite's `a`.
+fn deviation_rows(b: &Deviation, a: &Deviation) -> report::DeviationComparison {
+    report::DeviationComparison {
+        max_mm: Comparison::new(b.max, a.max),
+        min_mm: Comparison::new(b.min, a.min),
+        mean_mm: Comparison::new(b.mean, a.mean),
+    }
 }
 
 /// A whole-file rewrite tried, what the dynamics model says of it, and its variant.
@@ -120,7 +159,7 @@ fn quietest(
     if quietness(&orig.deviation, &first.sim.deviation).0 == 0 || !options.limit_feed {
         return Ok(first);
     }
-    match race_sample(input.len(), orig.layer_peaks.len()).filter(|_| !options.exhaustive) {
+    match race_sample(input.len(), orig.layers.len()).filter(|_| !options.exhaustive) {
         Some(sample) => raced(input, first, orig, &sample, options, again),
         None => {
             let variants = (search::quieter_variants(), 0.7, 0.04);
@@ -264,71 +303,158 @@ fn handed_back(b: &Deviation, a: &Deviation) -> String {
 pub(super) type Again<'a> =
     dyn FnMut(search::Variant, &[bool], Report, f64) -> Result<VtgReport, Error> + 'a;
 
-/// Rounds of [`keep_peak_layers`].
-const PEAK_ROUNDS: usize = 3;
+/// Rounds of [`keep_ringing_layers`].
+const KEEP_ROUNDS: usize = 3;
 
-/// The rewrite as `variant` with the layers that ring above the original's peak deviation kept
-/// as they were: each round keeps the layers whose largest printing deviation in `sim` (the
-/// rewrite's) is above the original's peak and above that layer's own in the original, writes
-/// the file again and simulates it, up to [`PEAK_ROUNDS`] times. The rewrite, its simulation
-/// and the layers kept, once neither its mean nor its peak is above the original's;
-/// `None` if no round gets there (the mean rose, or no layer is left to keep).
-fn keep_peak_layers(
+/// The share of the original's mean deviation the layers kept by [`mark_ringing_layers`] aim
+/// to bring the rewrite's under: a layer kept as it was starts from the ringing the layer
+/// before it left, which the per-layer figures it is chosen by did not see.
+const MEAN_MARGIN: f64 = 0.005;
+
+/// The rewrite as `variant` with the layers that ring more than the original's kept as they
+/// were ([`mark_ringing_layers`]): each round marks them from `sim` (the rewrite's simulation),
+/// writes the file again and simulates it, up to [`KEEP_ROUNDS`] times. The rewrite, its
+/// simulation and the layers kept, once neither its mean nor its peak is above the original's;
+/// `None` if no round gets there, or no layer is left to keep.
+fn keep_ringing_layers(
     original: &Simulated,
     mut sim: Simulated,
     variant: search::Variant,
     before: &Report,
     options: &VtgOptions,
     again: &mut Again<'_>,
-) -> Result<Option<(VtgReport, Simulated, Vec<usize>)>, Error> {
+) -> Result<Option<LayersKept>, Error> {
     let b = original.deviation;
-    let mut kept = vec![false; original.layer_peaks.len().max(sim.layer_peaks.len())];
-    for _ in 0..PEAK_ROUNDS {
-        let mut more = false;
-        for (l, &peak) in sim.layer_peaks.iter().enumerate() {
-            let was = original.layer_peaks.get(l).copied().unwrap_or(0.0);
-            if peak > b.max && peak > was && !kept[l] {
-                kept[l] = true;
-                more = true;
-            }
-        }
-        if !more {
+    let mut kept = vec![false; original.layers.len().max(sim.layers.len())];
+    let mut why = Marked::default();
+    for _ in 0..KEEP_ROUNDS {
+        let marked = mark_ringing_layers(original, &sim, &mut kept);
+        if marked.peak + marked.mean == 0 {
             return Ok(None);
         }
+        why.peak += marked.peak;
+        why.mean += marked.mean;
         let next = again(variant, &kept, before.clone(), 0.95)?;
         let Some(a) = printing_deviation(&next.output, options) else {
             return Ok(None);
         };
-        if a.deviation.mean > b.mean {
-            return Ok(None);
-        }
-        if a.deviation.max <= b.max {
+        if a.deviation.mean <= b.mean && a.deviation.max <= b.max {
             let layers = (0..kept.len()).filter(|&l| kept[l]).collect();
-            return Ok(Some((next, a, layers)));
+            return Ok(Some(LayersKept {
+                report: next,
+                sim: a,
+                layers,
+                why,
+            }));
         }
         sim = a;
     }
     Ok(None)
 }
 
-/// What the dynamics model says of a file: the deviation over its printing moves, and the
-/// largest deviation while printing of each layer (by layer index).
+/// Marks in `kept` the layers to keep as they were, from `sim` (the file written with the
+/// layers `kept` marks already kept) against `original`, and how many for each reason (none
+/// when none is left to mark).
+///
+/// The peak: every layer whose printing peak is above the original's file peak (VTG Table 2's
+/// max row). The mean: the file's mean deviation is Σ sums / Σ samples over its layers, so it
+/// is at most the original's mean `m` exactly when Σ (sum − m · samples) ≤ 0. Each layer's
+/// share of that total, rewritten (from `sim`) and as it was (from `original`), says what
+/// keeping it gives back; the layers that give back most are kept first, until the total is
+/// [`MEAN_MARGIN`] of `m` under zero. A layer that rings less rewritten is never kept for the
+/// mean, so the rest of the file keeps its rounded corners.
+fn mark_ringing_layers(original: &Simulated, sim: &Simulated, kept: &mut [bool]) -> Marked {
+    let b = original.deviation;
+    let excess = |s: &Simulated, l: usize| {
+        s.layers
+            .get(l)
+            .map_or(0.0, |r| r.sum - b.mean * r.samples as f64)
+    };
+    let gain = |l: usize| excess(sim, l) - excess(original, l);
+    // The file's total as `sim` has it, then with each layer newly kept counted as it was.
+    let mut total: f64 = (0..kept.len()).map(|l| excess(sim, l)).sum();
+    let samples: u64 = sim.layers.iter().map(|r| r.samples).sum();
+    // Where the mean rose, aim under it by the margin; where it did not, only keep it so.
+    let target = if total > 0.0 {
+        -MEAN_MARGIN * b.mean * samples as f64
+    } else {
+        0.0
+    };
+    let mut marked = Marked::default();
+    for (l, k) in kept.iter_mut().enumerate() {
+        if !*k && sim.layers.get(l).is_some_and(|r| r.peak > b.max) {
+            *k = true;
+            marked.peak += 1;
+            total -= gain(l);
+        }
+    }
+    let mut candidates: Vec<(f64, usize)> = (0..kept.len())
+        .filter(|&l| !kept[l])
+        .map(|l| (gain(l), l))
+        .filter(|&(g, _)| g > 0.0)
+        .collect();
+    candidates.sort_by(|x, y| y.0.total_cmp(&x.0));
+    for (g, l) in candidates {
+        if total <= target {
+            break;
+        }
+        kept[l] = true;
+        marked.mean += 1;
+        total -= g;
+    }
+    marked
+}
+
+/// What [`keep_ringing_layers`] made: the rewrite, its simulation, the layers kept and why.
+struct LayersKept {
+    report: VtgReport,
+    sim: Simulated,
+    layers: Vec<usize>,
+    why: Marked,
+}
+
+/// Layers [`mark_ringing_layers`] kept, by reason.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Marked {
+    /// Rewritten, they rang above the original's peak.
+    peak: usize,
+    /// Kept to bring the mean under the original's.
+    mean: usize,
+}
+
+/// What the dynamics model says of a file: the deviation over its printing moves, and how each
+/// layer rang while printing (by layer index).
+#[derive(Clone)]
 pub(super) struct Simulated {
     deviation: Deviation,
-    layer_peaks: Vec<f64>,
+    layers: Vec<LayerRinging>,
+}
+
+/// How one layer rang while printing: its largest deviation, and the sum and count of its
+/// samples (the layer's share of the file's mean).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct LayerRinging {
+    peak: f64,
+    sum: f64,
+    samples: u64,
 }
 
 /// The dynamics model run on a file, `None` when it cannot run on it (a print too long to
 /// simulate, for instance).
 pub(super) fn printing_deviation(bytes: &[u8], options: &VtgOptions) -> Option<Simulated> {
     let r = crate::dynamics::vibration(bytes, &vibration_options(options)).ok()?;
-    let mut layer_peaks = vec![0.0; r.layers.iter().map(|l| l.layer + 1).max().unwrap_or(0)];
+    let n = r.layers.iter().map(|l| l.layer + 1).max().unwrap_or(0);
+    let mut layers = vec![LayerRinging::default(); n];
     for l in &r.layers {
-        layer_peaks[l.layer] = l.printing_amplitude;
+        layers[l.layer] = LayerRinging {
+            peak: l.printing_amplitude,
+            sum: l.printing_mean * l.printing_samples as f64,
+            samples: l.printing_samples,
+        };
     }
     Some(Simulated {
         deviation: r.printing_deviation_mm,
-        layer_peaks,
+        layers,
     })
 }
 
@@ -346,4 +472,100 @@ fn vibration_options(options: &VtgOptions) -> crate::dynamics::VibrationOptions 
 fn quietness(b: &Deviation, a: &Deviation) -> (u8, f64) {
     let rose = u8::from(a.mean >= b.mean) + u8::from(a.max > b.max);
     (rose, a.mean)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A simulation of layers given as (peak, mean, samples), its file figures their totals.
+    fn simulated(layers: &[(f64, f64, u64)]) -> Simulated {
+        let layers: Vec<LayerRinging> = layers
+            .iter()
+            .map(|&(peak, mean, samples)| LayerRinging {
+                peak,
+                sum: mean * samples as f64,
+                samples,
+            })
+            .collect();
+        let sum: f64 = layers.iter().map(|l| l.sum).sum();
+        let samples: u64 = layers.iter().map(|l| l.samples).sum();
+        Simulated {
+            deviation: Deviation {
+                max: layers.iter().map(|l| l.peak).fold(0.0, f64::max),
+                min: 0.0,
+                mean: sum / samples as f64,
+                max_at: [0.0; 3],
+                samples,
+            },
+            layers,
+        }
+    }
+
+    #[test]
+    fn a_layer_above_the_original_peak_is_kept_and_quieter_layers_are_not() {
+        let original = simulated(&[(0.5, 0.02, 1000), (0.4, 0.02, 1000), (0.3, 0.02, 1000)]);
+        // The second layer rings above the original's peak; the mean falls elsewhere.
+        let rewrite = simulated(&[(0.4, 0.015, 1000), (0.6, 0.018, 1000), (0.2, 0.015, 1000)]);
+        let mut kept = vec![false; 3];
+        assert_eq!(
+            mark_ringing_layers(&original, &rewrite, &mut kept),
+            Marked { peak: 1, mean: 0 }
+        );
+        assert_eq!(kept, [false, true, false]);
+        // Nothing left to mark once it is kept and the rewrite rings so.
+        let again = simulated(&[(0.4, 0.015, 1000), (0.4, 0.02, 1000), (0.2, 0.015, 1000)]);
+        assert_eq!(
+            mark_ringing_layers(&original, &again, &mut kept),
+            Marked::default()
+        );
+    }
+
+    #[test]
+    fn the_layers_that_raise_the_mean_most_are_kept_until_it_is_under_the_original() {
+        // Original mean 0.02 over four equal layers. Rewritten, layers 0 and 2 ring more
+        // (+0.010 and +0.004 mm), layer 1 less (−0.006), layer 3 as before: the mean rises
+        // by 0.002. Keeping layer 0 alone brings it to 0.0175, under the original's with the
+        // margin; layer 2 also rises, but keeping it is not needed.
+        let original = simulated(&[(0.3, 0.02, 1000); 4]);
+        let rewrite = simulated(&[
+            (0.3, 0.03, 1000),
+            (0.3, 0.014, 1000),
+            (0.3, 0.024, 1000),
+            (0.3, 0.02, 1000),
+        ]);
+        let mut kept = vec![false; 4];
+        assert_eq!(
+            mark_ringing_layers(&original, &rewrite, &mut kept),
+            Marked { peak: 0, mean: 1 }
+        );
+        assert_eq!(kept, [true, false, false, false]);
+        // Where the mean already falls and no peak rises, nothing is kept.
+        let quiet = simulated(&[
+            (0.3, 0.021, 1000),
+            (0.3, 0.015, 1000),
+            (0.3, 0.02, 1000),
+            (0.3, 0.02, 1000),
+        ]);
+        let mut none = vec![false; 4];
+        assert_eq!(
+            mark_ringing_layers(&original, &quiet, &mut none),
+            Marked::default()
+        );
+        assert_eq!(none, [false; 4]);
+    }
+
+    #[test]
+    fn the_largest_rises_are_kept_first_and_a_quieter_layer_never() {
+        // Two layers ring more, one less: both that rang more are needed to bring the mean
+        // under the original's with the margin, the largest rise first; the quieter one stays.
+        let original = simulated(&[(0.3, 0.02, 1000); 3]);
+        let rewrite = simulated(&[(0.3, 0.021, 1000), (0.3, 0.022, 1000), (0.3, 0.019, 1000)]);
+        let mut kept = vec![false; 3];
+        assert_eq!(
+            mark_ringing_layers(&original, &rewrite, &mut kept),
+            Marked { peak: 0, mean: 2 }
+        );
+        assert_eq!(kept, [true, true, false]);
+    }
 }

@@ -1549,6 +1549,15 @@ export type LayerVibration = {
    */
   printing_amplitude: number,
   /**
+   * Mean deviation while extruding in the layer, mm (0 where it prints nothing).
+   */
+  printing_mean: number,
+  /**
+   * Samples taken while extruding in the layer (one per `T_s`): the weight of its
+   * `printing_mean` in the file's.
+   */
+  printing_samples: number,
+  /**
    * Mean deviation in the layer, mm.
    */
   mean: number,
