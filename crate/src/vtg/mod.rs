@@ -246,9 +246,7 @@ pub fn vtg_with_progress(
         sources: &sources,
         options,
         limits: rewrite::limits_for(&path, options),
-    };
-    let attempt = |variant, kept: &[bool], before, progress: Progress<'_>| {
-        run.attempt(variant, kept, before, progress)
+        known: std::sync::Mutex::new(None),
     };
     let first = search::Variant::default();
     // The original's simulated deviation does not depend on the rewrite: where there are
@@ -259,26 +257,24 @@ pub fn vtg_with_progress(
                 .dynamics
                 .then(|| closed_loop::printing_deviation(input, options))
         },
-        || attempt(first, &[], before, &mut |f| progress(0.3 + 0.4 * f)),
+        || run.attempt(first, &[], before, &mut |f| progress(0.3 + 0.4 * f)),
     );
     let mut report = report?;
     if !progress(0.7) {
         return Err(cancelled());
     }
     if let Some(original) = original_deviation {
-        report = closed_loop::with_simulated_deviation(
-            input,
-            original,
-            report,
-            options,
-            &mut |variant, kept, before, f| {
-                attempt(variant, kept, before, &mut |g| progress(f + 0.05 * g))
-            },
-        )?;
+        let mut again = Retry {
+            run: &run,
+            progress,
+        };
+        report =
+            closed_loop::with_simulated_deviation(input, original, report, options, &mut again)?;
     }
-    // The move lists are done with (the estimates and the firmware's figures stream): on the
-    // 34 MB file they are 450 MB of the peak.
+    // The move lists and the offers kept are done with (the estimates and the firmware's
+    // figures stream): on the 34 MB file the lists are 450 MB of the peak.
     let junction_model = path.junction_model;
+    drop(run);
     drop((path, sources));
     let mut report = with_estimates(input, report, options)?;
     report.firmware = Some(firmware_report(
@@ -298,6 +294,10 @@ struct Run<'a> {
     sources: &'a source::Sources,
     options: &'a VtgOptions,
     limits: KinematicLimits,
+    /// The offers of the last rewrite and the layers it kept: a later rewrite of the same
+    /// variant that keeps those layers and more (the closed loop's rounds) drops the offers of
+    /// the others ([`rewrite::Offers::keep_layers`]) instead of making every path's again.
+    known: std::sync::Mutex<Option<(rewrite::Offers, Vec<bool>)>>,
 }
 
 impl Run<'_> {
@@ -311,25 +311,12 @@ impl Run<'_> {
         progress: Progress<'_>,
     ) -> Result<VtgReport, Error> {
         let Run {
-            input,
             path,
-            sources,
             options,
             limits,
+            ..
         } = *self;
-        let mut step = |f: f64| progress(0.8 * f);
-        let offers = rewrite::offers(
-            input,
-            path,
-            sources,
-            (options, &limits),
-            (variant, kept),
-            &mut step,
-        )?;
-        if !progress(0.8) {
-            return Err(Error::new(0, 0, ErrorKind::Cancelled));
-        }
-        let (rewritten, measured) = search::within_allowed_time(input, &offers, options, &before)?;
+        let (rewritten, measured) = self.rewrite(variant, kept, &before, progress)?;
         // The output's metrics streamed, not from a kept move list: rounding corners can
         // multiply the moves tenfold.
         let metrics = || {
@@ -358,6 +345,86 @@ impl Run<'_> {
             after_metrics,
             rewritten,
         ))
+    }
+
+    /// The last rewrite's offers with the layers `kept` marks dropped, where it was of `variant`
+    /// and kept no layer that `kept` does not.
+    fn known_offers(&self, variant: search::Variant, kept: &[bool]) -> Option<rewrite::Offers> {
+        let mut known = self.known.lock().ok()?;
+        let (offers, was_kept) = known.as_ref()?;
+        let more = (was_kept.iter().enumerate()).all(|(l, &k)| !k || kept.get(l) == Some(&true));
+        if offers.variant() != variant || !more {
+            return None;
+        }
+        let (mut offers, _) = known.take()?;
+        offers.keep_layers(kept);
+        Some(offers)
+    }
+
+    /// The file rewritten as `variant`, the layers `kept` marks left as they are, within the
+    /// time and lines allowed (`before`: the original's analysis), and its analysis where the
+    /// allowance measured it; progress to 0.8.
+    fn rewrite(
+        &self,
+        variant: search::Variant,
+        kept: &[bool],
+        before: &Report,
+        progress: Progress<'_>,
+    ) -> Result<(rewrite::Rewritten, Option<Report>), Error> {
+        let mut offers = match self.known_offers(variant, kept) {
+            Some(offers) => offers,
+            None => rewrite::offers(
+                self.input,
+                self.path,
+                self.sources,
+                (self.options, &self.limits),
+                (variant, kept),
+                &mut |f: f64| progress(0.8 * f),
+            )?,
+        };
+        if !progress(0.8) {
+            return Err(Error::new(0, 0, ErrorKind::Cancelled));
+        }
+        let written = search::within_allowed_time(self.input, &offers, self.options, before);
+        if let Ok(mut known) = self.known.lock() {
+            *known = Some((std::mem::take(&mut offers), kept.to_vec()));
+        }
+        written
+    }
+}
+
+/// The closed loop's rewrites of one file ([`closed_loop::Again`]), each reporting its progress
+/// as a twentieth of the job's from where the loop says.
+struct Retry<'r, 'p> {
+    run: &'r Run<'r>,
+    progress: Progress<'p>,
+}
+
+impl closed_loop::Again for Retry<'_, '_> {
+    fn report(
+        &mut self,
+        variant: search::Variant,
+        kept: &[bool],
+        before: Report,
+        from: f64,
+    ) -> Result<VtgReport, Error> {
+        let progress = &mut *self.progress;
+        self.run
+            .attempt(variant, kept, before, &mut |g| progress(from + 0.05 * g))
+    }
+
+    fn output(
+        &mut self,
+        variant: search::Variant,
+        kept: &[bool],
+        before: &Report,
+        from: f64,
+    ) -> Result<Vec<u8>, Error> {
+        let progress = &mut *self.progress;
+        let (rewritten, _) = self
+            .run
+            .rewrite(variant, kept, before, &mut |g| progress(from + 0.05 * g))?;
+        Ok(rewritten.output)
     }
 }
 

@@ -133,6 +133,8 @@ pub(crate) fn first_mode_hz(path: &PrintPath) -> f64 {
 #[derive(Debug, Default)]
 pub(crate) struct Offers {
     offers: Vec<Offer>,
+    /// Each offer's path: its layer, and whether it has a sharp corner.
+    paths: Vec<(u32, bool)>,
     candidate_paths: u64,
     variant: Variant,
 }
@@ -183,6 +185,10 @@ pub(crate) fn offers(
         !kept_layers.get(layer).copied().unwrap_or(false)
     });
     out.candidate_paths = candidates.iter().filter(|c| c.2).count() as u64;
+    out.paths = candidates
+        .iter()
+        .map(|&(i, _, sharp)| (moves.get(i).map_or(u32::MAX, |m| m.layer), sharp))
+        .collect();
     let offering = Offering {
         input,
         path,
@@ -350,6 +356,26 @@ impl Offering<'_> {
 }
 
 impl Offers {
+    /// The variant these offers were made for.
+    pub(crate) fn variant(&self) -> Variant {
+        self.variant
+    }
+
+    /// Drops the offers of the layers `kept` marks: what [`offers`] makes with them kept, to
+    /// the bit, since each path's offers depend on that path alone. The closed loop's rounds
+    /// that keep layers take them from the whole file's instead of rewriting every path again
+    /// (on the 34 MB file, 6 s a round natively).
+    pub(crate) fn keep_layers(&mut self, kept: &[bool]) {
+        let keep: Vec<bool> = (self.paths.iter())
+            .map(|&(layer, _)| !kept.get(layer as usize).copied().unwrap_or(false))
+            .collect();
+        let mut k = keep.iter();
+        self.offers.retain(|_| k.next().copied().unwrap_or(true));
+        let mut k = keep.iter();
+        self.paths.retain(|_| k.next().copied().unwrap_or(true));
+        self.candidate_paths = self.paths.iter().filter(|p| p.1).count() as u64;
+    }
+
     /// Whether any path offers a rewrite that costs time or energy: otherwise what the budget
     /// allows changes nothing.
     pub(crate) fn has_dearer(&self) -> bool {
@@ -1052,6 +1078,51 @@ mod tests {
         let needed = added as f64 / 44.0 * 100.0;
         assert_eq!(run(needed).paths.rewritten, 1);
         assert_eq!(run(needed - 100.0 / 44.0).paths.rewritten, 0);
+    }
+
+    /// Offers made with layers kept are the whole file's with those layers' offers dropped:
+    /// the same file written, and the same candidates counted.
+    #[test]
+    fn offers_with_layers_kept_are_the_whole_files_less_those_layers() {
+        let mut src = String::from("M83\nM204 P1250\nG1 X100 Y100 F6000\n");
+        for layer in 0..4 {
+            src.push_str(&format!("G1 Z{:.1}\n", 0.2 * f64::from(layer + 1)));
+            for (x, y) in [(120, 100), (130, 104), (120, 110), (100, 110), (100, 100)] {
+                src.push_str(&format!("G1 X{x} Y{y} E0.5 F3600\n"));
+            }
+        }
+        let options = crate::vtg::VtgOptions {
+            dynamics: false,
+            allow_more_lines_pct: 1000.0,
+            ..Default::default()
+        };
+        let input = src.as_bytes();
+        let path = crate::path::extract(input, &options.analyze, true).expect("path");
+        let sources = crate::vtg::source::move_sources(input, &options.analyze).expect("sources");
+        let limits = super::limits_for(&path, &options);
+        let make = |kept: &[bool]| {
+            let at = (&options, &limits);
+            super::offers(
+                input,
+                &path,
+                &sources,
+                at,
+                (super::Variant::default(), kept),
+                &mut |_| true,
+            )
+            .expect("offers")
+        };
+        let write = |o: &super::Offers| o.write(input, (0.0, 1000), 1.0);
+        let kept = [false, true, false, true];
+        let direct = make(&kept);
+        let mut filtered = make(&[]);
+        assert!(filtered.offers.len() > direct.offers.len());
+        filtered.keep_layers(&kept);
+        assert_eq!(filtered.candidate_paths, direct.candidate_paths);
+        assert_eq!(filtered.paths, direct.paths);
+        let (a, b) = (write(&filtered), write(&direct));
+        assert_eq!(a.output, b.output);
+        assert!(a.rewritten_paths > 0 && a.output != input);
     }
 
     #[test]
