@@ -70,7 +70,7 @@ pub(super) fn with_simulated_deviation(
         return Ok(best.report);
     }
     let before = best.report.before.clone();
-    if let Some(kept) = with_layers_kept(&orig, &best, &before, options, again)? {
+    if let Some(kept) = with_layers_kept(&orig, best, &before, options, again)? {
         return Ok(kept);
     }
     // Every rewrite tried rings more than the original: the original is handed back.
@@ -85,7 +85,7 @@ pub(super) fn with_simulated_deviation(
 /// not keep the no-dearer rule.
 fn with_layers_kept(
     orig: &Simulated,
-    tried: &Tried,
+    tried: Tried,
     before: &Report,
     options: &VtgOptions,
     again: &mut dyn Again,
@@ -96,14 +96,7 @@ fn with_layers_kept(
         sim: a,
         layers,
         why,
-    }) = keep_ringing_layers(
-        orig,
-        tried.sim.clone(),
-        tried.variant,
-        before,
-        options,
-        again,
-    )?
+    }) = keep_ringing_layers(orig, tried.sim, tried.variant, before, options, again)?
     else {
         return Ok(None);
     };
@@ -443,7 +436,6 @@ struct Marked {
 
 /// What the dynamics model says of a file: the deviation over its printing moves, and how each
 /// layer rang while printing (by layer index).
-#[derive(Clone)]
 pub(super) struct Simulated {
     deviation: Deviation,
     layers: Vec<LayerRinging>,

@@ -352,8 +352,8 @@ impl Run<'_> {
     fn known_offers(&self, variant: search::Variant, kept: &[bool]) -> Option<rewrite::Offers> {
         let mut known = self.known.lock().ok()?;
         let (offers, was_kept) = known.as_ref()?;
-        let more = (was_kept.iter().enumerate()).all(|(l, &k)| !k || kept.get(l) == Some(&true));
-        if offers.variant() != variant || !more {
+        let covered = (was_kept.iter().enumerate()).all(|(l, &k)| !k || kept.get(l) == Some(&true));
+        if offers.variant() != variant || !covered {
             return None;
         }
         let (mut offers, _) = known.take()?;
