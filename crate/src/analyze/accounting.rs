@@ -8,7 +8,7 @@
 use std::collections::{HashMap, VecDeque};
 
 use super::report::{Bounds, FanEvent, FeatureSummary, TemperatureEvent};
-use super::toolpath::{MetricsAccumulator, DEFAULT_CRITICAL_ANGLE_DEG};
+use super::toolpath::{MetricsAccumulator, MoveTrace, PathEnd, DEFAULT_CRITICAL_ANGLE_DEG};
 use crate::energy::Accumulator;
 use crate::energy::Material;
 use crate::gcode::{feature_kind, FeatureKind};
@@ -62,8 +62,12 @@ pub struct Accounts {
     pub travel: FeatureSummary,
     /// Material named in the file's comments, if any.
     pub material: Option<Material>,
-    /// Toolpath metrics of the VTG paper (VTG eq. 24–26, 31).
+    /// Toolpath metrics of the VTG paper (VTG eq. 24–26, 31), unless the timing side takes
+    /// them (see [`Self::toolpath_on_timing_side`]).
     pub toolpath: MetricsAccumulator,
+    toolpath_here: bool,
+    /// Where the last move ended, for each move's [`MoveTrace`].
+    path_end: PathEnd,
     moves_read: u64,
     /// The last point put into the bounds, while moves keep extruding.
     bounded: Option<[f64; 3]>,
@@ -79,9 +83,17 @@ impl Accounts {
             travel: summary("travel", None),
             material: None,
             toolpath: MetricsAccumulator::new(DEFAULT_CRITICAL_ANGLE_DEG),
+            toolpath_here: true,
+            path_end: PathEnd::default(),
             moves_read: 0,
             bounded: None,
         }
+    }
+
+    /// Leaves the toolpath metrics to the timing side, which takes them from each move's
+    /// [`MoveTrace`] (see [`Timing::with_toolpath_metrics`]); [`Self::merge`] takes them back.
+    pub fn toolpath_on_timing_side(&mut self) {
+        self.toolpath_here = false;
     }
 
     /// A comment that is not a marker (learns the material).
@@ -130,14 +142,21 @@ impl Accounts {
         } else {
             (TRAVEL, false)
         };
-        self.toolpath
-            .push(&m.from, &m.to, m.kind.arc(), extruding, slot, infill);
+        let trace = MoveTrace {
+            extruding,
+            infill,
+            joins: self.path_end.step(&m.from, &m.to),
+        };
         let s = self.slot(slot);
         s.moves += 1;
         s.distance_mm += m.length_mm;
         s.filament_mm += m.extrusion();
         self.moves_read += 1;
         let motion = Motion::from(m);
+        if self.toolpath_here {
+            self.toolpath
+                .push_chord(chord(&motion.delta), m.kind.arc(), slot, trace);
+        }
         if motion.arc.is_none() && motion.rotary_time_s == 0.0 {
             TimeMsg::Move {
                 delta: motion.delta,
@@ -145,12 +164,14 @@ impl Accounts {
                 line: motion.line,
                 slot,
                 layers,
+                trace,
             }
         } else {
             TimeMsg::Motion {
                 m: Box::new(motion),
                 slot,
                 layers,
+                trace,
             }
         }
     }
@@ -185,6 +206,9 @@ impl Accounts {
     /// Adds the timing side's per-feature and per-layer times and energies, and gives its
     /// energy model the material the file names.
     pub fn merge(&mut self, timing: &mut TimeBook, layers: &mut LayerTracker) {
+        if let Some(t) = timing.toolpath.take() {
+            self.toolpath = t;
+        }
         if let Some(m) = self.material {
             timing.energy.set_material_from_file(m);
         }
@@ -229,12 +253,14 @@ pub enum TimeMsg {
         line: u32,
         slot: u32,
         layers: (u32, u32),
+        trace: MoveTrace,
     },
     /// Any other move, with its feature slot and layers.
     Motion {
         m: Box<Motion>,
         slot: u32,
         layers: (u32, u32),
+        trace: MoveTrace,
     },
     /// A dwell: the queue drains, then time passes.
     Dwell { secs: f64, layers: (u32, u32) },
@@ -269,6 +295,8 @@ pub struct TimeBook {
     pending: VecDeque<(u64, Pending)>,
     pub temperatures: Vec<TemperatureEvent>,
     pub fans: Vec<FanEvent>,
+    /// The toolpath metrics, when the timing side takes them.
+    pub toolpath: Option<MetricsAccumulator>,
 }
 
 fn add(v: &mut Vec<(f64, f64)>, i: u32, t: f64, e: f64) {
@@ -292,6 +320,15 @@ impl Timing {
         }
     }
 
+    /// Takes the toolpath metrics from the moves' [`MoveTrace`]s, for a read side that leaves
+    /// them here ([`Accounts::toolpath_on_timing_side`]). In the browser the read side is the
+    /// slower half of `analyze` (it also encodes every move for the other worker), so they
+    /// ride with the planner there.
+    pub fn with_toolpath_metrics(mut self) -> Self {
+        self.book.toolpath = Some(MetricsAccumulator::new(DEFAULT_CRITICAL_ANGLE_DEG));
+        self
+    }
+
     /// Handles one message from the read side.
     pub fn handle(&mut self, msg: TimeMsg) {
         let Timing {
@@ -306,7 +343,11 @@ impl Timing {
                 line,
                 slot,
                 layers,
+                trace,
             } => {
+                if let Some(t) = &mut book.toolpath {
+                    t.push_chord(chord(&delta), None, slot, trace);
+                }
                 let seq = *moves;
                 *moves += 1;
                 book.tags.push_back((seq, slot, layers));
@@ -319,7 +360,15 @@ impl Timing {
                 };
                 planner.push(&m, seq, &mut |pm| book.planned(pm));
             }
-            TimeMsg::Motion { m, slot, layers } => {
+            TimeMsg::Motion {
+                m,
+                slot,
+                layers,
+                trace,
+            } => {
+                if let Some(t) = &mut book.toolpath {
+                    t.push_chord(chord(&m.delta), m.arc.as_ref(), slot, trace);
+                }
                 let seq = *moves;
                 *moves += 1;
                 book.tags.push_back((seq, slot, layers));
@@ -358,6 +407,7 @@ impl TimeBook {
             pending: VecDeque::new(),
             temperatures: Vec::new(),
             fans: Vec::new(),
+            toolpath: None,
         }
     }
 
@@ -461,6 +511,12 @@ fn account_move(m: &Move, extruding: bool, totals: &mut Totals, bounded: &mut Op
             totals.retractions += 1;
         }
     }
+}
+
+/// A move's XYZ chord from its XYZE displacement.
+#[inline]
+fn chord(delta: &[f64; 4]) -> [f64; 3] {
+    [delta[0], delta[1], delta[2]]
 }
 
 #[cfg(test)]

@@ -6,9 +6,16 @@
 //! batches of bytes; [`TimingApart`] is fed those batches and returns its results as bytes;
 //! [`report_apart`] joins the two. The timing side is the same code as `analyze`'s and numbers
 //! travel as their bits, so the report is `analyze`'s to the bit.
+//!
+//! The halves are split where they balance in wasm: the read side (parser, machine, counts,
+//! and the encoding of every move) was the slower one, about 290 ms against the planner's
+//! 200 ms on the 34 MB corpus file in node, so the toolpath metrics (VTG eq. 24–26, 31, about
+//! a sixth of the read side) ride with the planner here, from each move's chord and
+//! [`MoveTrace`](super::toolpath::MoveTrace): 240 ms against 230 ms. Natively the pipeline
+//! keeps them on the read side.
 
 use super::accounting::{Accounts, TimeMsg, Timing};
-use super::wire::{self, TimingSetup, WireMsg};
+use super::wire::{self, MoveContext, TimingSetup, WireMsg};
 use super::{report, Report, Tally};
 use crate::energy::Accumulator;
 use crate::error::{Error, ErrorKind};
@@ -16,10 +23,11 @@ use crate::gcode::SlicerInfo;
 use crate::progress::Progress;
 use crate::read::{AnalyzeOptions, Reader};
 
-/// Bytes per batch: about 18 000 moves. A browser's `postMessage` costs far more per call
-/// than a channel's send: with batches of 2048 moves (117 kB, 640 posts for the 34 MB corpus
-/// file) Chromium's read side took 610–700 ms, with 1 MB batches 400–615 ms (a noisy 2-core
-/// machine). The timing side still starts within the first 3 % of the file.
+/// Bytes per batch: about 38 000 moves (the wire sends only what changed, see
+/// [`wire::MoveContext`]). A browser's `postMessage` costs far more per call than a channel's
+/// send: with batches of 2048 moves (117 kB, 640 posts for the 34 MB corpus file) Chromium's
+/// read side took 610–700 ms, with 1 MB batches 400–615 ms (a noisy 2-core machine). The
+/// timing side still starts within the first 3 % of the file.
 const BATCH_BYTES: usize = 1 << 20;
 
 /// What the read side keeps until the timing side's results come back.
@@ -45,8 +53,10 @@ pub fn read_apart(
     wire::put_setup(&mut batch, &setup);
     let mut info = SlicerInfo::default();
     let mut acc = Accounts::new();
+    acc.toolpath_on_timing_side();
+    let mut sent = MoveContext::default();
     let mut to_timing = |msg: TimeMsg| {
-        wire::put_msg(&mut batch, &msg);
+        wire::put_msg(&mut batch, &mut sent, &msg);
         if batch.len() >= BATCH_BYTES {
             send(&batch);
             batch.clear();
@@ -69,6 +79,8 @@ pub fn read_apart(
 #[derive(Debug, Default)]
 pub struct TimingApart {
     timing: Option<Timing>,
+    /// What the moves of the batches so far sent (see [`MoveContext`]).
+    received: MoveContext,
 }
 
 fn transfer(reason: &'static str) -> Error {
@@ -83,9 +95,11 @@ impl TimingApart {
 
     /// Plans the moves of one batch.
     pub fn feed(&mut self, batch: &[u8]) -> Result<(), Error> {
-        wire::read_msgs(batch, |msg| {
+        wire::read_msgs(batch, &mut self.received, |msg| {
             match msg {
-                WireMsg::Setup(setup) => self.timing = Some(setup.timing()),
+                WireMsg::Setup(setup) => {
+                    self.timing = Some(setup.timing().with_toolpath_metrics());
+                }
                 WireMsg::Time(msg) => self
                     .timing
                     .as_mut()

@@ -11,9 +11,10 @@
 //! length along the arc, and turn by their tangents at those points: an arc-fitted file meets
 //! its lines tangentially, where its chords would show a corner of half the sweep at each end.
 //!
-//! The accumulator costs a handful of multiplications, one `acos` and one `sqrt` per move, so
-//! `analyze` runs it on its read side. The metrics of a kept or streamed [`crate::path`] are
-//! in [`crate::vtg::metrics`].
+//! The accumulator costs a handful of multiplications, one `acos` and a few square roots per
+//! move. `analyze` runs it on its read side natively, and beside the planner in the browser
+//! (see `analyze::apart`), from each move's chord and [`MoveTrace`]. The metrics of a kept or
+//! streamed [`crate::path`] are in [`crate::vtg::metrics`].
 
 use serde::Serialize;
 
@@ -54,8 +55,10 @@ pub struct ToolpathMetrics {
 pub struct MetricsAccumulator {
     cos_critical: f64,
     critical_deg: f64,
-    /// Last point of the open path, its incoming segment and the path's feature.
+    /// The open path's incoming segment and feature.
     last: Option<Open>,
+    /// Where the last move pushed by position ended.
+    end: PathEnd,
     l_total: f64,
     l_infill: f64,
     n_total: u64,
@@ -68,10 +71,39 @@ pub struct MetricsAccumulator {
 
 #[derive(Debug, Clone, Copy)]
 struct Open {
-    end: [f64; 3],
     seg: [f64; 3],
     len: f64,
     feature: u32,
+}
+
+/// What [`MetricsAccumulator::push_chord`] needs of a move besides its chord: whether it
+/// extrudes, its feature (any identifier) and whether that is infill, and whether it starts
+/// where the move before it ended (see [`PathEnd`]). `analyze` sends it to its timing side
+/// with each move, so the metrics can be taken there (see `analyze::apart`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct MoveTrace {
+    pub extruding: bool,
+    pub infill: bool,
+    pub joins: bool,
+}
+
+/// The end of the move before, to tell whether the next one starts there (within 1e-9 mm
+/// on each axis: a path is a run of moves each starting where the last ended).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PathEnd([f64; 3]);
+
+impl PathEnd {
+    /// Whether the move from `from` to `to` starts where the last one ended; `to` becomes
+    /// the end. Positions shorter than XYZ never join.
+    #[inline]
+    pub fn step(&mut self, from: &[f64], to: &[f64]) -> bool {
+        let (Some(from), Some(to)) = (from.get(..3), to.get(..3)) else {
+            return false;
+        };
+        let joins = same_point(&self.0, from);
+        self.0 = [to[0], to[1], to[2]];
+        joins
+    }
 }
 
 impl MetricsAccumulator {
@@ -86,6 +118,7 @@ impl MetricsAccumulator {
             cos_critical: math::cos(deg.to_radians()),
             critical_deg: deg,
             last: None,
+            end: PathEnd::default(),
             l_total: 0.0,
             l_infill: 0.0,
             n_total: 0,
@@ -110,12 +143,34 @@ impl MetricsAccumulator {
         feature: u32,
         infill: bool,
     ) {
-        if !extruding || from.len() < 3 || to.len() < 3 {
+        let joins = self.end.step(from, to);
+        if from.len() < 3 || to.len() < 3 {
             self.last = None;
             return;
         }
-        let end = [to[0], to[1], to[2]];
         let chord = [to[0] - from[0], to[1] - from[1], to[2] - from[2]];
+        let trace = MoveTrace {
+            extruding,
+            infill,
+            joins,
+        };
+        self.push_chord(chord, arc, feature, trace);
+    }
+
+    /// One move by its chord (`to − from`, XYZ, mm), for a caller that tracks the positions
+    /// itself ([`PathEnd`]): the same metrics as [`Self::push`] with the same move.
+    #[inline]
+    pub fn push_chord(
+        &mut self,
+        chord: [f64; 3],
+        arc: Option<&Arc>,
+        feature: u32,
+        trace: MoveTrace,
+    ) {
+        if !trace.extruding {
+            self.last = None;
+            return;
+        }
         let chord_len = norm(chord);
         // A line is its own direction at both ends; an arc leaves and arrives along its
         // tangents, taken as long as its chord so VTG eq. 31 sees a segment of the same size.
@@ -140,29 +195,54 @@ impl MetricsAccumulator {
             return;
         }
         self.l_total += len;
-        if infill {
+        if trace.infill {
             self.l_infill += len;
         }
-        let continues = match self.last {
-            Some(o) => o.feature == feature && same_point(&o.end, from),
-            None => false,
-        };
-        let points = if continues { 1 } else { 2 };
+        let open = self.last.filter(|o| trace.joins && o.feature == feature);
+        let points = if open.is_some() { 1 } else { 2 };
         self.n_total += points;
-        if infill {
+        if trace.infill {
             self.n_infill += points;
         }
-        if continues {
-            if let Some(o) = self.last {
-                self.corner(&o.seg, o.len, &start_seg, chord_len);
-            }
+        if let Some(o) = open {
+            self.corner(&o.seg, o.len, &start_seg, chord_len);
         }
         self.last = Some(Open {
-            end,
             seg,
             len: chord_len,
             feature,
         });
+    }
+
+    /// The running sums as words (IEEE bits for the lengths and angle sums), for sending the
+    /// metrics of a file read apart back to its read side ([`Self::from_words`]).
+    pub fn to_words(&self) -> [u64; 8] {
+        [
+            self.l_total.to_bits(),
+            self.l_infill.to_bits(),
+            self.n_total,
+            self.n_infill,
+            self.n_turning,
+            self.n_corners,
+            self.sum_turn.to_bits(),
+            self.sum_chord.to_bits(),
+        ]
+    }
+
+    /// An accumulator with critical angle `critical_angle_deg` holding the sums of
+    /// [`Self::to_words`] (its open path is not carried: the file has ended).
+    pub fn from_words(critical_angle_deg: f64, w: [u64; 8]) -> Self {
+        Self {
+            l_total: f64::from_bits(w[0]),
+            l_infill: f64::from_bits(w[1]),
+            n_total: w[2],
+            n_infill: w[3],
+            n_turning: w[4],
+            n_corners: w[5],
+            sum_turn: f64::from_bits(w[6]),
+            sum_chord: f64::from_bits(w[7]),
+            ..Self::new(critical_angle_deg)
+        }
     }
 
     /// Turning angle (VTG eq. 26) and chord error (VTG eq. 31) at the point between segments
@@ -316,5 +396,44 @@ mod tests {
         assert!((m.mean_chord_error_mm - sagitta).abs() < 1e-9);
         assert!((m.mean_turn_deg - 10.0).abs() < 1e-2);
         assert_eq!(m.n_turning, 0);
+    }
+
+    /// Property tests (proptest is a native-only dev-dependency).
+    #[cfg(not(target_arch = "wasm32"))]
+    mod props {
+        use super::*;
+        use proptest::prelude::*;
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(64))]
+
+            /// Metrics taken as the timing side takes them (each move's chord and trace, the
+            /// joins from a [`PathEnd`]) and carried back as words equal those taken by
+            /// position, on moves over a coarse grid (so ends meet and points repeat), with
+            /// jumps, travels, feature changes and zero-length moves.
+            #[test]
+            fn by_chord_and_trace_equals_by_position(
+                moves in proptest::collection::vec(
+                    (0u8..4, 0u8..4, 0u8..2, any::<bool>(), any::<bool>(), 0u32..3, any::<bool>()),
+                    0..60,
+                ),
+            ) {
+                let mut by_position = MetricsAccumulator::new(DEFAULT_CRITICAL_ANGLE_DEG);
+                let mut by_chord = MetricsAccumulator::new(DEFAULT_CRITICAL_ANGLE_DEG);
+                let mut end = PathEnd::default();
+                let mut at = [0.0, 0.0, 0.2];
+                for (x, y, z, jump, extruding, feature, infill) in moves {
+                    let from = if jump { [f64::from(y), f64::from(x), 0.2] } else { at };
+                    let to = [f64::from(x) * 2.5, f64::from(y) * 1.5, 0.2 + f64::from(z) * 0.2];
+                    by_position.push(&from, &to, None, extruding, feature, infill);
+                    let trace = MoveTrace { extruding, infill, joins: end.step(&from, &to) };
+                    let chord = [to[0] - from[0], to[1] - from[1], to[2] - from[2]];
+                    by_chord.push_chord(chord, None, feature, trace);
+                    at = to;
+                }
+                let carried = MetricsAccumulator::from_words(DEFAULT_CRITICAL_ANGLE_DEG, by_chord.to_words());
+                prop_assert_eq!(carried.finish(), by_position.finish());
+            }
+        }
     }
 }
