@@ -610,7 +610,8 @@ test('analyze of the 34 MB corpus file in the worker is within 2× of the native
   // shared, and a burst of load elsewhere then slows both sides alike instead of one. The CLI
   // plans on a second thread while it reads; the worker hands the planning to a second worker
   // (timing-worker.js). On one worker the ratio was 1.3–2.1× (2.12× failed a CI run on a
-  // machine whose two cores let the CLI's threads overlap well).
+  // machine whose two cores let the CLI's threads overlap well); on two workers, 2.07× failed
+  // another before the halves were balanced (docs/measurements/performance.md).
   const RUNS = 11;
   const native = [];
   const browser = [];
