@@ -27,6 +27,7 @@ pub(crate) mod budget;
 mod compact;
 pub(crate) mod rewrite;
 pub(crate) mod smooth;
+pub(crate) mod smoothings;
 
 /// What a whole-file rewrite is tried with; [`crate::vtg::vtg`] tries others where the dynamics
 /// model finds the first one ringing more than the original.

@@ -27,6 +27,7 @@ use crate::vtg::feed::Written;
 use crate::vtg::kinematics::KinematicLimits;
 use crate::vtg::resample::WalkStats;
 use crate::vtg::smooth::{smooth_path, Settings, SmoothPath, Smoothed};
+use crate::vtg::smoothings::{Pending, Smoothing, SmoothingKey, Smoothings};
 use crate::vtg::source::{MoveSource, Sources};
 use crate::vtg::tuning::TUNING;
 use crate::vtg::VtgOptions;
@@ -141,13 +142,15 @@ pub(crate) struct Offers {
 
 /// Rewrites every eligible path of `input` in every way worth offering: the free rewrite, and
 /// the dearer ones (see [`budget`]); [`Offers::write`] then writes the file with the choice.
+/// Paths smoothed the same way before are taken from `smoothings`, and those smoothed now kept
+/// there (within its bound).
 pub(crate) fn offers(
     input: &[u8],
     path: &PrintPath,
     all: &Sources,
     (options, limits): (&VtgOptions, &KinematicLimits),
     (variant, kept_layers): (Variant, &[bool]),
-    progress: crate::progress::Progress<'_>,
+    (smoothings, progress): (&mut Smoothings, crate::progress::Progress<'_>),
 ) -> Result<Offers, Error> {
     let mut out = Offers {
         variant,
@@ -174,9 +177,7 @@ pub(crate) fn offers(
         &path.profile.name,
     );
     let cos_critical = crate::math::cos(settings.critical_rad);
-    // The candidates first (cheap), then the paths rewritten in parallel batches: each path is
-    // independent, results are merged in file order (the same output on any number of
-    // threads), and progress and cancellation are checked between batches.
+    // The candidates first (cheap), then the paths rewritten ([`Offering::offer_all`]).
     // Where arcs are written, the paths without sharp corners too: they can save lines.
     let mut candidates = candidates(moves, sources, cos_critical, settings.arcs);
     // Layers kept as they are (where a rewrite rang above the original's peak).
@@ -194,6 +195,8 @@ pub(crate) fn offers(
         path,
         all,
         energy: &energy,
+        smoothings,
+        variant,
         settings,
         dearer: TUNING.dearer_speed_shares.map(|min_speed_share| Settings {
             min_speed_share,
@@ -202,20 +205,8 @@ pub(crate) fn offers(
         // Dearer variants only where they can differ from the free rewrite.
         buy_time: options.allow_slower_pct > 0.0 && settings.speed_share_matters(),
     };
-    let mut offers: Vec<Offer> = Vec::with_capacity(candidates.len());
-    for (b, batch) in candidates.chunks(BATCH_PATHS).enumerate() {
-        if !progress((b * BATCH_PATHS) as f64 / candidates.len().max(1) as f64) {
-            return Err(Error::new(0, 0, ErrorKind::Cancelled));
-        }
-        // One offer per path, kept in file order: sums over them are then the same to the
-        // last bit as a sequential run's (the wasm build's, which the CLI's JSON must equal).
-        offers.extend(crate::parallel::map_chunks(batch, |chunk| {
-            chunk
-                .iter()
-                .map(|&(i, j, sharp)| offering.offer(i, j, sharp))
-                .collect()
-        }));
-    }
+    let (offers, pending) = offering.offer_all(&candidates, progress)?;
+    smoothings.keep_all(pending);
     out.offers = offers;
     Ok(out)
 }
@@ -298,6 +289,9 @@ struct Offering<'a> {
     path: &'a PrintPath,
     all: &'a Sources,
     energy: &'a Accumulator,
+    /// Paths smoothed before, and the variant smoothing them now.
+    smoothings: &'a Smoothings,
+    variant: Variant,
     /// The free rewrite's settings.
     settings: Settings,
     /// The dearer variants' (`Tuning::dearer_speed_shares`).
@@ -307,10 +301,45 @@ struct Offering<'a> {
 }
 
 impl Offering<'_> {
+    /// The offers of the `candidates` paths, in parallel batches: each path is independent,
+    /// results are merged in file order (the same output on any number of threads), and
+    /// progress and cancellation are checked between batches. With them, the smoothings made
+    /// that fit beside those kept.
+    fn offer_all(
+        &self,
+        candidates: &[(usize, usize, bool)],
+        progress: crate::progress::Progress<'_>,
+    ) -> Result<(Vec<Offer>, Pending), Error> {
+        let mut pending = Pending::default();
+        let mut offers: Vec<Offer> = Vec::with_capacity(candidates.len());
+        for (b, batch) in candidates.chunks(BATCH_PATHS).enumerate() {
+            if !progress((b * BATCH_PATHS) as f64 / candidates.len().max(1) as f64) {
+                return Err(Error::new(0, 0, ErrorKind::Cancelled));
+            }
+            // One offer per path, kept in file order: sums over them are then the same to the
+            // last bit as a sequential run's (the wasm build's, which the CLI's JSON must
+            // equal).
+            let made = crate::parallel::map_chunks(batch, |chunk| {
+                chunk
+                    .iter()
+                    .map(|&(i, j, sharp)| self.offer(i, j, sharp))
+                    .collect()
+            });
+            for (offer, fresh) in made {
+                offers.push(offer);
+                for (key, smoothing) in fresh {
+                    self.smoothings.admit(&mut pending, key, smoothing);
+                }
+            }
+        }
+        Ok((offers, pending))
+    }
+
     /// The ways of writing moves `i..j`: the free rewrite, and with time to spend the dearer
     /// variants that round more corners; a path without a `sharp` corner only with arcs, as
-    /// its original points lie ([`super::compact`]).
-    fn offer(&self, i: usize, j: usize, sharp: bool) -> Offer {
+    /// its original points lie ([`super::compact`]). With them, the smoothings made for it
+    /// that were not kept before.
+    fn offer(&self, i: usize, j: usize, sharp: bool) -> (Offer, Vec<(SmoothingKey, Smoothing)>) {
         let (moves, sources) = (&self.path.moves, &self.all.moves[..]);
         let machine = PlanContext {
             limits: self.all.limits_at(i),
@@ -330,28 +359,40 @@ impl Offering<'_> {
                 &settings,
                 &machine,
             );
-            return Offer {
+            let offer = Offer {
                 free: compact,
                 dearer: Vec::new(),
             };
+            return (offer, Vec::new());
         }
-        let write =
-            |s: &Settings| rewrite_path(self.input, &moves[i..j], &sources[i..j], s, &machine);
-        let base = write(&self.settings).unwrap_or_default();
+        let mut fresh = Vec::new();
+        let mut write = |k: u8, s: &Settings| {
+            let key = SmoothingKey::new(self.variant, k, i);
+            let mut smooth = |path: &SmoothPath<'_>, settings: &Settings| {
+                if let Some(kept) = self.smoothings.get(&key) {
+                    return kept.clone();
+                }
+                let made = smooth_path(path, settings).map(std::sync::Arc::new);
+                fresh.push((key, made.clone()));
+                made
+            };
+            let (run, src) = (&moves[i..j], &sources[i..j]);
+            rewrite_path(self.input, (run, src), s, &machine, &mut smooth)
+        };
+        let base = write(0, &self.settings).unwrap_or_default();
         let kept = base.iter().map(|o| o.corners_removed).max().unwrap_or(0);
         // With time to spend, the variants that round the corners the firmware takes faster
         // sharp, too: first those it takes nearly as fast round.
         let mut offer = Offer::default();
         base.into_iter().for_each(|o| offer.push(o));
         if self.buy_time {
-            self.dearer
-                .iter()
-                .filter_map(write)
+            (self.dearer.iter().zip(1..))
+                .filter_map(|(s, k)| write(k, s))
                 .flatten()
                 .filter(|o| o.corners_removed > kept)
                 .for_each(|o| offer.push(o));
         }
-        offer
+        (offer, fresh)
     }
 }
 
@@ -639,10 +680,10 @@ impl PlanContext<'_> {
 /// buys corners the fastest way buys more of them.
 fn rewrite_path(
     input: &[u8],
-    run: &[PathMove],
-    src: &[MoveSource],
+    (run, src): (&[PathMove], &[MoveSource]),
     file_settings: &Settings,
     machine: &PlanContext<'_>,
+    smooth: &mut dyn FnMut(&SmoothPath<'_>, &Settings) -> Smoothing,
 ) -> Option<Vec<Outcome>> {
     let settings = &machine.settings(file_settings);
     let o = Polyline::of(run, src)?;
@@ -657,7 +698,7 @@ fn rewrite_path(
             &[]
         },
     };
-    let smoothed = smooth_path(&path, settings)?;
+    let smoothed = smooth(&path, settings)?;
     let original = machine.cost(pts[0], &pts[1..], &e[1..], feed);
     let costs = Costs { original };
     let (cheapest, fastest) = cheapest_and_fastest(&smoothed, pts[0], settings, machine, costs);
@@ -1028,6 +1069,8 @@ pub(crate) fn sharp_turns<'a>(
 
 #[cfg(test)]
 mod tests {
+    use crate::vtg::smoothings::Smoothings;
+
     /// Filament (relative E) pushed before each `;WIDTH:` line, in order, and the total.
     fn filament_at_notes(g: &str) -> (Vec<(String, f64)>, f64) {
         let mut e = 0.0;
@@ -1082,8 +1125,8 @@ mod tests {
 
     /// Offers made with layers kept are the whole file's with those layers' offers dropped:
     /// the same file written, and the same candidates counted.
-    #[test]
-    fn offers_with_layers_kept_are_the_whole_files_less_those_layers() {
+    /// Four layers of a pentagon with sharp corners, printed at 60 mm/s.
+    fn pentagon_layers() -> String {
         let mut src = String::from("M83\nM204 P1250\nG1 X100 Y100 F6000\n");
         for layer in 0..4 {
             src.push_str(&format!("G1 Z{:.1}\n", 0.2 * f64::from(layer + 1)));
@@ -1091,26 +1134,46 @@ mod tests {
                 src.push_str(&format!("G1 X{x} Y{y} E0.5 F3600\n"));
             }
         }
+        src
+    }
+
+    /// The offers for `input` as `variant` with the layers `kept` left as they are, paths
+    /// smoothed before taken from `smoothings`.
+    fn offers_of(
+        input: &[u8],
+        (variant, kept): (super::Variant, &[bool]),
+        smoothings: &mut Smoothings,
+    ) -> super::Offers {
         let options = crate::vtg::VtgOptions {
             dynamics: false,
             allow_more_lines_pct: 1000.0,
             ..Default::default()
         };
-        let input = src.as_bytes();
         let path = crate::path::extract(input, &options.analyze, true).expect("path");
         let sources = crate::vtg::source::move_sources(input, &options.analyze).expect("sources");
         let limits = super::limits_for(&path, &options);
+        let at = (&options, &limits);
+        super::offers(
+            input,
+            &path,
+            &sources,
+            at,
+            (variant, kept),
+            (smoothings, &mut |_| true),
+        )
+        .expect("offers")
+    }
+
+    #[test]
+    fn offers_with_layers_kept_are_the_whole_files_less_those_layers() {
+        let src = pentagon_layers();
+        let input = src.as_bytes();
         let make = |kept: &[bool]| {
-            let at = (&options, &limits);
-            super::offers(
+            offers_of(
                 input,
-                &path,
-                &sources,
-                at,
                 (super::Variant::default(), kept),
-                &mut |_| true,
+                &mut Smoothings::new(0),
             )
-            .expect("offers")
         };
         let write = |o: &super::Offers| o.write(input, (0.0, 1000), 1.0);
         let kept = [false, true, false, true];
@@ -1123,6 +1186,40 @@ mod tests {
         let (a, b) = (write(&filtered), write(&direct));
         assert_eq!(a.output, b.output);
         assert!(a.rewritten_paths > 0 && a.output != input);
+    }
+
+    /// The closed loop's variants at another scale of the VTG eq. 29 speeds take the paths
+    /// smoothed at the first from the kept smoothings, and write what smoothing them again
+    /// writes; the scale still sets the speeds.
+    #[test]
+    fn smoothings_kept_at_one_scale_write_another_as_smoothing_again_does() {
+        let src = pentagon_layers();
+        let input = src.as_bytes();
+        let write = |o: &super::Offers| o.write(input, (0.0, 1000), 1.0).output;
+        let one = super::Variant {
+            thin: false,
+            ..Default::default()
+        };
+        let two = super::Variant {
+            feed_cap_scale: 2.0,
+            ..one
+        };
+        let mut kept = Smoothings::new(usize::MAX);
+        let at_one = write(&offers_of(input, (one, &[]), &mut kept));
+        let bytes = kept.bytes();
+        assert!(bytes > 0);
+        let from_kept = write(&offers_of(input, (two, &[]), &mut kept));
+        assert_eq!(kept.bytes(), bytes, "smoothed again");
+        let again = write(&offers_of(input, (two, &[]), &mut Smoothings::new(0)));
+        assert_eq!(from_kept, again);
+        assert_ne!(from_kept, at_one);
+        // Keyholes off is another smoothing: kept beside the first.
+        let no_keyholes = super::Variant {
+            keyholes: false,
+            ..one
+        };
+        offers_of(input, (no_keyholes, &[]), &mut kept);
+        assert!(kept.bytes() > bytes);
     }
 
     #[test]
