@@ -71,7 +71,8 @@ lint:
 # Property tests draw a fixed seed here so CI is reproducible; unset PROPTEST_RNG_SEED locally
 # (or set another) to explore new cases. The crate's own tests run in the test profile, with
 # debug assertions; the corpus conformance suite runs in release, which `cli` builds anyway:
-# its VTG and dynamics runs took 554 s in the test profile against 356 s there.
+# its VTG and dynamics runs took 554 s in the test profile against 356 s there, and its eight
+# test binaries, one linked with thin LTO, 106 s to build (tests/conformance/main.rs).
 test-rust:
 	PROPTEST_RNG_SEED=$${PROPTEST_RNG_SEED:-20261122} cargo test --workspace --exclude quietpath-conformance
 	PROPTEST_RNG_SEED=$${PROPTEST_RNG_SEED:-20261122} cargo test --release -p quietpath-conformance
@@ -90,8 +91,8 @@ bench: cli
 	@echo "sha256sum:"; time -p sha256sum "$(LARGE)" > /dev/null
 	target/release/quietpath bench "$(LARGE)"
 	cargo bench -p quietpath --bench parse
-	cargo test --release -p quietpath-conformance --test infill -- --ignored --nocapture
-	cargo test --release -p quietpath-conformance --test vtg -- --ignored --nocapture
+	cargo test --release -p quietpath-conformance infill:: -- --ignored --nocapture
+	cargo test --release -p quietpath-conformance vtg:: -- --ignored --nocapture
 
 ## The generated tables in docs/measurements/generated/ (analyze, vtg, infill, smooth on every
 ## corpus file and fixture, from the CLI's --json; a few minutes). CORPUS=… for another corpus folder.

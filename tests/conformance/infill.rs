@@ -1,7 +1,7 @@
 //! Conformance of `infill`: regenerated infill against PrusaSlicer's own, and the safety
 //! properties of the rewritten files (inside the part, same filament, re-parses cleanly).
 //!
-//! `cargo test -p quietpath-conformance --test infill -- --nocapture` prints the tables.
+//! `cargo test -p quietpath-conformance infill:: -- --nocapture` prints the tables.
 #![allow(clippy::unwrap_used)]
 
 use std::path::PathBuf;
@@ -289,7 +289,7 @@ fn rotated_candidates_cost_what_the_file_costs() {
 
 /// The speed target of the issue: 12 angles × 4 rotations × 5 patterns (240 candidates, each
 /// planned and costed for the whole file) on a 100-layer part in under 10 s. Release only:
-/// `cargo test --release -p quietpath-conformance --test infill -- --ignored --nocapture`.
+/// `cargo test --release -p quietpath-conformance infill:: -- --ignored --nocapture`.
 #[test]
 #[ignore = "timing: run in release with --ignored"]
 fn speed_240_candidates_on_a_100_layer_part() {

@@ -12,7 +12,7 @@
 //! `G4 S30` in its start G-code and PrusaSlicer gives it the same estimate as without), while
 //! `time_s` counts them, as the printer does: the comparison is of `time_s − dwell_s`.
 //!
-//! `cargo test -p quietpath-conformance --test slicer_times -- --nocapture` shows the tables.
+//! `cargo test -p quietpath-conformance slicer_times:: -- --nocapture` shows the tables.
 #![allow(clippy::unwrap_used)]
 
 use std::cmp::Ordering;

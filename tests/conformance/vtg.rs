@@ -12,7 +12,7 @@
 //! rises by at most 1 % and the simulated mean deviation falls. Where a file cannot meet one of
 //! these, it is named below with the reason, and what does hold for it is asserted.
 //!
-//! `cargo test -p quietpath-conformance --test vtg -- --nocapture` prints the table.
+//! `cargo test -p quietpath-conformance vtg:: -- --nocapture` prints the table.
 #![allow(clippy::unwrap_used)]
 
 use quietpath::gcode::{parse_line, Lines};
@@ -758,7 +758,7 @@ fn the_segment_budget_joins_steps_and_the_report_counts_the_written_file() {
 /// peak, kept as they were. `check` verifies the tolerance on the written file, the filament,
 /// the lines that are not moves and the no-dearer rule on both deviation figures; here, also
 /// the rest of the defaults' promises. About a minute in release, several in a debug build:
-/// `cargo test --release -p quietpath-conformance --test vtg -- --ignored --nocapture`
+/// `cargo test --release -p quietpath-conformance vtg:: -- --ignored --nocapture`
 /// (`make bench`).
 #[test]
 #[ignore = "a minute in release: run with --ignored (make bench)"]
