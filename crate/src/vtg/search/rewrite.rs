@@ -1123,8 +1123,6 @@ mod tests {
         assert_eq!(run(needed - 100.0 / 44.0).paths.rewritten, 0);
     }
 
-    /// Offers made with layers kept are the whole file's with those layers' offers dropped:
-    /// the same file written, and the same candidates counted.
     /// Four layers of a pentagon with sharp corners, printed at 60 mm/s.
     fn pentagon_layers() -> String {
         let mut src = String::from("M83\nM204 P1250\nG1 X100 Y100 F6000\n");
@@ -1164,6 +1162,8 @@ mod tests {
         .expect("offers")
     }
 
+    /// Offers made with layers kept are the whole file's with those layers' offers dropped:
+    /// the same file written, and the same candidates counted.
     #[test]
     fn offers_with_layers_kept_are_the_whole_files_less_those_layers() {
         let src = pentagon_layers();
