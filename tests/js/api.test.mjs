@@ -236,6 +236,21 @@ describe('errors', () => {
     assert.throws(() => qp.analyze(new TextEncoder().encode(bad), { strict: true }), (e) => e instanceof Error && e.line === 4);
   });
 
+  test('numbers: an overflowing 1e999 is an Error on its line; compact lower case parses', () => {
+    assert.throws(
+      () => qp.analyze('G1 X1\nG1 X1e999\n', { strict: true }),
+      (e) => e instanceof Error && !(e instanceof WebAssembly.RuntimeError) && e.line === 2,
+    );
+    const r = qp.analyze('M83\ng1x.5e1f600\n');
+    assert.equal(r.moves, 1);
+    assert.equal(r.distance_mm, 0.5);
+    assert.equal(r.filament_mm, 1);
+  });
+
+  test('an invalid option is an Error, not a silently ignored value', () => {
+    assert.throws(() => qp.analyze('G1 X1', { filament_diameter_mm: -1 }), (e) => e instanceof Error);
+  });
+
   test('lenient mode: the malformed line becomes a warning', () => {
     const r = qp.analyze(bad);
     assertReportShape(r, 'malformed (lenient)');
