@@ -8,7 +8,7 @@ export PATH := $(CURDIR)/node_modules/.bin:$(HOME)/.cargo/bin:$(PATH)
 CORPUS ?= $(CURDIR)/../shared/corpus
 LARGE := $(CORPUS)/curaengine-4.13.0_extruder-idler-x2.5_large.gcode
 
-.PHONY: all setup setup-test pkg wasm-web wasm-node wasm-bundler serve test typecheck test-rust test-wasm test-js test-fuzz lint cli bench measurements measure-vtg-w16 fuzz clean
+.PHONY: all setup setup-test pkg wasm-web wasm-node wasm-bundler serve test typecheck test-rust test-js fuzz-smoke lint cli bench measurements measure-vtg-w16 fuzz clean
 
 all: pkg cli
 
@@ -50,7 +50,7 @@ cli:
 	cargo build --release
 
 ## Everything: formatting, lints, the playground's type check, Rust tests, wasm tests in Node, JS API and browser tests.
-test: setup-test lint typecheck test-rust test-wasm test-js test-fuzz
+test: setup-test lint typecheck test-rust test-js
 
 ## `// @ts-check` on the playground's www/*.js: tsc over the page's modules and app.js (DOM) and
 ## over the two workers (worker.js, sw.js: the webworker library), and over the browser test's
@@ -72,15 +72,13 @@ lint:
 # (or set another) to explore new cases. The crate's own tests run in the test profile, with
 # debug assertions; the corpus conformance suite runs in release, which `cli` builds anyway:
 # its VTG and dynamics runs took 554 s in the test profile against 356 s there, and its eight
-# test binaries, one linked with thin LTO, 106 s to build (tests/conformance/main.rs).
+# test binaries, one linked with thin LTO, 106 s to build (tests/conformance/main.rs). The CLI
+# (which `test-js` needs) is built in the same cargo run: the library's one codegen unit keeps
+# one core busy, and the binary's and the suite's links then share the two.
 test-rust:
 	PROPTEST_RNG_SEED=$${PROPTEST_RNG_SEED:-20261122} cargo test --workspace --exclude quietpath-conformance
+	cargo build --release -p quietpath -p quietpath-conformance --bin quietpath --test conformance
 	PROPTEST_RNG_SEED=$${PROPTEST_RNG_SEED:-20261122} cargo test --release -p quietpath-conformance
-
-# Only tests/wasm.rs has wasm-bindgen tests: the other test targets (and the library's unit
-# tests, a second compile of the crate) are native-only and would build for nothing.
-test-wasm: setup
-	wasm-pack test --node crate --test wasm
 
 test-js: pkg cli
 	npm test
@@ -105,8 +103,10 @@ measurements:
 measure-vtg-w16: cli
 	bash scripts/vtg-w16-tables.sh
 
-## Short, reproducible (seeded, fixed-count) fuzzing smoke run of every target (make test).
-test-fuzz:
+## Short, reproducible (seeded, fixed-count) cargo-fuzz run of every target: a nightly build of
+## about 3 minutes, so `make test` runs the same checks on mutated seeds on stable instead
+## (crate/tests/fuzz_mutations.rs), and CI runs this in its own job.
+fuzz-smoke:
 	FUZZ_SEED=20261122 crate/fuzz/smoke.sh 10
 
 ## Long, unseeded fuzzing run of all eight targets, 10 minutes each, keeping its corpus.

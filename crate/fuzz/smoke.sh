@@ -9,7 +9,7 @@
 # written to fuzz/artifacts/<target>/ (git-ignored): copy them into fuzz/regressions/ so that
 # `cargo test` (tests/fuzz_regressions.rs) replays them for ever.
 #
-# FUZZ_SEED=N makes the run reproducible (what `make test` does): libFuzzer's random seed is N,
+# FUZZ_SEED=N makes the run reproducible (what `make fuzz-smoke` does): libFuzzer's random seed is N,
 # each target starts from the committed seeds alone (a fresh corpus directory) and runs a fixed
 # number of inputs (about SECONDS' worth on the 2-core reference machine, from the table below),
 # so every machine tries the same inputs in the same order and CI cannot turn red on a find
