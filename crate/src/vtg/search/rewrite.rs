@@ -373,7 +373,9 @@ impl Offering<'_> {
                     return kept.clone();
                 }
                 let made = smooth_path(path, settings).map(std::sync::Arc::new);
-                fresh.push((key, made.clone()));
+                if self.smoothings.keeps_any() {
+                    fresh.push((key, made.clone()));
+                }
                 made
             };
             let (run, src) = (&moves[i..j], &sources[i..j]);

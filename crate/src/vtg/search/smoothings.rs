@@ -62,6 +62,11 @@ impl Smoothings {
         }
     }
 
+    /// Whether any smoothing can be kept (a bound of 0 keeps none: no need to hand them in).
+    pub(crate) fn keeps_any(&self) -> bool {
+        self.bound > 0
+    }
+
     /// The smoothing kept for `key`, if any.
     pub(crate) fn get(&self, key: &SmoothingKey) -> Option<&Smoothing> {
         self.kept.get(key)
@@ -190,5 +195,6 @@ mod tests {
         let mut none = Smoothings::new(0);
         none.keep(SmoothingKey::new(v, 0, 7), None);
         assert!(none.get(&SmoothingKey::new(v, 0, 7)).is_none());
+        assert!(!none.keeps_any() && wide.keeps_any());
     }
 }
