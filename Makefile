@@ -49,7 +49,7 @@ serve: pkg
 cli:
 	cargo build --release
 
-## Everything: formatting, lints, the playground's type check, Rust tests, wasm tests in Node, JS API and browser tests.
+## Everything: formatting, lints, the playground's type check, Rust tests (fuzz checks on mutated seeds among them), JS API and browser tests (the wasm package in Node and Chromium).
 test: setup-test lint typecheck test-rust test-js
 
 ## `// @ts-check` on the playground's www/*.js: tsc over the page's modules and app.js (DOM) and

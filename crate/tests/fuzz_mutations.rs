@@ -143,6 +143,16 @@ fn mutate(data: &mut Vec<u8>, rng: &mut Rng, dict: &[Vec<u8>], other: &[u8]) {
     }
 }
 
+/// A seed picked by `rng` with one to five mutations.
+fn mutated(seeds: &[Vec<u8>], dict: &[Vec<u8>], rng: &mut Rng) -> Vec<u8> {
+    let mut input = seeds[rng.below(seeds.len())].clone();
+    for _ in 0..1 + rng.below(5) {
+        let other = &seeds[rng.below(seeds.len())];
+        mutate(&mut input, rng, dict, other);
+    }
+    input
+}
+
 /// Runs `runs` mutated inputs through `check`; panics listing every input that panicked or
 /// took more than 10 s (cargo fuzz's `-timeout=10`), each saved to the temporary directory.
 fn smoke(target: &str, check: fn(&[u8]), runs: usize) {
@@ -154,11 +164,7 @@ fn smoke(target: &str, check: fn(&[u8]), runs: usize) {
             .fold(0u64, |h, b| h.wrapping_mul(31) ^ u64::from(b)));
     let mut failures = Vec::new();
     for run in 0..runs {
-        let mut input = seeds[rng.below(seeds.len())].clone();
-        for _ in 0..1 + rng.below(5) {
-            let other = &seeds[rng.below(seeds.len())];
-            mutate(&mut input, &mut rng, &dict, other);
-        }
+        let input = mutated(&seeds, &dict, &mut rng);
         let started = Instant::now();
         let panicked = catch_unwind(AssertUnwindSafe(|| check(&input))).is_err();
         let secs = started.elapsed().as_secs_f64();
@@ -226,4 +232,14 @@ fn the_dictionary_unescapes_hex_bytes() {
     assert_eq!(unescape(r"\x0d\x0a"), b"\r\n");
     assert_eq!(unescape(r#"a\"b"#), b"a\"b");
     assert_eq!(unescape(r"\xzz"), b"xzz");
+}
+
+#[test]
+fn most_mutated_inputs_differ_from_every_seed() {
+    let (seeds, dict) = (seeds("analyze"), dictionary());
+    let mut rng = Rng(seed());
+    let new = (0..200)
+        .filter(|_| !seeds.contains(&mutated(&seeds, &dict, &mut rng)))
+        .count();
+    assert!(new >= 180, "only {new} of 200 mutated inputs are new");
 }
