@@ -45,6 +45,26 @@ fn non_finite_numbers_are_warned_with_their_line() {
     assert!(matches!(e.kind, ErrorKind::NonFiniteNumber { letter: 'X' }));
 }
 
+/// A limit below the feed floor (0.001 mm/s) caps a move at the floor, in Marlin's planner and
+/// in Klipper's (`SET_VELOCITY_LIMIT`: Klipper has no `M203`), not at a speed that makes it last
+/// for ever (found by the seeded mutation run: `M203 … Y93.0495e-324`).
+#[test]
+fn a_vanishing_feed_limit_keeps_the_feed_floor() {
+    for (flavor, limit) in [
+        ("", "M203 X180 Y9.3e-323"),
+        (";FLAVOR:Klipper\n", "SET_VELOCITY_LIMIT VELOCITY=9.3e-323"),
+    ] {
+        let input = format!("{flavor}G21\nG90\n{limit}\nG1 Y10 F600\n");
+        let r = lenient(input.as_bytes()).expect("lenient");
+        // 10 mm at 0.001 mm/s, give or take the ramps.
+        assert!(
+            (r.time_s - 10_000.0).abs() < 1.0,
+            "{flavor:?}: {} s",
+            r.time_s
+        );
+    }
+}
+
 #[test]
 fn random_bytes_never_panic() {
     // A fixed xorshift stream: reproducible, no dependency.

@@ -605,6 +605,9 @@ fn cruise_speed(
             factor = factor.at_most(max / axis_feedrate[i].abs());
         }
     }
+    // The floor holds after the limits too: an `M203 Y1e-322` would otherwise make a move last
+    // for ever (the factor stays at most 1: the cruise is at least the floor).
+    factor = factor.at_least(crate::machine::MIN_FEED_MM_S / cruise);
     cruise *= factor;
     for v in &mut axis_feedrate {
         *v *= factor;
@@ -662,6 +665,8 @@ fn klipper_speed_and_accel(
         limit(3, distance / e.abs());
     }
     let acceleration = acceleration.at_least(1e-3);
+    // As in `cruise_speed`: the feed floor holds after the limits too.
+    let cruise = cruise.at_least(crate::machine::MIN_FEED_MM_S);
     let inv_distance = 1.0 / distance;
     let axis_feedrate = delta.map(|d| cruise * d * inv_distance);
     (
