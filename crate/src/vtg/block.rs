@@ -85,7 +85,9 @@ pub(crate) fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &
         push_e(&mut text, frame, ek, last, &mut e_written);
         // No F is written into a file that has none yet.
         if let Some(now) = f_now {
-            let f = rounded(piece.feed * 60.0, 1);
+            // At least 0.1 mm/min, the least one decimal writes: `F0` would not be a slow feed
+            // but none (Marlin keeps the feed before it).
+            let f = rounded((piece.feed * 60.0).max(0.1), 1);
             if (now - f).abs() > 0.05 {
                 text.push_str(" F");
                 push_trimmed(&mut text, f, 1);
