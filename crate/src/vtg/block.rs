@@ -85,9 +85,7 @@ pub(crate) fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &
         push_e(&mut text, frame, ek, last, &mut e_written);
         // No F is written into a file that has none yet.
         if let Some(now) = f_now {
-            // At least 0.1 mm/min, the least one decimal writes: `F0` would not be a slow feed
-            // but none (Marlin keeps the feed before it).
-            let f = rounded((piece.feed * 60.0).max(0.1), 1);
+            let f = writable_feed(piece.feed * 60.0, 1);
             if (now - f).abs() > 0.05 {
                 text.push_str(" F");
                 push_trimmed(&mut text, f, 1);
@@ -103,10 +101,18 @@ pub(crate) fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &
     if let (Some(now), Some(after)) = (f_now, frame.f_after) {
         if (now - after).abs() > 1e-9 {
             text.push_str("\nG1 F");
-            push_trimmed(&mut text, after, 3);
+            push_trimmed(&mut text, writable_feed(after, 3), 3);
         }
     }
     text
+}
+
+/// The feed `f` (mm/min) as written with `decimals` places; a positive feed under one unit of
+/// the last place is written as that unit: as `F0` it would be no feed at all, not a slow one
+/// (Marlin keeps the feed before it).
+fn writable_feed(f: f64, decimals: usize) -> f64 {
+    let unit = 0.1f64.powi(decimals as i32);
+    rounded(if f > 0.0 { f.max(unit) } else { f }, decimals)
 }
 
 /// The ` E` word of the point with filament `ek` from the path start (`last`: the block's last
@@ -126,5 +132,21 @@ fn push_e(text: &mut String, frame: &Frame<'_>, ek: f64, last: bool, e_written: 
             push_trimmed(text, written - *e_written, 5);
             *e_written = written;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::writable_feed;
+
+    #[test]
+    fn a_positive_feed_is_never_written_as_zero() {
+        assert_eq!(writable_feed(0.026, 1), 0.1);
+        assert_eq!(writable_feed(1e-49, 3), 0.001);
+        assert_eq!(writable_feed(1234.56, 1), 1234.6);
+        assert_eq!(writable_feed(0.04, 3), 0.04);
+        // Not positive: as it is (the firmware ignores it, as it ignored the original's).
+        assert_eq!(writable_feed(-12.0, 1), -12.0);
+        assert_eq!(writable_feed(0.0, 1), 0.0);
     }
 }
