@@ -164,6 +164,30 @@ fn inputs_without_infill_and_bad_options_are_errors() {
     assert!(matches!(e.kind, ErrorKind::Cancelled));
 }
 
+/// A feed too slow for the written word's places is written as its least positive value, not
+/// `F0`: Marlin reads `F0` as no feed at all and keeps the one before, so the infill would run
+/// at the travel speed and the search would have timed a file that is not the one written.
+#[test]
+fn a_very_slow_infill_feed_is_never_written_as_f0() {
+    let text = std::fs::read_to_string(data("rect_infill_45.gcode")).unwrap();
+    // The infill's feed, 80 mm/s, down to 0.3 mm/min.
+    let slow = text.replace("F4800", "F0.3");
+    assert_ne!(slow, text);
+    let o = InfillOptions {
+        patterns: vec![Pattern::Rectilinear],
+        angles_deg: vec![0.0, 90.0],
+        ..InfillOptions::default()
+    };
+    let r = infill(slow.as_bytes(), &o).unwrap();
+    let out = String::from_utf8(r.output).unwrap();
+    let zero_feeds = out
+        .lines()
+        .filter(|l| l.split_whitespace().any(|w| w == "F0" || w == "F0.000"))
+        .count();
+    assert_eq!(zero_feeds, 0);
+    assert!(out.lines().any(|l| l.ends_with(" F1")), "no F1 written");
+}
+
 #[test]
 fn per_layer_hybrid_is_kept_only_when_it_wins() {
     let input = std::fs::read(data("rect_infill_45.gcode")).unwrap();

@@ -37,6 +37,17 @@ pub fn fixed(v: f64, decimals: usize) -> String {
     s
 }
 
+/// `v`, or where it is positive but under one unit of the last of `decimals` places, that unit:
+/// the least positive number `decimals` places write. A feed rate written as `F0` is no feed at
+/// all to Marlin (it keeps the one before), not a slow one.
+pub fn least_positive(v: f64, decimals: usize) -> f64 {
+    if v > 0.0 {
+        v.max(0.1f64.powi(decimals as i32))
+    } else {
+        v
+    }
+}
+
 /// The value [`push_fixed`] and [`push_trimmed`] write, as a number.
 pub fn rounded(v: f64, decimals: usize) -> f64 {
     match scaled(v, decimals) {
@@ -110,6 +121,16 @@ mod tests {
         let mut s = String::new();
         push_trimmed(&mut s, v, d);
         s
+    }
+
+    #[test]
+    fn a_positive_number_is_kept_above_what_rounds_to_zero() {
+        assert_eq!(least_positive(0.3, 0), 1.0);
+        assert_eq!(least_positive(1e-49, 3), 0.1f64.powi(3));
+        assert_eq!(trimmed(least_positive(1e-49, 3), 3), "0.001");
+        assert_eq!(least_positive(1800.0, 0), 1800.0);
+        assert_eq!(least_positive(-5.0, 1), -5.0);
+        assert_eq!(least_positive(0.0, 1), 0.0);
     }
 
     #[test]

@@ -11,7 +11,7 @@ use super::cost::Replacement;
 use super::geom::{dist, Path, P2};
 use super::program::{Block, Program};
 use crate::error::Warnings;
-use crate::gcode::number::{push_fixed, rounded};
+use crate::gcode::number::{least_positive, push_fixed, rounded};
 #[cfg(test)]
 use crate::gcode::parse_line;
 use crate::machine::{axis, Event, ExtrusionMode, MoveKind};
@@ -159,7 +159,7 @@ impl Sink for Text {
     fn filament(&mut self, e: f64, f: f64) {
         self.0.push_str("G1 E");
         push_fixed(&mut self.0, e, 5);
-        let _ = writeln!(self.0, " F{f:.0}");
+        let _ = writeln!(self.0, " F{:.0}", least_positive(f, 0));
     }
 
     fn travel(&mut self, to: P2, f: f64) {
@@ -167,7 +167,7 @@ impl Sink for Text {
         push_fixed(&mut self.0, to[0], 3);
         self.0.push_str(" Y");
         push_fixed(&mut self.0, to[1], 3);
-        let _ = writeln!(self.0, " F{f:.0}");
+        let _ = writeln!(self.0, " F{:.0}", least_positive(f, 0));
     }
 
     fn extrude(&mut self, to: P2, e: f64, f: Option<f64>) {
@@ -178,7 +178,7 @@ impl Sink for Text {
         self.0.push_str(" E");
         push_fixed(&mut self.0, e, 5);
         if let Some(f) = f {
-            let _ = write!(self.0, " F{f:.0}");
+            let _ = write!(self.0, " F{:.0}", least_positive(f, 0));
         }
         self.0.push('\n');
     }
@@ -188,7 +188,7 @@ impl Sink for Text {
     }
 
     fn feed(&mut self, f: f64) {
-        let _ = write!(self.0, "G1 F{f:.3}");
+        let _ = write!(self.0, "G1 F{:.3}", least_positive(f, 3));
     }
 }
 
@@ -254,19 +254,19 @@ impl Sink for Run {
     }
 
     fn filament(&mut self, e: f64, f: f64) {
-        let f = self.as_written(f, 0);
+        let f = self.as_written(least_positive(f, 0), 0);
         self.g(1, &[(b'E', e), (b'F', f)]);
     }
 
     fn travel(&mut self, to: P2, f: f64) {
-        let f = self.as_written(f, 0);
+        let f = self.as_written(least_positive(f, 0), 0);
         self.g(1, &[(b'X', to[0]), (b'Y', to[1]), (b'F', f)]);
     }
 
     fn extrude(&mut self, to: P2, e: f64, f: Option<f64>) {
         match f {
             Some(f) => {
-                let f = self.as_written(f, 0);
+                let f = self.as_written(least_positive(f, 0), 0);
                 self.g(1, &[(b'X', to[0]), (b'Y', to[1]), (b'E', e), (b'F', f)]);
             }
             None => self.g(1, &[(b'X', to[0]), (b'Y', to[1]), (b'E', e)]),
@@ -279,7 +279,7 @@ impl Sink for Run {
     }
 
     fn feed(&mut self, f: f64) {
-        let f = self.as_written(f, 3);
+        let f = self.as_written(least_positive(f, 3), 3);
         self.g(1, &[(b'F', f)]);
     }
 }

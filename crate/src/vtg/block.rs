@@ -6,7 +6,7 @@
 use std::fmt::Write as _;
 
 use super::arcs::Piece;
-use crate::gcode::number::{push_trimmed, rounded};
+use crate::gcode::number::{least_positive, push_trimmed, rounded};
 use crate::machine::ExtrusionMode;
 
 /// What the block must agree with in the file around it.
@@ -107,12 +107,10 @@ pub(crate) fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &
     text
 }
 
-/// The feed `f` (mm/min) as written with `decimals` places; a positive feed under one unit of
-/// the last place is written as that unit: as `F0` it would be no feed at all, not a slow one
-/// (Marlin keeps the feed before it).
+/// The feed `f` (mm/min) as written with `decimals` places, never `F0` for a positive one
+/// ([`least_positive`]).
 fn writable_feed(f: f64, decimals: usize) -> f64 {
-    let unit = 0.1f64.powi(decimals as i32);
-    rounded(if f > 0.0 { f.max(unit) } else { f }, decimals)
+    rounded(least_positive(f, decimals), decimals)
 }
 
 /// The ` E` word of the point with filament `ek` from the path start (`last`: the block's last
