@@ -105,7 +105,12 @@ fn cos_theta(prev: &Segment, curr: &Segment) -> f64 {
 /// gentle bend (more than 135°) are limited as the arc they approximate.
 pub fn junction_deviation(prev: &Segment, curr: &Segment, limits: &Limits) -> f64 {
     if prev.cruise <= 1e-4 || is_e_only(prev) || is_e_only(curr) {
-        return MINIMUM_PLANNER_SPEED;
+        // Held to both moves' cruise speeds, as the bend's speed is below: a move slower than
+        // the planner's minimum (a feed capped near the floor) would otherwise start faster than
+        // it runs, and end slower than the next one starts.
+        return MINIMUM_PLANNER_SPEED
+            .at_most(curr.cruise)
+            .at_most(prev.cruise);
     }
     let cos = cos_theta(prev, curr);
     let v_sqr = if cos > 0.999_999 {
