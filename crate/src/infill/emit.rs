@@ -133,6 +133,8 @@ fn r5(v: f64) -> f64 {
 /// Where a block's lines go: text for the written file ([`Text`]), or straight into a copy of
 /// the machine ([`Run`]), which gets the very words the text parses to without printing and
 /// parsing a line (the round trip was a third of an infill search).
+/// The writer hands every feed through [`least_positive`] first, at the places each sink writes
+/// it with: a positive feed is never written as `F0` (no feed at all, to Marlin).
 trait Sink {
     /// `G10` (`on`) or `G11`.
     fn firmware_retract(&mut self, on: bool);
@@ -159,7 +161,7 @@ impl Sink for Text {
     fn filament(&mut self, e: f64, f: f64) {
         self.0.push_str("G1 E");
         push_fixed(&mut self.0, e, 5);
-        let _ = writeln!(self.0, " F{:.0}", least_positive(f, 0));
+        let _ = writeln!(self.0, " F{f:.0}");
     }
 
     fn travel(&mut self, to: P2, f: f64) {
@@ -167,7 +169,7 @@ impl Sink for Text {
         push_fixed(&mut self.0, to[0], 3);
         self.0.push_str(" Y");
         push_fixed(&mut self.0, to[1], 3);
-        let _ = writeln!(self.0, " F{:.0}", least_positive(f, 0));
+        let _ = writeln!(self.0, " F{f:.0}");
     }
 
     fn extrude(&mut self, to: P2, e: f64, f: Option<f64>) {
@@ -178,7 +180,7 @@ impl Sink for Text {
         self.0.push_str(" E");
         push_fixed(&mut self.0, e, 5);
         if let Some(f) = f {
-            let _ = write!(self.0, " F{:.0}", least_positive(f, 0));
+            let _ = write!(self.0, " F{f:.0}");
         }
         self.0.push('\n');
     }
@@ -188,7 +190,7 @@ impl Sink for Text {
     }
 
     fn feed(&mut self, f: f64) {
-        let _ = write!(self.0, "G1 F{:.3}", least_positive(f, 3));
+        let _ = write!(self.0, "G1 F{f:.3}");
     }
 }
 
@@ -254,19 +256,19 @@ impl Sink for Run {
     }
 
     fn filament(&mut self, e: f64, f: f64) {
-        let f = self.as_written(least_positive(f, 0), 0);
+        let f = self.as_written(f, 0);
         self.g(1, &[(b'E', e), (b'F', f)]);
     }
 
     fn travel(&mut self, to: P2, f: f64) {
-        let f = self.as_written(least_positive(f, 0), 0);
+        let f = self.as_written(f, 0);
         self.g(1, &[(b'X', to[0]), (b'Y', to[1]), (b'F', f)]);
     }
 
     fn extrude(&mut self, to: P2, e: f64, f: Option<f64>) {
         match f {
             Some(f) => {
-                let f = self.as_written(least_positive(f, 0), 0);
+                let f = self.as_written(f, 0);
                 self.g(1, &[(b'X', to[0]), (b'Y', to[1]), (b'E', e), (b'F', f)]);
             }
             None => self.g(1, &[(b'X', to[0]), (b'Y', to[1]), (b'E', e)]),
@@ -279,7 +281,7 @@ impl Sink for Run {
     }
 
     fn feed(&mut self, f: f64) {
-        let f = self.as_written(least_positive(f, 3), 3);
+        let f = self.as_written(f, 3);
         self.g(1, &[(b'F', f)]);
     }
 }
@@ -317,7 +319,7 @@ impl<S: Sink> Writer<'_, S> {
         } else {
             r5(d)
         };
-        self.out.filament(rounded(v, 5), f);
+        self.out.filament(rounded(v, 5), least_positive(f, 0));
     }
 
     fn travel(&mut self, to: P2) {
@@ -329,8 +331,10 @@ impl<S: Sink> Writer<'_, S> {
         if d >= self.habit.min_travel_mm {
             self.retract(true);
         }
-        self.out
-            .travel([rounded(to[0], 3), rounded(to[1], 3)], self.habit.travel_f);
+        self.out.travel(
+            [rounded(to[0], 3), rounded(to[1], 3)],
+            least_positive(self.habit.travel_f, 0),
+        );
         self.pos = to;
     }
 
@@ -352,7 +356,7 @@ impl<S: Sink> Writer<'_, S> {
             } else {
                 r5(inc)
             };
-            let f = first.then_some(self.habit.print_f);
+            let f = first.then_some(least_positive(self.habit.print_f, 0));
             first = false;
             self.out
                 .extrude([rounded(q[0], 3), rounded(q[1], 3)], rounded(v, 5), f);
@@ -373,7 +377,7 @@ impl<S: Sink> Writer<'_, S> {
         if self.absolute {
             self.out.set_e(block.end_logical[3]);
         }
-        self.out.feed(block.end_feed_mm_s * 60.0);
+        self.out.feed(least_positive(block.end_feed_mm_s * 60.0, 3));
         self.out
     }
 }
