@@ -2,11 +2,13 @@
 //!
 //! Natively the items are cut into contiguous blocks that scoped threads claim one after
 //! another; the results come back in the items' order, so the outcome is the same bit for bit
-//! as a sequential run. In wasm (one thread) and for short lists, the map runs in place.
+//! as a sequential run. The wasm build with the `threads` feature does the same on a pool of
+//! Web Workers sharing the module's memory (rayon through `wasm-bindgen-rayon`, started from JS
+//! with `initThreadPool`); the plain wasm build, and short lists, map in place.
 
 /// Threads to use natively: the cores available (at most 8), or `QUIETPATH_THREADS` when set
-/// (`QUIETPATH_THREADS=1` runs everything on one thread, as wasm does: the way to measure what
-/// the browser will pay). Read once.
+/// (`QUIETPATH_THREADS=1` runs everything on one thread, as the plain wasm build does: the way
+/// to measure what a browser without a pool will pay). Read once.
 #[cfg(not(target_arch = "wasm32"))]
 pub fn threads() -> usize {
     static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
@@ -20,20 +22,49 @@ pub fn threads() -> usize {
     })
 }
 
-/// Threads to use: always one in wasm.
-#[cfg(target_arch = "wasm32")]
+/// Threads to use: one in the plain wasm build.
+#[cfg(all(target_arch = "wasm32", not(feature = "threads")))]
 pub fn threads() -> usize {
     1
 }
 
+/// Threads to use in the threaded wasm build: the calling thread and the pool's workers once
+/// [`use_pool`] has said the pool is up, else one (rayon would try to start its own threads,
+/// which wasm cannot).
+#[cfg(all(target_arch = "wasm32", feature = "threads"))]
+pub fn threads() -> usize {
+    pool::THREADS.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Tells the threaded wasm build that `initThreadPool(workers)` has resolved: the parallel
+/// maps run on those workers and the calling thread from now on (at most 8 threads, as
+/// natively).
+#[cfg(all(target_arch = "wasm32", feature = "threads"))]
+pub fn use_pool(workers: usize) {
+    let n = (workers + 1).clamp(1, 8);
+    pool::THREADS.store(n, std::sync::atomic::Ordering::Relaxed);
+}
+
+#[cfg(all(target_arch = "wasm32", feature = "threads"))]
+mod pool {
+    /// Threads the maps use (see [`super::threads`]).
+    pub static THREADS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(1);
+}
+
 /// Items below which threads cost more than they save.
-#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
+#[cfg_attr(
+    all(target_arch = "wasm32", not(feature = "threads")),
+    allow(dead_code)
+)]
 const MIN_ITEMS: usize = 64;
 
 /// Blocks per thread the items are cut into: threads claim the next block as they finish one,
 /// so a run of costly items (a part's dense layers) does not leave the other threads idle, as
 /// one fixed chunk per thread would.
-#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
+#[cfg_attr(
+    all(target_arch = "wasm32", not(feature = "threads")),
+    allow(dead_code)
+)]
 const BLOCKS_PER_THREAD: usize = 16;
 
 /// `f` applied to every item, in order; `f` sees a contiguous slice at a time.
@@ -43,7 +74,7 @@ where
     R: Send,
     F: Fn(&[T]) -> Vec<R> + Sync,
 {
-    #[cfg(not(target_arch = "wasm32"))]
+    #[cfg(any(not(target_arch = "wasm32"), feature = "threads"))]
     {
         let threads = threads();
         if threads > 1 && items.len() >= MIN_ITEMS {
@@ -67,7 +98,7 @@ where
     R: Send,
     F: Fn(&T) -> R + Sync,
 {
-    #[cfg(not(target_arch = "wasm32"))]
+    #[cfg(any(not(target_arch = "wasm32"), feature = "threads"))]
     {
         let threads = threads().min(items.len());
         if threads > 1 {
@@ -112,7 +143,40 @@ where
     parts.into_iter().map(|(_, r)| r).collect()
 }
 
-/// Runs `a` and `b`, natively on two threads, and returns both results.
+/// [`claimed`] on the Web Worker pool: the calling thread claims indices too, so the results
+/// are collected under a lock rather than returned by each thread.
+#[cfg(all(target_arch = "wasm32", feature = "threads"))]
+fn claimed<R, W>(n: usize, threads: usize, work: W) -> Vec<R>
+where
+    R: Send,
+    W: Fn(usize) -> R + Sync,
+{
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Mutex;
+    let next = AtomicUsize::new(0);
+    let parts: Mutex<Vec<(usize, R)>> = Mutex::new(Vec::with_capacity(n));
+    let claim = || loop {
+        let i = next.fetch_add(1, Ordering::Relaxed);
+        if i >= n {
+            return;
+        }
+        let r = work(i);
+        if let Ok(mut p) = parts.lock() {
+            p.push((i, r));
+        }
+    };
+    rayon::in_place_scope(|scope| {
+        for _ in 1..threads {
+            scope.spawn(|_| claim());
+        }
+        claim();
+    });
+    let mut parts = parts.into_inner().unwrap_or_default();
+    parts.sort_unstable_by_key(|(i, _)| *i);
+    parts.into_iter().map(|(_, r)| r).collect()
+}
+
+/// Runs `a` and `b`, natively on two threads (`b` on the calling one), and returns both results.
 pub fn join<A, B, RA, RB>(a: A, b: B) -> (RA, RB)
 where
     A: FnOnce() -> RA + Send,
@@ -129,6 +193,20 @@ where
                 Err(panic) => std::panic::resume_unwind(panic),
             }
         });
+    }
+    // In the threaded wasm build `b` stays on the calling thread, which alone may call into
+    // JS (a progress callback), and `a` goes to the pool.
+    #[cfg(all(target_arch = "wasm32", feature = "threads"))]
+    if threads() > 1 {
+        let mut ra = None;
+        let rb = rayon::in_place_scope(|scope| {
+            scope.spawn(|_| ra = Some(a()));
+            b()
+        });
+        if let Some(ra) = ra {
+            return (ra, rb);
+        }
+        unreachable!("the scope waits for its spawned job");
     }
     (a(), b())
 }

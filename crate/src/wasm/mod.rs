@@ -11,6 +11,9 @@ mod session;
 pub use apart::{ReadApart, TimingApart};
 pub use jobs::{infill, smooth, vibration, vtg};
 pub use session::Session;
+// The threaded build's pool of Web Workers: `await initThreadPool(n)`, then `usePool(n)`.
+#[cfg(feature = "threads")]
+pub use wasm_bindgen_rayon::init_thread_pool;
 
 use js_sys::{Function, Reflect, Uint8Array};
 use wasm_bindgen::prelude::*;
@@ -48,6 +51,21 @@ extern "C" {
 #[wasm_bindgen(start)]
 pub fn start() {
     console_error_panic_hook::set_once();
+}
+
+/// Runs the parallel maps (VTG's paths, the infill search's candidates, the dynamics model's
+/// layers) on `workers` pool workers and this thread from now on; call it once
+/// `initThreadPool(workers)` has resolved. Threaded build only.
+#[cfg(feature = "threads")]
+#[wasm_bindgen(js_name = usePool)]
+pub fn use_pool(workers: usize) {
+    crate::parallel::use_pool(workers);
+}
+
+/// Threads the parallel maps use: 1 in the plain build, or before `usePool`.
+#[wasm_bindgen]
+pub fn threads() -> usize {
+    crate::parallel::threads()
 }
 
 /// The library version.
