@@ -8,7 +8,7 @@ export PATH := $(CURDIR)/node_modules/.bin:$(HOME)/.cargo/bin:$(PATH)
 CORPUS ?= $(CURDIR)/../shared/corpus
 LARGE := $(CORPUS)/curaengine-4.13.0_extruder-idler-x2.5_large.gcode
 
-.PHONY: all setup setup-test pkg wasm-web wasm-node wasm-bundler serve test typecheck test-rust test-js fuzz-smoke lint cli bench measurements measure-vtg-w16 fuzz clean
+.PHONY: all setup setup-test pkg wasm-plain wasm-web wasm-web-threads wasm-node wasm-bundler serve test typecheck test-rust test-js fuzz-smoke lint cli bench measurements measure-vtg-w16 fuzz clean
 
 all: pkg cli
 
@@ -19,27 +19,47 @@ setup-test:
 	@scripts/setup.sh test
 
 ## Build the npm package (pkg/: web, node and bundler builds under one package.json), link the
-## web build into the playground and copy uPlot and three.js (the 3-D view) beside it, each with
-## its TypeScript declarations for `make typecheck` (a .d.ts beside the .js is what tsc reads).
+## web build and the threaded one into the playground and copy uPlot and three.js (the 3-D view)
+## beside them, each with its TypeScript declarations for `make typecheck` (a .d.ts beside the
+## .js is what tsc reads).
 pkg: setup
-	$(MAKE) --no-print-directory --output-sync=target -j3 wasm-web wasm-node wasm-bundler
+	$(MAKE) --no-print-directory --output-sync=target -j2 wasm-plain wasm-web-threads
 	node scripts/package.mjs
 	ln -sfn ../pkg/web www/pkg
+	ln -sfn ../pkg/web-threads www/pkg-threads
 	mkdir -p www/vendor
 	cp node_modules/uplot/dist/uPlot.esm.js node_modules/uplot/dist/uPlot.min.css www/vendor/
 	cp node_modules/three/build/three.module.js node_modules/three/build/three.core.js www/vendor/
 	cp node_modules/uplot/dist/uPlot.d.ts www/vendor/uPlot.esm.d.ts
 	cp www/types/three.module.d.ts www/vendor/
 
-# The three wasm-pack builds of `pkg`, run side by side: they share one compile (cargo's lock
-# holds the later two until it is done), then each runs wasm-bindgen and wasm-opt, whose -O3
-# pass (npm binaryen, one thread, about 45 s) was most of their time one after another.
+# The three plain wasm-pack builds of `pkg`, run side by side: they share one compile (cargo's
+# lock holds the later two until it is done), then each runs wasm-bindgen. Their modules are the
+# same, so wasm-opt (npm binaryen's -O3, one thread, about 45 s) runs once for the three
+# (scripts/wasm-opt-once.sh), beside the threaded build.
+wasm-plain:
+	$(MAKE) --no-print-directory --output-sync=target -j3 wasm-web wasm-node wasm-bundler
+	scripts/wasm-opt-once.sh
 wasm-web:
-	wasm-pack build crate --release --target web --out-dir ../pkg/web --out-name quietpath
+	wasm-pack build crate --release --target web --no-opt --out-dir ../pkg/web --out-name quietpath
+# The playground's threaded build (pkg/web-threads, not part of the npm package): the parallel
+# maps on a pool of Web Workers sharing the module's memory (the `threads` feature, rayon through
+# wasm-bindgen-rayon). Shared memory needs the atomics target feature in std as well, so std is
+# rebuilt with nightly's build-std; the linker arguments are wasm-bindgen's for threads, the
+# memory's maximum raised to 4 GB (the 34 MB file's VTG needs more than the 1 GB default). Its own
+# target directory: a different toolchain and flags, built beside the other three.
+THREADS_RUSTFLAGS := -C target-feature=+atomics,+bulk-memory,+mutable-globals,+simd128 \
+	-C link-arg=--shared-memory -C link-arg=--import-memory -C link-arg=--max-memory=4294967296 \
+	-C link-arg=--export=__wasm_init_tls -C link-arg=--export=__tls_size \
+	-C link-arg=--export=__tls_align -C link-arg=--export=__tls_base
+wasm-web-threads:
+	RUSTUP_TOOLCHAIN=nightly CARGO_UNSTABLE_BUILD_STD=panic_abort,std CARGO_TARGET_DIR=$(CURDIR)/target/wasm-threads \
+	RUSTFLAGS="$(THREADS_RUSTFLAGS)" \
+	wasm-pack build crate --release --target web --out-dir ../pkg/web-threads --out-name quietpath --features threads
 wasm-node:
-	wasm-pack build crate --release --target nodejs --out-dir ../pkg/node --out-name quietpath
+	wasm-pack build crate --release --target nodejs --no-opt --out-dir ../pkg/node --out-name quietpath
 wasm-bundler:
-	wasm-pack build crate --release --target bundler --out-dir ../pkg/bundler --out-name quietpath
+	wasm-pack build crate --release --target bundler --no-opt --out-dir ../pkg/bundler --out-name quietpath
 
 ## Build the wasm and serve the playground on http://127.0.0.1:$(PORT)
 serve: pkg

@@ -59,6 +59,7 @@ const rep = JSON.parse(await page.locator('[data-testid="report-json"]').textCon
 const summary = job === 'infill'
   ? { best: rep.best?.pattern, angle: rep.best?.angle_deg, total_j: rep.best?.total_j }
   : { message: rep.message ?? null, output_bytes: rep.output_bytes ?? null, corners: rep.table1?.n_turning };
-console.log(JSON.stringify({ job, secs, status: await st(), chromium_load_peak_mb: loadPeakMb, chromium_loaded_mb: loadedMb, chromium_job_peak_mb: Math.round(peakMb), ...summary }));
+const threads = Number(await page.evaluate(() => document.body.dataset.threads ?? '1'));
+console.log(JSON.stringify({ job, secs, threads, status: await st(), chromium_load_peak_mb: loadPeakMb, chromium_loaded_mb: loadedMb, chromium_job_peak_mb: Math.round(peakMb), ...summary }));
 await browser.close();
 server.close();

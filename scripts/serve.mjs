@@ -19,7 +19,9 @@ import { fileURLToPath } from 'node:url';
 export const CSP = [
   "default-src 'self'",
   "script-src 'self' 'wasm-unsafe-eval'",
-  "worker-src 'self'",
+  // blob: for the threaded build's pool: wasm-bindgen-rayon starts each worker from a blob of
+  // its own same-origin helper script (pkg-threads/snippets/…/workerHelpers.no-bundler.js).
+  "worker-src 'self' blob:",
   "connect-src 'self'",
   'img-src \'self\' data: blob:',
   "style-src 'self'",
@@ -34,6 +36,9 @@ export const SECURITY_HEADERS = Object.freeze({
   'Cache-Control': 'no-cache',
   'Referrer-Policy': 'no-referrer',
   'Cross-Origin-Opener-Policy': 'same-origin',
+  // With COOP, makes the page cross-origin isolated: SharedArrayBuffer, which the threaded
+  // build's shared wasm memory needs. Every resource the page loads is its own origin's.
+  'Cross-Origin-Embedder-Policy': 'require-corp',
 });
 
 export const MIME_TYPES = Object.freeze({

@@ -17,6 +17,12 @@ if ! rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknow
   rustup target add wasm32-unknown-unknown
 fi
 
+# The playground's threaded build rebuilds std with shared memory: nightly's build-std, from rust-src.
+if ! rustup component list --toolchain nightly --installed 2>/dev/null | grep -qx rust-src; then
+  say "adding nightly Rust with rust-src (the playground's threaded build)"
+  rustup toolchain install nightly --profile minimal --component rust-src
+fi
+
 WASM_PACK_VERSION=0.15.1
 if ! wasm-pack --version 2>/dev/null | grep -q "$WASM_PACK_VERSION"; then
   say "installing wasm-pack $WASM_PACK_VERSION (a few minutes, once)"

@@ -134,10 +134,12 @@ const vibrationRuns = {}; // target → vibration result, for the before/after c
 const downloadUrls = {};
 
 const client = new JobClient('./worker.js', {
-  onHello(version, caps, presets) {
+  onHello(version, caps, presets, threads) {
     els.version.textContent = version ? `v${version}` : '';
+    els.version.title = threads > 1 ? `jobs run on ${threads} threads` : 'jobs run on one thread';
     capabilities = new Set(caps);
     document.body.dataset.capabilities = caps.join(' '); // for tests and curious users
+    document.body.dataset.threads = String(threads);
     machines = Array.isArray(presets) ? presets : [];
     renderMachinePicker();
     updateActions();

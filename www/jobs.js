@@ -55,7 +55,7 @@ export class JobClient {
   /**
    * @param {string | URL} url
    * @param {object} hooks
-   * @param {(version: string | null, capabilities: string[], machines: MachineProfile[]) => void} [hooks.onHello]
+   * @param {(version: string | null, capabilities: string[], machines: MachineProfile[], threads: number) => void} [hooks.onHello]
    *   a worker has loaded the wasm (machines: the built-in presets)
    * @param {(detail: string, loaded: boolean, hadPending: boolean) => void} [hooks.onCrash]
    *   the worker died (pending requests were rejected with a JobError; hadPending says whether
@@ -148,7 +148,7 @@ export class JobClient {
     if (w !== this.worker || !msg) return;
     if (msg.type === 'hello') {
       w.loaded = true;
-      this.hooks.onHello?.(msg.version, msg.capabilities ?? ['analyze'], msg.machines ?? []);
+      this.hooks.onHello?.(msg.version, msg.capabilities ?? ['analyze'], msg.machines ?? [], msg.threads ?? 1);
       return;
     }
     const p = this.pending.get(msg.id);

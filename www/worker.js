@@ -2,7 +2,7 @@
 // quietpath job worker (module worker).
 //
 // Created by jobs.js as: new Worker('./worker.js', { type: 'module' })
-// It loads the wasm package from ./pkg/quietpath.js and runs every job off the
+// It loads the wasm package and runs every job off the
 // main thread, so the page stays responsive on big files. It keeps two
 // sessions: `input` (the loaded file) and `output` (the latest optimized
 // G-code), so jobs and layer drawing never copy the file across again.
@@ -44,10 +44,12 @@
 //           count: the session's number of layers)
 //
 // worker → page
-//   { type: 'hello', version, capabilities: string[], machines: MachineProfile[] }
+//   { type: 'hello', version, capabilities: string[], machines: MachineProfile[],
+//     threads: number }
 //       once, when the wasm is loaded; capabilities lists the jobs this build
 //       has (e.g. ['analyze', 'vtg']): the page disables the others;
-//       machines: the built-in presets (machines(); [] in a build without it).
+//       machines: the built-in presets (machines(); [] in a build without it);
+//       threads: the threads the jobs' parallel maps run on (1: the plain build).
 //   { id, type: 'progress', fraction }   0 ≤ fraction ≤ 1, increasing,
 //                                        throttled (≈ every 1 % / 50 ms)
 //   { id, type: 'error', message, line, column, excerpt, kind, fatal }
@@ -62,7 +64,7 @@
 // An uncaught failure shows up as the Worker's `error` event on the page.
 // ────────────────────────────────────────────────────────────────────────────
 
-import init, * as qp from './pkg/quietpath.js';
+import * as qp from './pkg/quietpath.js';
 
 const PROGRESS_STEP = 0.01;
 const PROGRESS_INTERVAL_MS = 50;
@@ -79,8 +81,8 @@ const byName = (o) => /** @type {Record<string, AnyFunction | undefined>} */ (o)
 
 // Which jobs this build offers: a Session method or a free function.
 function capabilities() {
-  const proto = byName(qp.Session?.prototype ?? {});
-  return JOBS.filter((j) => typeof byName(qp)[j] === 'function' || typeof proto[j] === 'function');
+  const proto = byName(pkg.Session?.prototype ?? {});
+  return JOBS.filter((j) => typeof byName(pkg)[j] === 'function' || typeof proto[j] === 'function');
 }
 
 /**
@@ -90,24 +92,56 @@ function capabilities() {
  * @typedef {{ id: number, type: 'layer', which: 'before' | 'after', index: number, z?: number | null }} LayerRequest
  */
 
+/**
+ * The package the jobs run on. Where the page is cross-origin isolated (scripts/serve.mjs sends
+ * COOP and COEP) and the machine has more than one core, the threaded build in ./pkg-threads/:
+ * its parallel maps (VTG's paths, the infill search's candidates, the dynamics model's sampled
+ * layers) run on a pool of workers that share its memory, one thread per core (at most 8) as the
+ * CLI uses, so the results are the CLI's. Elsewhere the plain build in ./pkg/, on one thread.
+ * Its initialisers (which differ: the threaded one takes the shared memory) are called in load().
+ * @type {Omit<typeof qp, 'default' | 'initSync'>}
+ */
+let pkg = qp;
+/** Threads the package's parallel maps use (the `hello` message says). */
+let threads = 1;
+
+/** Loads the threaded build where it can run, else the plain one. */
+async function load() {
+  const cores = Math.min(navigator.hardwareConcurrency || 1, 8);
+  if (self.crossOriginIsolated && cores > 1) {
+    try {
+      const threaded = await import('./pkg-threads/quietpath.js');
+      await threaded.default();
+      await threaded.initThreadPool(cores - 1);
+      threaded.usePool(cores - 1);
+      pkg = threaded;
+      threads = threaded.threads();
+      return;
+    } catch (err) {
+      console.warn('quietpath: the threaded build did not start; running on one thread', err);
+    }
+  }
+  await qp.default();
+}
+
 /** @type {unknown} */
 let loadError = null;
-const ready = init().then(
+const ready = load().then(
   () => {
     let v = null;
     try {
-      v = qp.version();
+      v = pkg.version();
     } catch {
       // version() is informational only
     }
     /** @type {qp.MachineProfile[]} */
     let machines = [];
     try {
-      machines = typeof qp.machines === 'function' ? qp.machines() : [];
+      machines = typeof pkg.machines === 'function' ? pkg.machines() : [];
     } catch {
       // an older build without the preset list: the picker offers "from the file" only
     }
-    self.postMessage({ type: 'hello', version: v, capabilities: capabilities(), machines });
+    self.postMessage({ type: 'hello', version: v, capabilities: capabilities(), machines, threads });
   },
   (err) => {
     loadError = err;
@@ -125,7 +159,7 @@ let timingRun = 0;
 const timingUp = ready.then(
   () =>
     new Promise((resolve) => {
-      if (loadError || typeof Worker !== 'function' || typeof qp.TimingApart !== 'function') return resolve(false);
+      if (loadError || typeof Worker !== 'function' || typeof pkg.TimingApart !== 'function') return resolve(false);
       try {
         timingWorker = new Worker(new URL('./timing-worker.js', import.meta.url), { type: 'module' });
       } catch {
@@ -307,7 +341,7 @@ async function handleLoad(msg) {
   dropSession(which);
   if (which === 'input') dropSession('output');
   try {
-    const session = new qp.Session(bytes, options ?? {});
+    const session = new pkg.Session(bytes, options ?? {});
     sessions[which] = { session, bytes, options: options ?? {} };
     const analyze = msg.analyze ?? which === 'input';
     if (!analyze) {
@@ -344,13 +378,13 @@ function handleJob(msg) {
   try {
     let result;
     const method = byName(s.session)[job];
-    const free = byName(qp)[job];
+    const free = byName(pkg)[job];
     if (typeof method === 'function') {
       result = job === 'analyze' ? s.session.analyze(progress) : method.call(s.session, options ?? {}, progress);
     } else if (typeof free === 'function') {
       // The free vtg() takes the analyze options inside its own (a Session has them already).
       const opts = job === 'vtg' && Object.keys(s.options).length && !options?.analyze ? { ...options, analyze: s.options } : options ?? {};
-      result = job === 'analyze' ? qp.analyze(s.bytes, s.options, progress) : free(s.bytes, opts, progress);
+      result = job === 'analyze' ? pkg.analyze(s.bytes, s.options, progress) : free(s.bytes, opts, progress);
     } else {
       throw new Error(`${job} is not available in this build`);
     }
@@ -362,7 +396,7 @@ function handleJob(msg) {
       // The optimized file becomes the "after" session (viewer, chained jobs).
       dropSession('output');
       const copy = out.slice();
-      sessions.output = { session: new qp.Session(copy, s.options), bytes: copy, options: s.options };
+      sessions.output = { session: new pkg.Session(copy, s.options), bytes: copy, options: s.options };
       output = out.byteOffset === 0 && out.buffer.byteLength === out.byteLength ? out.buffer : out.slice().buffer;
     }
     self.postMessage({ id, type: 'result', result, ms, output }, output ? [output] : []);

@@ -125,6 +125,18 @@ test('the demo loads and is analyzed on first visit', async () => {
   assert.ok(Date.now() - t0 < STEP_TIMEOUT);
 });
 
+/** Threads the page's jobs run on (its worker's `hello`), once the demo has loaded. */
+let pageThreads = 0;
+
+test('jobs run on a pool of workers, a thread per core as the CLI uses (at most 8)', async () => {
+  // serve.mjs's COOP and COEP make the page cross-origin isolated, which the threaded build's
+  // shared memory needs; the report-json tests below check that its results are the CLI's.
+  assert.equal(await page.evaluate(() => self.crossOriginIsolated), true);
+  const cores = await page.evaluate(() => navigator.hardwareConcurrency);
+  pageThreads = Number(await page.evaluate(() => document.body.dataset.threads));
+  assert.equal(pageThreads, cores > 1 ? Math.min(cores, 8) : 1);
+});
+
 test('the page looks right (screenshot)', async () => {
   await page.screenshot({ path: screenshotPath, fullPage: true });
   assert.ok(fs.statSync(screenshotPath).size > 10_000, 'screenshot is suspiciously small');
@@ -336,7 +348,10 @@ function runCli(job, file) {
   fs.rmSync(out, { force: true });
   const args = job === 'vibration' || job === 'analyze' ? [job, file, '--json'] : [job, file, '-o', out, '--json'];
   const t0 = process.hrtime.bigint();
-  const r = spawnSync(cli, args, { maxBuffer: 1 << 30, encoding: 'utf8' });
+  // On as many threads as the page's jobs (the infill search costs as many candidates a round as
+  // it has threads): navigator.hardwareConcurrency and the CLI's count can differ in a container.
+  const env = pageThreads ? { ...process.env, QUIETPATH_THREADS: String(pageThreads) } : process.env;
+  const r = spawnSync(cli, args, { maxBuffer: 1 << 30, encoding: 'utf8', env });
   const ms = Number(process.hrtime.bigint() - t0) / 1e6;
   let json = null;
   try {
@@ -500,6 +515,8 @@ test('the job UI with every capability: tables, charts, downloads, before/after 
   const errors = [];
   tab.on('pageerror', (e) => errors.push(String(e)));
   await tab.route('**/pkg/quietpath.js', (route) => route.fulfill({ status: 200, contentType: 'text/javascript', body: MOCK_PACKAGE }));
+  // The stand-in is a plain build: without a threaded one the worker loads it.
+  await tab.route('**/pkg-threads/quietpath.js', (route) => route.fulfill({ status: 404, body: '' }));
   const id = (x) => tab.locator(`[data-testid="${x}"]`);
   const idle = async () => {
     await tab.waitForFunction(() => !document.body.classList.contains('busy') && document.querySelector('[data-testid="status"]').textContent !== 'loading');
@@ -728,6 +745,8 @@ test('a crashing worker is reported and replaced', async () => {
     await route.fulfill({
       status: 200,
       contentType: 'text/javascript',
+      // A cross-origin isolated page runs only workers whose script says the same.
+      headers: { 'Cross-Origin-Embedder-Policy': 'require-corp' },
       body: "self.postMessage({ type: 'hello', version: 'crashy' });\n" +
         "self.onmessage = () => { throw new Error('simulated worker crash'); };\n",
     });
@@ -771,6 +790,28 @@ test('without its timing worker, a large file is analyzed in one worker, with th
   const report = JSON.parse(await tab.locator('[data-testid="report-json"]').textContent());
   assert.deepEqual(report, runCli('analyze', file).json, 'the one-worker report differs from the CLI');
   assert.ok(served >= 1, 'the job worker was not the one served here');
+  await ctx.close();
+});
+
+test('without the threaded build, jobs run on one thread with the same report', { timeout: JOB_TIMEOUT }, async () => {
+  // A server that lacks pkg-threads/ (or a page that is not cross-origin isolated): the plain build.
+  const ctx = await browser.newContext({ serviceWorkers: 'block' });
+  await ctx.route('**/worker.js', async (route) => {
+    const real = await route.fetch();
+    const text = await real.text();
+    assert.ok(text.includes("'./pkg-threads/quietpath.js'"));
+    await route.fulfill({ response: real, body: text.replace("'./pkg-threads/quietpath.js'", "'./no-such-pkg-threads.js'") });
+  });
+  const tab = await ctx.newPage();
+  tab.setDefaultTimeout(STEP_TIMEOUT);
+  await tab.goto(baseUrl);
+  await tab.waitForFunction(() => document.querySelector('[data-testid="status"]').textContent === 'ready');
+  assert.equal(await tab.evaluate(() => document.body.dataset.threads), '1');
+  const file = path.join(corpusDir, BENCHY);
+  await tab.locator('[data-testid="file"]').setInputFiles(file);
+  await tab.waitForFunction((n) => document.querySelector('[data-testid="filename"]').textContent === n && document.querySelector('[data-testid="status"]').textContent === 'ready', BENCHY, { timeout: JOB_TIMEOUT });
+  const report = JSON.parse(await tab.locator('[data-testid="report-json"]').textContent());
+  assert.deepEqual(report, runCli('analyze', file).json, 'the one-thread report differs from the CLI');
   await ctx.close();
 });
 

@@ -76,6 +76,9 @@ test('serves files with the right MIME types and security headers', async () => 
     assert.equal(res.headers.get('content-security-policy'), CSP);
     assert.equal(res.headers.get('x-content-type-options'), 'nosniff');
     assert.equal(res.headers.get('cache-control'), 'no-cache');
+    // Cross-origin isolated, for the threaded build's shared memory.
+    assert.equal(res.headers.get('cross-origin-opener-policy'), 'same-origin');
+    assert.equal(res.headers.get('cross-origin-embedder-policy'), 'require-corp');
     await res.arrayBuffer();
   }
   assert.equal(await (await fetch(base + '/pkg/quietpath.js')).text(), 'export default 1;');
@@ -85,7 +88,7 @@ test('the CSP forbids outside connections', () => {
   for (const d of [
     "default-src 'self'",
     "script-src 'self' 'wasm-unsafe-eval'",
-    "worker-src 'self'",
+    "worker-src 'self' blob:",
     "connect-src 'self'",
     "img-src 'self' data: blob:",
     "style-src 'self'",

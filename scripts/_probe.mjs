@@ -1,0 +1,20 @@
+import { chromium } from 'playwright-core';
+import { startServer } from '/work/main/scripts/serve.mjs';
+const server = await startServer({ root: '/work/main/www', port: 0 });
+const baseUrl = `http://127.0.0.1:${server.address().port}/`;
+const browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: ['--headless', '--no-sandbox', '--disable-gpu'] });
+const ctx = await browser.newContext();
+const tab = await ctx.newPage();
+tab.on('console', (m) => console.log('console:', m.type(), m.text()));
+tab.on('pageerror', (e) => console.log('pageerror:', e.message));
+tab.on('worker', (w) => console.log('worker:', w.url()));
+let served = 0;
+await tab.route('**/worker.js', async (route) => {
+  console.log('route', route.request().url(), served);
+  if (served++ > 0) return route.fallback();
+  await route.fulfill({ status: 200, contentType: 'text/javascript', body: "self.postMessage({ type: 'hello', version: 'crashy' });\nself.onmessage = () => { throw new Error('simulated worker crash'); };\n" });
+});
+await tab.goto(baseUrl);
+await new Promise((r) => setTimeout(r, 5000));
+console.log('status', await tab.locator('[data-testid="status"]').textContent(), await tab.locator('[data-testid="error"]').textContent());
+await browser.close(); server.close();
