@@ -47,7 +47,8 @@ wasm-web:
 # wasm-bindgen-rayon). Shared memory needs the atomics target feature in std as well, so std is
 # rebuilt with nightly's build-std; the linker arguments are wasm-bindgen's for threads, the
 # memory's maximum raised to 4 GB (the 34 MB file's VTG needs more than the 1 GB default). Its own
-# target directory: a different toolchain and flags, built beside the other three.
+# target directory: a different toolchain and flags, built beside the other three. The pool's
+# workers then start from their script's URL, not a blob (scripts/pool-helper.mjs: the CSP).
 THREADS_RUSTFLAGS := -C target-feature=+atomics,+bulk-memory,+mutable-globals,+simd128 \
 	-C link-arg=--shared-memory -C link-arg=--import-memory -C link-arg=--max-memory=4294967296 \
 	-C link-arg=--export=__wasm_init_tls -C link-arg=--export=__tls_size \
@@ -56,6 +57,7 @@ wasm-web-threads:
 	RUSTUP_TOOLCHAIN=nightly CARGO_UNSTABLE_BUILD_STD=panic_abort,std CARGO_TARGET_DIR=$(CURDIR)/target/wasm-threads \
 	RUSTFLAGS="$(THREADS_RUSTFLAGS)" \
 	wasm-pack build crate --release --target web --out-dir ../pkg/web-threads --out-name quietpath --features threads
+	node scripts/pool-helper.mjs pkg/web-threads
 wasm-node:
 	wasm-pack build crate --release --target nodejs --no-opt --out-dir ../pkg/node --out-name quietpath
 wasm-bundler:

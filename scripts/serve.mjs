@@ -19,9 +19,9 @@ import { fileURLToPath } from 'node:url';
 export const CSP = [
   "default-src 'self'",
   "script-src 'self' 'wasm-unsafe-eval'",
-  // blob: for the threaded build's pool: wasm-bindgen-rayon starts each worker from a blob of
-  // its own same-origin helper script (pkg-threads/snippets/…/workerHelpers.no-bundler.js).
-  "worker-src 'self' blob:",
+  // The threaded build's pool workers too: `make pkg` has them start from their helper script's
+  // own URL rather than a blob of it (scripts/pool-helper.mjs).
+  "worker-src 'self'",
   "connect-src 'self'",
   'img-src \'self\' data: blob:',
   "style-src 'self'",

@@ -88,7 +88,7 @@ test('the CSP forbids outside connections', () => {
   for (const d of [
     "default-src 'self'",
     "script-src 'self' 'wasm-unsafe-eval'",
-    "worker-src 'self' blob:",
+    "worker-src 'self'",
     "connect-src 'self'",
     "img-src 'self' data: blob:",
     "style-src 'self'",
