@@ -112,8 +112,10 @@ async function load() {
     try {
       const threaded = await import('./pkg-threads/quietpath.js');
       await threaded.default();
-      await threaded.initThreadPool(cores - 1);
-      threaded.usePool(cores - 1);
+      // A worker per core: the maps run on the pool while this worker waits (and runs the
+      // half of a join that reports progress).
+      await threaded.initThreadPool(cores);
+      threaded.usePool(cores);
       pkg = threaded;
       threads = threaded.threads();
       return;

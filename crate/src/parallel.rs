@@ -28,20 +28,18 @@ pub fn threads() -> usize {
     1
 }
 
-/// Threads to use in the threaded wasm build: the calling thread and the pool's workers once
-/// [`use_pool`] has said the pool is up, else one (rayon would try to start its own threads,
-/// which wasm cannot).
+/// Threads to use in the threaded wasm build: the pool's workers once [`use_pool`] has said the
+/// pool is up, else one (rayon would try to start its own threads, which wasm cannot).
 #[cfg(all(target_arch = "wasm32", feature = "threads"))]
 pub fn threads() -> usize {
     pool::THREADS.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 /// Tells the threaded wasm build that `initThreadPool(workers)` has resolved: the parallel
-/// maps run on those workers and the calling thread from now on (at most 8 threads, as
-/// natively).
+/// maps run on those workers from now on (at most 8, as natively).
 #[cfg(all(target_arch = "wasm32", feature = "threads"))]
 pub fn use_pool(workers: usize) {
-    let n = (workers + 1).clamp(1, 8);
+    let n = workers.clamp(1, 8);
     pool::THREADS.store(n, std::sync::atomic::Ordering::Relaxed);
 }
 
@@ -143,8 +141,10 @@ where
     parts.into_iter().map(|(_, r)| r).collect()
 }
 
-/// [`claimed`] on the Web Worker pool: the calling thread claims indices too, so the results
-/// are collected under a lock rather than returned by each thread.
+/// [`claimed`] on the Web Worker pool: `threads` claim loops spawned into it, while the calling
+/// thread (not one of the pool's) waits. The pool's workers steal each other's spawned work, so
+/// a map nested in an item (an infill candidate's layers) spreads over the pool as natively;
+/// the caller taking items itself could not share them.
 #[cfg(all(target_arch = "wasm32", feature = "threads"))]
 fn claimed<R, W>(n: usize, threads: usize, work: W) -> Vec<R>
 where
@@ -165,11 +165,10 @@ where
             p.push((i, r));
         }
     };
-    rayon::in_place_scope(|scope| {
-        for _ in 1..threads {
+    rayon::scope(|scope| {
+        for _ in 0..threads {
             scope.spawn(|_| claim());
         }
-        claim();
     });
     let mut parts = parts.into_inner().unwrap_or_default();
     parts.sort_unstable_by_key(|(i, _)| *i);

@@ -54,15 +54,16 @@ pub fn start() {
 }
 
 /// Runs the parallel maps (VTG's paths, the infill search's candidates, the dynamics model's
-/// layers) on `workers` pool workers and this thread from now on; call it once
-/// `initThreadPool(workers)` has resolved. Threaded build only.
+/// layers) on the `workers` pool workers from now on; call it once `initThreadPool(workers)`
+/// has resolved. Threaded build only.
 #[cfg(feature = "threads")]
 #[wasm_bindgen(js_name = usePool)]
 pub fn use_pool(workers: usize) {
     crate::parallel::use_pool(workers);
 }
 
-/// Threads the parallel maps use: 1 in the plain build, or before `usePool`.
+/// Threads the parallel maps use: the pool's workers, or 1 (the plain build, or before
+/// `usePool`).
 #[wasm_bindgen]
 pub fn threads() -> usize {
     crate::parallel::threads()
