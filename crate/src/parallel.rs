@@ -161,6 +161,7 @@ where
             return;
         }
         let r = work(i);
+        // Never poisoned: a panic aborts in wasm.
         if let Ok(mut p) = parts.lock() {
             p.push((i, r));
         }
