@@ -105,6 +105,13 @@ let pkg = qp;
 /** Threads the package's parallel maps use (the `hello` message says). */
 let threads = 1;
 
+/**
+ * How long the pool may take to start before the plain build is used instead: a pool worker that
+ * fails to load (its script missing from an offline cache, say) never says it is ready, and the
+ * pool's start would wait for ever. Starting takes a fraction of a second here.
+ */
+const POOL_START_MS = 10_000;
+
 /** Loads the threaded build where it can run, else the plain one. */
 async function load() {
   const cores = Math.min(navigator.hardwareConcurrency || 1, 8);
@@ -114,7 +121,16 @@ async function load() {
       await threaded.default();
       // A worker per core: the maps run on the pool while this worker waits (and runs the
       // half of a join that reports progress).
-      await threaded.initThreadPool(cores);
+      /** @type {ReturnType<typeof setTimeout> | undefined} */
+      let timer;
+      const late = new Promise((_, reject) => {
+        timer = setTimeout(() => reject(new Error(`the pool did not start in ${POOL_START_MS} ms`)), POOL_START_MS);
+      });
+      try {
+        await Promise.race([threaded.initThreadPool(cores), late]);
+      } finally {
+        clearTimeout(timer);
+      }
       threaded.usePool(cores);
       pkg = threaded;
       threads = threaded.threads();

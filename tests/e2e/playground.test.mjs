@@ -815,6 +815,27 @@ test('without the threaded build, jobs run on one thread with the same report', 
   await ctx.close();
 });
 
+test('a pool that never starts falls back to one thread', { timeout: JOB_TIMEOUT }, async () => {
+  // A pool worker that cannot load never says it is ready: the job worker waits a bounded time.
+  const ctx = await browser.newContext({ serviceWorkers: 'block' });
+  await ctx.route('**/worker.js', async (route) => {
+    const real = await route.fetch();
+    let text = await real.text();
+    for (const [from, to] of [['threaded.initThreadPool(cores)', 'new Promise(() => {})'], ['POOL_START_MS = 10_000', 'POOL_START_MS = 300']]) {
+      assert.ok(text.includes(from), `worker.js lacks ${from}`);
+      text = text.replace(from, to);
+    }
+    await route.fulfill({ response: real, body: text });
+  });
+  const tab = await ctx.newPage();
+  tab.setDefaultTimeout(STEP_TIMEOUT);
+  await tab.goto(baseUrl);
+  await tab.waitForFunction(() => document.querySelector('[data-testid="status"]').textContent === 'ready' && document.querySelector('[data-testid="filename"]').textContent === 'demo.gcode');
+  assert.equal(await tab.evaluate(() => document.body.dataset.threads), '1');
+  assert.ok(JSON.parse(await tab.locator('[data-testid="report-json"]').textContent()).layers > 0);
+  await ctx.close();
+});
+
 test('once loaded, the playground works offline', { timeout: JOB_TIMEOUT }, async () => {
   const ctx = await browser.newContext({ viewport: { width: 1280, height: 900 } });
   ctx.on('request', (req) => requests.push(req.url()));
