@@ -762,21 +762,33 @@ test('a crashing worker is reported and replaced', async () => {
   await tab.close();
 });
 
+/**
+ * A browser context of its own, without the service worker (which would answer from its cache),
+ * whose job worker is worker.js with each `[from, to]` of `edits` made; each `from` must be in
+ * it. A worker's own requests are not routed, so worker.js itself is what is edited (to ask for
+ * a file the server does not have, say). `served.count`: how many times it was served.
+ * @param {[string, string][]} edits
+ */
+async function contextWithWorkerEdits(edits) {
+  const ctx = await browser.newContext({ serviceWorkers: 'block' });
+  const served = { count: 0 };
+  await ctx.route('**/worker.js', async (route) => {
+    const real = await route.fetch();
+    let text = await real.text();
+    for (const [from, to] of edits) {
+      assert.ok(text.includes(from), `worker.js lacks ${from}`);
+      text = text.replace(from, to);
+    }
+    served.count++;
+    await route.fulfill({ response: real, body: text });
+  });
+  return { ctx, served };
+}
+
 test('without its timing worker, a large file is analyzed in one worker, with the same report', { timeout: JOB_TIMEOUT }, async () => {
   // timing-worker.js cannot load (a server or cache that lacks it): the job worker plans the
   // moves itself.
-  // A context of its own, without the service worker (which would answer from its cache). A
-  // worker's own requests are not routed, so the job worker is served asking for a file the
-  // server does not have.
-  const ctx = await browser.newContext({ serviceWorkers: 'block' });
-  let served = 0;
-  await ctx.route('**/worker.js', async (route) => {
-    const real = await route.fetch();
-    const text = await real.text();
-    assert.ok(text.includes("'./timing-worker.js'"));
-    served++;
-    await route.fulfill({ response: real, body: text.replace("'./timing-worker.js'", "'./no-such-timing-worker.js'") });
-  });
+  const { ctx, served } = await contextWithWorkerEdits([["'./timing-worker.js'", "'./no-such-timing-worker.js'"]]);
   const tab = await ctx.newPage();
   tab.setDefaultTimeout(STEP_TIMEOUT);
   await tab.goto(baseUrl);
@@ -789,19 +801,13 @@ test('without its timing worker, a large file is analyzed in one worker, with th
   assert.equal(await tab.locator('[data-testid="elapsed"]').getAttribute('data-workers'), '1');
   const report = JSON.parse(await tab.locator('[data-testid="report-json"]').textContent());
   assert.deepEqual(report, runCli('analyze', file).json, 'the one-worker report differs from the CLI');
-  assert.ok(served >= 1, 'the job worker was not the one served here');
+  assert.ok(served.count >= 1, 'the job worker was not the one served here');
   await ctx.close();
 });
 
 test('without the threaded build, jobs run on one thread with the same report', { timeout: JOB_TIMEOUT }, async () => {
   // A server that lacks pkg-threads/ (or a page that is not cross-origin isolated): the plain build.
-  const ctx = await browser.newContext({ serviceWorkers: 'block' });
-  await ctx.route('**/worker.js', async (route) => {
-    const real = await route.fetch();
-    const text = await real.text();
-    assert.ok(text.includes("'./pkg-threads/quietpath.js'"));
-    await route.fulfill({ response: real, body: text.replace("'./pkg-threads/quietpath.js'", "'./no-such-pkg-threads.js'") });
-  });
+  const { ctx } = await contextWithWorkerEdits([["'./pkg-threads/quietpath.js'", "'./no-such-pkg-threads.js'"]]);
   const tab = await ctx.newPage();
   tab.setDefaultTimeout(STEP_TIMEOUT);
   await tab.goto(baseUrl);
@@ -817,16 +823,10 @@ test('without the threaded build, jobs run on one thread with the same report', 
 
 test('a pool that never starts falls back to one thread', { timeout: JOB_TIMEOUT }, async () => {
   // A pool worker that cannot load never says it is ready: the job worker waits a bounded time.
-  const ctx = await browser.newContext({ serviceWorkers: 'block' });
-  await ctx.route('**/worker.js', async (route) => {
-    const real = await route.fetch();
-    let text = await real.text();
-    for (const [from, to] of [['threaded.initThreadPool(cores)', 'new Promise(() => {})'], ['POOL_START_MS = 10_000', 'POOL_START_MS = 300']]) {
-      assert.ok(text.includes(from), `worker.js lacks ${from}`);
-      text = text.replace(from, to);
-    }
-    await route.fulfill({ response: real, body: text });
-  });
+  const { ctx } = await contextWithWorkerEdits([
+    ['threaded.initThreadPool(cores)', 'new Promise(() => {})'],
+    ['POOL_START_MS = 10_000', 'POOL_START_MS = 300'],
+  ]);
   const tab = await ctx.newPage();
   tab.setDefaultTimeout(STEP_TIMEOUT);
   await tab.goto(baseUrl);
