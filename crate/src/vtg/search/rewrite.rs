@@ -1119,10 +1119,11 @@ mod tests {
         );
         let added = lines(&rounded.output) - lines(src.as_bytes());
         assert!(added > 0 && rounded.table1.n_turning.after == 0.0);
-        // Just enough lines for it (in percent of the file's 44): rounded; one fewer: not.
-        let needed = added as f64 / 44.0 * 100.0;
-        assert_eq!(run(needed).paths.rewritten, 1);
-        assert_eq!(run(needed - 100.0 / 44.0).paths.rewritten, 0);
+        // Just enough lines for it (in percent of the file's 44, half a line over so the
+        // budget's rounding down cannot take one off): rounded; one fewer: not.
+        let percent = |lines: f64| lines / 44.0 * 100.0;
+        assert_eq!(run(percent(added as f64 + 0.5)).paths.rewritten, 1);
+        assert_eq!(run(percent(added as f64 - 0.5)).paths.rewritten, 0);
     }
 
     /// Four layers of a pentagon with sharp corners, printed at 60 mm/s.

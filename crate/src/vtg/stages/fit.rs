@@ -8,7 +8,7 @@
 //! points are interpolated (the path keeps its end points).
 
 use crate::vec3::{norm, sub};
-use crate::vtg::bspline::{basis_by_degree, find_span, Curve, DEGREE};
+use crate::vtg::bspline::{basis_by_degree, find_span, reciprocals, Curve, DEGREE};
 use crate::vtg::tuning::TUNING;
 
 /// A fitted curve with the data it was fitted to.
@@ -123,9 +123,10 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<Curve> {
         ends: [q0, qm],
     };
     let mut add_row = |coef: &[(usize, f64)], target: [f64; 3]| eq.add_row(coef, target);
+    let inv = reciprocals(knots);
     for (q, &u) in data.iter().zip(params) {
         let span = find_span(knots, n, u);
-        let b = basis_by_degree(knots, span, u)[2];
+        let b = basis_by_degree(knots, inv.get(span)?, span, u)[2];
         let coef: [(usize, f64); 4] = [
             (span - 3, b[0]),
             (span - 2, b[1]),
