@@ -169,10 +169,18 @@ fn simulate_first(
 /// The original `input` and the first rewrite `output` simulated on the layers `sample` marks.
 fn sampled_pair(input: &[u8], output: &[u8], sample: &[bool], options: &VtgOptions) -> SampledPair {
     let vibration = vibration_options(options);
-    let sampled = |bytes: &[u8]| {
-        crate::dynamics::printing_deviation_in_layers(bytes, &vibration, sample).ok()
-    };
-    Some((sampled(input)?, sampled(output)?))
+    let on = |bytes| on_sample(bytes, &vibration, sample);
+    Some((on(input)?, on(output)?))
+}
+
+/// The printing deviation of `bytes` simulated on the layers `sample` marks, the machine at
+/// rest as each starts; `None` where the model cannot run on it.
+fn on_sample(
+    bytes: &[u8],
+    vibration: &crate::dynamics::VibrationOptions,
+    sample: &[bool],
+) -> Option<Deviation> {
+    crate::dynamics::printing_deviation_in_layers(bytes, vibration, sample).ok()
 }
 
 /// The quietest of `first` and the whole-file variants ([`search::quieter_variants`]) under
@@ -275,9 +283,7 @@ fn raced(
     again: &mut dyn Again,
 ) -> Result<Tried, Error> {
     let vibration = vibration_options(options);
-    let sampled = |bytes: &[u8]| {
-        crate::dynamics::printing_deviation_in_layers(bytes, &vibration, sample).ok()
-    };
+    let sampled = |bytes: &[u8]| on_sample(bytes, &vibration, sample);
     let Some((b, first_sampled)) = pair else {
         return Ok(first);
     };
