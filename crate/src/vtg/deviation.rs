@@ -112,8 +112,8 @@ pub(crate) fn polyline_deviation(
 /// segment a dozen times or more, and the searches compare squared distances, taking one
 /// square root for the nearest (this was a seventh of `vtg`'s time on the 34 MB corpus file).
 struct Original {
+    /// At least one.
     segments: Vec<Segment>,
-    segs: usize,
 }
 
 /// A segment `a`–`a + d`, with `1 / |d|²` (0 for a point).
@@ -153,8 +153,7 @@ impl Original {
                 }
             })
             .collect();
-        let segs = segments.len();
-        Self { segments, segs }
+        Self { segments }
     }
 
     /// Distance from `p` to segment `j`.
@@ -184,7 +183,7 @@ impl Original {
     /// Nearest original segment to `p`, searched around `cursor` first, then everywhere.
     fn nearest(&self, p: &[f64; 3], cursor: usize) -> (usize, f64) {
         const WINDOW: usize = 6;
-        let segs = self.segs;
+        let segs = self.segments.len();
         let lo = cursor.saturating_sub(WINDOW);
         let hi = (cursor + WINDOW).min(segs - 1);
         self.nearest_in(p, lo..hi + 1, cursor.min(segs - 1))
@@ -193,7 +192,7 @@ impl Original {
     /// Nearest segment over the whole polyline: where the window has lost track (the other
     /// polyline is much denser here, or doubles back), it puts the cursor back.
     fn nearest_anywhere(&self, p: &[f64; 3]) -> (usize, f64) {
-        self.nearest_in(p, 0..self.segs, 0)
+        self.nearest_in(p, 0..self.segments.len(), 0)
     }
 
     /// The largest distance along the output segment `q`–`p` (`q` nearest segment `jq`), by
