@@ -154,8 +154,7 @@ fn simulate_first(
     layers: usize,
     options: &VtgOptions,
 ) -> (Option<SampledPair>, Option<Simulated>) {
-    let race = race_sample(input.len(), layers)
-        .filter(|_| options.limit_feed && !options.exhaustive && crate::parallel::threads() > 1);
+    let race = race_layers(input.len(), layers, options).filter(|_| crate::parallel::threads() > 1);
     let Some(sample) = race else {
         return (None, printing_deviation(output, options));
     };
@@ -197,7 +196,7 @@ fn quietest(
     if quietness(&orig.deviation, &first.sim.deviation).0 == 0 || !options.limit_feed {
         return Ok(first);
     }
-    match race_sample(input.len(), orig.layers.len()).filter(|_| !options.exhaustive) {
+    match race_layers(input.len(), orig.layers.len(), options) {
         Some(sample) => {
             let pair = sampled
                 .unwrap_or_else(|| sampled_pair(input, &first.report.output, &sample, options));
@@ -252,6 +251,12 @@ const RACE_MIN_BYTES: usize = 512 << 10;
 /// The race samples every `RACE_STRIDE`-th layer, from the middle of the first stride (not
 /// the first layer, which firmware and slicers print slower than the rest).
 const RACE_STRIDE: usize = 8;
+
+/// The layers [`quietest`] races the variants on, where it races them: a file [`race_sample`]
+/// samples, the feed VTG eq. 29's (else no variant is tried) and `--exhaustive` not asked for.
+fn race_layers(bytes: usize, layers: usize, options: &VtgOptions) -> Option<Vec<bool>> {
+    race_sample(bytes, layers).filter(|_| options.limit_feed && !options.exhaustive)
+}
 
 /// The layers a file of `bytes` bytes and `layers` layers races its variants on ([`raced`]),
 /// `None` where it is small enough to try each whole or would have fewer than eight layers

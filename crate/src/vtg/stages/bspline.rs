@@ -245,7 +245,7 @@ impl Curve {
 /// interval, P&T's 0/0 = 0). They depend on the knots alone, so a curve keeps them per span
 /// and an evaluation multiplies where A2.2 would divide six times (on the 34 MB corpus file the
 /// recursion was an eighth of `vtg`'s time, most of it in the divisions).
-pub(crate) fn span_reciprocals(knots: &[f64], span: usize) -> [f64; 6] {
+fn span_reciprocals(knots: &[f64], span: usize) -> [f64; 6] {
     let mut out = [0.0; 6];
     if span < DEGREE || span + DEGREE >= knots.len() {
         return out;
