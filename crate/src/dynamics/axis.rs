@@ -14,6 +14,8 @@ use super::lumped::{dof, Coefficients, Mat6, Matrices, Vec6};
 use super::modal::{self, state_matrix, Mode};
 use super::modal_step::{product, ModalStepper};
 use super::parameters::Drive;
+use super::steppers::StepperTable;
+use std::sync::Arc;
 
 /// Simulation state of one axis.
 pub type State = SVector<f64, 12>;
@@ -132,15 +134,13 @@ pub const FLUSH_TO_ZERO: f64 = 1e-200;
 /// Steps between two flushes of the state to zero.
 const FLUSH_EVERY: u32 = 16;
 
-/// An axis with its steppers cached per bucket of nut positions, and its state.
+/// An axis with its steppers per bucket of nut positions ([`StepperTable`], shared with the
+/// other runs on the same drive), and its state.
 #[derive(Debug)]
 pub struct Axis {
-    drive: Drive,
-    ts: f64,
-    bucket_m: f64,
     /// `1 / bucket_m`: a product per step instead of a division.
     per_bucket: f64,
-    cache: Vec<Option<Box<Stepper>>>,
+    table: Arc<StepperTable>,
     /// Steps since the state was last flushed to zero ([`flush_to_zero`]).
     unflushed: u32,
     /// The bucket whose coordinates `z` is in.
@@ -160,11 +160,8 @@ impl Axis {
         let bucket_m = bucket_m.max(travel / Self::MAX_BUCKETS as f64);
         let count = ((travel / bucket_m).ceil() as usize).clamp(1, Self::MAX_BUCKETS) + 1;
         Self {
-            drive,
-            ts,
-            bucket_m,
             per_bucket: 1.0 / bucket_m,
-            cache: vec![None; count],
+            table: StepperTable::shared(drive, ts, bucket_m, count),
             unflushed: 0,
             current: usize::MAX,
             z: [0.0; 12],
@@ -172,7 +169,7 @@ impl Axis {
     }
 
     fn bucket(&self, position_m: f64) -> usize {
-        let last = self.cache.len() - 1;
+        let last = self.table.buckets() - 1;
         if position_m > 0.0 {
             ((position_m * self.per_bucket) as usize).min(last)
         } else {
@@ -180,21 +177,10 @@ impl Axis {
         }
     }
 
-    /// The stepper of bucket `idx` (computed on first use), `None` if the model cannot be
-    /// discretised there.
-    fn stepper(&mut self, idx: usize) -> Option<&Stepper> {
-        let slot = self.cache.get_mut(idx)?;
-        if slot.is_none() {
-            let centre = (idx as f64 + 0.5) * self.bucket_m;
-            *slot = Some(Box::new(stepper(&self.drive, centre, self.ts)?));
-        }
-        slot.as_deref()
-    }
-
     /// The stepper for the axis at `position_m`, `None` if the model cannot be discretised.
     pub fn at(&mut self, position_m: f64) -> Option<&Stepper> {
         let idx = self.bucket(position_m);
-        self.stepper(idx)
+        self.table.get(idx)
     }
 
     /// One period with the nut at `position_m`: commanded velocity `v` (m/s) at its start and
@@ -204,11 +190,11 @@ impl Axis {
         let idx = self.bucket(position_m);
         if idx != self.current {
             let x = self.state();
-            let modal = self.stepper(idx)?.modal.as_ref();
+            let modal = self.table.get(idx)?.modal.as_ref();
             self.z = modal.map_or(x.into(), |m| m.to_modal(&x.into()));
             self.current = idx;
         }
-        let st = self.cache.get(idx)?.as_deref()?;
+        let st = self.table.get(idx)?;
         match &st.modal {
             Some(m) => m.step(&mut self.z, v, a),
             None => st.dense_step(&mut self.z, v, a),
@@ -224,7 +210,7 @@ impl Axis {
     }
 
     fn modal(&self) -> Option<&ModalStepper> {
-        self.cache.get(self.current)?.as_deref()?.modal.as_ref()
+        self.table.get(self.current)?.modal.as_ref()
     }
 
     /// The physical state `[q̃, q̃̇]`.

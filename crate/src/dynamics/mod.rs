@@ -27,6 +27,7 @@ pub mod modal_step;
 pub mod parameters;
 mod sampled;
 pub mod simulate;
+mod steppers;
 mod stream;
 mod timeline;
 pub mod trajectory;
