@@ -12,7 +12,7 @@ use nalgebra::{DMatrix, SVector};
 use super::integrate::discretize;
 use super::lumped::{dof, Coefficients, Mat6, Matrices, Vec6};
 use super::modal::{self, state_matrix, Mode};
-use super::modal_step::{product, ModalStepper};
+use super::modal_step::{product, ModalPair, ModalStepper};
 use super::parameters::Drive;
 use super::steppers::StepperTable;
 use std::sync::Arc;
@@ -63,7 +63,7 @@ impl Stepper {
 /// times slower (a crawl at a vanishing feed rate took minutes); 1e-200 m is zero for any
 /// machine.
 #[inline]
-fn flush_to_zero(x: &mut [f64; 12]) {
+fn flush_to_zero(x: &mut [f64]) {
     for v in x {
         if v.abs() < FLUSH_TO_ZERO {
             *v = 0.0;
@@ -134,27 +134,23 @@ pub const FLUSH_TO_ZERO: f64 = 1e-200;
 /// Steps between two flushes of the state to zero.
 const FLUSH_EVERY: u32 = 16;
 
-/// An axis with its steppers per bucket of nut positions ([`StepperTable`], shared with the
-/// other runs on the same drive), and its state.
+/// One axis's drive discretised per bucket of nut positions ([`StepperTable`], shared with the
+/// other runs on the same drive), and the bucket its state is in the coordinates of.
 #[derive(Debug)]
 pub struct Axis {
     /// `1 / bucket_m`: a product per step instead of a division.
     per_bucket: f64,
     table: Arc<StepperTable>,
-    /// Steps since the state was last flushed to zero ([`flush_to_zero`]).
-    unflushed: u32,
-    /// The bucket whose coordinates `z` is in.
+    /// The bucket whose coordinates the axis's state is in (`usize::MAX`: none yet).
     current: usize,
-    /// The state: modal coordinates of bucket `current` if it has a modal form, else physical.
-    z: [f64; 12],
 }
 
 impl Axis {
     /// Most buckets per axis.
     pub const MAX_BUCKETS: usize = 4096;
 
-    /// An axis at rest, simulated every `ts` seconds, with the stiffness held constant over
-    /// `bucket_m` of travel.
+    /// `drive` simulated every `ts` seconds, with the stiffness held constant over `bucket_m`
+    /// of travel.
     pub fn new(drive: Drive, ts: f64, bucket_m: f64) -> Self {
         let travel = drive.travel_m();
         let bucket_m = bucket_m.max(travel / Self::MAX_BUCKETS as f64);
@@ -162,9 +158,7 @@ impl Axis {
         Self {
             per_bucket: 1.0 / bucket_m,
             table: StepperTable::shared(drive, ts, bucket_m, count),
-            unflushed: 0,
             current: usize::MAX,
-            z: [0.0; 12],
         }
     }
 
@@ -178,63 +172,153 @@ impl Axis {
     }
 
     /// The stepper for the axis at `position_m`, `None` if the model cannot be discretised.
-    pub fn at(&mut self, position_m: f64) -> Option<&Stepper> {
-        let idx = self.bucket(position_m);
-        self.table.get(idx)
-    }
-
-    /// One period with the nut at `position_m`: commanded velocity `v` (m/s) at its start and
-    /// acceleration `a` (m/s²) over it. `None` if the model cannot be discretised there.
-    #[inline]
-    pub fn step(&mut self, position_m: f64, v: f64, a: f64) -> Option<()> {
-        let idx = self.bucket(position_m);
-        if idx != self.current {
-            let x = self.state();
-            let modal = self.table.get(idx)?.modal.as_ref();
-            self.z = modal.map_or(x.into(), |m| m.to_modal(&x.into()));
-            self.current = idx;
-        }
-        let st = self.table.get(idx)?;
-        match &st.modal {
-            Some(m) => m.step(&mut self.z, v, a),
-            None => st.dense_step(&mut self.z, v, a),
-        }
-        // Every few steps is enough: a state sinks past 1e-200 only slowly, and only a
-        // component that stays subnormal costs time.
-        self.unflushed += 1;
-        if self.unflushed >= FLUSH_EVERY {
-            flush_to_zero(&mut self.z);
-            self.unflushed = 0;
-        }
-        Some(())
+    pub fn at(&self, position_m: f64) -> Option<&Stepper> {
+        self.table.get(self.bucket(position_m))
     }
 
     fn modal(&self) -> Option<&ModalStepper> {
         self.table.get(self.current)?.modal.as_ref()
     }
+}
 
-    /// The physical state `[q̃, q̃̇]`.
-    pub fn state(&self) -> State {
-        State::from(self.modal().map_or(self.z, |m| m.to_physical(&self.z)))
+/// The X and Y axes and their states, stepped side by side.
+///
+/// Where both axes' buckets have a modal form (always, on the presets), the two states step as
+/// one two-lane [`ModalPair`]; a bucket change rebases only its own lane.
+#[derive(Debug)]
+pub struct Axes {
+    axes: [Axis; 2],
+    /// Row `r` of axis `l`'s state is `z[r][l]`: in the modal coordinates of its bucket where
+    /// that has a modal form, else physical.
+    z: [[f64; 2]; 12],
+    /// The modal steps of both current buckets, where `both_modal`.
+    pair: ModalPair,
+    both_modal: bool,
+    /// Steps since the states were last flushed to zero ([`flush_to_zero`]).
+    unflushed: u32,
+}
+
+impl Axes {
+    /// Both axes at rest (see [`Axis::new`]).
+    pub fn new(drives: [Drive; 2], ts: f64, bucket_m: f64) -> Self {
+        Self {
+            axes: drives.map(|d| Axis::new(d, ts, bucket_m)),
+            z: [[0.0; 2]; 12],
+            pair: ModalPair::default(),
+            both_modal: false,
+            unflushed: 0,
+        }
     }
 
-    /// The table's deviation from the commanded position, m.
+    /// One period with the nuts at `position_m`: commanded velocities `v` (m/s) at its start
+    /// and accelerations `a` (m/s²) over it. `None` if the model cannot be discretised there.
     #[inline]
-    pub fn table(&self) -> f64 {
-        self.modal()
-            .map_or(self.z[TABLE], |m| m.physical_row(&self.z, 0))
+    pub fn step(&mut self, position_m: [f64; 2], v: [f64; 2], a: [f64; 2]) -> Option<()> {
+        for (lane, &p) in position_m.iter().enumerate() {
+            let idx = self.axes[lane].bucket(p);
+            if idx != self.axes[lane].current {
+                self.rebase(lane, idx)?;
+            }
+        }
+        if self.both_modal {
+            self.pair.step(&mut self.z, v, a);
+        } else {
+            for lane in 0..2 {
+                self.step_lane(lane, v[lane], a[lane])?;
+            }
+        }
+        // Every few steps is enough: a state sinks past 1e-200 only slowly, and only a
+        // component that stays subnormal costs time.
+        self.unflushed += 1;
+        if self.unflushed >= FLUSH_EVERY {
+            flush_to_zero(self.z.as_flattened_mut());
+            self.unflushed = 0;
+        }
+        Some(())
     }
 
-    /// The table's deviation velocity, m/s.
+    /// Axis `lane` moves into bucket `idx`: its state into that bucket's coordinates.
+    fn rebase(&mut self, lane: usize, idx: usize) -> Option<()> {
+        let x = self.state(lane);
+        let st = self.axes[lane].table.get(idx)?;
+        let z = match &st.modal {
+            Some(m) => {
+                self.pair.set_lane(lane, m);
+                m.to_modal(&x.into())
+            }
+            None => x.into(),
+        };
+        set_lane(&mut self.z, lane, &z);
+        self.axes[lane].current = idx;
+        self.both_modal = self.axes.iter().all(|a| a.modal().is_some());
+        Some(())
+    }
+
+    /// One period of axis `lane` alone (a bucket without a modal form).
+    fn step_lane(&mut self, lane: usize, v: f64, a: f64) -> Option<()> {
+        let st = self.axes[lane].table.get(self.axes[lane].current)?;
+        let mut x = lane_of(&self.z, lane);
+        match &st.modal {
+            Some(m) => m.step(&mut x, v, a),
+            None => st.dense_step(&mut x, v, a),
+        }
+        set_lane(&mut self.z, lane, &x);
+        Some(())
+    }
+
+    /// The physical state `[q̃, q̃̇]` of axis `lane`.
+    pub fn state(&self, lane: usize) -> State {
+        let x = lane_of(&self.z, lane);
+        State::from(self.axes[lane].modal().map_or(x, |m| m.to_physical(&x)))
+    }
+
+    /// The tables' deviations from the commanded positions, m.
     #[inline]
-    pub fn table_velocity(&self) -> f64 {
-        self.modal()
-            .map_or(self.z[TABLE_VELOCITY], |m| m.physical_row(&self.z, 1))
+    pub fn table(&self) -> [f64; 2] {
+        if self.both_modal {
+            self.pair.physical_rows(&self.z, 0)
+        } else {
+            self.rows_by_lane(0, TABLE)
+        }
     }
 
-    /// Brings the axis to rest.
+    /// The tables' deviation velocities, m/s.
+    #[inline]
+    pub fn table_velocity(&self) -> [f64; 2] {
+        if self.both_modal {
+            self.pair.physical_rows(&self.z, 1)
+        } else {
+            self.rows_by_lane(1, TABLE_VELOCITY)
+        }
+    }
+
+    /// Row `which` of [`ModalStepper`]'s table rows of each state on its own (`physical`: its
+    /// index in the physical state), where a bucket has no modal form.
+    #[cold]
+    fn rows_by_lane(&self, which: usize, physical: usize) -> [f64; 2] {
+        core::array::from_fn(|lane| {
+            let x = lane_of(&self.z, lane);
+            self.axes[lane]
+                .modal()
+                .map_or(x[physical], |m| m.physical_row(&x, which))
+        })
+    }
+
+    /// Brings both axes to rest.
     pub fn rest(&mut self) {
-        self.z = [0.0; 12];
+        self.z = [[0.0; 2]; 12];
+    }
+}
+
+/// Axis `lane`'s state out of the two-lane `z`.
+fn lane_of(z: &[[f64; 2]; 12], lane: usize) -> [f64; 12] {
+    core::array::from_fn(|r| z[r][lane])
+}
+
+/// Axis `lane`'s state into the two-lane `z`.
+fn set_lane(z: &mut [[f64; 2]; 12], lane: usize, x: &[f64; 12]) {
+    for (row, &v) in z.iter_mut().zip(x) {
+        row[lane] = v;
     }
 }
 
@@ -265,30 +349,37 @@ mod tests {
 
     #[test]
     fn modal_steps_follow_the_dense_step_across_buckets() {
-        // Back and forth over several 5 mm buckets with acceleration steps: the modal state
-        // (rebased at every bucket change) stays on the dense step's to rounding.
+        // Back and forth over several 5 mm buckets with acceleration steps, the two axes out of
+        // phase (they change buckets at different steps): each modal state (rebased at every
+        // bucket change of its own axis) stays on the dense step's to rounding.
         for name in ["ldam-ball-screw", "desktop-belt"] {
             let machine = MachineDynamics::preset(name).unwrap();
             let ts = 1e-3;
-            let mut modal = Axis::new(machine.y, ts, 0.005);
-            let mut dense = Axis::new(machine.y, ts, 0.005);
-            let (mut pos, mut v, mut x) = (0.3 * machine.y.travel_m(), 0.0, State::zeros());
+            let drives = [machine.x, machine.y];
+            let mut modal = Axes::new(drives, ts, 0.005);
+            let dense = drives.map(|d| Axis::new(d, ts, 0.005));
+            let mut pos = drives.map(|d| 0.3 * d.travel_m());
+            let (mut v, mut x) = ([0.0; 2], [State::zeros(); 2]);
             let (mut largest, mut worst, mut scale) = (0.0f64, 0.0f64, 0.0f64);
             for k in 0..60_000 {
-                let a = [2.0, 0.0, -2.0, -2.0, 0.0, 2.0][(k / 150) % 6];
-                assert!(modal.at(pos).unwrap().is_modal(), "{name} at {pos}");
-                x = dense.at(pos).unwrap().step(&x, v, a);
+                let pattern = [2.0, 0.0, -2.0, -2.0, 0.0, 2.0];
+                let a = [pattern[(k / 150) % 6], -pattern[(k / 110) % 6]];
                 modal.step(pos, v, a).unwrap();
-                largest = largest.max(x[TABLE].abs());
-                worst = worst.max((modal.table() - x[TABLE]).abs());
-                scale = scale.max(x.amax());
-                let diff = (modal.state() - x).amax();
-                assert!(
-                    diff <= 1e-8 * scale,
-                    "{name} step {k}: {diff} against {scale}"
-                );
-                pos += v * ts + 0.5 * a * ts * ts;
-                v += a * ts;
+                let table = modal.table();
+                for l in 0..2 {
+                    assert!(dense[l].at(pos[l]).unwrap().is_modal(), "{name} at {pos:?}");
+                    x[l] = dense[l].at(pos[l]).unwrap().step(&x[l], v[l], a[l]);
+                    largest = largest.max(x[l][TABLE].abs());
+                    worst = worst.max((table[l] - x[l][TABLE]).abs());
+                    scale = scale.max(x[l].amax());
+                    let diff = (modal.state(l) - x[l]).amax();
+                    assert!(
+                        diff <= 1e-8 * scale,
+                        "{name} axis {l} step {k}: {diff} against {scale}"
+                    );
+                    pos[l] += v[l] * ts + 0.5 * a[l] * ts * ts;
+                    v[l] += a[l] * ts;
+                }
             }
             assert!(largest > 1e-7, "{name}: the table moved {largest} m");
             assert!(worst <= 1e-8 * largest, "{name}: {worst} against {largest}");
@@ -301,7 +392,7 @@ mod tests {
         // Belt axis under a steady commanded acceleration (no feed-forward): the deviation
         // settles where the springs carry the inertia loads, x = K̃⁻¹ F̃_a a.
         let desk = MachineDynamics::preset("desktop-belt").unwrap();
-        let mut axis = Axis::new(desk.x, 1e-3, 0.005);
+        let axis = Axis::new(desk.x, 1e-3, 0.005);
         let st = axis.at(0.1).unwrap().clone();
         let mut x = State::zeros();
         for _ in 0..20_000 {

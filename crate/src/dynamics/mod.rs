@@ -27,7 +27,7 @@ pub mod modal_step;
 pub mod parameters;
 mod sampled;
 pub mod simulate;
-mod steppers;
+pub mod steppers;
 mod stream;
 mod timeline;
 pub mod trajectory;

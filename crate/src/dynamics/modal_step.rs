@@ -118,6 +118,71 @@ impl ModalStepper {
     }
 }
 
+/// Both axes' modal steps side by side: `z[r][l]` is row `r` of axis `l`'s modal state, and
+/// each coefficient is laid out the same way, so that a step is a run of two-lane products
+/// (SSE2 natively, SIMD128 in the browser) instead of two runs of single ones with shuffles
+/// between them. Each lane's arithmetic is [`ModalStepper::step`]'s and
+/// [`ModalStepper::physical_row`]'s, operation for operation: the results are the same bits.
+#[derive(Debug, Clone, Default)]
+pub struct ModalPair {
+    blocks: [[[f64; 2]; 4]; N / 2],
+    gamma: [[[f64; 2]; N]; 2],
+    table: [[[f64; 2]; N]; 2],
+}
+
+impl ModalPair {
+    /// Lane `lane` takes `m`'s coefficients.
+    pub fn set_lane(&mut self, lane: usize, m: &ModalStepper) {
+        for (pair, block) in self.blocks.iter_mut().zip(&m.blocks) {
+            for (p, &b) in pair.iter_mut().zip(block) {
+                p[lane] = b;
+            }
+        }
+        for (pairs, rows) in self.gamma.iter_mut().zip(&m.gamma) {
+            for (p, &g) in pairs.iter_mut().zip(rows) {
+                p[lane] = g;
+            }
+        }
+        for (pairs, rows) in self.table.iter_mut().zip(&m.table) {
+            for (p, &t) in pairs.iter_mut().zip(rows) {
+                p[lane] = t;
+            }
+        }
+    }
+
+    /// One period of both axes: [`ModalStepper::step`] lane by lane.
+    #[inline]
+    pub fn step(&self, z: &mut [[f64; 2]; N], v: [f64; 2], a: [f64; 2]) {
+        for (j, b) in self.blocks.iter().enumerate() {
+            let (i, k) = (2 * j, 2 * j + 1);
+            let (zi, zk) = (z[i], z[k]);
+            let (gi, gk) = (
+                (self.gamma[0][i], self.gamma[1][i]),
+                (self.gamma[0][k], self.gamma[1][k]),
+            );
+            for l in 0..2 {
+                z[i][l] = b[0][l] * zi[l] + b[1][l] * zk[l] + gi.0[l] * v[l] + gi.1[l] * a[l];
+                z[k][l] = b[2][l] * zi[l] + b[3][l] * zk[l] + gk.0[l] * v[l] + gk.1[l] * a[l];
+            }
+        }
+    }
+
+    /// Row `which` of both physical states: [`ModalStepper::physical_row`] lane by lane.
+    #[inline]
+    pub fn physical_rows(&self, z: &[[f64; 2]; N], which: usize) -> [f64; 2] {
+        let t = &self.table[which];
+        let mut acc = [[0.0f64; 2]; 4];
+        for (tc, zc) in t.chunks_exact(4).zip(z.chunks_exact(4)) {
+            for ((a, t), z) in acc.iter_mut().zip(tc).zip(zc) {
+                for l in 0..2 {
+                    a[l] += t[l] * z[l];
+                }
+            }
+        }
+        core::array::from_fn(|l| (acc[0][l] + acc[1][l]) + (acc[2][l] + acc[3][l]))
+    }
+}
+
 /// `m x` for a column-major `m` (the dense step's product too; it unrolls and vectorises).
 pub(super) fn product(m: &[[f64; N]; N], x: &[f64; N]) -> [f64; N] {
     let mut y = [0.0; N];

@@ -1,7 +1,7 @@
 //! Runs both axes over the sampled trajectory: trajectory deviation (VTG eq. 15), per-layer
 //! statistics and the table's acceleration signal.
 
-use super::axis::{Axis, State};
+use super::axis::{Axes, State};
 use super::parameters::MachineDynamics;
 use super::trajectory::{Command, Segment};
 use super::welch::Welch;
@@ -191,18 +191,15 @@ impl Outcome {
 /// One step of both axes from the command `prev` to `next`.
 #[inline]
 pub(super) fn step_axes(
-    axes: &mut [Axis; 2],
+    axes: &mut Axes,
     prev: &Command,
     next: &Command,
     ts: f64,
 ) -> Result<(), Error> {
-    for (ax, axis) in axes.iter_mut().enumerate() {
-        let v0 = prev.vel[ax] * 1e-3;
-        let a = (next.vel[ax] - prev.vel[ax]) * 1e-3 / ts;
-        axis.step(prev.pos[ax] * 1e-3, v0, a)
-            .ok_or_else(model_error)?;
-    }
-    Ok(())
+    let v0 = prev.vel.map(|v| v * 1e-3);
+    let a = core::array::from_fn(|ax| (next.vel[ax] - prev.vel[ax]) * 1e-3 / ts);
+    axes.step(prev.pos.map(|p| p * 1e-3), v0, a)
+        .ok_or_else(model_error)
 }
 
 /// The table's mean acceleration (X, Y, m/s²) over the `dt` since its velocity was `last_v`,
@@ -210,13 +207,14 @@ pub(super) fn step_axes(
 #[inline]
 pub(super) fn table_acceleration(
     next: &Command,
-    axes: &[Axis; 2],
+    axes: &Axes,
     last_v: &mut [f64; 2],
     dt: f64,
 ) -> [f64; 2] {
     let mut acc = [0.0; 2];
-    for (ax, axis) in axes.iter().enumerate() {
-        let v = next.vel[ax] * 1e-3 + axis.table_velocity();
+    let table = axes.table_velocity();
+    for ax in 0..2 {
+        let v = next.vel[ax] * 1e-3 + table[ax];
         acc[ax] = (v - last_v[ax]) / dt;
         last_v[ax] = v;
     }

@@ -8,7 +8,7 @@
 
 use std::collections::VecDeque;
 
-use super::axis::Axis;
+use super::axis::Axes;
 use super::parameters::MachineDynamics;
 use super::simulate::{
     budget, cancelled, step_axes, steps_to_end, still, table_acceleration, too_long, LayerSums,
@@ -27,7 +27,7 @@ const PROGRESS_STEPS: u64 = 1 << 20;
 
 /// One run of both axes, fed its segments in time order.
 pub struct Stream<'w> {
-    axes: [Axis; 2],
+    axes: Axes,
     settings: Settings,
     welch: &'w mut Welch,
     out: Outcome,
@@ -75,10 +75,7 @@ impl<'w> Stream<'w> {
     ) -> Self {
         let ts = settings.ts;
         Stream {
-            axes: [
-                Axis::new(machine.x, ts, settings.bucket_m),
-                Axis::new(machine.y, ts, settings.bucket_m),
-            ],
+            axes: Axes::new([machine.x, machine.y], ts, settings.bucket_m),
             settings,
             welch,
             out: Outcome::new(layers.unwrap_or(0)),
@@ -213,7 +210,7 @@ impl<'w> Stream<'w> {
             .map(|(s, c)| (s.layer, *c, s.extruding));
         let (layer, counted) = here.map_or((NO_LAYER, NO_LAYER), |h| (h.0, h.1));
         if let Some((_, _, extruding)) = here {
-            let (dx, dy) = (self.axes[0].table(), self.axes[1].table());
+            let [dx, dy] = self.axes.table();
             let dev = (dx * dx + dy * dy).sqrt() * 1e3;
             self.out
                 .add_deviation(dev, [next.pos[0], next.pos[1], t1], extruding, layer);
@@ -241,7 +238,7 @@ impl<'w> Stream<'w> {
             self.since = 0;
         }
         let mut jumped = false;
-        if seg.is_none() && self.axes.iter().all(|a| still(&a.state())) {
+        if seg.is_none() && (0..2).all(|l| still(&self.axes.state(l))) {
             // At rest and still: jump to the next move (nothing changes meanwhile).
             let Some(s) = self.get(self.j).map(|s| s.0) else {
                 return Ok(false);
@@ -249,7 +246,7 @@ impl<'w> Stream<'w> {
             let resume = ((s.start_s / ts).floor() as u64).saturating_sub(1);
             if resume > self.k {
                 self.k = resume;
-                self.axes.iter_mut().for_each(Axis::rest);
+                self.axes.rest();
                 self.last_v = [0.0; 2];
                 self.since = 0;
                 jumped = true;
