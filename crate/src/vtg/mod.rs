@@ -250,6 +250,12 @@ pub fn vtg_with_progress(
         smoothings: std::sync::Mutex::new(smoothings::Smoothings::new(smoothings_bound(
             input, options,
         ))),
+        budget: firmware::SegmentBudget::for_file(
+            input,
+            path.junction_model,
+            options.min_segment_time_ms,
+        ),
+        firmware_before: std::sync::OnceLock::new(),
     };
     let first = search::Variant::default();
     // The original's simulated deviation does not depend on the rewrite: where there are
@@ -276,16 +282,11 @@ pub fn vtg_with_progress(
     }
     // The move lists and the offers kept are done with (the estimates and the firmware's
     // figures stream): on the 34 MB file the lists are 450 MB of the peak.
-    let junction_model = path.junction_model;
+    let before_figures = run.firmware_before().clone()?;
+    let budget = run.budget.clone();
     drop(run);
     drop((path, sources));
-    let mut report = with_estimates(input, report, options)?;
-    report.firmware = Some(firmware_report(
-        input,
-        &report.output,
-        junction_model,
-        options,
-    )?);
+    let report = finish(input, report, options, (budget, before_figures))?;
     progress(1.0);
     Ok(report)
 }
@@ -316,6 +317,10 @@ struct Run<'a> {
     known: std::sync::Mutex<Option<(rewrite::Offers, Vec<bool>)>>,
     /// The paths smoothed so far, for the variants that smooth them the same way.
     smoothings: std::sync::Mutex<smoothings::Smoothings>,
+    /// The machine's segment budget, and the original's figures against it once measured
+    /// ([`Run::firmware_before`]).
+    budget: firmware::SegmentBudget,
+    firmware_before: std::sync::OnceLock<Result<firmware::FirmwareFigures, Error>>,
 }
 
 impl Run<'_> {
@@ -345,7 +350,12 @@ impl Run<'_> {
             )
         };
         let (after, after_metrics) = match measured {
-            Some(after) => (after, metrics()?),
+            Some(after) => {
+                // The original's firmware figures are wanted at the end: measured here, where
+                // the other thread would be idle.
+                let (after_metrics, _) = crate::parallel::join(metrics, || self.firmware_before());
+                (after, after_metrics?)
+            }
             None => {
                 let (after, after_metrics) = crate::parallel::join(
                     || crate::analyze::analyze(&rewritten.output, &options.analyze),
@@ -363,6 +373,12 @@ impl Run<'_> {
             after_metrics,
             rewritten,
         ))
+    }
+
+    /// The original's figures against the machine's segment budget, measured once.
+    fn firmware_before(&self) -> &Result<firmware::FirmwareFigures, Error> {
+        self.firmware_before
+            .get_or_init(|| firmware::figures(self.input, &self.options.analyze, &self.budget))
     }
 
     /// The last rewrite's offers with the layers `kept` marks dropped, where it was of `variant`
@@ -451,43 +467,39 @@ impl closed_loop::Again for Retry<'_, '_> {
     }
 }
 
-/// Both files measured against the machine's segment budget ([`firmware`]), read side by
-/// side where there are threads.
-fn firmware_report(
-    input: &[u8],
-    output: &[u8],
-    junction_model: crate::plan::JunctionModel,
-    options: &VtgOptions,
-) -> Result<firmware::FirmwareReport, Error> {
-    let budget =
-        firmware::SegmentBudget::for_file(input, junction_model, options.min_segment_time_ms);
-    let (before, after) = crate::parallel::join(
-        || firmware::figures(input, &options.analyze, &budget),
-        || firmware::figures(output, &options.analyze, &budget),
-    );
-    Ok(firmware::FirmwareReport::new(budget, before?, after?))
-}
-
-/// Lines the refreshed time estimates add to the file's header ([`with_estimates`]): its note
-/// and the estimate's own line.
+/// Lines the refreshed time estimates add to the file's header ([`finish`]): its note and the
+/// estimate's own line.
 pub(crate) const ESTIMATE_HEADER_LINES: i64 = 2;
 
-/// The report with its file's time comments and `M73` lines rewritten from the planner
-/// ([`crate::estimate`]) when the toolpath changed and the options ask for it.
-fn with_estimates(
+/// The report as handed back: its file's time comments and `M73` lines rewritten from the
+/// planner ([`crate::estimate`]) when the toolpath changed and the options ask for it, and the
+/// file measured against the machine's segment budget ([`firmware`]) beside the original's
+/// `before` figures. The refreshed file's analysis and its figures are read side by side
+/// where there are threads.
+fn finish(
     input: &[u8],
     mut report: VtgReport,
     options: &VtgOptions,
+    (budget, before): (firmware::SegmentBudget, firmware::FirmwareFigures),
 ) -> Result<VtgReport, Error> {
-    if options.estimates && report.output != input {
+    let figures = |output: &[u8]| firmware::figures(output, &options.analyze, &budget);
+    let refresh = options.estimates
+        && report.output != input
+        && crate::estimate::has_estimates(&report.output);
+    let after = if refresh {
         let note = format!("vtg: corners rounded within {} mm", options.tolerance_mm);
-        if let Some((output, after)) =
-            crate::estimate::refresh(&report.output, &options.analyze, &note)?
-        {
-            report.output = output;
-            report.after = after;
-        }
-    }
+        let e = crate::estimate::rewrite_estimates(&report.output, &options.analyze, &[note])?;
+        let (analysis, after) = crate::parallel::join(
+            || crate::analyze::analyze(&e.output, &options.analyze),
+            || figures(&e.output),
+        );
+        report.after = analysis?;
+        report.output = e.output;
+        after?
+    } else {
+        figures(&report.output)?
+    };
+    report.firmware = Some(firmware::FirmwareReport::new(budget, before, after));
     Ok(report)
 }
 
