@@ -45,6 +45,7 @@ use stages::{bspline, feed, fit, kinematics, resample, thin};
 
 use serde::{Deserialize, Serialize};
 
+use crate::analyze::toolpath::ToolpathMetrics;
 use crate::analyze::{AnalyzeOptions, Report};
 use crate::error::{Error, ErrorKind};
 use crate::progress::Progress;
@@ -250,12 +251,6 @@ pub fn vtg_with_progress(
         smoothings: std::sync::Mutex::new(smoothings::Smoothings::new(smoothings_bound(
             input, options,
         ))),
-        budget: firmware::SegmentBudget::for_file(
-            input,
-            path.junction_model,
-            options.min_segment_time_ms,
-        ),
-        firmware_before: std::sync::OnceLock::new(),
     };
     let first = search::Variant::default();
     // The original's simulated deviation does not depend on the rewrite: where there are
@@ -282,11 +277,11 @@ pub fn vtg_with_progress(
     }
     // The move lists and the offers kept are done with (the estimates and the firmware's
     // figures stream): on the 34 MB file the lists are 450 MB of the peak.
-    let before_figures = run.firmware_before().clone()?;
-    let budget = run.budget.clone();
+    let budget =
+        firmware::SegmentBudget::for_file(input, path.junction_model, options.min_segment_time_ms);
     drop(run);
     drop((path, sources));
-    let report = finish(input, report, options, (budget, before_figures))?;
+    let report = finish(input, report, options, budget)?;
     progress(1.0);
     Ok(report)
 }
@@ -317,11 +312,10 @@ struct Run<'a> {
     known: std::sync::Mutex<Option<(rewrite::Offers, Vec<bool>)>>,
     /// The paths smoothed so far, for the variants that smooth them the same way.
     smoothings: std::sync::Mutex<smoothings::Smoothings>,
-    /// The machine's segment budget, and the original's figures against it once measured
-    /// ([`Run::firmware_before`]).
-    budget: firmware::SegmentBudget,
-    firmware_before: std::sync::OnceLock<Result<firmware::FirmwareFigures, Error>>,
 }
+
+/// A rewrite's metrics ([`metrics::from_input`]): the file's, and by feature.
+type Metrics = Result<(ToolpathMetrics, Vec<ToolpathMetrics>), Error>;
 
 impl Run<'_> {
     /// One rewrite tried as `variant`, the layers `kept` marks left as they are, analysed and
@@ -339,27 +333,20 @@ impl Run<'_> {
             limits,
             ..
         } = *self;
-        let (rewritten, measured) = self.rewrite(variant, kept, &before, progress)?;
         // The output's metrics streamed, not from a kept move list: rounding corners can
         // multiply the moves tenfold.
-        let metrics = || {
-            metrics::from_input(
-                &rewritten.output,
-                &options.analyze,
-                options.critical_angle_deg,
-            )
+        let metrics = |output: &[u8]| -> Metrics {
+            metrics::from_input(output, &options.analyze, options.critical_angle_deg)
         };
+        let (rewritten, measured) =
+            self.rewrite((variant, kept), &before, Some(&metrics), progress)?;
         let (after, after_metrics) = match measured {
-            Some(after) => {
-                // The original's firmware figures are wanted at the end: measured here, where
-                // the other thread would be idle.
-                let (after_metrics, _) = crate::parallel::join(metrics, || self.firmware_before());
-                (after, after_metrics?)
-            }
+            Some((after, Some(beside))) => (after, beside?),
+            Some((after, None)) => (after, metrics(&rewritten.output)?),
             None => {
                 let (after, after_metrics) = crate::parallel::join(
                     || crate::analyze::analyze(&rewritten.output, &options.analyze),
-                    metrics,
+                    || metrics(&rewritten.output),
                 );
                 (after?, after_metrics?)
             }
@@ -373,12 +360,6 @@ impl Run<'_> {
             after_metrics,
             rewritten,
         ))
-    }
-
-    /// The original's figures against the machine's segment budget, measured once.
-    fn firmware_before(&self) -> &Result<firmware::FirmwareFigures, Error> {
-        self.firmware_before
-            .get_or_init(|| firmware::figures(self.input, &self.options.analyze, &self.budget))
     }
 
     /// The last rewrite's offers with the layers `kept` marks dropped, where it was of `variant`
@@ -397,14 +378,14 @@ impl Run<'_> {
 
     /// The file rewritten as `variant`, the layers `kept` marks left as they are, within the
     /// time and lines allowed (`before`: the original's analysis), and its analysis where the
-    /// allowance measured it; progress to 0.8.
+    /// allowance measured it, with what `beside` measured of it meanwhile; progress to 0.8.
     fn rewrite(
         &self,
-        variant: search::Variant,
-        kept: &[bool],
+        (variant, kept): (search::Variant, &[bool]),
         before: &Report,
+        beside: Option<search::Beside<'_, Metrics>>,
         progress: Progress<'_>,
-    ) -> Result<(rewrite::Rewritten, Option<Report>), Error> {
+    ) -> Result<(rewrite::Rewritten, Option<search::Measured<Metrics>>), Error> {
         let mut offers = match self.known_offers(variant, kept) {
             Some(offers) => offers,
             None => {
@@ -424,7 +405,8 @@ impl Run<'_> {
         if !progress(0.8) {
             return Err(Error::new(0, 0, ErrorKind::Cancelled));
         }
-        let written = search::within_allowed_time(self.input, &offers, self.options, before);
+        let written =
+            search::within_allowed_time(self.input, &offers, (self.options, before), beside);
         if let Ok(mut known) = self.known.lock() {
             *known = Some((std::mem::take(&mut offers), kept.to_vec()));
         }
@@ -460,9 +442,9 @@ impl closed_loop::Again for Retry<'_, '_> {
         from: f64,
     ) -> Result<Vec<u8>, Error> {
         let progress = &mut *self.progress;
-        let (rewritten, _) = self
-            .run
-            .rewrite(variant, kept, before, &mut |g| progress(from + 0.05 * g))?;
+        let (rewritten, _) = self.run.rewrite((variant, kept), before, None, &mut |g| {
+            progress(from + 0.05 * g)
+        })?;
         Ok(rewritten.output)
     }
 }
@@ -480,26 +462,36 @@ fn finish(
     input: &[u8],
     mut report: VtgReport,
     options: &VtgOptions,
-    (budget, before): (firmware::SegmentBudget, firmware::FirmwareFigures),
+    budget: firmware::SegmentBudget,
 ) -> Result<VtgReport, Error> {
-    let figures = |output: &[u8]| firmware::figures(output, &options.analyze, &budget);
+    let figures = |bytes: &[u8]| firmware::figures(bytes, &options.analyze, &budget);
     let refresh = options.estimates
         && report.output != input
         && crate::estimate::has_estimates(&report.output);
-    let after = if refresh {
-        let note = format!("vtg: corners rounded within {} mm", options.tolerance_mm);
-        let e = crate::estimate::rewrite_estimates(&report.output, &options.analyze, &[note])?;
-        let (analysis, after) = crate::parallel::join(
-            || crate::analyze::analyze(&e.output, &options.analyze),
-            || figures(&e.output),
-        );
-        report.after = analysis?;
-        report.output = e.output;
-        after?
-    } else {
-        figures(&report.output)?
+    let note = format!("vtg: corners rounded within {} mm", options.tolerance_mm);
+    let (estimated, before) = crate::parallel::join(
+        || {
+            refresh
+                .then(|| {
+                    crate::estimate::rewrite_estimates(&report.output, &options.analyze, &[note])
+                })
+                .transpose()
+        },
+        || figures(input),
+    );
+    let after = match estimated? {
+        Some(e) => {
+            let (analysis, after) = crate::parallel::join(
+                || crate::analyze::analyze(&e.output, &options.analyze),
+                || figures(&e.output),
+            );
+            report.after = analysis?;
+            report.output = e.output;
+            after?
+        }
+        None => figures(&report.output)?,
     };
-    report.firmware = Some(firmware::FirmwareReport::new(budget, before, after));
+    report.firmware = Some(firmware::FirmwareReport::new(budget, before?, after));
     Ok(report)
 }
 

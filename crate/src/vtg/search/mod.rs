@@ -160,12 +160,12 @@ pub(crate) fn smooth_cut(
 /// energy (the motors, heaters and electronics run as long as the print does): where the whole
 /// file comes out dearer than `allow_more_energy_pct` allows, the allowance is cut to the time
 /// spent less the excess energy's worth of time at the print's mean power.
-pub(crate) fn within_allowed_time(
+pub(crate) fn within_allowed_time<T>(
     input: &[u8],
     offers: &rewrite::Offers,
-    options: &VtgOptions,
-    before: &Report,
-) -> Result<(rewrite::Rewritten, Option<Report>), Error> {
+    (options, before): (&VtgOptions, &Report),
+    beside: Option<Beside<'_, T>>,
+) -> Result<(rewrite::Rewritten, Option<Measured<T>>), Error> {
     // Nothing to buy (every Marlin file of the corpus): the choice is the free rewrites'.
     let allowed = if offers.has_dearer() {
         options.allow_slower_pct / 100.0 * before.time_s
@@ -181,11 +181,15 @@ pub(crate) fn within_allowed_time(
             break;
         }
         let rewritten = offers.write(input, (allowed_s, lines), mean_power_w);
-        let after = crate::analyze::analyze(&rewritten.output, &options.analyze)?;
+        let (after, alongside) = crate::parallel::join(
+            || crate::analyze::analyze(&rewritten.output, &options.analyze),
+            || beside.map(|f| f(&rewritten.output)),
+        );
+        let after = after?;
         let added = after.time_s - before.time_s;
         let over_j = after.energy.total_j - energy_cap;
         if added <= allowed && over_j <= 0.0 {
-            return Ok((rewritten, Some(after)));
+            return Ok((rewritten, Some((after, alongside))));
         }
         if added > allowed {
             allowed_s -= TUNING.time_margin * (added - allowed);
@@ -196,6 +200,14 @@ pub(crate) fn within_allowed_time(
     }
     Ok((offers.write(input, (0.0, lines), mean_power_w), None))
 }
+
+/// A rewrite's analysis, as the time allowance measured it, and what was measured beside it
+/// ([`within_allowed_time`]'s `beside`: the output's metrics, where they are wanted, read
+/// while the analysis runs, in case this round's output is the one kept).
+pub(crate) type Measured<T> = (Report, Option<T>);
+
+/// What [`within_allowed_time`] measures of each output beside its analysis.
+pub(crate) type Beside<'f, T> = &'f dyn Fn(&[u8]) -> T;
 
 /// Lines the rewrite may add to `input`: `allow_more_lines_pct` of its lines, less the header
 /// the refreshed time estimates will add where it has estimates (`crate::vtg::ESTIMATE_HEADER_LINES`), so the file as
