@@ -249,19 +249,59 @@ pub fn vibration_with_progress(
     options.validate()?;
     let (settings, fs) = simulation_settings(options);
     let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
+    let (outcome, bounds, machine, file) =
+        simulate_file(input, options, (settings, &mut welch), progress)?;
+    let of = Simulated {
+        layers: &file.layers,
+        machine: &file.profile.name,
+    };
+    Ok(report(outcome, welch, (bounds, &machine), of, options))
+}
+
+/// [`vibration`]'s deviation over printing moves, whole and per layer, alone: the same
+/// figures to the bit, without the acceleration samples, the spectrum and the modes, which
+/// only the report reads (a twentieth of a simulation's time). For optimisers that judge
+/// their rewrites by it, many times a run.
+pub fn printing_deviation(
+    input: &[u8],
+    options: &VibrationOptions,
+) -> Result<(Deviation, Vec<LayerVibration>), Error> {
+    options.validate()?;
+    let (settings, fs) = simulation_settings(options);
+    let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
+    let settings = deviation_only(settings);
+    let (outcome, _, _, file) =
+        simulate_file(input, options, (settings, &mut welch), &mut |_| true)?;
+    let deviation = Deviation::of(&outcome.printing, outcome.printing_max_at);
+    Ok((deviation, layer_vibrations(&outcome, &file.layers)))
+}
+
+/// `input` read, planned and simulated at `settings` as the planner times each move (the
+/// acceleration samples into `welch`): the run's outcome, the trajectory's bounds, the machine's
+/// dynamics and what the walk learnt of the file.
+fn simulate_file(
+    input: &[u8],
+    options: &VibrationOptions,
+    (settings, welch): (simulate::Settings, &mut welch::Welch),
+    progress: Progress<'_>,
+) -> Result<
+    (
+        simulate::Outcome,
+        trajectory::Bounds,
+        MachineDynamics,
+        crate::path::Walked,
+    ),
+    Error,
+> {
     let dynamics_for = |name: &str| options.machine_dynamics(name);
-    let sim = stream::Simulating::new(dynamics_for, (settings, &mut welch), input, progress);
+    let sim = stream::Simulating::new(dynamics_for, (settings, welch), input, progress);
     let (sim, timed, file) = timeline::of_file(input, &options.analyze, sim)?;
     if !timed {
         return Err(untimed());
     }
     let by_markers = matches!(file.layer_source, crate::read::LayerSource::Markers(_));
     let (outcome, bounds, machine) = sim.finish(file.layers.len(), by_markers)?;
-    let of = Simulated {
-        layers: &file.layers,
-        machine: &file.profile.name,
-    };
-    Ok(report(outcome, welch, (bounds, &machine), of, options))
+    Ok((outcome, bounds, machine, file))
 }
 
 /// Simulates an already extracted, planned path (for optimisers that compare their output's
@@ -355,6 +395,15 @@ fn planned_segments(path: &PrintPath) -> Result<Vec<trajectory::Segment>, Error>
 /// The error for a path extracted without the planner's timing.
 fn untimed() -> Error {
     invalid("the path has no planned timing (extract it with plan = true)")
+}
+
+/// `settings` without acceleration samples: the deviation is all a run at them measures (it
+/// does not depend on the samples).
+fn deviation_only(settings: simulate::Settings) -> simulate::Settings {
+    simulate::Settings {
+        decimation: u64::MAX,
+        ..settings
+    }
 }
 
 /// The simulation's settings for `options`, and the accelerometer rate they give, Hz.

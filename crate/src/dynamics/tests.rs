@@ -167,3 +167,35 @@ fn layers_sampled_ring_as_in_the_whole_run_when_the_machine_settles_between() {
     let none = printing_deviation_in_layers(SQUARE, &options, &[]).unwrap();
     assert_eq!(none.samples, 0);
 }
+
+#[test]
+fn the_deviation_alone_is_the_reports_to_the_bit() {
+    // Without acceleration samples the run is the same: every deviation figure, whole and per
+    // layer, as `vibration` reports it (the square with its dwell, and the bundled demo).
+    let demo = include_bytes!("../../../www/demo/demo.gcode");
+    for input in [SQUARE, &demo[..]] {
+        let options = VibrationOptions::default();
+        let r = vibration(input, &options).unwrap();
+        let (deviation, layers) = printing_deviation(input, &options).unwrap();
+        assert_eq!(deviation, r.printing_deviation_mm);
+        assert_eq!(layers.len(), r.layers.len());
+        for (a, b) in layers.iter().zip(&r.layers) {
+            assert_eq!(
+                (
+                    a.layer,
+                    a.printing_amplitude,
+                    a.printing_mean,
+                    a.printing_samples
+                ),
+                (
+                    b.layer,
+                    b.printing_amplitude,
+                    b.printing_mean,
+                    b.printing_samples
+                )
+            );
+            assert_eq!((a.amplitude, a.mean), (b.amplitude, b.mean));
+        }
+        assert!(r.layers.iter().any(|l| l.acceleration_rms > 0.0));
+    }
+}

@@ -504,20 +504,18 @@ struct LayerRinging {
 /// The dynamics model run on a file, `None` when it cannot run on it (a print too long to
 /// simulate, for instance).
 pub(super) fn printing_deviation(bytes: &[u8], options: &VtgOptions) -> Option<Simulated> {
-    let r = crate::dynamics::vibration(bytes, &vibration_options(options)).ok()?;
-    let n = r.layers.iter().map(|l| l.layer + 1).max().unwrap_or(0);
+    let (deviation, by_layer) =
+        crate::dynamics::printing_deviation(bytes, &vibration_options(options)).ok()?;
+    let n = by_layer.iter().map(|l| l.layer + 1).max().unwrap_or(0);
     let mut layers = vec![LayerRinging::default(); n];
-    for l in &r.layers {
+    for l in &by_layer {
         layers[l.layer] = LayerRinging {
             peak: l.printing_amplitude,
             sum: l.printing_mean * l.printing_samples as f64,
             samples: l.printing_samples,
         };
     }
-    Some(Simulated {
-        deviation: r.printing_deviation_mm,
-        layers,
-    })
+    Some(Simulated { deviation, layers })
 }
 
 /// The dynamics model's options for a file read as `options` read it.
