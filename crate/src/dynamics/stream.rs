@@ -25,6 +25,15 @@ use crate::progress::Progress;
 /// Steps between two progress callbacks.
 const PROGRESS_STEPS: u64 = 1 << 20;
 
+/// Where a step falls: the layers of its segment (by marker, by counting) and whether it
+/// extrudes.
+#[derive(Clone, Copy)]
+struct Here {
+    layer: u32,
+    counted: u32,
+    extruding: bool,
+}
+
 /// One run of both axes, fed its segments in time order.
 pub struct Stream<'w> {
     axes: Axes,
@@ -143,9 +152,10 @@ impl<'w> Stream<'w> {
         i.checked_sub(self.base).and_then(|w| self.window.get(w))
     }
 
-    /// Command at `t` (non-decreasing between calls) and the index of the segment it is in.
+    /// Command at `t` (non-decreasing between calls) and what the segment it is in says of
+    /// where it is.
     #[inline]
-    fn at(&mut self, t: f64) -> (Command, Option<usize>) {
+    fn at(&mut self, t: f64) -> (Command, Option<Here>) {
         while self.j < self.pushed && self.get(self.j).is_some_and(|s| s.0.end_s() <= t) {
             self.j += 1;
         }
@@ -155,7 +165,14 @@ impl<'w> Stream<'w> {
             self.base += 1;
         }
         match self.get(self.j) {
-            Some((s, _)) if t >= s.start_s => (s.command(t - s.start_s), Some(self.j)),
+            Some((s, counted)) if t >= s.start_s => {
+                let here = Here {
+                    layer: s.layer,
+                    counted: *counted,
+                    extruding: s.extruding,
+                };
+                (s.command(t - s.start_s), Some(here))
+            }
             _ => {
                 let pos = match self.j.checked_sub(1).and_then(|i| self.get(i)) {
                     Some((prev, _)) => prev.to,
@@ -179,8 +196,8 @@ impl<'w> Stream<'w> {
             if t1 >= horizon {
                 break;
             }
-            let (next, seg) = self.at(t1);
-            if !self.step(next, seg, t1)? {
+            let (next, here) = self.at(t1);
+            if !self.step(next, here, t1)? {
                 break;
             }
             if self.out.steps as f64 > 2.0 * self.most_steps {
@@ -200,16 +217,13 @@ impl<'w> Stream<'w> {
     /// One step to the command `next` at `t1`, in segment `seg`; `false` where the machine is
     /// at rest and still with no segment to come.
     #[inline]
-    fn step(&mut self, next: Command, seg: Option<usize>, t1: f64) -> Result<bool, Error> {
+    fn step(&mut self, next: Command, here: Option<Here>, t1: f64) -> Result<bool, Error> {
         let ts = self.settings.ts;
         step_axes(&mut self.axes, &self.prev, &next, ts)?;
         self.k += 1;
         self.out.steps += 1;
-        let here = seg
-            .and_then(|i| self.get(i))
-            .map(|(s, c)| (s.layer, *c, s.extruding));
-        let (layer, counted) = here.map_or((NO_LAYER, NO_LAYER), |h| (h.0, h.1));
-        if let Some((_, _, extruding)) = here {
+        let (layer, counted) = here.map_or((NO_LAYER, NO_LAYER), |h| (h.layer, h.counted));
+        if let Some(Here { extruding, .. }) = here {
             let [dx, dy] = self.axes.table();
             let dev = (dx * dx + dy * dy).sqrt() * 1e3;
             self.out
@@ -238,7 +252,7 @@ impl<'w> Stream<'w> {
             self.since = 0;
         }
         let mut jumped = false;
-        if seg.is_none() && (0..2).all(|l| still(&self.axes.state(l))) {
+        if here.is_none() && (0..2).all(|l| still(&self.axes.state(l))) {
             // At rest and still: jump to the next move (nothing changes meanwhile).
             let Some(s) = self.get(self.j).map(|s| s.0) else {
                 return Ok(false);
