@@ -141,12 +141,34 @@ pub fn refresh(
     output: &[u8],
     options: &AnalyzeOptions,
     job: &str,
-) -> Result<Option<(Vec<u8>, crate::analyze::Report)>, Error> {
+) -> Result<Option<Refreshed>, Error> {
     if !has_estimates(output) {
         return Ok(None);
     }
     let (e, after) = rewrite_and_analyze(output, options, &[job.to_string()])?;
     Ok(Some((e.output, after)))
+}
+
+/// A file with its estimates refreshed, and its analysis.
+pub type Refreshed = (Vec<u8>, crate::analyze::Report);
+
+/// [`refresh`], and `beside` measured of the file it hands back (the refreshed one, else
+/// `output`), side by side with the refreshed file's analysis where there are threads.
+pub fn refresh_beside<T>(
+    output: &[u8],
+    options: &AnalyzeOptions,
+    job: &str,
+    beside: impl Fn(&[u8]) -> T,
+) -> Result<(Option<Refreshed>, T), Error> {
+    if !has_estimates(output) {
+        return Ok((None, beside(output)));
+    }
+    let e = rewrite_estimates(output, options, &[job.to_string()])?;
+    let (after, measured) = crate::parallel::join(
+        || crate::analyze::analyze(&e.output, options),
+        || beside(&e.output),
+    );
+    Ok((Some((e.output, after?)), measured))
 }
 
 /// Puts the header after the first line when it is a comment (slicers and hosts recognise a

@@ -454,10 +454,9 @@ impl closed_loop::Again for Retry<'_, '_> {
 pub(crate) const ESTIMATE_HEADER_LINES: i64 = 2;
 
 /// The report as handed back: its file's time comments and `M73` lines rewritten from the
-/// planner ([`crate::estimate`]) when the toolpath changed and the options ask for it, and the
-/// file measured against the machine's segment budget ([`firmware`]) beside the original's
-/// `before` figures. The refreshed file's analysis and its figures are read side by side
-/// where there are threads.
+/// planner ([`crate::estimate::refresh`]) when the toolpath changed and the options ask for
+/// it, and the file measured against the machine's segment budget ([`firmware`]) beside the
+/// original's figures, each read side by side with other work where there are threads.
 fn finish(
     input: &[u8],
     mut report: VtgReport,
@@ -465,33 +464,23 @@ fn finish(
     budget: firmware::SegmentBudget,
 ) -> Result<VtgReport, Error> {
     let figures = |bytes: &[u8]| firmware::figures(bytes, &options.analyze, &budget);
-    let refresh = options.estimates
-        && report.output != input
-        && crate::estimate::has_estimates(&report.output);
     let note = format!("vtg: corners rounded within {} mm", options.tolerance_mm);
-    let (estimated, before) = crate::parallel::join(
+    let (refreshed, before) = crate::parallel::join(
         || {
-            refresh
-                .then(|| {
-                    crate::estimate::rewrite_estimates(&report.output, &options.analyze, &[note])
-                })
-                .transpose()
+            if options.estimates && report.output != input {
+                crate::estimate::refresh_beside(&report.output, &options.analyze, &note, figures)
+            } else {
+                Ok((None, figures(&report.output)))
+            }
         },
         || figures(input),
     );
-    let after = match estimated? {
-        Some(e) => {
-            let (analysis, after) = crate::parallel::join(
-                || crate::analyze::analyze(&e.output, &options.analyze),
-                || figures(&e.output),
-            );
-            report.after = analysis?;
-            report.output = e.output;
-            after?
-        }
-        None => figures(&report.output)?,
-    };
-    report.firmware = Some(firmware::FirmwareReport::new(budget, before?, after));
+    let (refreshed, after) = refreshed?;
+    if let Some((output, analysis)) = refreshed {
+        report.output = output;
+        report.after = analysis;
+    }
+    report.firmware = Some(firmware::FirmwareReport::new(budget, before?, after?));
     Ok(report)
 }
 
