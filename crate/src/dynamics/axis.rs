@@ -176,8 +176,13 @@ impl Axis {
         self.table.get(self.bucket(position_m))
     }
 
+    /// The stepper of the bucket the state is in.
+    fn current(&self) -> Option<&Stepper> {
+        self.table.get(self.current)
+    }
+
     fn modal(&self) -> Option<&ModalStepper> {
-        self.table.get(self.current)?.modal.as_ref()
+        self.current()?.modal.as_ref()
     }
 }
 
@@ -256,7 +261,7 @@ impl Axes {
 
     /// One period of axis `lane` alone (a bucket without a modal form).
     fn step_lane(&mut self, lane: usize, v: f64, a: f64) -> Option<()> {
-        let st = self.axes[lane].table.get(self.axes[lane].current)?;
+        let st = self.axes[lane].current()?;
         let mut x = lane_of(&self.z, lane);
         match &st.modal {
             Some(m) => m.step(&mut x, v, a),

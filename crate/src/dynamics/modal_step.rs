@@ -133,21 +133,13 @@ pub struct ModalPair {
 impl ModalPair {
     /// Lane `lane` takes `m`'s coefficients.
     pub fn set_lane(&mut self, lane: usize, m: &ModalStepper) {
-        for (pair, block) in self.blocks.iter_mut().zip(&m.blocks) {
-            for (p, &b) in pair.iter_mut().zip(block) {
-                p[lane] = b;
-            }
-        }
-        for (pairs, rows) in self.gamma.iter_mut().zip(&m.gamma) {
-            for (p, &g) in pairs.iter_mut().zip(rows) {
-                p[lane] = g;
-            }
-        }
-        for (pairs, rows) in self.table.iter_mut().zip(&m.table) {
-            for (p, &t) in pairs.iter_mut().zip(rows) {
-                p[lane] = t;
-            }
-        }
+        into_lane(
+            self.blocks.as_flattened_mut(),
+            m.blocks.as_flattened(),
+            lane,
+        );
+        into_lane(self.gamma.as_flattened_mut(), m.gamma.as_flattened(), lane);
+        into_lane(self.table.as_flattened_mut(), m.table.as_flattened(), lane);
     }
 
     /// One period of both axes: [`ModalStepper::step`] lane by lane.
@@ -180,6 +172,13 @@ impl ModalPair {
             }
         }
         core::array::from_fn(|l| (acc[0][l] + acc[1][l]) + (acc[2][l] + acc[3][l]))
+    }
+}
+
+/// `values` into lane `lane` of `pairs`, in order.
+fn into_lane(pairs: &mut [[f64; 2]], values: &[f64], lane: usize) {
+    for (p, &v) in pairs.iter_mut().zip(values) {
+        p[lane] = v;
     }
 }
 
