@@ -250,7 +250,7 @@ pub fn vibration_with_progress(
     let (settings, fs) = simulation_settings(options);
     let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
     let (outcome, bounds, machine, file) =
-        simulate_file(input, options, (settings, &mut welch), progress)?;
+        simulate_file(input, options, (settings, Some(&mut welch)), progress)?;
     let of = Simulated {
         layers: &file.layers,
         machine: &file.profile.name,
@@ -267,22 +267,20 @@ pub fn printing_deviation(
     options: &VibrationOptions,
 ) -> Result<(Deviation, Vec<LayerVibration>), Error> {
     options.validate()?;
-    let (settings, fs) = simulation_settings(options);
-    let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
+    let (settings, _) = simulation_settings(options);
     let settings = deviation_only(settings);
-    let (outcome, _, _, file) =
-        simulate_file(input, options, (settings, &mut welch), &mut |_| true)?;
+    let (outcome, _, _, file) = simulate_file(input, options, (settings, None), &mut |_| true)?;
     let deviation = Deviation::of(&outcome.printing, outcome.printing_max_at);
     Ok((deviation, layer_vibrations(&outcome, &file.layers)))
 }
 
 /// `input` read, planned and simulated at `settings` as the planner times each move (the
-/// acceleration samples into `welch`): the run's outcome, the trajectory's bounds, the machine's
+/// acceleration samples into `welch`, where there is one): the run's outcome, the trajectory's bounds, the machine's
 /// dynamics and what the walk learnt of the file.
 fn simulate_file(
     input: &[u8],
     options: &VibrationOptions,
-    (settings, welch): (simulate::Settings, &mut welch::Welch),
+    (settings, welch): (simulate::Settings, Option<&mut welch::Welch>),
     progress: Progress<'_>,
 ) -> Result<
     (
@@ -340,7 +338,7 @@ fn simulated(
     let (settings, fs) = simulation_settings(options);
     let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
     let layers = of.layers.len();
-    let outcome = simulate::run(segs, layers, &machine, settings, &mut welch, progress)?;
+    let outcome = simulate::run(segs, layers, &machine, settings, Some(&mut welch), progress)?;
     let bounds = trajectory::Bounds::of(segs);
     Ok(report(outcome, welch, (bounds, &machine), of, options))
 }

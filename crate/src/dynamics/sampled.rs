@@ -3,7 +3,7 @@
 
 use super::simulate::{self, Outcome, Stats};
 use super::trajectory::{self, Segment};
-use super::{deviation_only, simulation_settings, untimed, welch, Deviation, VibrationOptions};
+use super::{deviation_only, simulation_settings, untimed, Deviation, VibrationOptions};
 use crate::error::Error;
 
 /// The deviation over the printing moves of the layers `layers` marks (by layer index), each
@@ -24,11 +24,10 @@ pub fn printing_deviation_in_layers(
     let segs = segs.ok_or_else(untimed)?;
     let machine = options.machine_dynamics(&file.profile.name)?;
     let runs: Vec<&[Segment]> = segs.chunk_by(|a, b| a.layer == b.layer).collect();
-    let (settings, fs) = simulation_settings(options);
+    let (settings, _) = simulation_settings(options);
     let settings = deviation_only(settings);
     let outcomes = crate::parallel::map_each(&runs, |run| {
-        let mut welch = welch::Welch::new(options.window, fs, options.window_kind, 2);
-        simulate::run(run, 0, &machine, settings, &mut welch, &mut |_| true)
+        simulate::run(run, 0, &machine, settings, None, &mut |_| true)
     });
     let mut printing = Stats::default();
     let mut max_at = [0.0; 3];

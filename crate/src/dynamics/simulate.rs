@@ -281,13 +281,13 @@ fn model_error() -> Error {
 }
 
 /// Simulates X and Y over `segs`, pushing the table's acceleration (m/s², X and Y) into
-/// `welch` every `decimation` steps.
+/// `welch` every `decimation` steps (`None`: a deviation-only run, no spectrum kept).
 pub fn run(
     segs: &[Segment],
     layers: usize,
     machine: &MachineDynamics,
     settings: Settings,
-    welch: &mut Welch,
+    welch: Option<&mut Welch>,
     progress: Progress<'_>,
 ) -> Result<Outcome, Error> {
     let (total, _) = step_budget(segs, settings.ts)?;

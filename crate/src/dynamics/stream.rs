@@ -38,7 +38,8 @@ struct Here {
 pub struct Stream<'w> {
     axes: Axes,
     settings: Settings,
-    welch: &'w mut Welch,
+    /// The spectrum's estimator (`None`: a deviation-only run, which samples no acceleration).
+    welch: Option<&'w mut Welch>,
     out: Outcome,
     /// Per-layer sums by the layer each segment has by counting, where the file's layers are
     /// not yet known to come from its markers and their count is known only at the end (`None`:
@@ -79,7 +80,7 @@ impl<'w> Stream<'w> {
     pub fn new(
         machine: &MachineDynamics,
         settings: Settings,
-        welch: &'w mut Welch,
+        welch: Option<&'w mut Welch>,
         (layers, max_segments, total): (Option<usize>, usize, Option<u64>),
     ) -> Self {
         let ts = settings.ts;
@@ -240,7 +241,9 @@ impl<'w> Stream<'w> {
         if self.since >= self.settings.decimation {
             let dt = self.since as f64 * ts;
             let acc = table_acceleration(&next, &self.axes, &mut self.last_v, dt);
-            self.welch.push(&acc);
+            if let Some(welch) = self.welch.as_deref_mut() {
+                welch.push(&acc);
+            }
             self.out.add_acceleration(&acc, layer);
             if let Some(l) = self
                 .counted
@@ -326,7 +329,7 @@ impl<'w, 'p, F: FnOnce(&str) -> Result<MachineDynamics, Error>> Simulating<'w, '
     /// `dynamics_for` (given the machine preset's name).
     pub(super) fn new(
         dynamics_for: F,
-        (settings, welch): (Settings, &'w mut Welch),
+        (settings, welch): (Settings, Option<&'w mut Welch>),
         input: &[u8],
         progress: Progress<'p>,
     ) -> Self {
@@ -335,7 +338,7 @@ impl<'w, 'p, F: FnOnce(&str) -> Result<MachineDynamics, Error>> Simulating<'w, '
         Simulating {
             dynamics_for: Some(dynamics_for),
             settings,
-            welch: Some(welch),
+            welch,
             stream: None,
             machine: None,
             max_segments,
@@ -391,10 +394,10 @@ impl<F: FnOnce(&str) -> Result<MachineDynamics, Error>> Emit for Simulating<'_, 
     }
 
     fn machine(&mut self, profile: &MachineProfile) {
-        let (Some(dynamics_for), Some(welch)) = (self.dynamics_for.take(), self.welch.take())
-        else {
+        let Some(dynamics_for) = self.dynamics_for.take() else {
             return;
         };
+        let welch = self.welch.take();
         match dynamics_for(&profile.name) {
             Ok(machine) => {
                 let sizes = (None, self.max_segments, None);
