@@ -343,6 +343,13 @@ impl Run<'_> {
         let (after, after_metrics) = match measured {
             Some((after, Some(beside))) => (after, beside?),
             Some((after, None)) => (after, metrics(&rewritten.output)?),
+            // Without the model this report is the last, and [`finish`] analyses the file with
+            // its estimates refreshed, the one handed back, and fills `after` and Table 2 from
+            // that: an analysis of this one would be thrown away (on the 34 MB file, a whole
+            // pass on both cores). Until then `after` is the original's.
+            None if !options.dynamics && refreshes(options, self.input, &rewritten.output) => {
+                (before.clone(), metrics(&rewritten.output)?)
+            }
             None => {
                 let (after, after_metrics) = crate::parallel::join(
                     || crate::analyze::analyze(&rewritten.output, &options.analyze),
@@ -449,6 +456,12 @@ impl closed_loop::Again for Retry<'_, '_> {
     }
 }
 
+/// Whether [`finish`] rewrites the time estimates of `output` (the rewrite of `input`) and
+/// analyses the file it writes.
+fn refreshes(options: &VtgOptions, input: &[u8], output: &[u8]) -> bool {
+    options.estimates && output != input && crate::estimate::has_estimates(output)
+}
+
 /// Lines the refreshed time estimates add to the file's header ([`finish`]): its note and the
 /// estimate's own line.
 pub(crate) const ESTIMATE_HEADER_LINES: i64 = 2;
@@ -467,7 +480,7 @@ fn finish(
     let note = format!("vtg: corners rounded within {} mm", options.tolerance_mm);
     let (refreshed, before) = crate::parallel::join(
         || {
-            if options.estimates && report.output != input {
+            if refreshes(options, input, &report.output) {
                 crate::estimate::refresh_beside(&report.output, &options.analyze, &note, figures)
             } else {
                 Ok((None, figures(&report.output)))
@@ -478,6 +491,7 @@ fn finish(
     let (refreshed, after) = refreshed?;
     if let Some((output, analysis)) = refreshed {
         report.output = output;
+        report.table2 = report::table2(&report.before, &analysis, report.table2.deviation);
         report.after = analysis;
     }
     report.firmware = Some(firmware::FirmwareReport::new(budget, before?, after?));
@@ -487,6 +501,25 @@ fn finish(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Without the model, the report's `after` and Table 2 are the analysis of the file handed
+    /// back, estimates refreshed, whether or not the rewrite was analysed before the refresh.
+    #[test]
+    fn the_report_analyses_the_file_handed_back() {
+        let demo = include_bytes!("../../../www/demo/demo.gcode");
+        let options = VtgOptions {
+            dynamics: false,
+            ..VtgOptions::default()
+        };
+        let r = vtg(demo, &options).unwrap();
+        assert!(crate::estimate::has_estimates(&r.output) && r.output != demo);
+        let written = crate::analyze::analyze(&r.output, &options.analyze).unwrap();
+        assert_eq!(r.after, written);
+        assert_eq!(r.table2.time_s.after, written.time_s);
+        assert_eq!(r.table2.energy_j.after, written.energy.total_j);
+        assert_eq!(r.table2.material_g.after, written.material_g);
+        assert_ne!(r.after, r.before);
+    }
 
     #[test]
     fn out_of_range_options_are_refused_by_name() {

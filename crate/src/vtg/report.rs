@@ -198,6 +198,24 @@ pub struct VtgReport {
     pub output: Vec<u8>,
 }
 
+/// Table 2 of the analyses `before` and `after`, with the dynamics model's `deviation` rows
+/// where it ran.
+pub(crate) fn table2(
+    before: &Report,
+    after: &Report,
+    deviation: Option<DeviationComparison>,
+) -> Table2 {
+    let c = Comparison::new;
+    Table2 {
+        deviation,
+        energy_j: c(before.energy.total_j, after.energy.total_j),
+        servo_energy_j: c(before.energy.servo_j, after.energy.servo_j),
+        material_g: c(before.material_g, after.material_g),
+        co2_g: c(before.energy.co2_g, after.energy.co2_g),
+        time_s: c(before.time_s, after.time_s),
+    }
+}
+
 /// Assembles the report.
 pub(crate) fn build(
     options: &VtgOptions,
@@ -219,14 +237,7 @@ pub(crate) fn build(
         mean_turn_deg: c(mb.mean_turn_deg, ma.mean_turn_deg),
         mean_chord_error_mm: c(mb.mean_chord_error_mm, ma.mean_chord_error_mm),
     };
-    let table2 = Table2 {
-        deviation: None,
-        energy_j: c(before.energy.total_j, after.energy.total_j),
-        servo_energy_j: c(before.energy.servo_j, after.energy.servo_j),
-        material_g: c(before.material_g, after.material_g),
-        co2_g: c(before.energy.co2_g, after.energy.co2_g),
-        time_s: c(before.time_s, after.time_s),
-    };
+    let table2 = table2(&before, &after, None);
     let layers = lb
         .into_iter()
         .zip(la)
