@@ -275,8 +275,8 @@ pub fn printing_deviation(
 }
 
 /// `input` read, planned and simulated at `settings` as the planner times each move (the
-/// acceleration samples into `welch`, where there is one): the run's outcome, the trajectory's bounds, the machine's
-/// dynamics and what the walk learnt of the file.
+/// acceleration samples into `welch`, where there is one): the run's outcome, the
+/// trajectory's bounds, the machine's dynamics and what the walk learnt of the file.
 fn simulate_file(
     input: &[u8],
     options: &VibrationOptions,

@@ -345,8 +345,8 @@ impl Run<'_> {
             Some((after, None)) => (after, metrics(&rewritten.output)?),
             // Without the model this report is the last, and [`finish`] analyses the file with
             // its estimates refreshed, the one handed back, and fills `after` and Table 2 from
-            // that: an analysis of this one would be thrown away (on the 34 MB file, a whole
-            // pass on both cores). Until then `after` is the original's.
+            // that: an analysis of this one would be thrown away (a planning pass over the
+            // whole output). Until then `after` is the original's.
             None if !options.dynamics && refreshes(options, self.input, &rewritten.output) => {
                 (before.clone(), metrics(&rewritten.output)?)
             }
