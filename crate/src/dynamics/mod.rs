@@ -268,7 +268,6 @@ pub fn printing_deviation(
 ) -> Result<(Deviation, Vec<LayerVibration>), Error> {
     options.validate()?;
     let (settings, _) = simulation_settings(options);
-    let settings = deviation_only(settings);
     let (outcome, _, _, file) = simulate_file(input, options, (settings, None), &mut |_| true)?;
     let deviation = Deviation::of(&outcome.printing, outcome.printing_max_at);
     Ok((deviation, layer_vibrations(&outcome, &file.layers)))
@@ -393,15 +392,6 @@ fn planned_segments(path: &PrintPath) -> Result<Vec<trajectory::Segment>, Error>
 /// The error for a path extracted without the planner's timing.
 fn untimed() -> Error {
     invalid("the path has no planned timing (extract it with plan = true)")
-}
-
-/// `settings` without acceleration samples: the deviation is all a run at them measures (it
-/// does not depend on the samples).
-fn deviation_only(settings: simulate::Settings) -> simulate::Settings {
-    simulate::Settings {
-        decimation: u64::MAX,
-        ..settings
-    }
 }
 
 /// The simulation's settings for `options`, and the accelerometer rate they give, Hz.

@@ -3,7 +3,7 @@
 
 use super::simulate::{self, Outcome, Stats};
 use super::trajectory::{self, Segment};
-use super::{deviation_only, simulation_settings, untimed, Deviation, VibrationOptions};
+use super::{simulation_settings, untimed, Deviation, VibrationOptions};
 use crate::error::Error;
 
 /// The deviation over the printing moves of the layers `layers` marks (by layer index), each
@@ -25,7 +25,6 @@ pub fn printing_deviation_in_layers(
     let machine = options.machine_dynamics(&file.profile.name)?;
     let runs: Vec<&[Segment]> = segs.chunk_by(|a, b| a.layer == b.layer).collect();
     let (settings, _) = simulation_settings(options);
-    let settings = deviation_only(settings);
     let outcomes = crate::parallel::map_each(&runs, |run| {
         simulate::run(run, 0, &machine, settings, None, &mut |_| true)
     });

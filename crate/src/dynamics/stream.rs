@@ -38,7 +38,8 @@ struct Here {
 pub struct Stream<'w> {
     axes: Axes,
     settings: Settings,
-    /// The spectrum's estimator (`None`: a deviation-only run, which samples no acceleration).
+    /// The spectrum's estimator (`None`: a deviation-only run, which samples no acceleration:
+    /// the deviation does not depend on the samples).
     welch: Option<&'w mut Welch>,
     out: Outcome,
     /// Per-layer sums by the layer each segment has by counting, where the file's layers are
@@ -238,12 +239,14 @@ impl<'w> Stream<'w> {
             }
         }
         self.since += 1;
-        if self.since >= self.settings.decimation {
+        let sampling = self
+            .welch
+            .as_deref_mut()
+            .filter(|_| self.since >= self.settings.decimation);
+        if let Some(welch) = sampling {
             let dt = self.since as f64 * ts;
             let acc = table_acceleration(&next, &self.axes, &mut self.last_v, dt);
-            if let Some(welch) = self.welch.as_deref_mut() {
-                welch.push(&acc);
-            }
+            welch.push(&acc);
             self.out.add_acceleration(&acc, layer);
             if let Some(l) = self
                 .counted
