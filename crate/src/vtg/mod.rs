@@ -480,7 +480,9 @@ fn finish(
     let note = format!("vtg: corners rounded within {} mm", options.tolerance_mm);
     let (refreshed, before) = crate::parallel::join(
         || {
-            if refreshes(options, input, &report.output) {
+            // `refreshes`, with its last condition left to `refresh_beside`, which asks it
+            // anyway (on a file without estimates it reads every line).
+            if options.estimates && report.output != input {
                 crate::estimate::refresh_beside(&report.output, &options.analyze, &note, figures)
             } else {
                 Ok((None, figures(&report.output)))
