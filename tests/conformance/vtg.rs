@@ -436,9 +436,11 @@ fn the_dynamics_model_closes_the_loop() {
 }
 
 /// `inside_corners` keeps every corner on the inside line: on the thesis triangle, whose infill
-/// tips then take keyhole loops that ring more than the stops they replace (so the closed loop
-/// drops them) where the racing line rounds them quietly, fewer sharp corners go; both stay
-/// within the tolerance.
+/// tips the racing line rounds with room to spare and the inside line only within loops or not
+/// at all, fewer sharp corners go; both stay within the tolerance. Geometry alone, without the
+/// dynamics model: its verdict on the inside line is a tie (the quietest rewrite's simulated
+/// peak within 0.3 % of the original's, either side of it as the walk's steps change by a
+/// few hundredths of a millimetre), and the rule it keeps has tests of its own.
 #[test]
 fn inside_corners_round_fewer_than_the_racing_line() {
     let bytes = std::fs::read(fixtures_dir().join("gcode/prusaslicer-2.5.0_thesis_triangle.gcode"))
@@ -448,6 +450,7 @@ fn inside_corners_round_fewer_than_the_racing_line() {
             &bytes,
             &VtgOptions {
                 inside_corners,
+                dynamics: false,
                 ..rounding()
             },
         )

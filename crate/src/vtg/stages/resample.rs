@@ -5,8 +5,9 @@
 //! The paper leaves `L_i` open; here it is what a CAM interpolator would pick: the longest step
 //! whose chord stays within the chord tolerance of the curve (sagitta `L²κ/8 ≤ δ`) and turns by
 //! at most a fraction of the critical angle (`κ·L ≤ θ_step`, so a rounded corner is walked in
-//! several gentle turns instead of one sharp one), checked on the stretch the step covers and
-//! halved until it holds. Line 2 of Algorithm 1 has `⟨C', C'⟩` where VTG eq. 27 has `⟨C', C''⟩`;
+//! several gentle turns instead of one sharp one). It is first guessed from the curvature
+//! sampled ahead ([`CurvatureIndex::longest_step`]), then checked on the stretch the step
+//! covers; where it does not hold, halved and bisected until it does. Line 2 of Algorithm 1 has `⟨C', C'⟩` where VTG eq. 27 has `⟨C', C''⟩`;
 //! VTG eq. 27 is used. Line 5's `F` is the step error `‖C(u) − P_i‖ − L_i`, and the damping `φ` of
 //! the paper scales the Newton step. Points are taken on the curve (`P_{i+1} = C(u_{i+1})`),
 //! which line 11 also gives once Newton has converged.
@@ -171,7 +172,11 @@ impl Walker<'_> {
         let kappa = e.curvature();
         // No longer than what is left of the curve (a closed loop ends near its start).
         let left = (u_end - u) * norm(e.d1) * 1.05;
-        let mut step = step_for(kappa, w).min(left).max(w.min_step_mm);
+        let (guess, mut sure) = match self.index.longest_step(u, p, kappa, w) {
+            Some((guess, sure)) => (guess, Some(sure)),
+            None => (step_for(kappa, w), None),
+        };
+        let mut step = guess.min(left).max(w.min_step_mm);
         let remaining = norm(sub(self.end_p, p));
         // The shortest step tried that did not fit.
         let mut too_long: Option<f64> = None;
@@ -206,6 +211,11 @@ impl Walker<'_> {
             );
             if floor {
                 break;
+            }
+            // The surer step from the curvature samples, if the guess was longer.
+            if let Some(s) = sure.take().filter(|&s| s < step) {
+                step = s.max(w.min_step_mm);
+                continue;
             }
             step = (0.5 * step)
                 .min(step_for(k, w).max(0.25 * step))
@@ -298,6 +308,8 @@ pub(crate) struct CurvatureIndex {
     /// Curvature of span `i` (`breaks[i]..breaks[i+1]`) at `SPAN_SAMPLES` equally spaced
     /// points, ends included.
     samples: Vec<[f64; SPAN_SAMPLES]>,
+    /// The curve's points there.
+    points: Vec<[[f64; 3]; SPAN_SAMPLES]>,
     /// Largest of each span's samples.
     span_max: Vec<f64>,
 }
@@ -314,14 +326,20 @@ impl CurvatureIndex {
                 breaks.push(k);
             }
         }
-        let samples: Vec<[f64; SPAN_SAMPLES]> = breaks
+        let evals: Vec<[Eval; SPAN_SAMPLES]> = breaks
             .windows(2)
             .map(|w| {
                 std::array::from_fn(|i| {
                     let t = i as f64 / (SPAN_SAMPLES - 1) as f64;
-                    curve.eval(w[0] + (w[1] - w[0]) * t).curvature()
+                    curve.eval(w[0] + (w[1] - w[0]) * t)
                 })
             })
+            .collect();
+        let samples: Vec<[f64; SPAN_SAMPLES]> = (evals.iter())
+            .map(|e| std::array::from_fn(|i| e[i].curvature()))
+            .collect();
+        let points = (evals.iter())
+            .map(|e| std::array::from_fn(|i| e[i].p))
             .collect();
         let span_max = samples
             .iter()
@@ -330,8 +348,46 @@ impl CurvatureIndex {
         Self {
             breaks,
             samples,
+            points,
             span_max,
         }
+    }
+
+    /// The longest step from `p` (parameter `u`, curvature `kappa` there) that the sampled
+    /// curvature ahead allows, and a shorter one that is surer to fit; `None` when no sample
+    /// ahead stops the step (the end decides). The samples are met in order, each raising the
+    /// largest curvature seen, until one lies farther from `p` than the step that curvature
+    /// allows. The step ends between it and the last sample that fitted: where the curvature
+    /// taken as rising linearly between the two allows exactly the step (the guess), or
+    /// where the failing sample's curvature allows it (the surer step). Both are first
+    /// tries for the walk, checked as any other: on a corner they spare the halving and
+    /// bisection that would otherwise find that length.
+    pub(crate) fn longest_step(
+        &self,
+        u: f64,
+        p: &[f64; 3],
+        kappa: f64,
+        w: &Walk,
+    ) -> Option<(f64, f64)> {
+        let first = self.breaks.partition_point(|&k| k <= u).saturating_sub(1);
+        let (mut k_max, mut reached) = (kappa, 0.0f64);
+        for i in first..self.samples.len() {
+            let (s0, s1) = (self.breaks[i], self.breaks[i + 1]);
+            for j in 0..SPAN_SAMPLES {
+                let at = s0 + (s1 - s0) * j as f64 / (SPAN_SAMPLES - 1) as f64;
+                if at <= u {
+                    continue;
+                }
+                let (k_before, k_here) = (k_max, k_max.max(self.samples[i][j]));
+                let chord = norm(sub(self.points[i][j], *p));
+                if chord > step_for(k_here, w) {
+                    let sure = step_for(k_here, w).max(reached);
+                    return Some((crossing([reached, chord], [k_before, k_here], w), sure));
+                }
+                (k_max, reached) = (k_here, chord);
+            }
+        }
+        None
     }
 
     /// Largest curvature on `[a, b]`.
@@ -381,6 +437,26 @@ impl CurvatureIndex {
         }
         best
     }
+}
+
+/// The step `L` in `[a, b]` that the curvature allows exactly, the curvature rising linearly
+/// from `k[0]` at `a` to `k[1]` at `b` (`a` fits, `b` does not): bisected to a thousandth
+/// of the bracket, from below.
+fn crossing([mut a, mut b]: [f64; 2], k: [f64; 2], w: &Walk) -> f64 {
+    let (from, span) = (a, b - a);
+    if span <= 0.0 {
+        return a;
+    }
+    for _ in 0..10 {
+        let mid = 0.5 * (a + b);
+        let k_mid = k[0] + (k[1] - k[0]) * (mid - from) / span;
+        if mid <= step_for(k_mid, w) {
+            a = mid;
+        } else {
+            b = mid;
+        }
+    }
+    a
 }
 
 /// VTG eq. 27 predictor and Newton corrector: `u` past `u_i` with `‖C(u) − P_i‖ = L`; `e` is the
@@ -463,6 +539,62 @@ mod tests {
             }
         }
         assert_eq!(s.last().unwrap().p, [10.0, 10.0, 0.2]);
+    }
+
+    /// On a circle (a quarter of radius `R` as an exact rational cubic: the quadratic arc with
+    /// weights 1, √2/2, 1 raised by one degree) the curvature is `1/R` everywhere: the first
+    /// guess is the step that curvature allows (the chord bound `√(8δR)` here, under the turn
+    /// bound `θR`), and the walk takes steps of that length.
+    #[test]
+    fn the_first_guess_on_a_circle_is_the_step_its_curvature_allows() {
+        let r = 10.0;
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let w1 = (1.0 + 2.0 * h) / 3.0;
+        let ctrl = vec![
+            [r, 0.0, 0.2],
+            [r, r * 2.0 * h / (3.0 * w1), 0.2],
+            [r * 2.0 * h / (3.0 * w1), r, 0.2],
+            [0.0, r, 0.2],
+        ];
+        let knots = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        let curve = Curve::rational(knots, ctrl, vec![1.0, w1, w1, 1.0]);
+        for u in [0.0, 0.3, 0.7, 1.0] {
+            let e = curve.eval(u);
+            assert!((e.p[0].hypot(e.p[1]) - r).abs() < 1e-9);
+            assert!((e.curvature() - 1.0 / r).abs() < 1e-9);
+        }
+        let w = Walk {
+            chord_tol_mm: 0.01,
+            max_turn_rad: 0.5,
+            max_step_mm: 1e4,
+            min_step_mm: 0.03,
+            phi: 1.0,
+            newton_tol_mm: 1e-7,
+        };
+        let expected = (8.0 * w.chord_tol_mm * r).sqrt();
+        assert!(expected < w.max_turn_rad * r);
+        let index = CurvatureIndex::new(&curve);
+        let e = curve.eval(curve.start());
+        let (guess, sure) = index
+            .longest_step(curve.start(), &e.p, e.curvature(), &w)
+            .unwrap();
+        assert!(
+            (guess - expected).abs() < 0.02 * expected,
+            "{guess} vs {expected}"
+        );
+        assert!(
+            (sure - expected).abs() < 0.02 * expected,
+            "{sure} vs {expected}"
+        );
+        let mut st = WalkStats::default();
+        let s = walk_curve(&curve, &w, &mut st).unwrap();
+        for x in &s[1..s.len() - 1] {
+            assert!(
+                (x.step_mm - expected).abs() < 0.03 * expected,
+                "{}",
+                x.step_mm
+            );
+        }
     }
 
     /// Property tests (proptest is a native-only dev-dependency).
