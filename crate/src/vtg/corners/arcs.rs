@@ -237,6 +237,34 @@ pub(crate) fn pieces(
     out
 }
 
+/// An upper bound of the distance between each arc of `pieces` and the run of `pts` it
+/// replaces, both ways, mm (0 without arcs). A run's points lie on its circle's side within
+/// the fit, in order of angle (every step turns one way, by less than a quarter turn), so over
+/// the angles of each chord both the chord and the arc cross every ray from the centre once:
+/// the two are no farther apart than the chord's farthest radius beyond the arc's, or its
+/// nearest approach to the centre within it (the exact distance from the centre to the
+/// chord). The path with its arcs is then within this of the polyline, whose own distance to
+/// the original is measured on far fewer points than the arcs flattened finely would take.
+pub(crate) fn offset_bound(pts: &[[f64; 3]], pieces: &[Piece]) -> f64 {
+    let mut worst = 0.0f64;
+    let mut start = 0usize;
+    for piece in pieces {
+        let run = pts.get(start..=piece.end).unwrap_or(&[]);
+        start = piece.end;
+        let (Some(shape), Some(first)) = (piece.arc, run.first()) else {
+            continue;
+        };
+        let c = [shape.center[0], shape.center[1], first[2]];
+        let radius = (first[0] - c[0]).hypot(first[1] - c[1]);
+        for w in run.windows(2) {
+            let outward = norm(sub(w[0], c)).max(norm(sub(w[1], c))) - radius;
+            let inward = radius - crate::vtg::deviation::point_segment(&c, &w[0], &w[1]);
+            worst = worst.max(outward).max(inward);
+        }
+    }
+    worst
+}
+
 /// The pieces as a polyline for measuring: arcs sampled so no chord is more than `sagitta` from
 /// its arc.
 pub(crate) fn flatten(pts: &[[f64; 3]], pieces: &[Piece], sagitta: f64) -> Vec<[f64; 3]> {
@@ -298,6 +326,36 @@ mod tests {
         for q in flatten(&pts, &p, 1e-4) {
             assert!(((q[0] - 10.0).hypot(q[1] - 20.0) - 2.0).abs() < 1e-9);
         }
+    }
+
+    /// Points on the circle `Δ` apart: the chords' sagitta `R(1 − cos(Δ/2))`; a point pushed
+    /// out by `f` adds its offset. And the bound holds against the arcs flattened finely and
+    /// the polyline, both ways (sampled densely).
+    #[test]
+    fn the_offset_bound_is_the_sagitta_and_holds_against_the_flattened_arcs() {
+        let (r, n) = (2.0, 6);
+        let pts = on_circle([10.0, 20.0], r, 0.0, 1.5, n);
+        let p = pieces(&pts, &[30.0; 6], 0.005, &FINE);
+        assert!(p.len() == 1 && p[0].arc.is_some());
+        let sagitta = r * (1.0 - (0.5 * 1.5 / n as f64).cos());
+        assert!((offset_bound(&pts, &p) - sagitta).abs() < 1e-9);
+        assert_eq!(offset_bound(&pts, &lines(&[30.0; 6])), 0.0);
+        // The middle point pushed out by 0.004 mm.
+        let mut out = pts.clone();
+        let k = (r + 0.004) / r;
+        out[3] = [
+            10.0 + (out[3][0] - 10.0) * k,
+            20.0 + (out[3][1] - 20.0) * k,
+            0.2,
+        ];
+        let p = pieces(&out, &[30.0; 6], 0.005, &FINE);
+        assert!(p.len() == 1 && p[0].arc.is_some(), "{p:?}");
+        let bound = offset_bound(&out, &p);
+        assert!(bound >= 0.004 - 1e-12, "{bound}");
+        let arc = flatten(&out, &p, 1e-6);
+        let measured = crate::vtg::deviation::both_ways(&arc, &out, 1e-4, 0.0);
+        assert!(measured <= bound + 1e-4, "{measured} vs {bound}");
+        assert!(measured >= 0.5 * bound, "{measured} vs {bound}");
     }
 
     #[test]

@@ -1043,6 +1043,16 @@ pub(super) fn fit_arcs(
     if pieces.iter().all(|p| p.arc.is_none()) {
         return None;
     }
+    // The arcs' own offset from the polyline plus the polyline's distance from the original
+    // bound the distance sought (the triangle inequality); where that is not within the
+    // tolerance, the arcs are flattened finely and measured themselves.
+    let off = arcs::offset_bound(all, &pieces);
+    if off < tol {
+        let near = both_ways(all, orig, tol / 10.0, tol - off);
+        if near + off <= tol {
+            return Some((pieces, near + off));
+        }
+    }
     let d = both_ways(
         &arcs::flatten(all, &pieces, 0.01 * tol),
         orig,
