@@ -174,6 +174,23 @@ impl Curve {
         span
     }
 
+    /// The point in knot span `span` whose degree-3 basis functions are `n3` (as
+    /// [`basis_by_degree`] gives them): [`Curve::eval`]'s point, to the bit, for a caller that
+    /// already has the basis (the fit, at its data). Non-rational curves only.
+    pub(crate) fn point_in_span(&self, span: usize, n3: &[f64; 4]) -> Option<[f64; 3]> {
+        if self.weights.is_some() || self.knots.len() != self.ctrl.p.len() + DEGREE + 1 {
+            return None;
+        }
+        let pts = self.ctrl.p.get(span.checked_sub(DEGREE)?..=span)?;
+        let mut out = [0.0; 3];
+        for (wi, pt) in n3.iter().zip(pts) {
+            for k in 0..3 {
+                out[k] += wi * pt[k];
+            }
+        }
+        Some(out)
+    }
+
     /// Knot vector.
     pub(crate) fn knots(&self) -> &[f64] {
         &self.knots

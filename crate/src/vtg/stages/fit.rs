@@ -48,7 +48,7 @@ pub(crate) fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit>
     }
     knots.extend([u1; DEGREE + 1]);
     for _ in 0..TUNING.fit_rounds {
-        let curve = solve(data, params, &knots)?;
+        let (curve, bases) = solve(data, params, &knots)?;
         let mut worst = 0.0f64;
         let mut bad_spans: Vec<usize> = Vec::new();
         let last = curve.ctrl().len() - 1;
@@ -56,8 +56,11 @@ pub(crate) fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit>
         // on one segment of the polyline, so the midpoint is on it too): ringing between data
         // points is caught as well. In parameter order, so each evaluation finds its span
         // where the last one was.
-        let mut check = |q: &[f64; 3], u: f64| {
-            let r = norm(sub(curve.eval(u).p, q));
+        // At the data the basis is the one the solve weighed them with: the same point as
+        // evaluating there, to the bit, without computing the basis again.
+        let mut check = |q: &[f64; 3], u: f64, basis: Option<&Basis>| {
+            let at = basis.and_then(|(span, n3)| curve.point_in_span(*span, n3));
+            let r = norm(sub(at.unwrap_or_else(|| curve.eval(u).p), q));
             worst = worst.max(r);
             if r > tol_mm {
                 let s = find_span(&knots, last, u);
@@ -66,15 +69,19 @@ pub(crate) fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit>
                 }
             }
         };
-        check(&data[0], params[0]);
-        for (q, u) in data.windows(2).zip(params.windows(2)) {
+        check(&data[0], params[0], bases.first());
+        for ((q, u), basis) in data
+            .windows(2)
+            .zip(params.windows(2))
+            .zip(bases.iter().skip(1))
+        {
             let mid = [
                 0.5 * (q[0][0] + q[1][0]),
                 0.5 * (q[0][1] + q[1][1]),
                 0.5 * (q[0][2] + q[1][2]),
             ];
-            check(&mid, 0.5 * (u[0] + u[1]));
-            check(&q[1], u[1]);
+            check(&mid, 0.5 * (u[0] + u[1]), None);
+            check(&q[1], u[1], Some(basis));
         }
         if !worst.is_finite() {
             return None;
@@ -108,7 +115,7 @@ pub(crate) fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit>
 /// The least-squares control points for fixed knots (A9.7's normal equations `NᵀN P = NᵀR`,
 /// band width 3, end points fixed), with a tiny penalty on the control polygon's second
 /// differences so spans without data stay determined.
-fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<Curve> {
+fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<(Curve, Vec<Basis>)> {
     let count = knots.len().checked_sub(DEGREE + 1)?;
     if count < DEGREE + 1 {
         return None;
@@ -124,9 +131,11 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<Curve> {
     };
     let mut add_row = |coef: &[(usize, f64)], target: [f64; 3]| eq.add_row(coef, target);
     let inv = reciprocals(knots);
+    let mut bases = Vec::with_capacity(data.len());
     for (q, &u) in data.iter().zip(params) {
         let span = find_span(knots, n, u);
         let b = basis_by_degree(knots, inv.get(span)?, span, u)[2];
+        bases.push((span, b));
         let coef: [(usize, f64); 4] = [
             (span - 3, b[0]),
             (span - 2, b[1]),
@@ -164,8 +173,11 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<Curve> {
     ctrl.push(q0);
     ctrl.extend(x);
     ctrl.push(qm);
-    Some(Curve::new(knots.to_vec(), ctrl))
+    Some((Curve::new(knots.to_vec(), ctrl), bases))
 }
+
+/// A datum's knot span and degree-3 basis functions, as [`solve`] weighed it.
+type Basis = (usize, [f64; 4]);
 
 /// The normal equations of [`solve`] being built: the band of `NᵀN` and `NᵀR` over the inner
 /// control points (the end points, fixed, are moved to the right-hand side).
@@ -345,5 +357,38 @@ mod tests {
         let c = f.curve.eval(10.0).p;
         let off = norm(sub(c, [10.0, 0.0, 0.2]));
         assert!(off > 0.03 && off <= 0.05, "{off}");
+    }
+
+    /// The residual check at the data reads the point off the solve's own basis: the same
+    /// bits as evaluating the curve there.
+    #[test]
+    fn the_point_from_the_solves_basis_is_the_evaluated_point() {
+        let pts = [
+            [0.0, 0.0, 0.2],
+            [10.0, 0.0, 0.2],
+            [10.0, 10.0, 0.2],
+            [3.0, 12.0, 0.2],
+        ];
+        let (d, u) = blended(&pts, 0.04);
+        let (start, end) = (u[0], *u.last().unwrap());
+        let inner = u
+            .iter()
+            .copied()
+            .step_by(3)
+            .filter(|&k| k > start && k < end);
+        let knots: Vec<f64> = [start; DEGREE + 1]
+            .into_iter()
+            .chain(inner)
+            .chain([end; DEGREE + 1])
+            .collect();
+        let (curve, bases) = solve(&d, &u, &knots).unwrap();
+        assert_eq!(bases.len(), d.len());
+        for (&at, (span, n3)) in u.iter().zip(&bases) {
+            assert_eq!(
+                curve.point_in_span(*span, n3),
+                Some(curve.eval(at).p),
+                "{at}"
+            );
+        }
     }
 }
