@@ -49,40 +49,7 @@ pub(crate) fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit>
     knots.extend([u1; DEGREE + 1]);
     for _ in 0..TUNING.fit_rounds {
         let (curve, bases) = solve(data, params, &knots)?;
-        let mut worst = 0.0f64;
-        let mut bad_spans: Vec<usize> = Vec::new();
-        let last = curve.ctrl().len() - 1;
-        // Residuals at the data and halfway between consecutive data (consecutive samples lie
-        // on one segment of the polyline, so the midpoint is on it too): ringing between data
-        // points is caught as well. In parameter order, so each evaluation finds its span
-        // where the last one was.
-        // At the data the basis is the one the solve weighed them with: the same point as
-        // evaluating there, to the bit, without computing the basis again.
-        let mut check = |q: &[f64; 3], u: f64, basis: Option<&Basis>| {
-            let at = basis.and_then(|(span, n3)| curve.point_in_span(*span, n3));
-            let r = norm(sub(at.unwrap_or_else(|| curve.eval(u).p), q));
-            worst = worst.max(r);
-            if r > tol_mm {
-                let s = find_span(&knots, last, u);
-                if bad_spans.last() != Some(&s) {
-                    bad_spans.push(s);
-                }
-            }
-        };
-        check(&data[0], params[0], bases.first());
-        for ((q, u), basis) in data
-            .windows(2)
-            .zip(params.windows(2))
-            .zip(bases.iter().skip(1))
-        {
-            let mid = [
-                0.5 * (q[0][0] + q[1][0]),
-                0.5 * (q[0][1] + q[1][1]),
-                0.5 * (q[0][2] + q[1][2]),
-            ];
-            check(&mid, 0.5 * (u[0] + u[1]), None);
-            check(&q[1], u[1], Some(basis));
-        }
+        let (worst, bad_spans) = residuals(data, params, (&curve, &bases), tol_mm);
         if !worst.is_finite() {
             return None;
         }
@@ -110,6 +77,51 @@ pub(crate) fn fit(data: &[[f64; 3]], params: &[f64], tol_mm: f64) -> Option<Fit>
         knots = next;
     }
     None
+}
+
+/// The largest residual of `curve` (fitted with `bases`) at the data and halfway between
+/// consecutive data (consecutive samples lie on one segment of the polyline, so the midpoint
+/// is on it too: ringing between data points is caught as well), and the knot spans where it
+/// exceeds `tol_mm`, in parameter order. At the data the basis is the one the solve weighed
+/// them with: the same point as evaluating there, to the bit, without computing the basis
+/// again.
+fn residuals(
+    data: &[[f64; 3]],
+    params: &[f64],
+    (curve, bases): (&Curve, &[Basis]),
+    tol_mm: f64,
+) -> (f64, Vec<usize>) {
+    let mut worst = 0.0f64;
+    let mut bad_spans: Vec<usize> = Vec::new();
+    let last = curve.ctrl().len() - 1;
+    let mut check = |q: &[f64; 3], u: f64, basis: Option<&Basis>| {
+        let at = basis.and_then(|(span, n3)| curve.point_in_span(*span, n3));
+        let r = norm(sub(at.unwrap_or_else(|| curve.eval(u).p), q));
+        worst = worst.max(r);
+        if r > tol_mm {
+            let s = find_span(curve.knots(), last, u);
+            if bad_spans.last() != Some(&s) {
+                bad_spans.push(s);
+            }
+        }
+    };
+    if let (Some(q), Some(&u)) = (data.first(), params.first()) {
+        check(q, u, bases.first());
+    }
+    for ((q, u), basis) in data
+        .windows(2)
+        .zip(params.windows(2))
+        .zip(bases.iter().skip(1))
+    {
+        let mid = [
+            0.5 * (q[0][0] + q[1][0]),
+            0.5 * (q[0][1] + q[1][1]),
+            0.5 * (q[0][2] + q[1][2]),
+        ];
+        check(&mid, 0.5 * (u[0] + u[1]), None);
+        check(&q[1], u[1], Some(basis));
+    }
+    (worst, bad_spans)
 }
 
 /// The least-squares control points for fixed knots (A9.7's normal equations `NᵀN P = NᵀR`,
