@@ -7,9 +7,9 @@
 //! at most a fraction of the critical angle (`κ·L ≤ θ_step`, so a rounded corner is walked in
 //! several gentle turns instead of one sharp one). It is first guessed from the curvature
 //! sampled ahead ([`CurvatureIndex::longest_step`]), then checked on the stretch the step
-//! covers; where it does not hold, halved and bisected until it does. Line 2 of Algorithm 1 has `⟨C', C'⟩` where VTG eq. 27 has `⟨C', C''⟩`;
-//! VTG eq. 27 is used. Line 5's `F` is the step error `‖C(u) − P_i‖ − L_i`, and the damping `φ` of
-//! the paper scales the Newton step. Points are taken on the curve (`P_{i+1} = C(u_{i+1})`),
+//! covers; where it does not hold, halved and bisected until it does. Line 2 of Algorithm 1
+//! has `⟨C', C'⟩` where VTG eq. 27 has `⟨C', C''⟩`; VTG eq. 27 is used. Line 5's `F` is the
+//! step error `‖C(u) − P_i‖ − L_i`, and the damping `φ` of the paper scales the Newton step. Points are taken on the curve (`P_{i+1} = C(u_{i+1})`),
 //! which line 11 also gives once Newton has converged.
 
 use crate::vec3::{dot, norm, sub};
@@ -354,14 +354,15 @@ impl CurvatureIndex {
     }
 
     /// The longest step from `p` (parameter `u`, curvature `kappa` there) that the sampled
-    /// curvature ahead allows, and a shorter one that is surer to fit; `None` when no sample
-    /// ahead stops the step (the end decides). The samples are met in order, each raising the
-    /// largest curvature seen, until one lies farther from `p` than the step that curvature
-    /// allows. The step ends between it and the last sample that fitted: where the curvature
-    /// taken as rising linearly between the two allows exactly the step (the guess), or
-    /// where the failing sample's curvature allows it (the surer step). Both are first
-    /// tries for the walk, checked as any other: on a corner they spare the halving and
-    /// bisection that would otherwise find that length.
+    /// curvature ahead allows, and a second try; `None` when no sample ahead stops the step
+    /// (the end decides). The samples are met in order, each raising the largest curvature
+    /// seen, until one lies farther from `p` than the step that curvature allows. The step
+    /// ends between it and the last sample that fitted: where the curvature taken as rising
+    /// linearly between the two allows exactly the step (the guess), or where the failing
+    /// sample's curvature allows it (the second try, surer where the curvature rises faster
+    /// than that, and taken only if shorter than the guess). Both are checked as any step is:
+    /// on a corner they spare the halving and bisection that would otherwise find that
+    /// length.
     pub(crate) fn longest_step(
         &self,
         u: f64,
