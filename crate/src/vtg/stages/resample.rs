@@ -87,15 +87,17 @@ pub(crate) fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Opti
     let mut p = first.p;
     // Bounded: each accepted step advances u by at least a minimum amount.
     let max_points = 200_000usize;
+    // The curve at the current point: the last step's solve evaluated it there already.
+    let mut e = first;
     while out.len() < max_points {
-        let e = curve.eval(u);
-        let (un, pn, k, step, d1_next) = walker.step(u, &p, &e)?;
+        let (un, pn, k, step, next) = walker.step(u, &p, &e)?;
         if step > 0.0 {
             let got = norm(sub(pn, p));
             stats.fluctuation_sum += ((step - got) / step).abs();
         }
         stats.steps += 1;
-        let t1 = d1_next.unwrap_or_else(|| curve.eval(un).d1);
+        let next = next.unwrap_or_else(|| curve.eval(un));
+        let t1 = next.d1;
         out.push(Sample {
             u: un,
             p: pn,
@@ -106,8 +108,7 @@ pub(crate) fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Opti
         if un >= u_end {
             return Some(out);
         }
-        u = un;
-        p = pn;
+        (u, p, e) = (un, pn, next);
     }
     None
 }
@@ -125,8 +126,8 @@ fn mean_curvature(t0: &[f64; 3], t1: &[f64; 3], chord: f64) -> f64 {
 
 /// A step of the walk: the parameter and point reached, the largest curvature over the step,
 /// the step `L_i` asked for (0: the end, reached by a shorter or longer last step) and the
-/// curve's derivative at the point (`None`: not evaluated there).
-type Step = (f64, [f64; 3], f64, f64, Option<[f64; 3]>);
+/// curve there, as the step's solve evaluated it (`None`: not evaluated there).
+type Step = (f64, [f64; 3], f64, f64, Option<Eval>);
 
 /// One curve being walked, with what every step reads: split from [`walk`] so choosing a step
 /// (try, shrink, lengthen by bisection, stretch to the end) reads apart from recording it.
@@ -150,7 +151,7 @@ impl Walker<'_> {
         let w = self.w;
         let (accepted, too_long) = self.shrink(u, p, e);
         let accepted = self.lengthen(u, p, e, accepted, too_long);
-        let (mut un, mut pn, k, mut step, mut d1_next) = accepted?;
+        let (mut un, mut pn, k, mut step, mut next) = accepted?;
         // Do not leave a sliver before the end: stretch this step to it instead (it is then
         // the last, shorter-or-longer step to the end, not a full `L_i`, as the end step is).
         if un < self.u_end
@@ -160,9 +161,9 @@ impl Walker<'_> {
             un = self.u_end;
             pn = self.end_p;
             step = 0.0;
-            d1_next = None;
+            next = None;
         }
-        Some((un, pn, k, step, d1_next))
+        Some((un, pn, k, step, next))
     }
 
     /// The first step that fits, from the longest the curvature at `u` allows, shrunk to what
@@ -198,7 +199,7 @@ impl Walker<'_> {
                 if un < u_end {
                     let k = self.max_curvature(u, un, [Some(kappa), Some(at.curvature())]);
                     if floor || fits(k, step, w) {
-                        return (Some((un, at.p, k, step, Some(at.d1))), too_long);
+                        return (Some((un, at.p, k, step, Some(at))), too_long);
                     }
                 }
             }
@@ -253,7 +254,7 @@ impl Walker<'_> {
                     .filter(|(_, _, k)| fits(*k, mid, w));
                 match fitted {
                     Some((un, at, k)) => {
-                        accepted = Some((un, at.p, k, mid, Some(at.d1)));
+                        accepted = Some((un, at.p, k, mid, Some(at)));
                         ok = mid;
                     }
                     None => bad = mid,
@@ -326,21 +327,17 @@ impl CurvatureIndex {
                 breaks.push(k);
             }
         }
-        let evals: Vec<[Eval; SPAN_SAMPLES]> = breaks
-            .windows(2)
-            .map(|w| {
-                std::array::from_fn(|i| {
-                    let t = i as f64 / (SPAN_SAMPLES - 1) as f64;
-                    curve.eval(w[0] + (w[1] - w[0]) * t)
-                })
-            })
-            .collect();
-        let samples: Vec<[f64; SPAN_SAMPLES]> = (evals.iter())
-            .map(|e| std::array::from_fn(|i| e[i].curvature()))
-            .collect();
-        let points = (evals.iter())
-            .map(|e| std::array::from_fn(|i| e[i].p))
-            .collect();
+        let spans = breaks.len().saturating_sub(1);
+        let mut samples: Vec<[f64; SPAN_SAMPLES]> = Vec::with_capacity(spans);
+        let mut points = Vec::with_capacity(spans);
+        for w in breaks.windows(2) {
+            let e: [Eval; SPAN_SAMPLES] = std::array::from_fn(|i| {
+                let t = i as f64 / (SPAN_SAMPLES - 1) as f64;
+                curve.eval(w[0] + (w[1] - w[0]) * t)
+            });
+            samples.push(std::array::from_fn(|i| e[i].curvature()));
+            points.push(std::array::from_fn(|i| e[i].p));
+        }
         let span_max = samples
             .iter()
             .map(|s| s.iter().copied().fold(0.0, f64::max))
