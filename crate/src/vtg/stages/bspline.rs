@@ -49,21 +49,30 @@ impl<const D: usize> Net<D> {
     /// The point and both derivatives in `span` from the basis functions of degrees 1–3.
     #[inline]
     fn at(&self, span: usize, [n1, n2, n3]: &[[f64; 4]; 3]) -> Option<[[f64; D]; 3]> {
-        let weigh = |w: &[f64], pts: &[[f64; D]]| -> [f64; D] {
-            let mut out = [0.0; D];
-            for (wi, pt) in w.iter().zip(pts) {
-                for k in 0..D {
-                    out[k] += wi * pt[k];
-                }
-            }
-            out
-        };
         Some([
-            weigh(n3, self.p.get(span - DEGREE..=span)?),
+            self.point(span, n3)?,
             weigh(&n2[..3], self.q.get(span - DEGREE..span)?),
             weigh(&n1[..2], self.r.get(span - DEGREE..span - 1)?),
         ])
     }
+
+    /// The point in `span` from the degree-3 basis functions.
+    #[inline]
+    fn point(&self, span: usize, n3: &[f64; 4]) -> Option<[f64; D]> {
+        Some(weigh(n3, self.p.get(span.checked_sub(DEGREE)?..=span)?))
+    }
+}
+
+/// `Σ w_i · pts_i`, summed in order from zero.
+#[inline]
+fn weigh<const D: usize>(w: &[f64], pts: &[[f64; D]]) -> [f64; D] {
+    let mut out = [0.0; D];
+    for (wi, pt) in w.iter().zip(pts) {
+        for k in 0..D {
+            out[k] += wi * pt[k];
+        }
+    }
+    out
 }
 
 /// A point of the curve with its first and second derivatives.
@@ -181,14 +190,7 @@ impl Curve {
         if self.weights.is_some() || self.knots.len() != self.ctrl.p.len() + DEGREE + 1 {
             return None;
         }
-        let pts = self.ctrl.p.get(span.checked_sub(DEGREE)?..=span)?;
-        let mut out = [0.0; 3];
-        for (wi, pt) in n3.iter().zip(pts) {
-            for k in 0..3 {
-                out[k] += wi * pt[k];
-            }
-        }
-        Some(out)
+        self.ctrl.point(span, n3)
     }
 
     /// Knot vector.

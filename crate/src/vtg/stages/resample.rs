@@ -9,8 +9,9 @@
 //! sampled ahead ([`CurvatureIndex::longest_step`]), then checked on the stretch the step
 //! covers; where it does not hold, halved and bisected until it does. Line 2 of Algorithm 1
 //! has `⟨C', C'⟩` where VTG eq. 27 has `⟨C', C''⟩`; VTG eq. 27 is used. Line 5's `F` is the
-//! step error `‖C(u) − P_i‖ − L_i`, and the damping `φ` of the paper scales the Newton step. Points are taken on the curve (`P_{i+1} = C(u_{i+1})`),
-//! which line 11 also gives once Newton has converged.
+//! step error `‖C(u) − P_i‖ − L_i`, and the damping `φ` of the paper scales the Newton step.
+//! Points are taken on the curve (`P_{i+1} = C(u_{i+1})`), which line 11 also gives once
+//! Newton has converged.
 
 use crate::vec3::{dot, norm, sub};
 use crate::vtg::bspline::{Curve, Eval};
@@ -370,22 +371,28 @@ impl CurvatureIndex {
         let first = self.breaks.partition_point(|&k| k <= u).saturating_sub(1);
         let (mut k_max, mut reached) = (kappa, 0.0f64);
         for i in first..self.samples.len() {
-            let (s0, s1) = (self.breaks[i], self.breaks[i + 1]);
             for j in 0..SPAN_SAMPLES {
-                let at = s0 + (s1 - s0) * j as f64 / (SPAN_SAMPLES - 1) as f64;
-                if at <= u {
+                if self.sample_at(i, j) <= u {
                     continue;
                 }
                 let (k_before, k_here) = (k_max, k_max.max(self.samples[i][j]));
                 let chord = norm(sub(self.points[i][j], *p));
-                if chord > step_for(k_here, w) {
-                    let sure = step_for(k_here, w).max(reached);
+                let allowed = step_for(k_here, w);
+                if chord > allowed {
+                    let sure = allowed.max(reached);
                     return Some((crossing([reached, chord], [k_before, k_here], w), sure));
                 }
                 (k_max, reached) = (k_here, chord);
             }
         }
         None
+    }
+
+    /// The parameter of sample `j` of span `i`, as the lookups place it.
+    #[inline]
+    fn sample_at(&self, i: usize, j: usize) -> f64 {
+        let (s0, s1) = (self.breaks[i], self.breaks[i + 1]);
+        s0 + (s1 - s0) * j as f64 / (SPAN_SAMPLES - 1) as f64
     }
 
     /// Largest curvature on `[a, b]`.
@@ -419,7 +426,7 @@ impl CurvatureIndex {
             } else {
                 partial = true;
                 for (k, &c) in self.samples.get(i).into_iter().flatten().enumerate() {
-                    let at = s0 + (s1 - s0) * k as f64 / (SPAN_SAMPLES - 1) as f64;
+                    let at = self.sample_at(i, k);
                     if at >= a && at <= b {
                         best = best.max(c);
                     }
