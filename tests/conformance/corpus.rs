@@ -362,3 +362,20 @@ fn analyze_with_the_timing_side_apart_gives_the_same_report() {
         }
     }
 }
+
+/// The clock an analysis keeps of its planning pass (what `vtg` refreshes a rewrite's time
+/// estimates from) is, to the bit, the clock a planning walk of the file gives, on every file
+/// of the corpus: the estimates written from either are the same.
+#[test]
+fn the_analysis_keeps_the_clock_a_planning_walk_gives() {
+    use quietpath::analyze::analyze_with_starts;
+    use quietpath::estimate::Clock;
+    let options = AnalyzeOptions::default();
+    for f in corpus() {
+        let bytes = f.read();
+        let walked = Clock::of(&bytes, &options).unwrap();
+        let (report, starts) = analyze_with_starts(&bytes, &options).unwrap();
+        let kept = Clock::from_analysis(&report, starts);
+        assert!(kept == walked, "{}: the clocks differ", f.name);
+    }
+}

@@ -297,7 +297,14 @@ pub struct TimeBook {
     pub fans: Vec<FanEvent>,
     /// The toolpath metrics, when the timing side takes them.
     pub toolpath: Option<MetricsAccumulator>,
+    /// Every timed move's line and start, when kept ([`Timing::keeping_starts`]), and the tag
+    /// of the move recorded last.
+    pub starts: Option<(MoveStarts, Option<u64>)>,
 }
+
+/// The line and planned start (s) of every timed move, in file order, an arc's firmware
+/// segments counted once at the first: the clock a file's time estimates are written from.
+pub type MoveStarts = Vec<(u32, f64)>;
 
 fn add(v: &mut Vec<(f64, f64)>, i: u32, t: f64, e: f64) {
     if i == NO_LAYER || i == TRAVEL {
@@ -326,6 +333,13 @@ impl Timing {
     /// ride with the planner there.
     pub fn with_toolpath_metrics(mut self) -> Self {
         self.book.toolpath = Some(MetricsAccumulator::new(DEFAULT_CRITICAL_ANGLE_DEG));
+        self
+    }
+
+    /// Keeps every timed move's line and start ([`MoveStarts`], `capacity` expected): the
+    /// file's clock, so that refreshing its estimates needs no planning pass of its own.
+    pub fn keeping_starts(mut self, capacity: usize) -> Self {
+        self.book.starts = Some((Vec::with_capacity(capacity), None));
         self
     }
 
@@ -408,10 +422,17 @@ impl TimeBook {
             temperatures: Vec::new(),
             fans: Vec::new(),
             toolpath: None,
+            starts: None,
         }
     }
 
     fn planned(&mut self, pm: &PlannedMove) {
+        if let Some((starts, last)) = &mut self.starts {
+            if *last != Some(pm.tag) {
+                *last = Some(pm.tag);
+                starts.push((pm.line, pm.start_s));
+            }
+        }
         let joules = self.energy.planned(pm);
         self.stamp_until(pm.tag, pm.start_s);
         while self.tags.front().is_some_and(|t| t.0 < pm.tag) {

@@ -15,6 +15,7 @@ use crate::plan::Limits;
 use crate::progress::Progress;
 pub use crate::read::{prescan, AnalyzeOptions, ExtrusionModeOption};
 use crate::read::{At, Flow, Fold, Reader, Setup};
+pub use accounting::MoveStarts;
 use accounting::{Accounts, TimeBook, TimeMsg};
 pub use report::*;
 
@@ -118,8 +119,31 @@ pub fn analyze_with_progress(
     options: &AnalyzeOptions,
     progress: Progress<'_>,
 ) -> Result<Report, Error> {
+    analyze_timed(input, options, progress, false).map(|(report, _)| report)
+}
+
+/// [`analyze`], and the line and planned start of every timed move: the clock its time
+/// estimates are written from ([`crate::estimate`]), from the same planning pass.
+pub fn analyze_with_starts(
+    input: &[u8],
+    options: &AnalyzeOptions,
+) -> Result<(Report, MoveStarts), Error> {
+    let (report, starts) = analyze_timed(input, options, &mut |_| true, true)?;
+    Ok((report, starts.unwrap_or_default()))
+}
+
+/// [`analyze_with_progress`], keeping the moves' starts where `keep_starts` asks.
+fn analyze_timed(
+    input: &[u8],
+    options: &AnalyzeOptions,
+    progress: Progress<'_>,
+    keep_starts: bool,
+) -> Result<(Report, Option<MoveStarts>), Error> {
     let mut reader = Reader::new(input, options)?;
     let mut timing = wire::TimingSetup::of(&reader, options).timing();
+    if keep_starts {
+        timing = timing.keeping_starts(crate::gcode::command_lines(input));
+    }
     let mut info = SlicerInfo::default();
     let mut acc = Accounts::new();
     pipeline::run(input.len(), &mut timing, |to_timing| {
@@ -129,14 +153,9 @@ pub fn analyze_with_progress(
     timing.finish();
     progress(1.0);
     let time_s = timing.planner.elapsed_s();
-    Ok(report(
-        input,
-        options,
-        reader,
-        acc,
-        (time_s, timing.book),
-        info,
-    ))
+    let starts = timing.book.starts.take().map(|(starts, _)| starts);
+    let report = report(input, options, reader, acc, (time_s, timing.book), info);
+    Ok((report, starts))
 }
 
 /// The report of a file read into `reader` and `acc`, from the timing side's planned time and

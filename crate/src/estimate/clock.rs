@@ -1,15 +1,15 @@
 //! The planner's clock at every line of a file.
 
-use crate::analyze::AnalyzeOptions;
+use crate::analyze::{AnalyzeOptions, MoveStarts};
 use crate::error::Error;
 use crate::path::{walk, MoveSink, PathFeature, PathMove};
 use crate::plan::PlannedMove;
 
 /// When the machine reaches each line of a file, by the same planner as `analyze`.
-#[derive(Debug, Clone)]
-pub(crate) struct Clock {
+#[derive(Debug, Clone, PartialEq)]
+pub struct Clock {
     /// (line, start time) of every timed move, in file order.
-    starts: Vec<(u32, f64)>,
+    starts: MoveStarts,
     /// The file's print time, s (`analyze`'s `time_s`).
     pub total_s: f64,
     /// Time until the second layer starts, s (the whole print for a file of one layer).
@@ -45,6 +45,28 @@ impl Clock {
                 .map_or(clock.total_s, |second| clock.at_line(second.line))
         });
         Ok(clock)
+    }
+
+    /// The clock of the file `report` analyses, from the starts its planning pass kept
+    /// ([`crate::analyze::analyze_with_starts`]): the same planner as [`Clock::of`], read from
+    /// the same moves, so the same clock, without planning the file again.
+    pub fn from_analysis(report: &crate::analyze::Report, starts: MoveStarts) -> Self {
+        let mut clock = Self {
+            starts,
+            total_s: report.time_s,
+            first_layer_s: None,
+            machine: format!(
+                "{}, {:?} junctions",
+                report.machine.profile, report.machine.junction_model
+            ),
+        };
+        let layers = &report.layer_list;
+        clock.first_layer_s = layers.first().map(|_| {
+            layers
+                .get(1)
+                .map_or(clock.total_s, |second| clock.at_line(second.line))
+        });
+        clock
     }
 
     /// Time elapsed when the machine reaches line `line` (1-based): the start of the first

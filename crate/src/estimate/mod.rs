@@ -17,7 +17,7 @@ use serde::Serialize;
 use crate::analyze::AnalyzeOptions;
 use crate::error::Error;
 use crate::gcode::{apply_edits, Edit, Lines, RawLine};
-use clock::Clock;
+pub use clock::Clock;
 use format::{At, Kind};
 
 /// Comment lines quietpath writes start with this (and are replaced, not repeated, when a
@@ -55,7 +55,12 @@ pub fn rewrite_estimates(
     options: &AnalyzeOptions,
     notes: &[String],
 ) -> Result<Estimated, Error> {
-    let clock = Clock::of(input, options)?;
+    Ok(rewrite_by_clock(input, &Clock::of(input, options)?, notes))
+}
+
+/// [`rewrite_estimates`] by `clock`, the clock of `input` ([`Clock::of`], or
+/// [`Clock::from_analysis`] of its analysis).
+pub fn rewrite_by_clock(input: &[u8], clock: &Clock, notes: &[String]) -> Estimated {
     let mut header = notes.to_vec();
     header.push(format!(
         "{}: print time {} by its planner ({}); M73 and time comments are its",
@@ -104,10 +109,10 @@ pub fn rewrite_estimates(
     if let Some(first) = first {
         add_header(&mut edits, &first, &header);
     }
-    Ok(Estimated {
+    Estimated {
         report,
         output: apply_edits(input, &edits),
-    })
+    }
 }
 
 /// Whether `input` carries any estimate (`M73` or a time comment) to make true.
@@ -154,16 +159,21 @@ pub type Refreshed = (Vec<u8>, crate::analyze::Report);
 
 /// [`refresh`], and `beside` measured of the file it hands back (the refreshed one, else
 /// `output`), side by side with the refreshed file's analysis where there are threads.
+/// `clock`: the clock of `output`, where its analysis kept one (else it is planned here).
 pub fn refresh_beside<T>(
     output: &[u8],
     options: &AnalyzeOptions,
-    job: &str,
+    (job, clock): (&str, Option<&Clock>),
     beside: impl Fn(&[u8]) -> T,
 ) -> Result<(Option<Refreshed>, T), Error> {
     if !has_estimates(output) {
         return Ok((None, beside(output)));
     }
-    let e = rewrite_estimates(output, options, &[job.to_string()])?;
+    let notes = [job.to_string()];
+    let e = match clock {
+        Some(clock) => rewrite_by_clock(output, clock, &notes),
+        None => rewrite_estimates(output, options, &notes)?,
+    };
     let (after, measured) = crate::parallel::join(
         || crate::analyze::analyze(&e.output, options),
         || beside(&e.output),

@@ -340,25 +340,26 @@ impl Run<'_> {
         };
         let (rewritten, measured) =
             self.rewrite((variant, kept), &before, Some(&metrics), progress)?;
-        let (after, after_metrics) = match measured {
-            Some((after, Some(beside))) => (after, beside?),
-            Some((after, None)) => (after, metrics(&rewritten.output)?),
+        let (after, clock, after_metrics) = match measured {
+            Some((after, clock, Some(beside))) => (after, Some(clock), beside?),
+            Some((after, clock, None)) => (after, Some(clock), metrics(&rewritten.output)?),
             // Without the model this report is the last, and [`finish`] analyses the file with
             // its estimates refreshed, the one handed back, and fills `after` and Table 2 from
             // that: an analysis of this one would be thrown away (a planning pass over the
             // whole output). Until then `after` is the original's.
             None if !options.dynamics && refreshes(options, self.input, &rewritten.output) => {
-                (before.clone(), metrics(&rewritten.output)?)
+                (before.clone(), None, metrics(&rewritten.output)?)
             }
             None => {
-                let (after, after_metrics) = crate::parallel::join(
-                    || crate::analyze::analyze(&rewritten.output, &options.analyze),
+                let (analysed, after_metrics) = crate::parallel::join(
+                    || search::analysed(&rewritten.output, options),
                     || metrics(&rewritten.output),
                 );
-                (after?, after_metrics?)
+                let (after, clock) = analysed?;
+                (after, Some(clock), after_metrics?)
             }
         };
-        Ok(report::build(
+        let mut report = report::build(
             options,
             &limits,
             before,
@@ -366,7 +367,9 @@ impl Run<'_> {
             path,
             after_metrics,
             rewritten,
-        ))
+        );
+        report.output_clock = clock;
+        Ok(report)
     }
 
     /// The last rewrite's offers with the layers `kept` marks dropped, where it was of `variant`
@@ -483,7 +486,8 @@ fn finish(
             // `refreshes`, with its last condition left to `refresh_beside`, which asks it
             // anyway (on a file without estimates it reads every line).
             if options.estimates && report.output != input {
-                crate::estimate::refresh_beside(&report.output, &options.analyze, &note, figures)
+                let job = (note.as_str(), report.output_clock.as_ref());
+                crate::estimate::refresh_beside(&report.output, &options.analyze, job, figures)
             } else {
                 Ok((None, figures(&report.output)))
             }
@@ -493,6 +497,7 @@ fn finish(
     let (refreshed, after) = refreshed?;
     if let Some((output, analysis)) = refreshed {
         report.output = output;
+        report.output_clock = None;
         report.table2 = report::table2(&report.before, &analysis, report.table2.deviation);
         report.after = analysis;
     }

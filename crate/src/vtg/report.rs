@@ -196,6 +196,10 @@ pub struct VtgReport {
     /// The rewritten G-code.
     #[serde(skip)]
     pub output: Vec<u8>,
+    /// The planner's clock of `output`, where its analysis kept one: its time estimates are
+    /// refreshed from it instead of planning the file again.
+    #[serde(skip)]
+    pub(crate) output_clock: Option<crate::estimate::Clock>,
 }
 
 /// Table 2 of the analyses `before` and `after`, with the dynamics model's `deviation` rows
@@ -285,6 +289,7 @@ pub(crate) fn build(
         after,
         firmware: None,
         output: rewritten.output,
+        output_clock: None,
         message: None,
         peak_layers_kept: Vec::new(),
     }

@@ -181,15 +181,15 @@ pub(crate) fn within_allowed_time<T>(
             break;
         }
         let rewritten = offers.write(input, (allowed_s, lines), mean_power_w);
-        let (after, alongside) = crate::parallel::join(
-            || crate::analyze::analyze(&rewritten.output, &options.analyze),
+        let (analysed, alongside) = crate::parallel::join(
+            || analysed(&rewritten.output, options),
             || beside.map(|f| f(&rewritten.output)),
         );
-        let after = after?;
+        let (after, clock) = analysed?;
         let added = after.time_s - before.time_s;
         let over_j = after.energy.total_j - energy_cap;
         if added <= allowed && over_j <= 0.0 {
-            return Ok((rewritten, Some((after, alongside))));
+            return Ok((rewritten, Some((after, clock, alongside))));
         }
         if added > allowed {
             allowed_s -= TUNING.time_margin * (added - allowed);
@@ -201,10 +201,21 @@ pub(crate) fn within_allowed_time<T>(
     Ok((offers.write(input, (0.0, lines), mean_power_w), None))
 }
 
-/// A rewrite's analysis, as the time allowance measured it, and what was measured beside it
-/// ([`within_allowed_time`]'s `beside`: the output's metrics, where they are wanted, read
-/// while the analysis runs, in case this round's output is the one kept).
-pub(crate) type Measured<T> = (Report, Option<T>);
+/// A rewrite's analysis and clock, as the time allowance measured it, and what was measured
+/// beside it ([`within_allowed_time`]'s `beside`: the output's metrics, where they are wanted,
+/// read while the analysis runs, in case this round's output is the one kept).
+pub(crate) type Measured<T> = (Report, crate::estimate::Clock, Option<T>);
+
+/// `output` analysed, and its clock from the same planning pass: what refreshing its time
+/// estimates reads, where it is the file handed back.
+pub(crate) fn analysed(
+    output: &[u8],
+    options: &VtgOptions,
+) -> Result<(Report, crate::estimate::Clock), Error> {
+    let (after, starts) = crate::analyze::analyze_with_starts(output, &options.analyze)?;
+    let clock = crate::estimate::Clock::from_analysis(&after, starts);
+    Ok((after, clock))
+}
 
 /// What [`within_allowed_time`] measures of each output beside its analysis.
 pub(crate) type Beside<'f, T> = &'f dyn Fn(&[u8]) -> T;
