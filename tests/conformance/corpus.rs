@@ -379,3 +379,27 @@ fn the_analysis_keeps_the_clock_a_planning_walk_gives() {
         assert!(kept == walked, "{}: the clocks differ", f.name);
     }
 }
+
+/// The firmware figures an analysis counts in its own pass (what `vtg` reports of the original
+/// and of the file it hands back) are, to the bit, those a planning walk of the file counts, on
+/// every file of the corpus and at two minimum segment times.
+#[test]
+fn the_analysis_counts_the_firmware_figures_a_planning_walk_gives() {
+    use quietpath::plan::JunctionModel;
+    use quietpath::vtg::firmware::{analysed_figures, figures, SegmentBudget};
+    let options = AnalyzeOptions::default();
+    for f in corpus() {
+        let bytes = f.read();
+        for ms in [None, Some(50.0)] {
+            let budget = SegmentBudget::for_file(&bytes, JunctionModel::ClassicJerk, ms);
+            let walked = figures(&bytes, &options, &budget).unwrap();
+            let (report, counted) = analysed_figures(&bytes, &options, &budget).unwrap();
+            assert_eq!(counted, walked, "{} at {ms:?} ms", f.name);
+            assert_eq!(
+                report.extruding_moves, walked.printing_segments,
+                "{}",
+                f.name
+            );
+        }
+    }
+}

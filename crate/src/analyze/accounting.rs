@@ -14,6 +14,7 @@ use crate::energy::Material;
 use crate::gcode::{feature_kind, FeatureKind};
 use crate::machine::{Heater, Move};
 use crate::math::Bound;
+use crate::plan::segments::SegmentCounter;
 use crate::plan::{Limits, Motion, PlannedMove, Planner};
 use crate::read::{LayerTracker, NO_LAYER};
 
@@ -300,6 +301,9 @@ pub struct TimeBook {
     /// Every timed move's line and start, when kept ([`Timing::keeping_starts`]), and the tag
     /// of the move recorded last.
     pub starts: Option<(MoveStarts, Option<u64>)>,
+    /// The planned blocks counted against a minimum segment time, when asked
+    /// ([`Timing::counting_segments`]).
+    pub segments: Option<SegmentCounter>,
 }
 
 /// The line and planned start (s) of every timed move, in file order, an arc's firmware
@@ -340,6 +344,12 @@ impl Timing {
     /// file's clock, so that refreshing its estimates needs no planning pass of its own.
     pub fn keeping_starts(mut self, capacity: usize) -> Self {
         self.book.starts = Some((Vec::with_capacity(capacity), None));
+        self
+    }
+
+    /// Counts the planned blocks against `min_segment_s` ([`SegmentCounter::timed`]).
+    pub fn counting_segments(mut self, min_segment_s: f64) -> Self {
+        self.book.segments = Some(SegmentCounter::new(min_segment_s));
         self
     }
 
@@ -423,6 +433,7 @@ impl TimeBook {
             fans: Vec::new(),
             toolpath: None,
             starts: None,
+            segments: None,
         }
     }
 
@@ -432,6 +443,9 @@ impl TimeBook {
                 *last = Some(pm.tag);
                 starts.push((pm.line, pm.start_s));
             }
+        }
+        if let Some(segments) = &mut self.segments {
+            segments.timed(pm);
         }
         let joules = self.energy.planned(pm);
         self.stamp_until(pm.tag, pm.start_s);

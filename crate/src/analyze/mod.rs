@@ -11,6 +11,7 @@ mod wire;
 use crate::error::{Error, ErrorKind};
 use crate::gcode::{Line, RawLine, SlicerInfo};
 use crate::machine::{axis, Event, Machine};
+use crate::plan::segments::{SegmentCounter, SegmentCounts};
 use crate::plan::Limits;
 use crate::progress::Progress;
 pub use crate::read::{prescan, AnalyzeOptions, ExtrusionModeOption};
@@ -40,6 +41,8 @@ struct Tally<'a> {
     progress: Progress<'a>,
     input_len: usize,
     next_progress: usize,
+    /// The moves counted against the segment budget, when asked ([`Keep::min_segment_s`]).
+    segments: Option<SegmentCounter>,
 }
 
 impl<'a> Tally<'a> {
@@ -58,6 +61,7 @@ impl<'a> Tally<'a> {
             progress,
             input_len,
             next_progress: PROGRESS_STEP,
+            segments: None,
         }
     }
 }
@@ -89,6 +93,9 @@ impl Fold for Tally<'_> {
 
     fn event(&mut self, _: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
         let to_timing = &mut self.to_timing;
+        if let (Event::Move(m), Some(segments)) = (event, &mut self.segments) {
+            segments.moved(m.is_extruding(), m.length_mm);
+        }
         match event {
             Event::Move(m) if at.untimed_homing(m) => {
                 self.acc.totals.homing_count += 1;
@@ -119,7 +126,7 @@ pub fn analyze_with_progress(
     options: &AnalyzeOptions,
     progress: Progress<'_>,
 ) -> Result<Report, Error> {
-    analyze_timed(input, options, progress, false).map(|(report, _)| report)
+    analyze_timed(input, options, progress, Keep::default()).map(|(report, _)| report)
 }
 
 /// [`analyze`], and the line and planned start of every timed move: the clock its time
@@ -128,34 +135,77 @@ pub fn analyze_with_starts(
     input: &[u8],
     options: &AnalyzeOptions,
 ) -> Result<(Report, MoveStarts), Error> {
-    let (report, starts) = analyze_timed(input, options, &mut |_| true, true)?;
-    Ok((report, starts.unwrap_or_default()))
+    let keep = Keep {
+        starts: true,
+        min_segment_s: None,
+    };
+    let (report, kept) = analyze_keeping(input, options, keep)?;
+    Ok((report, kept.starts.unwrap_or_default()))
 }
 
-/// [`analyze_with_progress`], keeping the moves' starts where `keep_starts` asks.
+/// What [`analyze_keeping`] keeps of its pass besides the report: what a rewrite's later steps
+/// would otherwise plan the file again for.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Keep {
+    /// Every timed move's line and start ([`MoveStarts`]).
+    pub starts: bool,
+    /// The segments counted against this minimum segment time, s ([`SegmentCounts`]).
+    pub min_segment_s: Option<f64>,
+}
+
+/// What [`analyze_keeping`] kept.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Kept {
+    /// Every timed move's line and start, where [`Keep::starts`] asked.
+    pub starts: Option<MoveStarts>,
+    /// The segment counts, where [`Keep::min_segment_s`] asked.
+    pub segments: Option<SegmentCounts>,
+}
+
+/// [`analyze`], keeping what `keep` asks of the same pass.
+pub fn analyze_keeping(
+    input: &[u8],
+    options: &AnalyzeOptions,
+    keep: Keep,
+) -> Result<(Report, Kept), Error> {
+    analyze_timed(input, options, &mut |_| true, keep)
+}
+
+/// [`analyze_with_progress`], keeping what `keep` asks.
 fn analyze_timed(
     input: &[u8],
     options: &AnalyzeOptions,
     progress: Progress<'_>,
-    keep_starts: bool,
-) -> Result<(Report, Option<MoveStarts>), Error> {
+    keep: Keep,
+) -> Result<(Report, Kept), Error> {
     let mut reader = Reader::new(input, options)?;
     let mut timing = wire::TimingSetup::of(&reader, options).timing();
-    if keep_starts {
+    if keep.starts {
         timing = timing.keeping_starts(crate::gcode::command_lines(input));
+    }
+    if let Some(min_segment_s) = keep.min_segment_s {
+        timing = timing.counting_segments(min_segment_s);
     }
     let mut info = SlicerInfo::default();
     let mut acc = Accounts::new();
+    let mut moves = None;
     pipeline::run(input.len(), &mut timing, |to_timing| {
         let mut tally = Tally::new(&mut acc, &mut info, to_timing, &mut *progress, input.len());
-        reader.read(input, &mut tally)
+        tally.segments = keep.min_segment_s.map(SegmentCounter::new);
+        let read = reader.read(input, &mut tally);
+        moves = tally.segments.take();
+        read
     })?;
     timing.finish();
     progress(1.0);
     let time_s = timing.planner.elapsed_s();
-    let starts = timing.book.starts.take().map(|(starts, _)| starts);
+    let kept = Kept {
+        starts: timing.book.starts.take().map(|(starts, _)| starts),
+        segments: (moves.as_ref().zip(timing.book.segments.as_ref()))
+            .map(|(moves, blocks)| SegmentCounter::merged(moves, blocks)),
+    };
     let report = report(input, options, reader, acc, (time_s, timing.book), info);
-    Ok((report, starts))
+    Ok((report, kept))
 }
 
 /// The report of a file read into `reader` and `acc`, from the timing side's planned time and

@@ -22,6 +22,7 @@ pub mod junction;
 pub mod klipper_config;
 pub mod limits;
 pub mod profiles;
+pub mod segments;
 pub mod trapezoid;
 
 use serde::Serialize;

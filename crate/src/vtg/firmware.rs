@@ -27,6 +27,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::path::PathFeature;
+use crate::plan::segments::{SegmentCounter, SegmentCounts};
 use crate::plan::JunctionModel;
 
 /// Marlin's `DEFAULT_MINSEGMENTTIME` (`Configuration_adv.h`), s: `M205 B` sets it in µs.
@@ -58,11 +59,7 @@ impl SegmentBudget {
     /// one in the file) over the default and `min_segment_time_ms` from the options over
     /// both.
     pub fn for_file(input: &[u8], model: JunctionModel, min_segment_time_ms: Option<f64>) -> Self {
-        let (time, source) = match (min_segment_time_ms, m205_b_us(input)) {
-            (Some(ms), _) => (ms / 1000.0, "option"),
-            (None, Some(us)) => (us / 1e6, "file"),
-            (None, None) => (MARLIN_MIN_SEGMENT_TIME_S, "default"),
-        };
+        let (time, source) = min_segment_time(input, min_segment_time_ms);
         Self {
             min_segment_time_s: time,
             min_segment_time_source: source.to_string(),
@@ -83,6 +80,21 @@ impl SegmentBudget {
             f64::INFINITY
         }
     }
+}
+
+/// The minimum segment time of a machine running `input`, s ([`SegmentBudget::for_file`]), and
+/// where it came from.
+fn min_segment_time(input: &[u8], min_segment_time_ms: Option<f64>) -> (f64, &'static str) {
+    match (min_segment_time_ms, m205_b_us(input)) {
+        (Some(ms), _) => (ms / 1000.0, "option"),
+        (None, Some(us)) => (us / 1e6, "file"),
+        (None, None) => (MARLIN_MIN_SEGMENT_TIME_S, "default"),
+    }
+}
+
+/// [`SegmentBudget::min_segment_time_s`] of `input`'s budget, without its planner model.
+pub fn min_segment_time_s(input: &[u8], min_segment_time_ms: Option<f64>) -> f64 {
+    min_segment_time(input, min_segment_time_ms).0
 }
 
 /// The value of the last `M205 B` word (µs) in `input`, if any. Only the lines with `205` in
@@ -190,35 +202,15 @@ impl FirmwareReport {
 }
 
 /// Counts what [`figures`] reports while the moves stream past.
-struct FiguresSink {
-    min_segment_s: f64,
-    figures: FirmwareFigures,
-    /// Start times of the planned blocks of the last second.
-    window: std::collections::VecDeque<f64>,
-}
+struct FiguresSink(SegmentCounter);
 
 impl crate::path::MoveSink for FiguresSink {
     fn moved(&mut self, _: usize, m: crate::path::PathMove, _: (u32, u32), _: &[PathFeature]) {
-        if m.is_extruding() {
-            self.figures.printing_segments += 1;
-            if m.length_mm < 0.1 {
-                self.figures.segments_under_0_1mm += 1;
-            }
-        }
+        self.0.moved(m.is_extruding(), m.length_mm);
     }
 
     fn timed(&mut self, pm: &crate::plan::PlannedMove) {
-        if pm.class == crate::plan::MoveClass::Print && pm.duration() < self.min_segment_s {
-            self.figures.segments_under_min_time += 1;
-        }
-        while self.window.front().is_some_and(|&t| t <= pm.start_s - 1.0) {
-            self.window.pop_front();
-        }
-        self.window.push_back(pm.start_s);
-        let n = self.window.len() as f64;
-        if n > self.figures.peak_segments_per_s {
-            self.figures.peak_segments_per_s = n;
-        }
+        self.0.timed(pm);
     }
 }
 
@@ -230,18 +222,43 @@ pub fn figures(
     options: &crate::analyze::AnalyzeOptions,
     budget: &SegmentBudget,
 ) -> Result<FirmwareFigures, crate::error::Error> {
-    let mut sink = FiguresSink {
-        min_segment_s: budget.min_segment_time_s,
-        figures: FirmwareFigures::default(),
-        window: std::collections::VecDeque::new(),
-    };
+    let mut sink = FiguresSink(SegmentCounter::new(budget.min_segment_time_s));
     crate::path::walk(input, options, true, &mut sink)?;
-    let mut f = sink.figures;
-    f.bytes = input.len() as u64;
-    let newlines = input.iter().filter(|&&b| b == b'\n').count() as u64;
-    f.lines = newlines + u64::from(input.last().is_some_and(|&b| b != b'\n'));
-    f.budget_segments_per_s = budget.segment_rate_hz(f.bytes as f64 / f.lines.max(1) as f64);
-    Ok(f)
+    Ok(FirmwareFigures::of(input, sink.0.counts(), budget))
+}
+
+/// [`crate::analyze::analyze`] of `input`, and its [`figures`] counted in the same pass
+/// ([`crate::analyze::analyze_keeping`]): the same figures, without a planning walk of their own.
+pub fn analysed_figures(
+    input: &[u8],
+    options: &crate::analyze::AnalyzeOptions,
+    budget: &SegmentBudget,
+) -> Result<(crate::analyze::Report, FirmwareFigures), crate::error::Error> {
+    let keep = crate::analyze::Keep {
+        starts: false,
+        min_segment_s: Some(budget.min_segment_time_s),
+    };
+    let (report, kept) = crate::analyze::analyze_keeping(input, options, keep)?;
+    let counts = kept.segments.unwrap_or_default();
+    Ok((report, FirmwareFigures::of(input, counts, budget)))
+}
+
+impl FirmwareFigures {
+    /// The figures of `input`, whose segments `counts` counted, against `budget`.
+    pub fn of(input: &[u8], counts: SegmentCounts, budget: &SegmentBudget) -> Self {
+        let newlines = memchr::memchr_iter(b'\n', input).count() as u64;
+        let lines = newlines + u64::from(input.last().is_some_and(|&b| b != b'\n'));
+        let bytes = input.len() as u64;
+        Self {
+            lines,
+            bytes,
+            printing_segments: counts.printing_segments,
+            segments_under_0_1mm: counts.segments_under_0_1mm,
+            segments_under_min_time: counts.segments_under_min_time,
+            peak_segments_per_s: counts.peak_segments_per_s,
+            budget_segments_per_s: budget.segment_rate_hz(bytes as f64 / lines.max(1) as f64),
+        }
+    }
 }
 
 #[cfg(test)]

@@ -39,6 +39,7 @@ pub mod source;
 mod stages;
 mod tuning;
 
+use crate::plan::segments::SegmentCounts;
 use corners::{arcs, blend, hairpin};
 use search::{budget, rewrite, smooth, smoothings};
 use stages::{bspline, feed, fit, kinematics, resample, thin};
@@ -226,13 +227,19 @@ pub fn vtg_with_progress(
     // planned path costs as much as the other two together (34 MB: 550 ms, 150 + 220 ms).
     let (read, path) = crate::parallel::join(
         || {
-            let before = crate::analyze::analyze(input, &options.analyze)?;
+            // The original's firmware figures are counted in its analysis' pass.
+            let min_segment_s = firmware::min_segment_time_s(input, options.min_segment_time_ms);
+            let keep = crate::analyze::Keep {
+                starts: false,
+                min_segment_s: Some(min_segment_s),
+            };
+            let (before, kept) = crate::analyze::analyze_keeping(input, &options.analyze, keep)?;
             let sources = source::move_sources(input, &options.analyze)?;
-            Ok::<_, Error>((before, sources))
+            Ok::<_, Error>((before, kept.segments, sources))
         },
         || crate::path::extract(input, &options.analyze, options.limit_feed),
     );
-    let ((before, sources), path) = (read?, path?);
+    let ((before, before_segments, sources), path) = (read?, path?);
     if !progress(0.3) {
         return Err(cancelled());
     }
@@ -281,7 +288,7 @@ pub fn vtg_with_progress(
         firmware::SegmentBudget::for_file(input, path.junction_model, options.min_segment_time_ms);
     drop(run);
     drop((path, sources));
-    let report = finish(input, report, options, budget)?;
+    let report = finish(input, report, options, (budget, before_segments))?;
     progress(1.0);
     Ok(report)
 }
@@ -340,23 +347,19 @@ impl Run<'_> {
         };
         let (rewritten, measured) =
             self.rewrite((variant, kept), &before, Some(&metrics), progress)?;
-        let (after, clock, after_metrics) = match measured {
-            Some((after, clock, Some(beside))) => (after, Some(clock), beside?),
-            Some((after, clock, None)) => (after, Some(clock), metrics(&rewritten.output)?),
-            // Without the model this report is the last, and [`finish`] analyses the file with
-            // its estimates refreshed, the one handed back, and fills `after` and Table 2 from
-            // that: an analysis of this one would be thrown away (a planning pass over the
-            // whole output). Until then `after` is the original's.
-            None if !options.dynamics && refreshes(options, self.input, &rewritten.output) => {
-                (before.clone(), None, metrics(&rewritten.output)?)
-            }
+        let (after, kept, after_metrics) = match measured {
+            Some((after, kept, Some(beside))) => (after, Some(kept), beside?),
+            Some((after, kept, None)) => (after, Some(kept), metrics(&rewritten.output)?),
+            // Analysed even where [`finish`] analyses the file again with its estimates
+            // refreshed: the clock and the segments kept here spare it a planning walk for
+            // each, which take longer on one thread than this pass takes on two.
             None => {
                 let (analysed, after_metrics) = crate::parallel::join(
-                    || search::analysed(&rewritten.output, options),
+                    || search::analysed(&rewritten.output, self.input, options),
                     || metrics(&rewritten.output),
                 );
-                let (after, clock) = analysed?;
-                (after, Some(clock), after_metrics?)
+                let (after, kept) = analysed?;
+                (after, Some(kept), after_metrics?)
             }
         };
         let mut report = report::build(
@@ -368,7 +371,7 @@ impl Run<'_> {
             after_metrics,
             rewritten,
         );
-        report.output_clock = clock;
+        report.output_kept = kept;
         Ok(report)
     }
 
@@ -459,12 +462,6 @@ impl closed_loop::Again for Retry<'_, '_> {
     }
 }
 
-/// Whether [`finish`] rewrites the time estimates of `output` (the rewrite of `input`) and
-/// analyses the file it writes.
-fn refreshes(options: &VtgOptions, input: &[u8], output: &[u8]) -> bool {
-    options.estimates && output != input && crate::estimate::has_estimates(output)
-}
-
 /// Lines the refreshed time estimates add to the file's header ([`finish`]): its note and the
 /// estimate's own line.
 pub(crate) const ESTIMATE_HEADER_LINES: i64 = 2;
@@ -472,32 +469,45 @@ pub(crate) const ESTIMATE_HEADER_LINES: i64 = 2;
 /// The report as handed back: its file's time comments and `M73` lines rewritten from the
 /// planner ([`crate::estimate::refresh`]) when the toolpath changed and the options ask for
 /// it, and the file measured against the machine's segment budget ([`firmware`]) beside the
-/// original's figures, each read side by side with other work where there are threads.
+/// original's figures. Each file's figures are read from the segments its analysis counted
+/// where it kept them (`before`: the original's; the output's in its report), else by a
+/// planning walk of their own, side by side with other work where there are threads; the
+/// estimates are refreshed from the clock the output's analysis kept, where it did.
 fn finish(
     input: &[u8],
     mut report: VtgReport,
     options: &VtgOptions,
-    budget: firmware::SegmentBudget,
+    (budget, before): (firmware::SegmentBudget, Option<SegmentCounts>),
 ) -> Result<VtgReport, Error> {
-    let figures = |bytes: &[u8]| firmware::figures(bytes, &options.analyze, &budget);
+    let figures = |bytes: &[u8], counted: Option<SegmentCounts>| match counted {
+        Some(counts) => Ok(firmware::FirmwareFigures::of(bytes, counts, &budget)),
+        None => firmware::figures(bytes, &options.analyze, &budget),
+    };
     let note = format!("vtg: corners rounded within {} mm", options.tolerance_mm);
+    let kept = report.output_kept.take();
+    let after_counts = kept.as_ref().map(|k| k.segments);
     let (refreshed, before) = crate::parallel::join(
         || {
-            // `refreshes`, with its last condition left to `refresh_beside`, which asks it
-            // anyway (on a file without estimates it reads every line).
+            let after_figures = |bytes: &[u8]| figures(bytes, after_counts);
+            // Where the file carries estimates: `refresh_beside` asks (on a file without any
+            // it reads every line).
             if options.estimates && report.output != input {
-                let job = (note.as_str(), report.output_clock.as_ref());
-                crate::estimate::refresh_beside(&report.output, &options.analyze, job, figures)
+                let job = (note.as_str(), kept.as_ref().map(|k| &k.clock));
+                crate::estimate::refresh_beside(
+                    &report.output,
+                    &options.analyze,
+                    job,
+                    after_figures,
+                )
             } else {
-                Ok((None, figures(&report.output)))
+                Ok((None, after_figures(&report.output)))
             }
         },
-        || figures(input),
+        || figures(input, before),
     );
     let (refreshed, after) = refreshed?;
     if let Some((output, analysis)) = refreshed {
         report.output = output;
-        report.output_clock = None;
         report.table2 = report::table2(&report.before, &analysis, report.table2.deviation);
         report.after = analysis;
     }
@@ -510,7 +520,8 @@ mod tests {
     use super::*;
 
     /// Without the model, the report's `after` and Table 2 are the analysis of the file handed
-    /// back, estimates refreshed, whether or not the rewrite was analysed before the refresh.
+    /// back, estimates refreshed (not of the rewrite before the refresh), and the firmware
+    /// figures, counted in the analyses' passes, those a planning walk of each file counts.
     #[test]
     fn the_report_analyses_the_file_handed_back() {
         let demo = include_bytes!("../../../www/demo/demo.gcode");
@@ -526,6 +537,9 @@ mod tests {
         assert_eq!(r.table2.energy_j.after, written.energy.total_j);
         assert_eq!(r.table2.material_g.after, written.material_g);
         assert_ne!(r.after, r.before);
+        let f = r.firmware.expect("figures");
+        let walked = |bytes: &[u8]| firmware::figures(bytes, &options.analyze, &f.budget).unwrap();
+        assert_eq!((f.before, f.after), (walked(demo), walked(&r.output)));
     }
 
     #[test]

@@ -196,10 +196,21 @@ pub struct VtgReport {
     /// The rewritten G-code.
     #[serde(skip)]
     pub output: Vec<u8>,
-    /// The planner's clock of `output`, where its analysis kept one: its time estimates are
-    /// refreshed from it instead of planning the file again.
+    /// What the analysis of `output` kept of its planning pass, where it was analysed: its
+    /// time estimates are refreshed, and its firmware figures read, from it instead of
+    /// planning the file again.
     #[serde(skip)]
-    pub(crate) output_clock: Option<crate::estimate::Clock>,
+    pub(crate) output_kept: Option<OutputKept>,
+}
+
+/// What an analysis of a rewrite's output kept of its planning pass
+/// ([`crate::analyze::analyze_keeping`]).
+#[derive(Debug, Clone)]
+pub(crate) struct OutputKept {
+    /// The planner's clock at every line.
+    pub(crate) clock: crate::estimate::Clock,
+    /// Its segments, counted against the input's minimum segment time.
+    pub(crate) segments: crate::plan::segments::SegmentCounts,
 }
 
 /// Table 2 of the analyses `before` and `after`, with the dynamics model's `deviation` rows
@@ -289,7 +300,7 @@ pub(crate) fn build(
         after,
         firmware: None,
         output: rewritten.output,
-        output_clock: None,
+        output_kept: None,
         message: None,
         peak_layers_kept: Vec::new(),
     }

@@ -21,6 +21,7 @@ use super::tuning::TUNING;
 use super::VtgOptions;
 use crate::analyze::Report;
 use crate::error::Error;
+use crate::vtg::report::OutputKept;
 use smooth::{Settings, SmoothPath, Smoothed};
 
 pub(crate) mod budget;
@@ -182,14 +183,14 @@ pub(crate) fn within_allowed_time<T>(
         }
         let rewritten = offers.write(input, (allowed_s, lines), mean_power_w);
         let (analysed, alongside) = crate::parallel::join(
-            || analysed(&rewritten.output, options),
+            || analysed(&rewritten.output, input, options),
             || beside.map(|f| f(&rewritten.output)),
         );
-        let (after, clock) = analysed?;
+        let (after, kept) = analysed?;
         let added = after.time_s - before.time_s;
         let over_j = after.energy.total_j - energy_cap;
         if added <= allowed && over_j <= 0.0 {
-            return Ok((rewritten, Some((after, clock, alongside))));
+            return Ok((rewritten, Some((after, kept, alongside))));
         }
         if added > allowed {
             allowed_s -= TUNING.time_margin * (added - allowed);
@@ -201,20 +202,31 @@ pub(crate) fn within_allowed_time<T>(
     Ok((offers.write(input, (0.0, lines), mean_power_w), None))
 }
 
-/// A rewrite's analysis and clock, as the time allowance measured it, and what was measured
-/// beside it ([`within_allowed_time`]'s `beside`: the output's metrics, where they are wanted,
-/// read while the analysis runs, in case this round's output is the one kept).
-pub(crate) type Measured<T> = (Report, crate::estimate::Clock, Option<T>);
+/// A rewrite's analysis and what it kept of its pass, as the time allowance measured it, and
+/// what was measured beside it ([`within_allowed_time`]'s `beside`: the output's metrics, where
+/// they are wanted, read while the analysis runs, in case this round's output is the one kept).
+pub(crate) type Measured<T> = (Report, OutputKept, Option<T>);
 
-/// `output` analysed, and its clock from the same planning pass: what refreshing its time
-/// estimates reads, where it is the file handed back.
+/// `output`, the rewrite of `input`, analysed, with its clock and its segments counted against
+/// `input`'s minimum segment time from the same planning pass: what refreshing its time
+/// estimates and measuring it against the firmware read, where it is the file handed back.
 pub(crate) fn analysed(
     output: &[u8],
+    input: &[u8],
     options: &VtgOptions,
-) -> Result<(Report, crate::estimate::Clock), Error> {
-    let (after, starts) = crate::analyze::analyze_with_starts(output, &options.analyze)?;
-    let clock = crate::estimate::Clock::from_analysis(&after, starts);
-    Ok((after, clock))
+) -> Result<(Report, OutputKept), Error> {
+    let min_s = crate::vtg::firmware::min_segment_time_s(input, options.min_segment_time_ms);
+    let keep = crate::analyze::Keep {
+        starts: true,
+        min_segment_s: Some(min_s),
+    };
+    let (after, kept) = crate::analyze::analyze_keeping(output, &options.analyze, keep)?;
+    let starts = kept.starts.unwrap_or_default();
+    let output_kept = OutputKept {
+        clock: crate::estimate::Clock::from_analysis(&after, starts),
+        segments: kept.segments.unwrap_or_default(),
+    };
+    Ok((after, output_kept))
 }
 
 /// What [`within_allowed_time`] measures of each output beside its analysis.
