@@ -492,7 +492,7 @@ fn finish(
             // Where the file carries estimates: `refresh_beside` asks (on a file without any
             // it reads every line).
             if options.estimates && report.output != input {
-                let job = (note.as_str(), kept.as_ref().map(|k| &k.clock));
+                let job = (note.as_str(), kept.as_ref().and_then(|k| k.clock.as_ref()));
                 crate::estimate::refresh_beside(
                     &report.output,
                     &options.analyze,

@@ -207,8 +207,8 @@ pub struct VtgReport {
 /// ([`crate::analyze::analyze_keeping`]).
 #[derive(Debug, Clone)]
 pub(crate) struct OutputKept {
-    /// The planner's clock at every line.
-    pub(crate) clock: crate::estimate::Clock,
+    /// The planner's clock at every line, where it was kept.
+    pub(crate) clock: Option<crate::estimate::Clock>,
     /// Its segments, counted against the input's minimum segment time.
     pub(crate) segments: crate::plan::segments::SegmentCounts,
 }
