@@ -440,16 +440,8 @@ impl Offers {
             steps_joined: self.variant.thin,
             ..Rewritten::default()
         };
-        let lines = budget::free_within_lines(&self.offers, allowed_lines);
+        let (lines, choice) = self.choice((allowed_s, allowed_lines), mean_power_w);
         let free = |k: usize| self.offers[k].free.as_ref().filter(|_| lines.keep_free[k]);
-        let saved = (0..self.offers.len())
-            .filter_map(free)
-            .fold([0.0, 0.0], |s, f| [s[0] - f.added[0], s[1] - f.added[1]]);
-        let choice = budget::choose(
-            &self.offers,
-            Budget::new(saved, allowed_s, mean_power_w),
-            &lines,
-        );
         let mut edits: Vec<&Edit> = Vec::new();
         for (k, (offer, chosen)) in self.offers.iter().zip(choice).enumerate() {
             let written = match chosen {
@@ -476,6 +468,43 @@ impl Offers {
         }
         out.output = apply_edits(input, edits);
         out
+    }
+
+    /// The free rewrites `allowed_lines` more lines allow ([`budget::free_within_lines`]), and
+    /// the dearer one bought for each offer, if any ([`budget::choose`]): [`Offers::write`]'s
+    /// choice.
+    fn choice(
+        &self,
+        (allowed_s, allowed_lines): (f64, i64),
+        mean_power_w: f64,
+    ) -> (budget::LineChoice, Vec<Option<usize>>) {
+        let lines = budget::free_within_lines(&self.offers, allowed_lines);
+        let free = |k: usize| self.offers[k].free.as_ref().filter(|_| lines.keep_free[k]);
+        let saved = (0..self.offers.len())
+            .filter_map(free)
+            .fold([0.0, 0.0], |s, f| [s[0] - f.added[0], s[1] - f.added[1]]);
+        let budget = Budget::new(saved, allowed_s, mean_power_w);
+        let choice = budget::choose(&self.offers, budget, &lines);
+        (lines, choice)
+    }
+
+    /// What the rewrites [`Offers::write`] writes at `allowed` add to the file by their own
+    /// costing (time s, motor energy J; each path planned alone, [`Outcome::added`]): the
+    /// choice's forecast of what the whole file's analysis will measure, before the file is
+    /// written.
+    pub(crate) fn forecast(&self, allowed: (f64, i64), mean_power_w: f64) -> [f64; 2] {
+        let (lines, choice) = self.choice(allowed, mean_power_w);
+        let mut sum = [0.0, 0.0];
+        for (k, (offer, chosen)) in self.offers.iter().zip(choice).enumerate() {
+            let written = match chosen {
+                Some(d) => offer.dearer.get(d),
+                None => offer.free.as_ref().filter(|_| lines.keep_free[k]),
+            };
+            if let Some(o) = written {
+                sum = [sum[0] + o.added[0], sum[1] + o.added[1]];
+            }
+        }
+        sum
     }
 }
 
