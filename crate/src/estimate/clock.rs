@@ -27,44 +27,43 @@ impl Clock {
             last_tag: None,
         };
         let walked = walk(input, options, true, &mut sink)?;
-        let mut clock = Self {
-            starts: sink.starts,
-            total_s: walked.time_s,
-            first_layer_s: None,
-            machine: format!(
-                "{}, {:?} junctions",
-                walked.profile.name, walked.junction_model
-            ),
-        };
-        // From the start of the print, as PrusaSlicer counts it: the start code's moves (purge
-        // line, wipe) print as part of the first layer.
-        clock.first_layer_s = walked.layers.first().map(|_| {
-            walked
-                .layers
-                .get(1)
-                .map_or(clock.total_s, |second| clock.at_line(second.line))
-        });
-        Ok(clock)
+        let machine = (walked.profile.name.as_str(), walked.junction_model);
+        let layer_lines = walked.layers.iter().map(|l| l.line);
+        Ok(Self::new(sink.starts, walked.time_s, machine, layer_lines))
     }
 
     /// The clock of the file `report` analyses, from the starts its planning pass kept
     /// ([`crate::analyze::analyze_with_starts`]): the same planner as [`Clock::of`], read from
     /// the same moves, so the same clock, without planning the file again.
     pub fn from_analysis(report: &crate::analyze::Report, starts: MoveStarts) -> Self {
+        let machine = (
+            report.machine.profile.as_str(),
+            report.machine.junction_model,
+        );
+        let layer_lines = report.layer_list.iter().map(|l| l.line);
+        Self::new(starts, report.time_s, machine, layer_lines)
+    }
+
+    /// The clock of a file planned in `total_s` with these `starts`, on `machine` (profile name
+    /// and junction model), whose layers start at `layer_lines`.
+    fn new(
+        starts: MoveStarts,
+        total_s: f64,
+        (profile, model): (&str, crate::plan::JunctionModel),
+        mut layer_lines: impl Iterator<Item = u32>,
+    ) -> Self {
         let mut clock = Self {
             starts,
-            total_s: report.time_s,
+            total_s,
             first_layer_s: None,
-            machine: format!(
-                "{}, {:?} junctions",
-                report.machine.profile, report.machine.junction_model
-            ),
+            machine: format!("{profile}, {model:?} junctions"),
         };
-        let layers = &report.layer_list;
-        clock.first_layer_s = layers.first().map(|_| {
-            layers
-                .get(1)
-                .map_or(clock.total_s, |second| clock.at_line(second.line))
+        // From the start of the print, as PrusaSlicer counts it: the start code's moves (purge
+        // line, wipe) print as part of the first layer.
+        clock.first_layer_s = layer_lines.next().map(|_| {
+            layer_lines
+                .next()
+                .map_or(clock.total_s, |second| clock.at_line(second))
         });
         clock
     }

@@ -441,27 +441,20 @@ impl Offers {
             ..Rewritten::default()
         };
         let (lines, choice) = self.choice((allowed_s, allowed_lines), mean_power_w);
-        let free = |k: usize| self.offers[k].free.as_ref().filter(|_| lines.keep_free[k]);
         let mut edits: Vec<&Edit> = Vec::new();
         for (k, (offer, chosen)) in self.offers.iter().zip(choice).enumerate() {
-            let written = match chosen {
-                Some(d) => {
-                    out.paid_paths += 1;
-                    offer.dearer.get(d)
+            if chosen.is_some() {
+                out.paid_paths += 1;
+            } else {
+                if offer.free.is_none() && !offer.dearer.is_empty() {
+                    out.kept_for_time += 1;
                 }
-                None => {
-                    if offer.free.is_none() && !offer.dearer.is_empty() {
-                        out.kept_for_time += 1;
-                    }
-                    if offer.free.as_ref().is_some_and(|f| f.corners_removed > 0)
-                        && !lines.keep_free[k]
-                    {
-                        out.kept_for_lines += 1;
-                    }
-                    free(k)
+                if offer.free.as_ref().is_some_and(|f| f.corners_removed > 0) && !lines.keep_free[k]
+                {
+                    out.kept_for_lines += 1;
                 }
-            };
-            if let Some(o) = written {
+            }
+            if let Some(o) = written(offer, chosen, lines.keep_free[k]) {
                 out.add(&o.part);
                 edits.extend(&o.edits);
             }
@@ -496,15 +489,20 @@ impl Offers {
         let (lines, choice) = self.choice(allowed, mean_power_w);
         let mut sum = [0.0, 0.0];
         for (k, (offer, chosen)) in self.offers.iter().zip(choice).enumerate() {
-            let written = match chosen {
-                Some(d) => offer.dearer.get(d),
-                None => offer.free.as_ref().filter(|_| lines.keep_free[k]),
-            };
-            if let Some(o) = written {
+            if let Some(o) = written(offer, chosen, lines.keep_free[k]) {
                 sum = [sum[0] + o.added[0], sum[1] + o.added[1]];
             }
         }
         sum
+    }
+}
+
+/// The outcome of `offer` the choice writes: the dearer one `chosen`, else its free one where
+/// the lines `keep_free` it, else none (the path stays as it was).
+fn written(offer: &Offer, chosen: Option<usize>, keep_free: bool) -> Option<&Outcome> {
+    match chosen {
+        Some(d) => offer.dearer.get(d),
+        None => offer.free.as_ref().filter(|_| keep_free),
     }
 }
 
