@@ -105,6 +105,14 @@ pub fn modes(drive: &Drive, position_m: f64) -> Vec<Mode> {
     modal::modes(&dyn6(&mats.m), &dyn6(&mats.c), &dyn6(&mats.k))
 }
 
+/// The slowest decay rate of the machine's free motion with the axis at `position_m`, 1/s
+/// ([`modal::slowest_decay`]).
+pub fn slowest_decay(drive: &Drive, position_m: f64) -> Option<f64> {
+    let c = drive.coefficients(position_m);
+    let (mats, _, _) = linear_model(&c, drive);
+    modal::slowest_decay(&dyn6(&mats.m), &dyn6(&mats.c), &dyn6(&mats.k))
+}
+
 /// Discretises the axis at `position_m` over `ts` seconds.
 pub fn stepper(drive: &Drive, position_m: f64, ts: f64) -> Option<Stepper> {
     let c = drive.coefficients(position_m);

@@ -65,6 +65,20 @@ pub fn modes(m: &DMatrix<f64>, c: &DMatrix<f64>, k: &DMatrix<f64>) -> Vec<Mode> 
     out
 }
 
+/// The slowest decay rate of free motion, `min −Re λ` over every eigenvalue of `A` (1/s,
+/// overdamped and rigid-body ones too): a state difference shrinks by at least `e^{-r t}` in
+/// `t` seconds, asymptotically. `None` if the matrices are unusable or the iteration does not
+/// converge; 0 or less where some motion never decays (an undamped mode).
+pub fn slowest_decay(m: &DMatrix<f64>, c: &DMatrix<f64>, k: &DMatrix<f64>) -> Option<f64> {
+    let a = state_matrix(m, c, k)?;
+    let schur = Schur::try_new(a, f64::EPSILON, 100_000)?;
+    schur
+        .complex_eigenvalues()
+        .iter()
+        .map(|l| -l.re)
+        .reduce(f64::min)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -97,6 +111,19 @@ mod tests {
             assert!((mode.frequency_hz - f).abs() < 1e-9 * f, "{mode:?} vs {f}");
             assert!(mode.damping_ratio.abs() < 1e-9);
         }
+    }
+
+    #[test]
+    fn the_slowest_decay_is_the_least_damped_modes() {
+        // Two uncoupled oscillators: −Re λ = ζ ωₙ = c / 2m for each; the slower one counts.
+        let m = DMatrix::from_diagonal_element(2, 2, 2.0);
+        let c = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![4.0, 0.4]));
+        let k = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![800.0, 5000.0]));
+        let r = slowest_decay(&m, &c, &k).unwrap();
+        assert!((r - 0.1).abs() < 1e-9, "{r}");
+        // Undamped: no decay.
+        let z = DMatrix::zeros(2, 2);
+        assert!(slowest_decay(&m, &z, &k).unwrap().abs() < 1e-9);
     }
 
     #[test]
