@@ -17,6 +17,10 @@ pub(super) trait Emit {
     fn emit(&mut self, seg: Segment, counted: u32);
     /// The file's machine, once, before the first segment.
     fn machine(&mut self, _profile: &MachineProfile) {}
+    /// Whether it takes no more segments (the walk may stop reading).
+    fn finished(&self) -> bool {
+        false
+    }
 }
 
 /// The segments on the layers `keep` accepts, in a list.
@@ -270,5 +274,9 @@ impl<E: Emit> MoveSink for Streamed<E> {
 
     fn machine(&mut self, profile: &MachineProfile) {
         self.timeline.emit.machine(profile);
+    }
+
+    fn finished(&self) -> bool {
+        self.timeline.emit.finished()
     }
 }

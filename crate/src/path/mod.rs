@@ -22,11 +22,11 @@ pub use geometry::{DrawPoint, LayerGeometry, SegmentKind, ARC_CHORD_DEG, TOOL_FL
 use serde::Serialize;
 
 use crate::error::{Error, Warning};
-use crate::gcode::{feature_kind, FeatureKind, Line};
+use crate::gcode::{feature_kind, FeatureKind, Line, RawLine};
 use crate::machine::{Event, ExtrusionMode, Machine, MoveKind, Pos};
 use crate::plan::{JunctionModel, Limits, MachineProfile, Motion, PlannedMove, Planner, Profile};
 use crate::read::{AnalyzeOptions, LayerSource};
-use crate::read::{At, Fold, Reader};
+use crate::read::{At, Flow, Fold, Reader};
 
 /// Feature index of moves before the file names any feature.
 pub const NO_FEATURE: u16 = u16::MAX;
@@ -155,6 +155,11 @@ pub trait MoveSink {
     fn limits(&mut self, _limits: &Limits) {}
     /// The machine the file is read for, once, before the first move.
     fn machine(&mut self, _profile: &MachineProfile) {}
+    /// Whether the sink wants no more moves: the walk then leaves the rest of the file's lines
+    /// unread, and what it learnt covers only what it read.
+    fn finished(&self) -> bool {
+        false
+    }
 }
 
 /// What [`walk`] learns of a file besides its moves.
@@ -202,6 +207,14 @@ struct Walk<'s, S> {
 }
 
 impl<S: MoveSink> Fold for Walk<'_, S> {
+    fn line(&mut self, _: &RawLine<'_>, _: Option<&Line<'_>>) -> Result<Flow, Error> {
+        Ok(if self.sink.finished() {
+            Flow::Skip
+        } else {
+            Flow::Read
+        })
+    }
+
     fn feature(&mut self, name: &str, _: &Machine) {
         let features = &mut self.features;
         self.current_feature = match features.iter().position(|f| f.name == name) {
