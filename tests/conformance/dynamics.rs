@@ -209,3 +209,92 @@ fn the_simulation_run_as_the_planner_times_each_move_is_the_one_run_on_the_kept_
         );
     }
 }
+
+#[test]
+fn a_long_print_run_in_two_halves_rings_as_it_does_run_whole() {
+    // Every corpus file long enough to split (half its print at least two warm-ups: 40 time
+    // constants of the belt preset's slowest decay, about 34 minutes), but the 34 MB one: the
+    // deviation run in two halves, the second started at rest a warm-up early, against the
+    // whole run. The free response it leaves out is e^-40 of the state: the same figures to
+    // rounding, and the same samples.
+    let options = VibrationOptions::default();
+    let mut split = 0;
+    let corpus = quietpath_conformance::corpus()
+        .into_iter()
+        .filter(|f| f.bytes <= 10 << 20);
+    let files = corpus.map(|f| (f.name.clone(), f.read()));
+    let long = ("a 2.8-hour star print".to_string(), long_star_print());
+    for (name, input) in files.chain([long]) {
+        let Ok(report) = quietpath::analyze::analyze(&input, &options.analyze) else {
+            continue;
+        };
+        let Ok(whole) = quietpath::dynamics::printing_deviation(&input, &options, None) else {
+            continue;
+        };
+        let path = quietpath::path::extract(&input, &options.analyze, false).expect("extract");
+        let machine = options
+            .machine_dynamics(&path.profile.name)
+            .expect("dynamics");
+        let Some(warmup) = quietpath::dynamics::split::warmup_s(&machine) else {
+            continue;
+        };
+        if (report.time_s / 2.0).floor() < 2.0 * warmup {
+            continue;
+        }
+        let halves = quietpath::dynamics::printing_deviation(&input, &options, Some(report.time_s))
+            .expect("split run");
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+        let (a, b) = (&whole.0, &halves.0);
+        eprintln!(
+            "{}: {:.0} s, warm-up {warmup} s: mean {} / {}, max {} / {}",
+            name, report.time_s, a.mean, b.mean, a.max, b.max
+        );
+        assert!(close(a.mean, b.mean), "{}: {a:?} against {b:?}", name);
+        assert!(close(a.max, b.max) && close(a.min, b.min), "{}", name);
+        assert_eq!(whole.1.len(), halves.1.len(), "{}", name);
+        for (l, m) in whole.1.iter().zip(&halves.1) {
+            assert_eq!(l.layer, m.layer, "{}", name);
+            assert_eq!(
+                l.printing_samples, m.printing_samples,
+                "{} layer {}",
+                name, l.layer
+            );
+            assert!(
+                close(l.printing_mean, m.printing_mean),
+                "{} layer {}",
+                name,
+                l.layer
+            );
+            assert!(
+                close(l.printing_amplitude, m.printing_amplitude),
+                "{}",
+                name
+            );
+        }
+        split += 1;
+    }
+    assert!(split >= 2, "only {split} files are long enough to split");
+}
+
+/// A print of about 2.8 hours at 50 mm/s: 240 layers of five laps of a seven-pointed star,
+/// each layer moved across the bed (so the model's stiffness changes with position), its
+/// sharp points ringing.
+fn long_star_print() -> Vec<u8> {
+    let mut g = String::from("G21\nG90\nM83\nG1 Z0.2 F600\nG1 X100 Y100 F6000\n");
+    let mut at = (100.0, 100.0);
+    for layer in 0..240 {
+        let z = 0.2 * (layer + 1) as f64;
+        g.push_str(&format!(";LAYER_CHANGE\n;Z:{z:.1}\nG1 Z{z:.1} F600\n"));
+        let shift = (layer % 100) as f64;
+        let centre = (60.0 + shift, 60.0 + 0.5 * shift);
+        for k in 0..=35 {
+            // Every third point of 7 round the circle: a {7/3} star.
+            let a = (k * 3 % 7) as f64 * std::f64::consts::TAU / 7.0;
+            let (x, y) = (centre.0 + 30.0 * a.cos(), centre.1 + 30.0 * a.sin());
+            let e = 0.04 * (x - at.0).hypot(y - at.1);
+            g.push_str(&format!("G1 X{x:.4} Y{y:.4} E{e:.5} F3000\n"));
+            at = (x, y);
+        }
+    }
+    g.into_bytes()
+}

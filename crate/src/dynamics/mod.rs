@@ -27,6 +27,7 @@ pub mod modal_step;
 pub mod parameters;
 mod sampled;
 pub mod simulate;
+pub mod split;
 pub mod steppers;
 mod stream;
 mod timeline;
@@ -261,14 +262,24 @@ pub fn vibration_with_progress(
 /// [`vibration`]'s deviation over printing moves, whole and per layer, alone: the same
 /// figures to the bit, without the acceleration samples, the spectrum and the modes, which
 /// only the report reads (a twentieth of a simulation's time). For optimisers that judge
-/// their rewrites by it, many times a run.
+/// their rewrites by it, many times a run. With `expected_s` (the print's planned time,
+/// about), a long print runs in two halves ([`split`]): the same figures to rounding, in
+/// about half the time where there are threads.
 pub fn printing_deviation(
     input: &[u8],
     options: &VibrationOptions,
+    expected_s: Option<f64>,
 ) -> Result<(Deviation, Vec<LayerVibration>), Error> {
     options.validate()?;
     let (settings, _) = simulation_settings(options);
-    let (outcome, _, _, file) = simulate_file(input, options, (settings, None), &mut |_| true)?;
+    let (outcome, file) = match expected_s {
+        Some(about) => split::deviation_run(input, options, settings, about)?,
+        None => {
+            let (outcome, _, _, file) =
+                simulate_file(input, options, (settings, None), &mut |_| true)?;
+            (outcome, file)
+        }
+    };
     let deviation = Deviation::of(&outcome.printing, outcome.printing_max_at);
     Ok((deviation, layer_vibrations(&outcome, &file.layers)))
 }

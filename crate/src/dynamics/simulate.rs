@@ -186,6 +186,39 @@ impl Outcome {
             l.add_acceleration(acc);
         }
     }
+
+    /// The run of the stretch of the same timeline after this one's ([`super::split`]) added:
+    /// the samples of both, each largest where it was first met.
+    pub(super) fn then(&mut self, later: Outcome) {
+        if later.deviation.count > 0
+            && (self.deviation.count == 0 || later.deviation.max > self.deviation.max)
+        {
+            self.max_at = later.max_at;
+        }
+        if later.printing.count > 0
+            && (self.printing.count == 0 || later.printing.max > self.printing.max)
+        {
+            self.printing_max_at = later.printing_max_at;
+        }
+        self.deviation.merge(&later.deviation);
+        self.printing.merge(&later.printing);
+        merge_layers(&mut self.layers, &later.layers);
+        self.steps += later.steps;
+        self.simulated_s += later.simulated_s;
+    }
+}
+
+/// Per-layer sums of a later stretch of the same timeline added to `into`, layer by layer.
+pub(super) fn merge_layers(into: &mut Vec<LayerSums>, later: &[LayerSums]) {
+    if into.len() < later.len() {
+        into.resize(later.len(), LayerSums::default());
+    }
+    for (l, m) in into.iter_mut().zip(later) {
+        l.deviation.merge(&m.deviation);
+        l.printing.merge(&m.printing);
+        l.accel_sq += m.accel_sq;
+        l.accel_count += m.accel_count;
+    }
 }
 
 /// One step of both axes from the command `prev` to `next`.

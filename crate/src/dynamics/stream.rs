@@ -14,6 +14,7 @@ use super::simulate::{
     budget, cancelled, step_axes, steps_to_end, still, table_acceleration, too_long, LayerSums,
     Outcome, Settings,
 };
+use super::split::{Half, HalfRun};
 use super::timeline::Emit;
 use super::trajectory::{Bounds, Command, Segment};
 use super::welch::Welch;
@@ -32,6 +33,17 @@ struct Here {
     layer: u32,
     counted: u32,
     extruding: bool,
+}
+
+/// The stretch of a timeline a run steps through ([`super::split`]): all of it, or one half.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct Steps {
+    /// The step the run starts from, the machine at rest.
+    pub from: u64,
+    /// The step the run stops at, where it stops before the end.
+    pub until: Option<u64>,
+    /// Steps up to this one are taken but not counted (the second half's warm-up).
+    pub counted_after: u64,
 }
 
 /// One run of both axes, fed its segments in time order.
@@ -72,6 +84,9 @@ pub struct Stream<'w> {
     /// Steps to the end when known up front (progress is reported only then).
     total: Option<u64>,
     next_progress: u64,
+    /// The stretch stepped through, and whether `prev` is set for its first step.
+    steps: Steps,
+    primed: bool,
 }
 
 impl<'w> Stream<'w> {
@@ -105,7 +120,22 @@ impl<'w> Stream<'w> {
             most_steps: budget(max_segments),
             total,
             next_progress: PROGRESS_STEPS,
+            steps: Steps::default(),
+            primed: true,
         }
+    }
+
+    /// The run stepping through `steps` only (a half of a split run, [`super::split`]).
+    pub(super) fn stepping(mut self, steps: Steps) -> Self {
+        self.k = steps.from;
+        self.primed = steps.from == 0;
+        self.steps = steps;
+        self
+    }
+
+    /// Whether the run has reached the step it stops at.
+    fn stopped(&self) -> bool {
+        self.steps.until.is_some_and(|u| self.k >= u)
     }
 
     /// The next segment on the timeline (`counted`: its layer by counting), and every step its
@@ -126,11 +156,19 @@ impl<'w> Stream<'w> {
             self.first_from = seg.from;
         }
         self.end_s = seg.end_s();
+        if self.stopped() {
+            // A first half done: the rest counts toward the budget only.
+            self.pushed += 1;
+            return Ok(());
+        }
         self.make_room(seg.layer, counted);
         self.window.push_back((seg, counted));
         self.pushed += 1;
-        if self.pushed == 1 {
+        if self.pushed == 1 && self.primed {
             self.prev = self.at(0.0).0;
+        }
+        if !self.primed {
+            self.drop_before_start();
         }
         self.advance(None, self.end_s, progress)
     }
@@ -142,9 +180,13 @@ impl<'w> Stream<'w> {
         progress: Progress<'_>,
     ) -> Result<(Outcome, Option<Vec<LayerSums>>), Error> {
         let ts = self.settings.ts;
-        let (total, budget) = steps_to_end(self.motion_s, self.pushed, self.end_s, ts)?;
-        self.most_steps = budget;
-        self.advance(Some(total), f64::INFINITY, progress)?;
+        // A first half that stopped has read only part of the file: the second half, which
+        // reads it all, checks the whole run's budget.
+        if !self.stopped() {
+            let (total, budget) = steps_to_end(self.motion_s, self.pushed, self.end_s, ts)?;
+            self.most_steps = budget;
+            self.advance(Some(total), f64::INFINITY, progress)?;
+        }
         self.out.simulated_s = self.out.steps as f64 * ts;
         Ok((self.out, self.counted))
     }
@@ -193,10 +235,16 @@ impl<'w> Stream<'w> {
         progress: Progress<'_>,
     ) -> Result<(), Error> {
         let ts = self.settings.ts;
-        while total.is_none_or(|n| self.k < n) {
+        while total.is_none_or(|n| self.k < n) && !self.stopped() {
             let t1 = (self.k + 1) as f64 * ts;
             if t1 >= horizon {
                 break;
+            }
+            if !self.primed {
+                // A half started later: the command its first step starts from, now that the
+                // segments around it are known.
+                self.prev = self.at(self.k as f64 * ts).0;
+                self.primed = true;
             }
             let (next, here) = self.at(t1);
             if !self.step(next, here, t1)? {
@@ -223,9 +271,11 @@ impl<'w> Stream<'w> {
         let ts = self.settings.ts;
         step_axes(&mut self.axes, &self.prev, &next, ts)?;
         self.k += 1;
-        self.out.steps += 1;
+        // A warm-up step is taken, not counted.
+        let counting = self.k > self.steps.counted_after;
+        self.out.steps += u64::from(counting);
         let (layer, counted) = here.map_or((NO_LAYER, NO_LAYER), |h| (h.layer, h.counted));
-        if let Some(Here { extruding, .. }) = here {
+        if let Some(Here { extruding, .. }) = here.filter(|_| counting) {
             let [dx, dy] = self.axes.table();
             let dev = (dx * dx + dy * dy).sqrt() * 1e3;
             self.out
@@ -242,7 +292,7 @@ impl<'w> Stream<'w> {
         let sampling = self
             .welch
             .as_deref_mut()
-            .filter(|_| self.since >= self.settings.decimation);
+            .filter(|_| counting && self.since >= self.settings.decimation);
         if let Some(welch) = sampling {
             let dt = self.since as f64 * ts;
             let acc = table_acceleration(&next, &self.axes, &mut self.last_v, dt);
@@ -264,6 +314,8 @@ impl<'w> Stream<'w> {
                 return Ok(false);
             };
             let resume = ((s.start_s / ts).floor() as u64).saturating_sub(1);
+            // A first half stops at its last step, at rest.
+            let resume = self.steps.until.map_or(resume, |u| resume.min(u));
             if resume > self.k {
                 self.k = resume;
                 self.axes.rest();
@@ -278,6 +330,18 @@ impl<'w> Stream<'w> {
             next
         };
         Ok(true)
+    }
+
+    /// A half started later holds, of the segments before its first step, only the last (as
+    /// [`Stream::at`] keeps the one before the cursor's): the rest of them would be half a
+    /// file's segments held for nothing (80 MB on the 34 MB corpus file).
+    fn drop_before_start(&mut self) {
+        let start = self.k as f64 * self.settings.ts;
+        while self.window.len() > 1 && self.window[1].0.end_s() <= start {
+            self.window.pop_front();
+            self.base += 1;
+        }
+        self.j = self.j.max(self.base);
     }
 
     /// Per-layer sums up to `layer` (and `counted`) where they grow to the layers met: made
@@ -298,7 +362,7 @@ impl<'w> Stream<'w> {
 
 /// The per-layer sums of a streamed run, `layers` of them, by marker (`by_markers`: the
 /// outcome's own) or by counting.
-fn finish_layers(
+pub(super) fn finish_layers(
     out: &mut Outcome,
     counted: Option<Vec<LayerSums>>,
     layers: usize,
@@ -325,6 +389,10 @@ pub(super) struct Simulating<'w, 'p, F> {
     bounds: Bounds,
     error: Option<Error>,
     progress: Progress<'p>,
+    /// The half of a split run this is ([`super::split`]), and the stretch it steps through
+    /// once the machine is known (`None`: a second half the run is not split for).
+    half: Option<Half>,
+    steps: Option<Steps>,
 }
 
 impl<'w, 'p, F: FnOnce(&str) -> Result<MachineDynamics, Error>> Simulating<'w, 'p, F> {
@@ -350,6 +418,30 @@ impl<'w, 'p, F: FnOnce(&str) -> Result<MachineDynamics, Error>> Simulating<'w, '
             bounds: Bounds::default(),
             error: None,
             progress,
+            half: None,
+            steps: Some(Steps::default()),
+        }
+    }
+
+    /// The run as `half` of a split one.
+    pub(super) fn half(mut self, half: Half) -> Self {
+        self.half = Some(half);
+        self
+    }
+
+    /// A half's outcome and sums by counted layer (`None`: a second half the run was not
+    /// split for), and whether the run was split.
+    pub(super) fn finish_half(self) -> Result<(HalfRun, bool), Error> {
+        if let Some(e) = self.error {
+            return Err(e);
+        }
+        let Some(steps) = self.machine.as_ref().map(|_| self.steps) else {
+            return Err(cancelled());
+        };
+        let split = steps.is_some_and(|s| s != Steps::default());
+        match self.stream {
+            Some(stream) => Ok((Some(stream.finish(self.progress)?), split)),
+            None => Ok((None, split)),
         }
     }
 
@@ -396,6 +488,10 @@ impl<F: FnOnce(&str) -> Result<MachineDynamics, Error>> Emit for Simulating<'_, 
         }
     }
 
+    fn finished(&self) -> bool {
+        self.stream.as_ref().is_some_and(Stream::stopped)
+    }
+
     fn machine(&mut self, profile: &MachineProfile) {
         let Some(dynamics_for) = self.dynamics_for.take() else {
             return;
@@ -404,7 +500,12 @@ impl<F: FnOnce(&str) -> Result<MachineDynamics, Error>> Emit for Simulating<'_, 
         match dynamics_for(&profile.name) {
             Ok(machine) => {
                 let sizes = (None, self.max_segments, None);
-                self.stream = Some(Stream::new(&machine, self.settings, welch, sizes));
+                self.steps = self.half.map_or(Some(Steps::default()), |h| {
+                    h.steps(&machine, self.settings.ts)
+                });
+                self.stream = self
+                    .steps
+                    .map(|st| Stream::new(&machine, self.settings, welch, sizes).stepping(st));
                 self.machine = Some(machine);
             }
             Err(e) => self.error = Some(e),

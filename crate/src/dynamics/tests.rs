@@ -176,7 +176,7 @@ fn the_deviation_alone_is_the_reports_to_the_bit() {
     for input in [SQUARE, &demo[..]] {
         let options = VibrationOptions::default();
         let r = vibration(input, &options).unwrap();
-        let (deviation, layers) = printing_deviation(input, &options).unwrap();
+        let (deviation, layers) = printing_deviation(input, &options, None).unwrap();
         assert_eq!(deviation, r.printing_deviation_mm);
         assert_eq!(layers.len(), r.layers.len());
         for (a, b) in layers.iter().zip(&r.layers) {

@@ -55,7 +55,7 @@ pub(super) fn with_simulated_deviation(
         first.table2.deviation = Some(rows(&b));
         return Ok(first);
     }
-    let (sampled, sim) = simulate_first(input, &first.output, orig.layers.len(), options);
+    let (sampled, sim) = simulate_first(input, &first, orig.layers.len(), options);
     let Some(sim) = sim else {
         return Ok(first);
     };
@@ -143,25 +143,25 @@ struct Tried {
 /// The race's sample of the original and the first rewrite, simulated ([`raced`]).
 type SampledPair = Option<(Deviation, Deviation)>;
 
-/// The first rewrite `output` simulated whole; where there are threads to spare and the file
+/// The first rewrite `first` simulated whole; where there are threads to spare and the file
 /// is one the race would sample ([`race_sample`]), the race's simulations of the original
 /// and the first rewrite on the sample run beside it: the whole simulation runs on one
 /// thread, and on the 34 MB corpus file the sample's 1.7 s fit beside its 4.5 s. They are
 /// wasted where the first rewrite keeps the rule, on a thread that would have been idle.
 fn simulate_first(
     input: &[u8],
-    output: &[u8],
+    first: &VtgReport,
     layers: usize,
     options: &VtgOptions,
 ) -> (Option<SampledPair>, Option<Simulated>) {
+    let output = &first.output[..];
+    let whole = || printing_deviation(output, first.after.time_s, options);
     let race = race_layers(input.len(), layers, options).filter(|_| crate::parallel::threads() > 1);
     let Some(sample) = race else {
-        return (None, printing_deviation(output, options));
+        return (None, whole());
     };
-    let (pair, sim) = crate::parallel::join(
-        || sampled_pair(input, output, &sample, options),
-        || printing_deviation(output, options),
-    );
+    let (pair, sim) =
+        crate::parallel::join(|| sampled_pair(input, output, &sample, options), whole);
     (Some(pair), sim)
 }
 
@@ -226,7 +226,7 @@ fn every_variant(
         }
         let f = from + step * k as f64;
         let report = again.report(variant, &[], best.report.before.clone(), f)?;
-        let Some(sim) = printing_deviation(&report.output, options) else {
+        let Some(sim) = printing_deviation(&report.output, report.after.time_s, options) else {
             break;
         };
         let score = quietness(b, &sim.deviation);
@@ -398,7 +398,7 @@ fn keep_ringing_layers(
         why.peak += marked.peak;
         why.mean += marked.mean;
         let next = again.report(variant, &kept, before.clone(), 0.95)?;
-        let Some(a) = printing_deviation(&next.output, options) else {
+        let Some(a) = printing_deviation(&next.output, next.after.time_s, options) else {
             return Ok(None);
         };
         if a.deviation.mean <= b.mean && a.deviation.max <= b.max {
@@ -501,11 +501,17 @@ struct LayerRinging {
     samples: u64,
 }
 
-/// The dynamics model run on a file, `None` when it cannot run on it (a print too long to
-/// simulate, for instance).
-pub(super) fn printing_deviation(bytes: &[u8], options: &VtgOptions) -> Option<Simulated> {
+/// The dynamics model run on a file that plans to `expected_s` seconds (its analysis' time:
+/// a long print is run in two halves, [`crate::dynamics::split`]), `None` when it cannot run
+/// on it (a print too long to simulate, for instance).
+pub(super) fn printing_deviation(
+    bytes: &[u8],
+    expected_s: f64,
+    options: &VtgOptions,
+) -> Option<Simulated> {
+    let vibration = vibration_options(options);
     let (deviation, by_layer) =
-        crate::dynamics::printing_deviation(bytes, &vibration_options(options)).ok()?;
+        crate::dynamics::printing_deviation(bytes, &vibration, Some(expected_s)).ok()?;
     let n = by_layer.iter().map(|l| l.layer + 1).max().unwrap_or(0);
     let mut layers = vec![LayerRinging::default(); n];
     for l in &by_layer {

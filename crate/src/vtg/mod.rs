@@ -262,11 +262,12 @@ pub fn vtg_with_progress(
     let first = search::Variant::default();
     // The original's simulated deviation does not depend on the rewrite: where there are
     // threads, it runs beside the first one (on a long print it takes as long).
+    let expected_s = before.time_s;
     let (original_deviation, report) = crate::parallel::join(
         || {
             options
                 .dynamics
-                .then(|| closed_loop::printing_deviation(input, options))
+                .then(|| closed_loop::printing_deviation(input, expected_s, options))
         },
         || run.attempt(first, &[], before, &mut |f| progress(0.3 + 0.4 * f)),
     );
