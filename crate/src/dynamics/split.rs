@@ -9,7 +9,8 @@
 //!
 //! The split is the run's, not the threads': where there is one thread the halves run in
 //! turn, so a file is judged alike on every build. A machine with a mode that never decays
-//! (the ball-screw preset's undamped one), or a print shorter than two warm-ups, is run whole.
+//! (the ball-screw preset's undamped one), or a print whose split comes before two warm-ups,
+//! is run whole.
 
 use super::parameters::{Drive, MachineDynamics};
 use super::simulate::{LayerSums, Outcome, Settings};

@@ -489,7 +489,11 @@ impl<F: FnOnce(&str) -> Result<MachineDynamics, Error>> Emit for Simulating<'_, 
     }
 
     fn finished(&self) -> bool {
-        self.stream.as_ref().is_some_and(Stream::stopped)
+        match &self.stream {
+            Some(stream) => stream.stopped(),
+            // A second half the run is not split for: nothing to read.
+            None => self.machine.is_some(),
+        }
     }
 
     fn machine(&mut self, profile: &MachineProfile) {
