@@ -145,9 +145,9 @@ type SampledPair = Option<(Deviation, Deviation)>;
 
 /// The first rewrite `first` simulated whole; where there are threads to spare and the file
 /// is one the race would sample ([`race_sample`]), the race's simulations of the original
-/// and the first rewrite on the sample run beside it: the whole simulation runs on one
-/// thread, and on the 34 MB corpus file the sample's 1.7 s fit beside its 4.5 s. They are
-/// wasted where the first rewrite keeps the rule, on a thread that would have been idle.
+/// and the first rewrite on the sample run beside it (on the 34 MB corpus file the sample
+/// takes 1.7 s, the whole run's two halves about 2 s each). They are wasted where the first
+/// rewrite keeps the rule.
 fn simulate_first(
     input: &[u8],
     first: &VtgReport,
