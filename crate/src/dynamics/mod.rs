@@ -264,7 +264,8 @@ pub fn vibration_with_progress(
 /// only the report reads (a twentieth of a simulation's time). For optimisers that judge
 /// their rewrites by it, many times a run. With `expected_s` (the print's planned time,
 /// about), a long print runs in two halves ([`split`]): the same figures to rounding, in
-/// about half the time where there are threads.
+/// about two thirds of the time where there are threads (the 34 MB corpus file: 2.1 s
+/// against 3.3 s).
 pub fn printing_deviation(
     input: &[u8],
     options: &VibrationOptions,

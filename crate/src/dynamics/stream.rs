@@ -333,8 +333,8 @@ impl<'w> Stream<'w> {
     }
 
     /// A half started later holds, of the segments before its first step, only the last (as
-    /// [`Stream::at`] keeps the one before the cursor's): the rest of them would be half a
-    /// file's segments held for nothing (80 MB on the 34 MB corpus file).
+    /// [`Stream::at`] keeps the one before the cursor's): the rest of them would be all the
+    /// segments of the file before it, held for nothing.
     fn drop_before_start(&mut self) {
         let start = self.k as f64 * self.settings.ts;
         while self.window.len() > 1 && self.window[1].0.end_s() <= start {
