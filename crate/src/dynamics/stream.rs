@@ -432,17 +432,35 @@ impl<'w, 'p, F: FnOnce(&str) -> Result<MachineDynamics, Error>> Simulating<'w, '
     /// A half's outcome and sums by counted layer (`None`: a second half the run was not
     /// split for), and whether the run was split.
     pub(super) fn finish_half(self) -> Result<(HalfRun, bool), Error> {
+        let Checked {
+            stream,
+            progress,
+            steps,
+            ..
+        } = self.checked()?;
+        let split = steps.is_some_and(|s| s != Steps::default());
+        match stream {
+            Some(stream) => Ok((Some(stream.finish(progress)?), split)),
+            None => Ok((None, split)),
+        }
+    }
+
+    /// The run's parts once it is known to have gone through ([`Checked`]); the walk's error,
+    /// or `Cancelled` where the walk stopped before it learnt the machine.
+    fn checked(self) -> Result<Checked<'w, 'p>, Error> {
         if let Some(e) = self.error {
             return Err(e);
         }
-        let Some(steps) = self.machine.as_ref().map(|_| self.steps) else {
-            return Err(cancelled());
-        };
-        let split = steps.is_some_and(|s| s != Steps::default());
-        match self.stream {
-            Some(stream) => Ok((Some(stream.finish(self.progress)?), split)),
-            None => Ok((None, split)),
-        }
+        // `path::walk` tells the machine before the first move: none only where the walk
+        // stopped before reading.
+        let machine = self.machine.ok_or_else(cancelled)?;
+        Ok(Checked {
+            stream: self.stream,
+            machine,
+            bounds: self.bounds,
+            progress: self.progress,
+            steps: self.steps,
+        })
     }
 
     /// The run's outcome (its per-layer sums, `layers` of them, by marker where `by_markers`),
@@ -452,22 +470,32 @@ impl<'w, 'p, F: FnOnce(&str) -> Result<MachineDynamics, Error>> Simulating<'w, '
         layers: usize,
         by_markers: bool,
     ) -> Result<(Outcome, Bounds, MachineDynamics), Error> {
-        if let Some(e) = self.error {
-            return Err(e);
-        }
-        // `path::walk` tells the machine before the first move: no stream only where the walk
-        // stopped before reading.
-        let (Some(stream), Some(machine)) = (self.stream, self.machine) else {
-            return Err(cancelled());
-        };
+        let Checked {
+            stream,
+            machine,
+            bounds,
+            progress,
+            ..
+        } = self.checked()?;
+        let stream = stream.ok_or_else(cancelled)?;
         // Read to the end: the rest is a few steps.
-        if !(self.progress)(0.95) {
+        if !progress(0.95) {
             return Err(cancelled());
         }
-        let (mut out, counted) = stream.finish(self.progress)?;
+        let (mut out, counted) = stream.finish(progress)?;
         finish_layers(&mut out, counted, layers, by_markers);
-        Ok((out, self.bounds, machine))
+        Ok((out, bounds, machine))
     }
+}
+
+/// A run that went through, taken apart to finish: its stream (`None`: a second half the run
+/// was not split for), machine, bounds, progress and steps.
+struct Checked<'w, 'p> {
+    stream: Option<Stream<'w>>,
+    machine: MachineDynamics,
+    bounds: Bounds,
+    progress: Progress<'p>,
+    steps: Option<Steps>,
 }
 
 impl<F: FnOnce(&str) -> Result<MachineDynamics, Error>> Emit for Simulating<'_, '_, F> {
