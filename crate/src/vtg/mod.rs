@@ -377,15 +377,15 @@ impl Run<'_> {
     }
 
     /// The last rewrite's offers with the layers `kept` marks dropped, where it was of `variant`
-    /// and kept no layer that `kept` does not.
+    /// and kept no layer that `kept` does not. Either way they are taken: the rewrite about to
+    /// be made replaces them when it is done, so offers it cannot use are freed before it
+    /// makes its own (on the 34 MB file, up to 40 MB of the closed loop's peak).
     fn known_offers(&self, variant: search::Variant, kept: &[bool]) -> Option<rewrite::Offers> {
-        let mut known = self.known.lock().ok()?;
-        let (offers, was_kept) = known.as_ref()?;
+        let (mut offers, was_kept) = self.known.lock().ok()?.take()?;
         let covered = (was_kept.iter().enumerate()).all(|(l, &k)| !k || kept.get(l) == Some(&true));
         if offers.variant() != variant || !covered {
             return None;
         }
-        let (mut offers, _) = known.take()?;
         offers.keep_layers(kept);
         Some(offers)
     }
