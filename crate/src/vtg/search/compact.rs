@@ -45,8 +45,8 @@ pub(super) fn compact_path(
         e_before: first.e_before,
         last_e_word: last.e_word,
         total_e: *e.last()?,
-        f_before: first.f_before,
-        f_after: last.f_after,
+        f_before: first.f_before(),
+        f_after: last.f_after(),
         notes: notes(input, src, e)?,
     };
     let text = block::write(&frame, &pts[1..], &e[1..], &pieces);

@@ -791,7 +791,7 @@ impl Polyline {
         let feed: Vec<f64> = src
             .iter()
             .zip(run)
-            .map(|(s, m)| s.f_after.map_or(m.feed_mm_s, |f| f / 60.0))
+            .map(|(s, m)| s.f_after().map_or(m.feed_mm_s, |f| f / 60.0))
             .collect();
         // How the planner ran each original move, when the path was planned.
         let planned: Vec<Profile> = run
@@ -947,8 +947,8 @@ impl Draft<'_> {
             e_before: first_src.e_before,
             last_e_word: last_src.e_word,
             total_e: sum,
-            f_before: first_src.f_before,
-            f_after: last_src.f_after,
+            f_before: first_src.f_before(),
+            f_after: last_src.f_after(),
             notes,
         };
         let text = block::write(&frame, &written.points, &written.e, &pieces);
@@ -983,10 +983,7 @@ pub(super) fn notes<'i>(
     let mut notes = Vec::new();
     for (s, &at) in src.iter().zip(e).skip(1) {
         if s.notes.lines > 0 {
-            notes.push((
-                at,
-                std::str::from_utf8(input.get(s.notes.from..s.notes.to)?).ok()?,
-            ));
+            notes.push((at, std::str::from_utf8(input.get(s.notes.range())?).ok()?));
         }
     }
     Some(notes)
