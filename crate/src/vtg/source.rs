@@ -53,8 +53,7 @@ impl MoveSource {
 pub struct Notes {
     /// Lines.
     pub lines: u32,
-    /// Length of the byte range (a run of annotations is a few lines long; a longer one is
-    /// cut at 4 GB, which no slicer writes).
+    /// Length of the byte range (a run longer than 4 GB is split, [`Notes::with`]).
     pub len: u32,
     /// Start of the byte range in the input.
     pub from: usize,
@@ -64,6 +63,30 @@ impl Notes {
     /// The byte range in the input.
     pub fn range(&self) -> std::ops::Range<usize> {
         self.from..self.from + self.len as usize
+    }
+
+    /// This run with the annotation at bytes `offset..end` added: a run of its own where this
+    /// one would outgrow `max` bytes (the earlier annotations then stay where they are, before
+    /// a rewritten block, and the line count no longer joins the moves either side into one
+    /// path); `None` where the line alone would, so it is read as a plain comment.
+    fn with(self, offset: usize, end: usize, max: usize) -> Option<Notes> {
+        let fits = |from: usize| {
+            u32::try_from(end - from)
+                .ok()
+                .filter(|&l| l as usize <= max)
+        };
+        match fits(self.from).filter(|_| self.lines > 0) {
+            Some(len) => Some(Notes {
+                lines: self.lines + 1,
+                len,
+                from: self.from,
+            }),
+            None => Some(Notes {
+                lines: 1,
+                len: fits(offset)?,
+                from: offset,
+            }),
+        }
     }
 }
 
@@ -119,21 +142,15 @@ impl Fold for Read {
             self.notes = Notes::default();
             return Ok(Flow::Read);
         };
-        if !is_annotation(line) {
+        let end = raw.offset + raw.text.len();
+        let joined = is_annotation(line)
+            .then(|| self.notes.with(raw.offset, end, u32::MAX as usize))
+            .flatten();
+        let Some(notes) = joined else {
             self.line_notes = std::mem::take(&mut self.notes);
             return Ok(Flow::Read);
-        }
-        let end = raw.offset + raw.text.len();
-        let from = if self.notes.lines > 0 {
-            self.notes.from
-        } else {
-            raw.offset
         };
-        self.notes = Notes {
-            lines: self.notes.lines + 1,
-            len: u32::try_from(end - from).unwrap_or(u32::MAX),
-            from,
-        };
+        self.notes = notes;
         Ok(Flow::Skip)
     }
 
@@ -245,5 +262,18 @@ mod tests {
         let first = s.moves.first().unwrap();
         assert_eq!((first.f_before(), first.notes.lines), (None, 0));
         assert_eq!(first.f_after(), Some(600.0));
+    }
+
+    #[test]
+    fn a_run_of_notes_that_would_outgrow_its_length_starts_again() {
+        let one = Notes::default().with(10, 20, 25).unwrap();
+        assert_eq!((one.lines, one.from, one.len), (1, 10, 10));
+        let two = one.with(21, 30, 25).unwrap();
+        assert_eq!((two.lines, two.from, two.len), (2, 10, 20));
+        // 10..40 is 30 bytes, over 25: the run starts again at the new line.
+        let again = two.with(31, 40, 25).unwrap();
+        assert_eq!((again.lines, again.from, again.len), (1, 31, 9));
+        // A line longer than the bound alone is no note.
+        assert_eq!(again.with(41, 80, 25), None);
     }
 }
