@@ -53,7 +53,7 @@ impl MoveSource {
 pub struct Notes {
     /// Lines.
     pub lines: u32,
-    /// Length of the byte range (a run longer than 4 GB is split, [`Notes::with`]).
+    /// Length of the byte range (a run that would pass 4 GB starts again at its next line).
     pub len: u32,
     /// Start of the byte range in the input.
     pub from: usize,
