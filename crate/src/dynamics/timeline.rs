@@ -73,9 +73,11 @@ pub(super) fn from_path(
     capacity: usize,
 ) -> Option<Vec<Segment>> {
     let mut timeline = Timeline::new(Kept::new(keep, capacity));
-    timeline.xy_feed_limit = xy_feed_limit(&path.print_limits);
+    timeline.latch(&path.print_limits);
     for m in &path.moves {
-        timeline.push(m, m.timing?, (m.layer, m.layer));
+        if !timeline.place(m, m.timing, (m.layer, m.layer)) {
+            return None;
+        }
     }
     Some(timeline.emit.finish(true))
 }
@@ -102,7 +104,7 @@ pub(super) fn of_file<E: Emit>(
 ) -> Result<(E, bool, Walked), Error> {
     let mut sink = Streamed {
         timeline: Timeline::new(emit),
-        xy_feed_limit: f64::NAN,
+        limits: None,
         latched: false,
         waiting: VecDeque::new(),
         early: Vec::new(),
@@ -114,7 +116,7 @@ pub(super) fn of_file<E: Emit>(
     }
     if !sink.latched {
         // No extruding move: the limits of the whole file's end are the ones in force.
-        sink.latch(xy_feed_limit(&walked.print_limits));
+        sink.latch(&walked.print_limits);
     }
     Ok((sink.timeline.emit, !sink.untimed, walked))
 }
@@ -136,6 +138,8 @@ struct Timeline<E> {
     planned_end: f64,
     /// [`xy_feed_limit`] of the limits in force when printing (arcs' feed cap).
     xy_feed_limit: f64,
+    /// The limits in force when printing, which time homing moves ([`Timeline::homing`]).
+    print_limits: Option<Limits>,
 }
 
 impl<E: Emit> Timeline<E> {
@@ -146,7 +150,50 @@ impl<E: Emit> Timeline<E> {
             cursor: 0.0,
             planned_end: 0.0,
             xy_feed_limit: f64::NAN,
+            print_limits: None,
         }
+    }
+
+    /// The limits in force when printing are `limits`.
+    fn latch(&mut self, limits: &Limits) {
+        self.xy_feed_limit = xy_feed_limit(limits);
+        self.print_limits = Some(limits.clone());
+    }
+
+    /// Move `m` on layers `layers`, timed `t` by the planner; a homing move the planner leaves
+    /// untimed (`G28` on Klipper, `crate::read::At::untimed_homing`) as [`Timeline::homing`]
+    /// times it. `false` for any other move without timing.
+    fn place(&mut self, m: &PathMove, t: Option<MoveTiming>, layers: (u32, u32)) -> bool {
+        match t {
+            Some(t) => self.push(m, t, layers),
+            None if matches!(m.kind, MoveKind::Home) => {
+                if let Some(profile) = self.homing(m) {
+                    self.put(m, self.cursor, profile, layers);
+                }
+            }
+            None => return false,
+        }
+        true
+    }
+
+    /// A homing move the planner leaves untimed, as the simulation runs it: from rest to rest
+    /// at the file's feed and the printing travel acceleration, each within the axes' own
+    /// limits along the move. Klipper homes at each stepper's `homing_speed`, which no file
+    /// tells; the toolhead does stop before and after (the planner empties its look-ahead),
+    /// and the head does travel to the switch, so a file that homes mid-print or at its end is
+    /// simulated with the move rather than refused (the planner's clock, which does not count
+    /// it, is left as it is). `None` where the printing limits are not known yet.
+    fn homing(&self, m: &PathMove) -> Option<Profile> {
+        let l = self.print_limits.as_ref()?;
+        let (mut feed, mut accel) = (m.feed_mm_s, l.travel_acceleration.value);
+        for i in [axis::X, axis::Y, axis::Z] {
+            let share = (m.to[i] - m.from[i]).abs() / m.length_mm;
+            if share > 0.0 {
+                feed = feed.min(l.max_feedrate[i].value / share);
+                accel = accel.min(l.max_acceleration[i].value / share);
+            }
+        }
+        Some(Profile::new(m.length_mm, 0.0, feed, 0.0, accel))
     }
 
     /// Move `m`, timed `t`, on layers `layers` (by marker, by counting).
@@ -181,6 +228,11 @@ impl<E: Emit> Timeline<E> {
             (cursor + gap, t.profile)
         };
         self.planned_end = self.planned_end.max(t.start_s + t.duration_s);
+        self.put(m, start, profile, layers);
+    }
+
+    /// Move `m` on the timeline from `start`, run as `profile`.
+    fn put(&mut self, m: &PathMove, start: f64, profile: Profile, layers: (u32, u32)) {
         let duration = profile.duration();
         if !(duration.is_finite() && duration > 0.0) {
             return;
@@ -209,8 +261,8 @@ type Waiting = (usize, PathMove, Option<MoveTiming>, (u32, u32));
 /// whose limits cap the arcs' feeds, timed moves wait in `early`.
 struct Streamed<E> {
     timeline: Timeline<E>,
-    /// [`xy_feed_limit`] of the limits in force now.
-    xy_feed_limit: f64,
+    /// The limits in force now (the walk tells them before the first move).
+    limits: Option<Limits>,
     /// Whether the printing limits are known (the first extruding move was read).
     latched: bool,
     waiting: VecDeque<Waiting>,
@@ -226,16 +278,15 @@ impl<E: Emit> Streamed<E> {
             self.early.push(w);
             return;
         }
-        match w.2 {
-            Some(t) => self.timeline.push(&w.1, t, w.3),
-            None => self.untimed = true,
+        if !self.timeline.place(&w.1, w.2, w.3) {
+            self.untimed = true;
         }
     }
 
-    /// The printing limits are known: the arcs' feed cap is `limit`.
-    fn latch(&mut self, limit: f64) {
+    /// The printing limits are known: `limits` cap the arcs' feeds and time homing moves.
+    fn latch(&mut self, limits: &Limits) {
         self.latched = true;
-        self.timeline.xy_feed_limit = limit;
+        self.timeline.latch(limits);
         for w in std::mem::take(&mut self.early) {
             self.done(w);
         }
@@ -245,7 +296,10 @@ impl<E: Emit> Streamed<E> {
 impl<E: Emit> MoveSink for Streamed<E> {
     fn moved(&mut self, index: usize, m: PathMove, layers: (u32, u32), _: &[PathFeature]) {
         if !self.latched && m.is_extruding() {
-            self.latch(self.xy_feed_limit);
+            if let Some(limits) = self.limits.take() {
+                self.latch(&limits);
+                self.limits = Some(limits);
+            }
         }
         self.waiting.push_back((index, m, None, layers));
     }
@@ -269,7 +323,7 @@ impl<E: Emit> MoveSink for Streamed<E> {
     }
 
     fn limits(&mut self, limits: &Limits) {
-        self.xy_feed_limit = xy_feed_limit(limits);
+        self.limits = Some(limits.clone());
     }
 
     fn machine(&mut self, profile: &MachineProfile) {

@@ -216,6 +216,33 @@ mod tests {
     }
 
     #[test]
+    fn a_klipper_homing_move_runs_from_rest_to_rest() {
+        // Klipper's planner leaves `G28` untimed; the simulation runs it after the last move,
+        // from rest to rest at the modal feed (50 mm/s) and the travel acceleration that
+        // SET_VELOCITY_LIMIT set (2000 mm/s²): 40 mm in 40/50 + 50/2000 s.
+        let g = b"SET_VELOCITY_LIMIT ACCEL=2000\nG21\nG90\nM83\nG1 Z0.2 F600\n\
+G1 X10 Y0 F6000\nG1 X40 Y40 E1 F3000\nG28 X0\n";
+        let options = Default::default();
+        let path = crate::path::extract(g, &options, true).unwrap();
+        let home = path.moves.last().unwrap();
+        assert!(matches!(home.kind, crate::machine::MoveKind::Home));
+        assert!(home.timing.is_none());
+        let whole = segments(&path).unwrap();
+        let (streamed, _) = segments_of_file(g, &options, |_| true).unwrap();
+        assert_eq!(streamed.as_ref(), Some(&whole));
+        let (before, last) = (&whole[whole.len() - 2], &whole[whole.len() - 1]);
+        assert_eq!((last.from, last.to), ([40.0, 40.0], [0.0, 40.0]));
+        assert!((last.start_s - before.end_s()).abs() < 1e-12);
+        let p = last.profile;
+        assert_eq!(
+            (p.entry, p.peak, p.exit, p.acceleration),
+            (0.0, 50.0, 0.0, 2000.0)
+        );
+        assert!((last.duration_s - (0.8 + 0.025)).abs() < 1e-12, "{last:?}");
+        assert!(!last.extruding);
+    }
+
+    #[test]
     fn an_arc_ends_at_its_end_point() {
         let g = b"G21\nG90\nM83\nG1 X10 Y0 F6000\nG3 X0 Y10 I-10 J0 E1 F1200\n";
         let path = crate::path::extract(g, &Default::default(), true).unwrap();
