@@ -83,7 +83,7 @@ pub(super) fn with_simulated_deviation(
 
 /// `tried` written again with the layers that ring more than the original's kept as they were
 /// ([`keep_ringing_layers`]), its deviation rows and message filled; `None` where that does
-/// not keep the no-dearer rule.
+/// not keep the no-dearer rule, or keeps every layer with a rewritten path.
 fn with_layers_kept(
     orig: &Simulated,
     tried: Tried,
@@ -101,6 +101,10 @@ fn with_layers_kept(
     else {
         return Ok(None);
     };
+    if kept.paths.rewritten == 0 && kept.paths.compacted == 0 {
+        // Every layer with a rewritten path kept: the original, which is handed back as such.
+        return Ok(None);
+    }
     kept.table2.deviation = Some(deviation_rows(&b, &a.deviation));
     let mut reasons = Vec::new();
     if why.peak > 0 {
@@ -210,7 +214,8 @@ fn quietest(
 }
 
 /// Each of `variants` written whole and simulated in turn, until one keeps the no-dearer rule;
-/// the quietest of them and `best` kept. Progress runs from `from`, `step` a variant.
+/// the quietest of them and `best` kept (a variant that rewrote no path is not one of them).
+/// Progress runs from `from`, `step` a variant.
 fn every_variant(
     mut best: Tried,
     (variants, from, step): (impl IntoIterator<Item = search::Variant>, f64, f64),
@@ -226,6 +231,12 @@ fn every_variant(
         }
         let f = from + step * k as f64;
         let report = again.report(variant, &[], best.report.before.clone(), f)?;
+        if report.paths.rewritten == 0 && report.paths.compacted == 0 {
+            // The original as it is (every path kept for lines, say): it rings as the original
+            // does, which keeps the rule trivially, but it is no rewrite to hand back as one.
+            // Where no rewrite keeps the rule, the original comes back with the reason.
+            continue;
+        }
         let Some(sim) = printing_deviation(&report.output, report.after.time_s, options) else {
             break;
         };
