@@ -731,6 +731,18 @@ function resetOptimized() {
 }
 
 /**
+ * Whether a job handed back the input as it was, with nothing better to download: an infill
+ * search that kept the original, or a VTG rewrite whose report says why it kept the original
+ * (no layers kept: those rewrite the rest).
+ * @param {string} job
+ * @param {JobResult} result
+ */
+function handedBack(job, result) {
+  if (job === 'infill') return result.best?.pattern === 'original';
+  return job === 'vtg' && Boolean(result.message) && !result.peak_layers_kept?.length;
+}
+
+/**
  * @param {string} job
  * @param {JobResult} result
  * @param {ArrayBuffer | null} outBytes
@@ -742,8 +754,7 @@ function showJobResult(job, result, outBytes, target, { fromList = false } = {})
   els.resultPanel.hidden = false;
   els.resultJob.textContent = `· ${JOB_NAMES[job]}${target === 'output' ? ' of the optimized output' : ''}`;
   els.resultLine.textContent = resultLine(job, result);
-  // An infill search that kept the original hands back the input: nothing better to download.
-  const keptOriginal = job === 'infill' && result.best?.pattern === 'original';
+  const keptOriginal = handedBack(job, result);
   if (fromList) {
     // An earlier job shown again: its tables and JSON; the viewer keeps the latest output.
     if (job === 'vibration') renderCompare(vibrationCompare());
@@ -802,8 +813,7 @@ const jobEntries = [];
  * @param {number} ms
  */
 function addJobEntry(job, result, outBytes, target, ms) {
-  const keptOriginal = job === 'infill' && result.best?.pattern === 'original';
-  const entry = { id: jobEntries.length + 1, job, result, target, ms, file: loaded?.name, bytes: outBytes && !keptOriginal ? outBytes : null };
+  const entry = { id: jobEntries.length + 1, job, result, target, ms, file: loaded?.name, bytes: outBytes && !handedBack(job, result) ? outBytes : null };
   jobEntries.push(entry);
   renderJobList(entry.id);
 }

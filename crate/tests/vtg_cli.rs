@@ -131,5 +131,12 @@ fn vtg_adds_no_lines_by_default_and_says_so() {
         table.contains("kept sharp for lines") && table.contains("--allow-more-lines"),
         "{table}"
     );
+    // No corner of the square can be rounded without lines: the file comes back as it was,
+    // and the table says so first.
+    assert_eq!(after, before);
+    assert!(
+        table.contains("kept the original: rounding the corners of any of the"),
+        "{table}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

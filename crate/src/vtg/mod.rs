@@ -283,6 +283,9 @@ pub fn vtg_with_progress(
         report =
             closed_loop::with_simulated_deviation(input, original, report, options, &mut again)?;
     }
+    if report.message.is_none() {
+        report.message = report.paths.nothing_rewritten(options.critical_angle_deg);
+    }
     // The move lists and the offers kept are done with (the estimates and the firmware's
     // figures stream): on the 34 MB file the lists are 450 MB of the peak.
     let budget =
@@ -541,6 +544,25 @@ mod tests {
         let f = r.firmware.expect("figures");
         let walked = |bytes: &[u8]| firmware::figures(bytes, &options.analyze, &f.budget).unwrap();
         assert_eq!((f.before, f.after), (walked(demo), walked(&r.output)));
+    }
+
+    /// A file that comes back as it was, nothing rewritten, says why: here no corner is sharp.
+    #[test]
+    fn a_file_with_nothing_to_rewrite_says_so() {
+        let straight = b"G21\nG90\nM83\nG1 Z0.2 F600\nG1 X10 Y10 F6000\nG1 X60 Y10 E2 F1800\n\
+G1 X110 Y12 E2\n";
+        for dynamics in [false, true] {
+            let options = VtgOptions {
+                dynamics,
+                ..VtgOptions::default()
+            };
+            let r = vtg(straight, &options).unwrap();
+            assert_eq!(r.output, straight);
+            assert_eq!(
+                r.message.as_deref(),
+                Some("kept the original: no path turns by more than the critical angle (30°)")
+            );
+        }
     }
 
     #[test]

@@ -145,6 +145,45 @@ pub struct PathCounts {
     pub keyholes: u64,
 }
 
+impl PathCounts {
+    /// Why the file comes back as it was where no path was rewritten (none compacted either),
+    /// in the words the closed loop's hand-back uses; `None` where something was rewritten.
+    pub(crate) fn nothing_rewritten(&self, critical_angle_deg: f64) -> Option<String> {
+        if self.rewritten > 0 || self.compacted > 0 {
+            return None;
+        }
+        let why = if self.candidates == 0 {
+            format!("no path turns by more than the critical angle ({critical_angle_deg}°)")
+        } else if self.kept_for_lines > 0 && self.kept_for_time > 0 {
+            format!(
+                "rounding the corners of any of the {} paths that have them would add lines \
+                 (--allow-more-lines) or cost time or energy (--allow-slower) the file has none \
+                 of to spare",
+                self.candidates
+            )
+        } else if self.kept_for_lines > 0 {
+            format!(
+                "rounding the corners of any of the {} paths that have them would add lines, \
+                 and the line budget has none to spare (--allow-more-lines)",
+                self.candidates
+            )
+        } else if self.kept_for_time > 0 {
+            format!(
+                "rounding the corners of any of the {} paths that have them would cost time or \
+                 energy the file has none of to spare (--allow-slower)",
+                self.candidates
+            )
+        } else {
+            format!(
+                "none of the {} paths with sharp corners could be rounded within the tolerance \
+                 at no cost",
+                self.candidates
+            )
+        };
+        Some(format!("kept the original: {why}"))
+    }
+}
+
 /// Per-layer toolpath metrics before and after.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(test, derive(ts_rs::TS))]
