@@ -8,7 +8,7 @@ export PATH := $(CURDIR)/node_modules/.bin:$(HOME)/.cargo/bin:$(PATH)
 CORPUS ?= $(CURDIR)/../shared/corpus
 LARGE := $(CORPUS)/curaengine-4.13.0_extruder-idler-x2.5_large.gcode
 
-.PHONY: all setup setup-test pkg wasm-plain wasm-web wasm-web-threads wasm-node wasm-bundler serve test typecheck test-rust test-js fuzz-smoke lint cli bench measurements measure-vtg-w16 fuzz clean
+.PHONY: all setup setup-test pkg wasm-plain wasm-web wasm-web-threads wasm-node wasm-bundler serve test typecheck test-rust test-js fuzz-smoke lint cli bench measurements measure-vtg-w16 measure-vtg-unseen fuzz clean
 
 all: pkg cli
 
@@ -124,6 +124,12 @@ measurements:
 ## (scripts/vtg-w16-tables.sh, docs/measurements/vtg.md; about 4-5 min). W16_HEIGHT=… mm (default 4).
 measure-vtg-w16: cli
 	bash scripts/vtg-w16-tables.sh
+
+## VTG on parts and slicers it was not tuned on: three models of tests/fixtures/models/unseen/
+## sliced with CuraEngine, Slic3r and PrusaSlicer (for Klipper), with the defaults and with lines
+## allowed (scripts/vtg-unseen-parts.sh, docs/measurements/vtg.md; about 3 min). Needs the slicers.
+measure-vtg-unseen: cli
+	bash scripts/vtg-unseen-parts.sh
 
 ## Short, reproducible (seeded, fixed-count) cargo-fuzz run of every target: a nightly build of
 ## about 3 minutes, so `make test` runs the same checks on mutated seeds on stable instead
