@@ -50,7 +50,7 @@ pub(super) fn with_simulated_deviation(
     let b = orig.deviation;
     let rows = |a: &Deviation| deviation_rows(&b, a);
     let mut first = first;
-    if first.paths.rewritten == 0 && first.paths.compacted == 0 {
+    if first.paths.rewrote_nothing() {
         // Nothing rewritten: the file rings as the original does, and no variant would differ.
         first.table2.deviation = Some(rows(&b));
         return Ok(first);
@@ -101,7 +101,7 @@ fn with_layers_kept(
     else {
         return Ok(None);
     };
-    if kept.paths.rewritten == 0 && kept.paths.compacted == 0 {
+    if kept.paths.rewrote_nothing() {
         // Every layer with a rewritten path kept: the original, which is handed back as such.
         return Ok(None);
     }
@@ -231,7 +231,7 @@ fn every_variant(
         }
         let f = from + step * k as f64;
         let report = again.report(variant, &[], best.report.before.clone(), f)?;
-        if report.paths.rewritten == 0 && report.paths.compacted == 0 {
+        if report.paths.rewrote_nothing() {
             // The original as it is (every path kept for lines, say): it rings as the original
             // does, which keeps the rule trivially, but it is no rewrite to hand back as one.
             // Where no rewrite keeps the rule, the original comes back with the reason.

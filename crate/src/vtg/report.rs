@@ -146,10 +146,17 @@ pub struct PathCounts {
 }
 
 impl PathCounts {
-    /// Why the file comes back as it was where no path was rewritten (none compacted either),
-    /// in the words the closed loop's hand-back uses; `None` where something was rewritten.
+    /// Whether no path was rewritten, with its corners rounded or compacted into arcs: the
+    /// output is then the original's toolpath.
+    pub(crate) fn rewrote_nothing(&self) -> bool {
+        self.rewritten == 0 && self.compacted == 0
+    }
+
+    /// Why the file comes back as it was where no path was rewritten
+    /// ([`PathCounts::rewrote_nothing`]), in the words the closed loop's hand-back uses;
+    /// `None` where something was rewritten.
     pub(crate) fn nothing_rewritten(&self, critical_angle_deg: f64) -> Option<String> {
-        if self.rewritten > 0 || self.compacted > 0 {
+        if !self.rewrote_nothing() {
             return None;
         }
         let why = if self.candidates == 0 {
