@@ -508,3 +508,28 @@ fn vtg_and_infill_rewrite_the_estimates_they_change() {
         assert!(assert_estimates_true(&text) >= least, "{cmd}");
     }
 }
+
+/// A file VTG hands back as it was (the corpus spiral vase: rounding any corner would add
+/// lines): the stage is not applied, and says why in VTG's words.
+#[test]
+fn a_vtg_stage_that_keeps_the_file_says_why() {
+    let file = scratch_copy("vtg-kept", "prusaslicer-2.7.4_spiral-vase.gcode");
+    let out = cli(
+        &["optimize", "--in-place", "--json", file.to_str().unwrap()],
+        &[],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let vtg = &report["stages"][0];
+    assert_eq!(
+        (&vtg["stage"], &vtg["applied"]),
+        (&"vtg".into(), &false.into())
+    );
+    let why = vtg["message"].as_str().unwrap();
+    assert!(why.starts_with("kept the original: "), "{why}");
+    assert_eq!(vtg["time_s"][0], vtg["time_s"][1]);
+}

@@ -105,6 +105,11 @@ impl Stage {
     /// VTG on the file so far.
     pub fn vtg(&mut self, o: &VtgOptions, progress: Progress<'_>) -> Result<StageReport, Error> {
         let r = vtg_with_progress(&self.file, o, progress)?;
+        if let Some(why) = r.message.filter(|_| r.peak_layers_kept.is_empty()) {
+            // Handed back as it was (nothing to round within the budgets, or every rewrite
+            // rang more): the stage says why, as VTG does.
+            return Ok(self.unchanged("vtg", why));
+        }
         let turns = |rep: &Report| rep.toolpath.n_turning;
         let done = format!(
             "sharp corners {} → {} ({:+.1} %), largest deviation {:.3} mm of {} mm{}",
