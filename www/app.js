@@ -877,7 +877,7 @@ function resultLine(job, r) {
   const pct = (a, b) => (isNum(a) && isNum(b) && b !== 0 ? signedPercent(a / b - 1) : '—');
   switch (job) {
     case 'vtg':
-      if (r.message && !r.peak_layers_kept?.length) return `Your file is kept as it was: ${r.message.replace(/^kept the original: /, '')}.`;
+      if (handedBack(job, r)) return `Your file is kept as it was: ${r.message.replace(/^kept the original: /, '')}.`;
       return `Tolerance ${n(r.tolerance_mm)} mm, largest deviation from the original path ${n(r.max_deviation_mm, 4)} mm; energy ${pct(r.after?.energy?.total_j, r.before?.energy?.total_j)}, time ${pct(r.after?.time_s, r.before?.time_s)}${isNum(r.paths?.arcs_written) && r.paths.arcs_written > 0 ? `; ${r.paths.arcs_written} arcs` : ''}${isNum(r.paths?.kept_for_lines) && r.paths.kept_for_lines > 0 ? `; ${r.paths.kept_for_lines} paths kept sharp to add no lines (allow more lines to round them)` : ''}${r.peak_layers_kept?.length ? `; ${r.message}` : ''}.`;
     case 'infill': {
       const b = r.best ?? {};
