@@ -105,14 +105,22 @@ pub enum ErrorKind {
         /// Why.
         reason: &'static str,
     },
+    /// The file has nothing of the kind an optimizer rewrites (no sparse infill for the infill
+    /// search): the file is fine, the optimizer has no work on it.
+    #[error("nothing to regenerate: {reason}")]
+    NothingToRegenerate {
+        /// What the file lacks.
+        reason: &'static str,
+    },
     /// The job was cancelled by the caller.
     #[error("cancelled")]
     Cancelled,
 }
 
-/// An error tied to its position in the input.
+/// An error tied to its position in the input. Shown as `line L, column C: what`, the
+/// position left out where it is 0 (an error about the whole file or the options).
 #[derive(Debug, Clone, PartialEq, thiserror::Error, Serialize)]
-#[error("line {line}, column {column}: {kind}")]
+#[error("{}{kind}", Position(*.line, *.column))]
 pub struct Error {
     /// 1-based line number in the file (0 when not tied to a line).
     pub line: u32,
@@ -129,6 +137,19 @@ impl Error {
     }
 }
 
+/// The `line L, column C: ` prefix of an [`Error`], each part only where it is known.
+struct Position(u32, u32);
+
+impl core::fmt::Display for Position {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match (self.0, self.1) {
+            (0, _) => Ok(()),
+            (line, 0) => write!(f, "line {line}: "),
+            (line, column) => write!(f, "line {line}, column {column}: "),
+        }
+    }
+}
+
 /// A non-fatal problem, reported with its line so the user can look at it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[cfg_attr(test, derive(ts_rs::TS))]
@@ -142,9 +163,13 @@ pub struct Warning {
 
 impl From<&Error> for Warning {
     fn from(e: &Error) -> Self {
+        let message = match e.column {
+            0 => e.kind.to_string(),
+            column => format!("column {column}: {}", e.kind),
+        };
         Warning {
             line: e.line,
-            message: format!("column {}: {}", e.column, e.kind),
+            message,
         }
     }
 }
@@ -195,5 +220,33 @@ impl Warnings {
     /// Splits into the kept list and the dropped count.
     pub fn into_parts(self) -> (Vec<Warning>, u64) {
         (self.list, self.dropped)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_message_names_only_the_position_known() {
+        let kind = || ErrorKind::InvalidNumber { letter: 'X' };
+        assert_eq!(
+            Error::new(4, 7, kind()).to_string(),
+            "line 4, column 7: invalid number after 'X'"
+        );
+        assert_eq!(
+            Error::new(4, 0, kind()).to_string(),
+            "line 4: invalid number after 'X'"
+        );
+        let whole = Error::new(0, 0, ErrorKind::Cancelled);
+        assert_eq!(whole.to_string(), "cancelled");
+        assert_eq!(
+            Warning::from(&Error::new(4, 0, kind())).message,
+            kind().to_string()
+        );
+        assert_eq!(
+            Warning::from(&Error::new(4, 7, kind())).message,
+            "column 7: invalid number after 'X'"
+        );
     }
 }

@@ -118,7 +118,7 @@ fn errors_name_the_file_line_and_column() {
     let out = run(bin().arg("analyze").arg(&file).arg("--strict"));
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("bad.gcode:line 3, column 5"), "{err}");
+    assert!(err.contains("bad.gcode: line 3, column 5"), "{err}");
     // Lenient by default: a warning with the line, and the report still comes.
     let out = run(bin().arg("analyze").arg(&file).arg("--json"));
     assert!(out.status.success());

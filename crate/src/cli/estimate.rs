@@ -36,7 +36,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let input = read(&args.file)?;
     let options = args.opts.options()?;
     let e = rewrite_estimates(&input, &options, &["estimates rewritten".to_string()])
-        .map_err(|e| format!("{}:{}", args.file.display(), e))?;
+        .map_err(|e| format!("{}: {e}", args.file.display()))?;
     output::finish_rewrite(
         &args.file,
         &target,

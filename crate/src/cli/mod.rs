@@ -305,7 +305,7 @@ fn run(cli: Cli) -> Result<(), String> {
             let mut bar = output::ProgressBar::for_input(input.len());
             let options = opts.options()?;
             let report = analyze_with_progress(&input, &options, &mut |f| bar.update(f))
-                .map_err(|e| format!("{}:{}", file.display(), e))?;
+                .map_err(|e| format!("{}: {e}", file.display()))?;
             bar.finish();
             let mut stdout = std::io::stdout().lock();
             if json {
@@ -329,7 +329,7 @@ fn run(cli: Cli) -> Result<(), String> {
             };
             let mut warnings = Warnings::default();
             gcode::for_each_line(&input, strictness, &mut warnings, |_, _, _| Ok(()))
-                .map_err(|e| format!("{}:{}", file.display(), e))?;
+                .map_err(|e| format!("{}: {e}", file.display()))?;
             for w in warnings.list() {
                 eprintln!("warning: {}:{}: {}", file.display(), w.line, w.message);
             }

@@ -117,7 +117,7 @@ fn one(args: &Args, o: &OptimizeOptions, file: &Path) -> Result<OptimizeReport, 
     let mut bar =
         output::ProgressBar::new(show && std::io::IsTerminal::is_terminal(&std::io::stderr()));
     let report = optimize_with_progress(&input, o, &mut |f| bar.update(f))
-        .map_err(|e| format!("{}:{}", file.display(), e))?;
+        .map_err(|e| format!("{}: {e}", file.display()))?;
     bar.finish();
     output::write_atomically(file, &to, args.in_place, |w| w.write_all(&report.output))?;
     Ok(report)

@@ -84,12 +84,12 @@ pub fn run(args: Args) -> Result<(), String> {
     };
     let mut bar = output::ProgressBar::for_input(input.len());
     let report = dynamics::vibration_with_progress(&input, &options, &mut |f| bar.update(f))
-        .map_err(|e| format!("{}:{}", args.file.display(), e))?;
+        .map_err(|e| format!("{}: {e}", args.file.display()))?;
     bar.finish();
     let mut stdout = std::io::stdout().lock();
     if let Some(other) = &args.compare {
         let after = dynamics::vibration(&read(other)?, &options)
-            .map_err(|e| format!("{}:{}", other.display(), e))?;
+            .map_err(|e| format!("{}: {e}", other.display()))?;
         let change = dynamics::compare(&report, &after);
         if args.json {
             output::write_json(

@@ -98,7 +98,7 @@ pub fn run(args: Args) -> Result<(), String> {
     };
     let mut bar = output::ProgressBar::for_input(input.len());
     let report = vtg_with_progress(&input, &options, &mut |f| bar.update(f))
-        .map_err(|e| format!("{}:{}", args.file.display(), e))?;
+        .map_err(|e| format!("{}: {e}", args.file.display()))?;
     bar.finish();
     output::finish_rewrite(
         &args.file,

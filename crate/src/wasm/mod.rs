@@ -93,8 +93,13 @@ fn js_error(e: &Error) -> JsValue {
     let set = |k: &str, v: JsValue| {
         let _ = Reflect::set(&err, &JsValue::from_str(k), &v);
     };
-    set("line", JsValue::from(e.line));
-    set("column", JsValue::from(e.column));
+    // An error about the whole file or the options has no position: left unset, not 0.
+    if e.line > 0 {
+        set("line", JsValue::from(e.line));
+    }
+    if e.column > 0 {
+        set("column", JsValue::from(e.column));
+    }
     if let Ok(kind) = serde_json::to_string(&e.kind) {
         if let Ok(v) = js_sys::JSON::parse(&kind) {
             set("kind", v);
