@@ -263,7 +263,7 @@ async function infill() {
         ['---', '---', '---', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:', '---:'],
         rows,
       ) +
-      `\n\nNo sparse infill (the command exits non-zero: "the file ${NO_SPARSE} to regenerate"): ` +
+      `\n\nNo sparse infill (the command exits non-zero: "nothing to regenerate: the file ${NO_SPARSE}"): ` +
       (none.length ? none.join(', ') : 'none') +
       '.',
   );

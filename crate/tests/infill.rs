@@ -118,7 +118,10 @@ fn inputs_without_infill_and_bad_options_are_errors() {
         b";TYPE:Internal infill\n",
     ] {
         let e = infill(input, &o).unwrap_err();
-        assert!(matches!(e.kind, ErrorKind::InvalidOption { .. }), "{e}");
+        assert!(
+            matches!(e.kind, ErrorKind::NothingToRegenerate { .. }),
+            "{e}"
+        );
     }
     // Not G-code at all: the reader's own error.
     assert!(infill(b"\xff\xfe\x00G\x001", &o).is_err());
@@ -409,7 +412,7 @@ fn no_fixture_gets_a_dearer_file() {
             }
             // Vases and walls-only parts: nothing to regenerate is an error, not a file.
             Err(e) => assert!(
-                matches!(e.kind, ErrorKind::InvalidOption { .. }),
+                matches!(e.kind, ErrorKind::NothingToRegenerate { .. }),
                 "{name}: {e}"
             ),
         }

@@ -533,3 +533,45 @@ fn a_vtg_stage_that_keeps_the_file_says_why() {
     assert!(why.starts_with("kept the original: "), "{why}");
     assert_eq!(vtg["time_s"][0], vtg["time_s"][1]);
 }
+
+/// A file without sparse infill (the corpus spiral vase): `infill` alone says there is nothing
+/// to regenerate, naming no line (the file is fine), and `optimize --infill`, which a slicer
+/// runs on every file it exports, passes the file on with the stage not applied and why.
+#[test]
+fn an_infill_stage_on_a_file_without_sparse_infill_says_why() {
+    let file = scratch_copy("no-infill", "prusaslicer-2.7.4_spiral-vase.gcode");
+    let alone = cli(&["infill", file.to_str().unwrap(), "-o", "/dev/null"], &[]);
+    let err = String::from_utf8_lossy(&alone.stderr);
+    assert!(!alone.status.success());
+    assert!(
+        err.contains("spiral-vase.gcode: nothing to regenerate: the file marks no sparse infill"),
+        "{err}"
+    );
+    assert!(!err.contains("line 0"), "{err}");
+    let out = cli(
+        &[
+            "optimize",
+            "--infill",
+            "--no-vtg",
+            "--in-place",
+            "--json",
+            file.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let infill = &report["stages"][0];
+    assert_eq!(
+        (&infill["stage"], &infill["applied"]),
+        (&"infill".into(), &false.into())
+    );
+    assert_eq!(
+        infill["message"],
+        "nothing to regenerate: the file marks no sparse infill"
+    );
+}

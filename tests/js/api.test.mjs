@@ -251,6 +251,19 @@ describe('errors', () => {
     assert.throws(() => qp.analyze('G1 X1', { filament_diameter_mm: -1 }), (e) => e instanceof Error);
   });
 
+  test('an error about the whole file names no line: infill on a file without sparse infill', () => {
+    const vase = fs.readFileSync(path.join(corpusDir, 'prusaslicer-2.7.4_spiral-vase.gcode'));
+    assert.throws(
+      () => qp.infill(vase, { angles_deg: [0], patterns: ['rectilinear'] }),
+      (e) =>
+        e instanceof Error &&
+        e.kind?.kind === 'nothing_to_regenerate' &&
+        e.line === undefined &&
+        e.column === undefined &&
+        e.message === 'nothing to regenerate: the file marks no sparse infill',
+    );
+  });
+
   test('lenient mode: the malformed line becomes a warning', () => {
     const r = qp.analyze(bad);
     assertReportShape(r, 'malformed (lenient)');

@@ -75,12 +75,16 @@ fn invalid(reason: &'static str) -> Error {
     Error::new(0, 0, ErrorKind::InvalidOption { reason })
 }
 
+/// The file has no sparse infill the search can regenerate.
+fn nothing(reason: &'static str) -> Error {
+    Error::new(0, 0, ErrorKind::NothingToRegenerate { reason })
+}
+
 fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>, Error> {
     options.validate()?;
     let before = analyze(input, &options.analyze)?;
     let prog = program::read(input, &options.analyze)?;
-    let habit = emit::habit(&prog)
-        .ok_or_else(|| invalid("the file marks no sparse infill to regenerate"))?;
+    let habit = emit::habit(&prog).ok_or_else(|| nothing("the file marks no sparse infill"))?;
     let mut by_layer: Vec<Vec<usize>> = vec![Vec::new(); prog.layer_count];
     for (i, mv) in prog.moves.iter().enumerate() {
         if let Some(l) = by_layer.get_mut(mv.layer as usize) {
@@ -90,7 +94,7 @@ fn prepare<'a>(input: &'a [u8], options: &InfillOptions) -> Result<Prepared<'a>,
     let clearance = region::clearance(&prog, &by_layer).unwrap_or(DEFAULT_CLEARANCE_MM);
     let mut work = work_items(&prog, &by_layer, clearance);
     if work.is_empty() {
-        return Err(invalid(
+        return Err(nothing(
             "no layer has a sparse-infill region inside closed walls",
         ));
     }

@@ -2,7 +2,7 @@
 
 use super::{notes, OptimizeOptions, StageReport};
 use crate::analyze::{AnalyzeOptions, Report};
-use crate::error::Error;
+use crate::error::{Error, ErrorKind};
 use crate::estimate::{rewrite_and_analyze, EstimateReport};
 use crate::infill::{infill_with_progress, Choice, InfillOptions};
 use crate::progress::Progress;
@@ -88,7 +88,16 @@ impl Stage {
             estimates: false,
             ..options.clone()
         };
-        let r = infill_with_progress(&self.file, &o, progress)?;
+        let r = match infill_with_progress(&self.file, &o, progress) {
+            Ok(r) => r,
+            // A file without sparse infill (a vase, a solid plate) still goes through the rest
+            // of the pipeline: a post-processing script runs on every file the slicer exports.
+            Err(Error {
+                kind: ErrorKind::NothingToRegenerate { reason },
+                ..
+            }) => return Ok(self.unchanged("infill", format!("nothing to regenerate: {reason}"))),
+            Err(e) => return Err(e),
+        };
         if r.best.pattern == Choice::Original {
             let why = r.best.message.unwrap_or_default();
             return Ok(self.unchanged("infill", why));

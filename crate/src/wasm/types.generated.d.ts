@@ -784,6 +784,12 @@ export type ErrorKind = {
    */
   reason: string,
 } | {
+  "kind": "nothing_to_regenerate",
+  /**
+   * What the file lacks.
+   */
+  reason: string,
+} | {
   "kind": "cancelled"
 };
 
