@@ -295,6 +295,11 @@ struct Writer<'a, S> {
     retracted: bool,
     absolute: bool,
     e: f64,
+    /// Filament (mm) an E unit stands for at the block
+    /// ([`crate::machine::Machine::filament_per_e_unit`]):
+    /// the habit is measured in filament, the words are written in the file's units (a
+    /// volume where `M200` or the flavour says so, before the `M221` flow factor).
+    e_unit: f64,
 }
 
 impl<S: Sink> Writer<'_, S> {
@@ -313,6 +318,7 @@ impl<S: Sink> Writer<'_, S> {
         } else {
             (self.habit.retract_mm, self.habit.unretract_f)
         };
+        let d = d / self.e_unit;
         let v = if self.absolute {
             self.e = r5(self.e + d);
             self.e
@@ -349,7 +355,7 @@ impl<S: Sink> Writer<'_, S> {
             if d < 1e-9 {
                 continue;
             }
-            let inc = self.habit.e_per_mm * d;
+            let inc = self.habit.e_per_mm * d / self.e_unit;
             let v = if self.absolute {
                 self.e = r5(self.e + inc);
                 self.e
@@ -390,6 +396,9 @@ fn writer<'a, S: Sink>(block: &Block, out: S, start: P2, habit: &'a Habit) -> Wr
         retracted: block.retracted_start,
         absolute: block.machine.extrusion_mode() == ExtrusionMode::Absolute,
         e: block.machine.logical_position()[axis::E],
+        e_unit: Some(block.machine.filament_per_e_unit())
+            .filter(|u| u.is_finite() && *u > 0.0)
+            .unwrap_or(1.0),
     }
 }
 

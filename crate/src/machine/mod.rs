@@ -10,6 +10,11 @@
 //!   time it as one; on Klipper it is untimed homing, see `read::At::untimed_homing`).
 //! - `G10`/`G11` without `P`/`L` are firmware retraction with the `M207`/`M208` lengths.
 //! - `M220` scales feed rates, `M221` scales extrusion.
+//! - `M200 D<d>` (Marlin, RepRapFirmware) reads E words as cubic millimetres of filament of
+//!   diameter `d` (`D0` or `S0` reads them as millimetres again, `S1` as volume with the last
+//!   diameter); Cura's volumetric flavours (`;FLAVOR:Marlin(Volumetric)`, `UltiGCode`) write
+//!   volume from the first line ([`MachineConfig::volumetric_diameter_mm`]). Klipper has no
+//!   `M200`.
 
 pub mod arc;
 pub mod extrusion;
@@ -22,6 +27,12 @@ use crate::gcode::{Code, Command, Line, Params};
 pub use arc::{Arc, ArcSpec, Plane};
 pub use extrusion::{infer_extrusion_mode, ExtrusionInference, ExtrusionMode, ModeSource};
 pub use timeline::{FanEvent, TemperatureEvent};
+
+/// Filament diameter `M200 S1` assumes before any `M200 D`, mm (Marlin's
+/// `DEFAULT_NOMINAL_FILAMENT_DIA`).
+pub const DEFAULT_VOLUMETRIC_DIAMETER_MM: f64 = 1.75;
+/// Largest `M200 D` taken as a filament diameter, mm.
+const MAX_FILAMENT_DIAMETER_MM: f64 = 10.0;
 
 /// Number of tracked axes: X, Y, Z, E, A, B, C, U, V, W.
 pub const AXES: usize = 10;
@@ -247,6 +258,9 @@ pub struct MachineConfig {
     /// (the toolhead stops there), and `M84`/`M18` waits [`KLIPPER_MOTORS_OFF_S`] when a motor
     /// was on.
     pub klipper: bool,
+    /// E words are volumes (mm³) of filament of this diameter from the start of the file, mm:
+    /// the file's flavour says so (Cura's volumetric flavours), not an `M200` in it.
+    pub volumetric_diameter_mm: Option<f64>,
 }
 
 impl Default for MachineConfig {
@@ -256,8 +270,14 @@ impl Default for MachineConfig {
             retract_mm: DEFAULT_RETRACT_MM,
             retract_feed_mm_s: DEFAULT_RETRACT_FEED_MM_S,
             klipper: false,
+            volumetric_diameter_mm: None,
         }
     }
+}
+
+/// Cross-section of filament of diameter `d`, mm² (`None` for a diameter that is no filament).
+fn filament_area(d: f64) -> Option<f64> {
+    (d.is_finite() && d > 0.0).then(|| core::f64::consts::PI * d * d / 4.0)
 }
 
 /// The modal state of the printer.
@@ -274,6 +294,11 @@ pub struct Machine {
     feed_mm_s: f64,
     speed_factor: f64,
     flow_factor: f64,
+    /// Filament (mm) an E unit stands for, flow aside: 1, or 1 / area where E words are
+    /// volumes (`M200`).
+    e_unit_mm: f64,
+    /// The last `M200 D` diameter, mm, which `M200 S1` turns volumetric extrusion on with.
+    volumetric_diameter_mm: f64,
     retracted: bool,
     retract_mm: f64,
     retract_feed_mm_s: f64,
@@ -304,6 +329,13 @@ impl Machine {
             feed_mm_s: DEFAULT_FEED_MM_S,
             speed_factor: 1.0,
             flow_factor: 1.0,
+            e_unit_mm: config
+                .volumetric_diameter_mm
+                .and_then(filament_area)
+                .map_or(1.0, |a| 1.0 / a),
+            volumetric_diameter_mm: config
+                .volumetric_diameter_mm
+                .unwrap_or(DEFAULT_VOLUMETRIC_DIAMETER_MM),
             retracted: false,
             retract_mm: config.retract_mm,
             retract_feed_mm_s: config.retract_feed_mm_s,
@@ -337,6 +369,13 @@ impl Machine {
         } else {
             self.e_mode
         }
+    }
+
+    /// Filament (mm) one unit of the E words stands for now: the `M221` flow factor, over the
+    /// filament's cross-section where E words are volumes (`M200`). Writers of new E words
+    /// divide the filament they mean by it.
+    pub fn filament_per_e_unit(&self) -> f64 {
+        self.flow_factor * self.e_unit_mm
     }
 
     /// Modal feed rate, mm/s, before the `M220` override.
@@ -532,6 +571,7 @@ impl Machine {
                 }
             }
             220 | 221 => self.set_override(line_no, number, p.get(b'S'), warnings),
+            200 if !self.klipper => self.set_volumetric(p.get(b'D'), p.get(b'S')),
             // Klipper's M400 waits for the queue to drain: a dwell of no time, which stops the
             // look-ahead as a heater wait does.
             400 if self.klipper => return Some(Event::Dwell(0.0)),
@@ -544,6 +584,26 @@ impl Machine {
             _ => {}
         }
         None
+    }
+
+    /// `M200`: a diameter `d` (`D`) over 0 reads E words as volumes of that filament, `D0`
+    /// as millimetres; `S0` switches volume off and `S1` on with the last diameter (Marlin 2;
+    /// RepRapFirmware takes `D` alone). A diameter past any filament's is ignored.
+    fn set_volumetric(&mut self, d: Option<f64>, s: Option<f64>) {
+        let mut on = self.e_unit_mm != 1.0;
+        if let Some(d) = d.filter(|d| (0.0..=MAX_FILAMENT_DIAMETER_MM).contains(d)) {
+            on = d > 0.0;
+            if on {
+                self.volumetric_diameter_mm = d;
+            }
+        }
+        if let Some(s) = s {
+            on = s != 0.0;
+        }
+        self.e_unit_mm = match filament_area(self.volumetric_diameter_mm) {
+            Some(a) if on => 1.0 / a,
+            _ => 1.0,
+        };
     }
 
     /// `M220 S` (speed factor) or `M221 S` (flow factor), in percent.
@@ -617,7 +677,7 @@ impl Machine {
 
     /// Moves the state to `target` (logical).
     fn go_to(&mut self, target: &Pos) {
-        let flow = self.flow_factor;
+        let flow = self.filament_per_e_unit();
         for (i, ((phys, logical), t)) in self
             .physical
             .iter_mut()
@@ -992,6 +1052,44 @@ mod tests {
         let e: Vec<f64> = moves(&ev).iter().map(Move::extrusion).collect();
         assert_eq!(e, vec![1.0, 1.0, 2.0, 1.0, 0.5, 0.0]);
         assert_eq!(m.position()[axis::E], 5.5);
+    }
+
+    /// `M200 D1.75`: a volume of π·1.75²/4 mm³ is 1 mm of filament; `D0` and `S0` read
+    /// millimetres again, `S1` volume with the last diameter; Klipper has no `M200`.
+    #[test]
+    fn volumetric_extrusion_reads_e_as_cubic_millimetres() {
+        let area = std::f64::consts::PI * 1.75 * 1.75 / 4.0;
+        let src = format!(
+            "M83\nM200 D1.75\nG1 X1 E{area}\nM200 D0\nG1 X2 E1\nM200 S1\nG1 X3 E{a2}\n\
+             M221 S50\nG1 X4 E{area}\nM200 S0\nG1 X5 E1",
+            a2 = 2.0 * area
+        );
+        let e = |config| {
+            let (m, ev, _) = run(&src, config);
+            let e: Vec<f64> = moves(&ev).iter().map(Move::extrusion).collect();
+            (e, m.filament_per_e_unit())
+        };
+        let (marlin, unit) = e(MachineConfig::default());
+        for (got, want) in marlin.iter().zip([1.0, 1.0, 2.0, 0.5, 0.5]) {
+            assert!((got - want).abs() < 1e-12, "{marlin:?}");
+        }
+        assert_eq!(unit, 0.5);
+        let klipper = MachineConfig {
+            klipper: true,
+            ..MachineConfig::default()
+        };
+        let (ignored, _) = e(klipper);
+        assert!((ignored[0] - area).abs() < 1e-12, "{ignored:?}");
+        // A volumetric flavour: volume from the first line, until the file says otherwise.
+        let flavour = MachineConfig {
+            volumetric_diameter_mm: Some(2.85),
+            ..MachineConfig::default()
+        };
+        let (m, ev, _) = run("M83\nG1 X1 E6.379\nM200 D0\nG1 X2 E1", flavour);
+        let e: Vec<f64> = moves(&ev).iter().map(Move::extrusion).collect();
+        let big = std::f64::consts::PI * 2.85 * 2.85 / 4.0;
+        assert!((e[0] - 6.379 / big).abs() < 1e-12 && e[1] == 1.0, "{e:?}");
+        assert_eq!(m.filament_per_e_unit(), 1.0);
     }
 
     #[test]

@@ -127,6 +127,9 @@ pub(crate) struct Setup {
     /// The Klipper version a config was given for (it decides how `SET_VELOCITY_LIMIT`
     /// reads); `None` without a config, where the file's commands are read as they come.
     pub klipper_version: Option<KlipperVersion>,
+    /// The filament diameter E words are volumes of from the first line (a volumetric
+    /// flavour, [`volumetric_flavour`]), mm.
+    pub volumetric: Option<f64>,
 }
 
 impl Setup {
@@ -144,6 +147,7 @@ impl Setup {
             retract_mm: self.retract.0.unwrap_or(default.retract_mm),
             retract_feed_mm_s: self.retract.1.unwrap_or(default.retract_feed_mm_s),
             klipper: self.klipper(),
+            volumetric_diameter_mm: self.volumetric,
         })
     }
 }
@@ -197,6 +201,7 @@ pub(crate) fn prepare(input: &[u8], options: &AnalyzeOptions) -> Result<Setup, E
             source: LimitSource::Option,
         };
     }
+    let volumetric = volumetric_diameter(options, &pre, &mut warnings);
     let units = if pre.flavor.as_deref() == Some("reprapfirmware") {
         FeedUnits::PerMinute
     } else {
@@ -215,7 +220,38 @@ pub(crate) fn prepare(input: &[u8], options: &AnalyzeOptions) -> Result<Setup, E
         units,
         retract: retract.unwrap_or_default(),
         klipper_version,
+        volumetric,
     })
+}
+
+/// The filament diameter E words are volumes of from the first line, where the file's
+/// flavour writes them so ([`volumetric_flavour`]): the options', else 1.75 mm, said in a
+/// warning (Cura writes no diameter in these files).
+fn volumetric_diameter(
+    options: &AnalyzeOptions,
+    pre: &prescan::Prescan,
+    warnings: &mut Warnings,
+) -> Option<f64> {
+    volumetric_flavour(pre.flavor.as_deref()).then(|| {
+        let d = options
+            .filament_diameter_mm
+            .unwrap_or(machine::DEFAULT_VOLUMETRIC_DIAMETER_MM);
+        warnings.push(
+            0,
+            format!(
+                "E words read as volumes (mm³) of {d} mm filament: the file's flavour is \
+                 Cura's volumetric one (set another diameter with the filament diameter option)"
+            ),
+        );
+        d
+    })
+}
+
+/// Whether a file of `flavor` (its header's, lower case) writes E as volume from its first
+/// line: Cura's `Marlin(Volumetric)` and `UltiGCode` flavours, which leave the printer's own
+/// volumetric mode to convert it.
+fn volumetric_flavour(flavor: Option<&str>) -> bool {
+    flavor.is_some_and(|f| f.contains("volumetric") || f == "ultigcode")
 }
 
 /// The limits before the file's first line: Klipper's config alone when given (a slicer's
