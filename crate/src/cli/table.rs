@@ -154,7 +154,11 @@ fn write_warnings(out: &mut dyn Write, r: &Report) -> io::Result<()> {
     if !r.warnings.is_empty() {
         writeln!(out, "\n  warnings ({}):", r.warnings.len() as u64 + dropped)?;
         for w in r.warnings.iter().take(20) {
-            writeln!(out, "    line {}: {}", w.line, w.message)?;
+            match w.line {
+                // A remark about the whole file.
+                0 => writeln!(out, "    {}", w.message)?,
+                line => writeln!(out, "    line {line}: {}", w.message)?,
+            }
         }
         let more = r.warnings.len().saturating_sub(20) as u64 + dropped;
         if more > 0 {
