@@ -431,7 +431,9 @@ fn keep_ringing_layers(
 /// when none is left to mark).
 ///
 /// The peak: every layer whose printing peak is above the original's file peak (VTG Table 2's
-/// max row). The mean: the file's mean deviation is Σ sums / Σ samples over its layers, so it
+/// max row). A layer kept already that still rings above it starts from the ringing the
+/// rewritten layer before it left (its own moves are the original's): the nearest layer
+/// before it not kept yet is kept instead. The mean: the file's mean deviation is Σ sums / Σ samples over its layers, so it
 /// is at most the original's mean `m` exactly when Σ (sum − m · samples) ≤ 0. Each layer's
 /// share of that total, rewritten (from `sim`) and as it was (from `original`), says what
 /// keeping it gives back; the layers that give back most are kept first, until the total is
@@ -455,11 +457,16 @@ fn mark_ringing_layers(original: &Simulated, sim: &Simulated, kept: &mut [bool])
         0.0
     };
     let mut marked = Marked::default();
-    for (l, k) in kept.iter_mut().enumerate() {
-        if !*k && sim.layers.get(l).is_some_and(|r| r.peak > b.max) {
-            *k = true;
+    for l in 0..kept.len() {
+        if !sim.layers.get(l).is_some_and(|r| r.peak > b.max) {
+            continue;
+        }
+        // A layer kept already that still rings above the peak carries the ringing of the
+        // rewritten layer before it (its own moves are the original's): that one is kept too.
+        if let Some(k) = (0..=l).rev().find(|&k| !kept[k]) {
+            kept[k] = true;
             marked.peak += 1;
-            total -= gain(l);
+            total -= gain(k);
         }
     }
     let mut candidates: Vec<(f64, usize)> = (0..kept.len())
@@ -593,7 +600,19 @@ mod tests {
         // Nothing left to mark once it is kept and the rewrite rings so.
         let again = simulated(&[(0.4, 0.015, 1000), (0.4, 0.02, 1000), (0.2, 0.015, 1000)]);
         assert_eq!(
-            mark_ringing_layers(&original, &again, &mut kept),
+            mark_ringing_layers(&original, &again, &mut kept.clone()),
+            Marked::default()
+        );
+        // Kept, it still rings above the peak: the ringing comes from the layer before it,
+        // which is kept too; with every layer before it kept, there is nothing left to mark.
+        let carried = simulated(&[(0.4, 0.015, 1000), (0.55, 0.02, 1000), (0.2, 0.015, 1000)]);
+        assert_eq!(
+            mark_ringing_layers(&original, &carried, &mut kept),
+            Marked { peak: 1, mean: 0 }
+        );
+        assert_eq!(kept, [true, true, false]);
+        assert_eq!(
+            mark_ringing_layers(&original, &carried, &mut kept),
             Marked::default()
         );
     }
