@@ -509,26 +509,33 @@ fn vtg_and_infill_rewrite_the_estimates_they_change() {
     }
 }
 
-/// A file VTG hands back as it was (the corpus spiral vase: rounding any corner would add
-/// lines): the stage is not applied, and says why in VTG's words.
-#[test]
-fn a_vtg_stage_that_keeps_the_file_says_why() {
-    let file = scratch_copy("vtg-kept", "prusaslicer-2.7.4_spiral-vase.gcode");
-    let out = cli(
-        &["optimize", "--in-place", "--json", file.to_str().unwrap()],
-        &[],
-    );
+/// `optimize --in-place --json` with `options` on `file`, which must succeed; its first stage,
+/// which must be `stage`, not applied.
+fn first_stage_not_applied(options: &[&str], file: &Path, stage: &str) -> serde_json::Value {
+    let mut args = vec!["optimize"];
+    args.extend(options);
+    args.extend(["--in-place", "--json", file.to_str().unwrap()]);
+    let out = cli(&args, &[]);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let vtg = &report["stages"][0];
+    let first = report["stages"][0].clone();
     assert_eq!(
-        (&vtg["stage"], &vtg["applied"]),
-        (&"vtg".into(), &false.into())
+        (&first["stage"], &first["applied"]),
+        (&stage.into(), &false.into())
     );
+    first
+}
+
+/// A file VTG hands back as it was (the corpus spiral vase: rounding any corner would add
+/// lines): the stage is not applied, and says why in VTG's words.
+#[test]
+fn a_vtg_stage_that_keeps_the_file_says_why() {
+    let file = scratch_copy("vtg-kept", "prusaslicer-2.7.4_spiral-vase.gcode");
+    let vtg = first_stage_not_applied(&[], &file, "vtg");
     let why = vtg["message"].as_str().unwrap();
     assert!(why.starts_with("kept the original: "), "{why}");
     assert_eq!(vtg["time_s"][0], vtg["time_s"][1]);
@@ -548,28 +555,7 @@ fn an_infill_stage_on_a_file_without_sparse_infill_says_why() {
         "{err}"
     );
     assert!(!err.contains("line 0"), "{err}");
-    let out = cli(
-        &[
-            "optimize",
-            "--infill",
-            "--no-vtg",
-            "--in-place",
-            "--json",
-            file.to_str().unwrap(),
-        ],
-        &[],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let infill = &report["stages"][0];
-    assert_eq!(
-        (&infill["stage"], &infill["applied"]),
-        (&"infill".into(), &false.into())
-    );
+    let infill = first_stage_not_applied(&["--infill", "--no-vtg"], &file, "infill");
     assert_eq!(
         infill["message"],
         "nothing to regenerate: the file marks no sparse infill"
