@@ -125,9 +125,10 @@ measurements:
 measure-vtg-w16: cli
 	bash scripts/vtg-w16-tables.sh
 
-## VTG on parts and slicers it was not tuned on: three models of tests/fixtures/models/unseen/
-## sliced with CuraEngine, Slic3r and PrusaSlicer (for Klipper), with the defaults and with lines
-## allowed (scripts/vtg-unseen-parts.sh, docs/measurements/vtg.md; about 3 min). Needs the slicers.
+## VTG on parts and slicers it was not tuned on: four models of tests/fixtures/models/unseen/
+## sliced with CuraEngine, Slic3r and PrusaSlicer (for Klipper, and under less common settings),
+## with the defaults and with lines allowed (scripts/vtg-unseen-parts.sh,
+## docs/measurements/vtg.md; about 4 min). Needs the slicers.
 measure-vtg-unseen: cli
 	bash scripts/vtg-unseen-parts.sh
 

@@ -6,9 +6,15 @@
 # honeycomb) and PrusaSlicer 2.5 for a Klipper printer (SET_VELOCITY_LIMIT ACCEL=5000
 # SQUARE_CORNER_VELOCITY=5 in its start G-code, 0.15 mm, gyroid, perimeters 120 mm/s, infill
 # 200 mm/s), then `quietpath vtg --json` with the defaults and with `--allow-more-lines 1000`
-# (extra vtg options are passed on to both). Prints a markdown table per run: lines, sharp
-# corners, energy, time, the dynamics model's mean and peak deviation, the measured deviation,
-# layers kept, the peak segment rate against the machine's budget, and the message.
+# (extra vtg options are passed on to both). A fourth model, an L-bracket
+# (tests/fixtures/models/unseen/bracket.scad), is sliced under each slicer's less common settings:
+# CuraEngine with volumetric E and Z hops, concentric infill with ironing, lightning infill
+# with coasting; PrusaSlicer with firmware retraction, fuzzy skin and two copies printed one
+# after the other, and for RepRapFirmware with ironing at 0.1 mm; Slic3r for Smoothieware with
+# concentric infill at 0.3 mm, and with firmware retraction and a Hilbert-curve top.
+# Prints a markdown table per run: lines, sharp corners, energy, time, the dynamics model's
+# mean and peak deviation, the measured deviation, layers kept, the peak segment rate against
+# the machine's budget, and the message.
 # Results: docs/measurements/vtg.md ("Parts it was not tuned on").
 #
 # Needs Debian's `openscad`, `prusa-slicer`, `slic3r` and `cura-engine`, python3 and `make cli`.
@@ -60,6 +66,46 @@ G1 Z5 F3000" \
     --output "$work/prusaslicer-klipper_$model.gcode" "$work/$model.stl" >/dev/null 2>&1
   files+=("$work/curaengine_$model.gcode" "$work/slic3r_$model.gcode" "$work/prusaslicer-klipper_$model.gcode")
 done
+
+# One more part, an L-bracket with ribs, a bored boss, a slot, a cross hole and a separate
+# tube, under settings the tuning never met: each slicer's less common options.
+openscad -o "$work/bracket.stl" "$root/tests/fixtures/models/unseen/bracket.scad" >/dev/null 2>&1
+cura() { # output name, settings...
+  local name="$1"
+  shift
+  CuraEngine slice -j "$resources/definitions/fdmprinter.def.json" \
+    -s machine_width=220 -s machine_depth=220 -s machine_height=250 -s center_object=true \
+    -s layer_height=0.2 "$@" -l "$work/bracket.stl" -o "$work/$name.gcode" >/dev/null 2>&1
+  files+=("$work/$name.gcode")
+}
+extruder=(-e0 -s machine_nozzle_size=0.4 -s material_diameter=1.75)
+cura curaengine_bracket_volumetric_gyroid_zhop -s machine_gcode_flavor="RepRap (Volumetric)" \
+  -s relative_extrusion=true "${extruder[@]}" -s infill_pattern=gyroid \
+  -s infill_sparse_density=20 -s retraction_hop_enabled=true
+cura curaengine_bracket_concentric_ironing "${extruder[@]}" -s infill_pattern=concentric \
+  -s infill_sparse_density=30 -s ironing_enabled=true
+cura curaengine_bracket_lightning_coasting "${extruder[@]}" -s infill_pattern=lightning \
+  -s infill_sparse_density=15 -s coasting_enable=true -s acceleration_enabled=true \
+  -s acceleration_print=3000 -s jerk_enabled=true -s jerk_print=8
+prusa-slicer --export-gcode --gcode-flavor marlin2 --use-firmware-retraction \
+  --fuzzy-skin external --duplicate 2 --complete-objects --extruder-clearance-radius 20 \
+  --layer-height 0.2 --fill-density 20% --fill-pattern cubic \
+  --output "$work/prusaslicer_bracket_fwretract_fuzzy_sequential.gcode" "$work/bracket.stl" >/dev/null 2>&1
+prusa-slicer --export-gcode --gcode-flavor reprapfirmware --ironing --ironing-type top \
+  --layer-height 0.1 --fill-density 40% --fill-pattern rectilinear --seam-position rear \
+  --use-relative-e-distances \
+  --output "$work/prusaslicer_bracket_rrf_ironing_0.1mm.gcode" "$work/bracket.stl" >/dev/null 2>&1
+slic3r --no-gui --gcode-flavor smoothie --print-center 100,100 --filament-diameter 1.75 \
+  --nozzle-diameter 0.4 --layer-height 0.3 --perimeters 3 --fill-density 25% \
+  --fill-pattern concentric \
+  --output "$work/slic3r_bracket_smoothie_concentric.gcode" "$work/bracket.stl" >/dev/null 2>&1
+slic3r --no-gui --gcode-flavor reprap --use-firmware-retraction --use-relative-e-distances \
+  --print-center 100,100 --filament-diameter 1.75 --nozzle-diameter 0.4 --layer-height 0.2 \
+  --fill-density 60% --fill-pattern rectilinear --top-infill-pattern hilbertcurve \
+  --output "$work/slic3r_bracket_fwretract_hilbert.gcode" "$work/bracket.stl" >/dev/null 2>&1
+files+=("$work/prusaslicer_bracket_fwretract_fuzzy_sequential.gcode"
+  "$work/prusaslicer_bracket_rrf_ironing_0.1mm.gcode"
+  "$work/slic3r_bracket_smoothie_concentric.gcode" "$work/slic3r_bracket_fwretract_hilbert.gcode")
 
 run() { # title, extra options...
   local title="$1"
