@@ -294,9 +294,8 @@ pub struct Machine {
     feed_mm_s: f64,
     speed_factor: f64,
     flow_factor: f64,
-    /// Filament (mm) an E unit stands for, flow aside: 1, or 1 / area where E words are
-    /// volumes (`M200`).
-    e_unit_mm: f64,
+    /// E words are volumes (mm³) of filament of `volumetric_diameter_mm` (`M200`).
+    volumetric: bool,
     /// The last `M200 D` diameter, mm, which `M200 S1` turns volumetric extrusion on with.
     volumetric_diameter_mm: f64,
     retracted: bool,
@@ -329,10 +328,7 @@ impl Machine {
             feed_mm_s: DEFAULT_FEED_MM_S,
             speed_factor: 1.0,
             flow_factor: 1.0,
-            e_unit_mm: config
-                .volumetric_diameter_mm
-                .and_then(filament_area)
-                .map_or(1.0, |a| 1.0 / a),
+            volumetric: config.volumetric_diameter_mm.is_some(),
             volumetric_diameter_mm: config
                 .volumetric_diameter_mm
                 .unwrap_or(DEFAULT_VOLUMETRIC_DIAMETER_MM),
@@ -375,7 +371,11 @@ impl Machine {
     /// filament's cross-section where E words are volumes (`M200`). Writers of new E words
     /// divide the filament they mean by it.
     pub fn filament_per_e_unit(&self) -> f64 {
-        self.flow_factor * self.e_unit_mm
+        let area = self
+            .volumetric
+            .then(|| filament_area(self.volumetric_diameter_mm))
+            .flatten();
+        area.map_or(self.flow_factor, |a| self.flow_factor / a)
     }
 
     /// Modal feed rate, mm/s, before the `M220` override.
@@ -590,20 +590,15 @@ impl Machine {
     /// as millimetres; `S0` switches volume off and `S1` on with the last diameter (Marlin 2;
     /// RepRapFirmware takes `D` alone). A diameter past any filament's is ignored.
     fn set_volumetric(&mut self, d: Option<f64>, s: Option<f64>) {
-        let mut on = self.e_unit_mm != 1.0;
         if let Some(d) = d.filter(|d| (0.0..=MAX_FILAMENT_DIAMETER_MM).contains(d)) {
-            on = d > 0.0;
-            if on {
+            self.volumetric = d > 0.0;
+            if self.volumetric {
                 self.volumetric_diameter_mm = d;
             }
         }
         if let Some(s) = s {
-            on = s != 0.0;
+            self.volumetric = s != 0.0;
         }
-        self.e_unit_mm = match filament_area(self.volumetric_diameter_mm) {
-            Some(a) if on => 1.0 / a,
-            _ => 1.0,
-        };
     }
 
     /// `M220 S` (speed factor) or `M221 S` (flow factor), in percent.
