@@ -433,8 +433,9 @@ fn keep_ringing_layers(
 /// The peak: every layer whose printing peak is above the original's file peak (VTG Table 2's
 /// max row). A layer kept already that still rings above it starts from the ringing the
 /// rewritten layer before it left (its own moves are the original's): the nearest layer
-/// before it not kept yet is kept instead. The mean: the file's mean deviation is Σ sums / Σ samples over its layers, so it
-/// is at most the original's mean `m` exactly when Σ (sum − m · samples) ≤ 0. Each layer's
+/// before it not kept yet is kept instead. The mean: the file's mean deviation is Σ sums /
+/// Σ samples over its layers, so it is at most the original's mean `m` exactly when
+/// Σ (sum − m · samples) ≤ 0. Each layer's
 /// share of that total, rewritten (from `sim`) and as it was (from `original`), says what
 /// keeping it gives back; the layers that give back most are kept first, until the total is
 /// [`MEAN_MARGIN`] of `m` under zero. A layer that rings less rewritten is never kept for the
