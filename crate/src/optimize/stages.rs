@@ -92,10 +92,9 @@ impl Stage {
             Ok(r) => r,
             // A file without sparse infill (a vase, a solid plate) still goes through the rest
             // of the pipeline: a post-processing script runs on every file the slicer exports.
-            Err(Error {
-                kind: ErrorKind::NothingToRegenerate { reason },
-                ..
-            }) => return Ok(self.unchanged("infill", format!("nothing to regenerate: {reason}"))),
+            Err(e) if matches!(e.kind, ErrorKind::NothingToRegenerate { .. }) => {
+                return Ok(self.unchanged("infill", e.kind.to_string()))
+            }
             Err(e) => return Err(e),
         };
         if r.best.pattern == Choice::Original {
