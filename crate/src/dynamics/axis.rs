@@ -31,7 +31,16 @@ pub struct Stepper {
     phi: [[f64; 12]; 12],
     gamma: [[f64; 12]; 2],
     modal: Option<ModalStepper>,
+    /// The state, at the end of a period, that a jump of 1 m/s in the commanded velocity
+    /// left `j / JUMP_STEPS` of a period before it ([`jump_responses`]), in the coordinates the
+    /// bucket steps in (modal where it has a modal form).
+    jumps: Box<[[f64; 12]; JUMP_STEPS + 1]>,
 }
+
+/// Entries of a bucket's table of jump responses over one period ([`jump_responses`]): a
+/// jump's time is placed to 1/128 of a period by linear interpolation between them (at 1 ms
+/// the presets' fastest modes, near 4.8 kHz, turn 0.47 rad between two entries).
+pub const JUMP_STEPS: usize = 64;
 
 impl Stepper {
     /// One period: `x ← Φ x + Γ [v, a]` (commanded velocity at the start, m/s, and
@@ -51,6 +60,17 @@ impl Stepper {
             *yr += self.gamma[0][r] * v + self.gamma[1][r] * a;
         }
         *x = y;
+    }
+
+    /// The response at the end of a period to a jump of 1 m/s in the commanded velocity a
+    /// share `before_end` (0 to 1) of the period before it.
+    #[inline]
+    fn jump_response(&self, before_end: f64) -> [f64; 12] {
+        let x = (before_end.clamp(0.0, 1.0)) * JUMP_STEPS as f64;
+        let j = (x as usize).min(JUMP_STEPS - 1);
+        let w = x - j as f64;
+        let (r0, r1) = (&self.jumps[j], &self.jumps[j + 1]);
+        core::array::from_fn(|i| r0[i] + w * (r1[i] - r0[i]))
     }
 
     /// Whether the bucket steps in modal coordinates.
@@ -129,11 +149,47 @@ pub fn stepper(drive: &Drive, position_m: f64, ts: f64) -> Option<Stepper> {
         b_a[(6 + i, 0)] = f_a[i] / m;
     }
     let d = discretize(&a, &b_v, &b_a, ts)?;
+    let modal = ModalStepper::new(&a, &d.phi, &d.gamma, [TABLE, TABLE_VELOCITY]);
+    let mut jumps = Box::new(jump_responses(&a, &b_v, &b_a, ts)?);
+    if let Some(m) = &modal {
+        for r in jumps.iter_mut() {
+            *r = m.to_modal(r);
+        }
+    }
     Some(Stepper {
         phi: core::array::from_fn(|c| core::array::from_fn(|r| d.phi[(r, c)])),
         gamma: core::array::from_fn(|c| core::array::from_fn(|r| d.gamma[(r, c)])),
-        modal: ModalStepper::new(&a, &d.phi, &d.gamma, [TABLE, TABLE_VELOCITY]),
+        modal,
+        jumps,
     })
+}
+
+/// The state `τ = j ts / JUMP_STEPS` after a jump of 1 m/s in the commanded velocity, from
+/// rest, for `j` from 0 to [`JUMP_STEPS`]: `r(τ) = e^{Aτ} b_a + ∫₀^τ e^{As} ds b_v`. A planned
+/// path's commanded velocity jumps at its corners (the junction speed turned through the
+/// corner's angle), an impulse of acceleration that a period's constant acceleration would
+/// spread over the whole period: the ringing it starts then depends on where the corner falls
+/// between two steps (the peak deviation of a layer shifted by a fraction of a millisecond
+/// moved by up to 3 %). The step adds `r(τ) Δv` for each jump instead. `r` follows from one
+/// discretisation at the table's spacing `h`: `r(τ + h) = Φ(h) r(τ) + Γ_v(h)`, `r(0) = b_a`.
+fn jump_responses(
+    a: &DMatrix<f64>,
+    b_v: &DMatrix<f64>,
+    b_a: &DMatrix<f64>,
+    ts: f64,
+) -> Option<[[f64; 12]; JUMP_STEPS + 1]> {
+    let h = discretize(a, b_v, b_a, ts / JUMP_STEPS as f64)?;
+    let phi: [[f64; 12]; 12] = core::array::from_fn(|c| core::array::from_fn(|r| h.phi[(r, c)]));
+    let mut r: [f64; 12] = core::array::from_fn(|i| b_a[(i, 0)]);
+    let mut table = [[0.0; 12]; JUMP_STEPS + 1];
+    for entry in table.iter_mut() {
+        *entry = r;
+        r = product(&phi, &r);
+        for (i, ri) in r.iter_mut().enumerate() {
+            *ri += h.gamma[(i, 0)];
+        }
+    }
+    Some(table)
 }
 
 /// State components smaller than this are set to zero every few steps (subnormal numbers
@@ -246,6 +302,22 @@ impl Axes {
         if self.unflushed >= FLUSH_EVERY {
             flush_to_zero(self.z.as_flattened_mut());
             self.unflushed = 0;
+        }
+        Some(())
+    }
+
+    /// A jump `dv` (m/s, X and Y) in the commanded velocities a share `before_end` (0 to 1) of
+    /// the period just stepped before its end: its response added to each state
+    /// ([`jump_responses`]). The step itself took the velocity without the jump.
+    #[inline]
+    pub fn jump(&mut self, before_end: f64, dv: [f64; 2]) -> Option<()> {
+        for (lane, &dv) in dv.iter().enumerate() {
+            if dv != 0.0 {
+                let r = self.axes[lane].current()?.jump_response(before_end);
+                for (row, ri) in self.z.iter_mut().zip(r) {
+                    row[lane] += ri * dv;
+                }
+            }
         }
         Some(())
     }

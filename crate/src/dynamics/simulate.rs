@@ -59,6 +59,13 @@ impl Stats {
         self.max = self.max.max(v);
     }
 
+    /// The largest raised to `v`, a peak met between samples ([`peak_between`]): the mean
+    /// and the count stay those of the samples.
+    #[inline]
+    fn raise(&mut self, v: f64) {
+        self.max = self.max.max(v);
+    }
+
     /// Both runs' samples as one: `other`'s added to these.
     pub fn merge(&mut self, other: &Stats) {
         self.count += other.count;
@@ -106,6 +113,15 @@ impl LayerSums {
         self.deviation.add(dev);
         if extruding {
             self.printing.add(dev);
+        }
+    }
+
+    /// A peak `dev` (mm) met between samples, taken while extruding or not.
+    #[inline]
+    pub(super) fn raise(&mut self, dev: f64, extruding: bool) {
+        self.deviation.raise(dev);
+        if extruding {
+            self.printing.raise(dev);
         }
     }
 
@@ -179,6 +195,23 @@ impl Outcome {
         }
     }
 
+    /// A peak `dev` (mm) met between samples near X, Y (mm) and time `at`, in layer `layer`.
+    pub(super) fn raise(&mut self, dev: f64, at: [f64; 3], extruding: bool, layer: u32) {
+        if dev > self.deviation.max {
+            self.max_at = at;
+        }
+        self.deviation.raise(dev);
+        if extruding {
+            if dev > self.printing.max {
+                self.printing_max_at = at;
+            }
+            self.printing.raise(dev);
+        }
+        if let Some(l) = self.layers.get_mut(layer as usize) {
+            l.raise(dev, extruding);
+        }
+    }
+
     /// An acceleration sample of the table (X, Y, m/s²) in layer `layer`.
     #[inline]
     pub(super) fn add_acceleration(&mut self, acc: &[f64; 2], layer: u32) {
@@ -221,18 +254,83 @@ pub(super) fn merge_layers(into: &mut Vec<LayerSums>, later: &[LayerSums]) {
     }
 }
 
-/// One step of both axes from the command `prev` to `next`.
+/// The peak of a deviation between three evenly spaced samples whose middle one `y1` is a
+/// local maximum: the vertex of the parabola through them. Sampled every period `ts`, a
+/// ringing of frequency `f` shows its crest up to `1 - cos(π f ts)` low (1.2 % at 50 Hz and
+/// 1 ms, 4.9 % at 100 Hz), and by how much depends on where the samples fall. Whatever the
+/// phase, the vertex is within 0.02 % of a pure ringing's crest at 50 Hz and 0.35 % at 100 Hz;
+/// it is how spectrum analysers place a peak between bins.
+#[inline]
+pub(super) fn peak_between(y0: f64, y1: f64, y2: f64) -> f64 {
+    let curvature = y0 - 2.0 * y1 + y2;
+    if curvature < 0.0 {
+        let offset = 0.5 * (y0 - y2) / curvature;
+        y1 - 0.25 * (y0 - y2) * offset
+    } else {
+        y1
+    }
+}
+
+/// Most jumps of the commanded velocity placed within one period ([`Jumps`]); any more (a
+/// period over a run of segments shorter than an eighth of it) are spread over the period as
+/// before.
+pub(super) const MAX_JUMPS: usize = 8;
+
+/// The jumps of the commanded velocity within one period, where one segment gives way to the
+/// next: each with the share of the period from it to the period's end, and the jump (X, Y,
+/// mm/s).
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Jumps {
+    count: usize,
+    at: [(f64, [f64; 2]); MAX_JUMPS],
+}
+
+impl Jumps {
+    /// None.
+    #[inline]
+    pub(super) fn clear(&mut self) {
+        self.count = 0;
+    }
+
+    /// A jump `dv` a share `before_end` of the period before its end (dropped beyond
+    /// [`MAX_JUMPS`]: the step then spreads it over the period).
+    #[inline]
+    pub(super) fn push(&mut self, before_end: f64, dv: [f64; 2]) {
+        if self.count < MAX_JUMPS && (dv[0] != 0.0 || dv[1] != 0.0) {
+            self.at[self.count] = (before_end, dv);
+            self.count += 1;
+        }
+    }
+
+    fn iter(&self) -> impl Iterator<Item = &(f64, [f64; 2])> {
+        self.at[..self.count].iter()
+    }
+}
+
+/// One step of both axes from the command `prev` to `next`: the velocity between them taken
+/// as linear, apart from `jumps`, each placed where it happens ([`Axes::jump`]).
 #[inline]
 pub(super) fn step_axes(
     axes: &mut Axes,
     prev: &Command,
     next: &Command,
+    jumps: &Jumps,
     ts: f64,
 ) -> Result<(), Error> {
     let v0 = prev.vel.map(|v| v * 1e-3);
-    let a = core::array::from_fn(|ax| (next.vel[ax] - prev.vel[ax]) * 1e-3 / ts);
+    let mut change = core::array::from_fn(|ax| next.vel[ax] - prev.vel[ax]);
+    for (_, dv) in jumps.iter() {
+        change[0] -= dv[0];
+        change[1] -= dv[1];
+    }
+    let a = change.map(|c| c * 1e-3 / ts);
     axes.step(prev.pos.map(|p| p * 1e-3), v0, a)
-        .ok_or_else(model_error)
+        .ok_or_else(model_error)?;
+    for &(before_end, dv) in jumps.iter() {
+        axes.jump(before_end, dv.map(|v| v * 1e-3))
+            .ok_or_else(model_error)?;
+    }
+    Ok(())
 }
 
 /// The table's mean acceleration (X, Y, m/s²) over the `dt` since its velocity was `last_v`,
@@ -330,4 +428,33 @@ pub fn run(
         stream.push(*s, s.layer, progress)?;
     }
     Ok(stream.finish(progress)?.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_peak_between_samples_is_a_ringings_crest_whatever_the_phase() {
+        // A parabola's vertex exactly.
+        let parabola = |x: f64| 3.0 - (x - 0.3) * (x - 0.3);
+        let vertex = peak_between(parabola(-1.0), parabola(0.0), parabola(1.0));
+        assert!((vertex - 3.0).abs() < 1e-12, "{vertex}");
+        // A 50 Hz and a 100 Hz ringing sampled every millisecond at any phase.
+        for (hz, within) in [(50.0, 2.5e-4), (100.0, 3.6e-3)] {
+            let step = 2.0 * std::f64::consts::PI * hz * 1e-3;
+            for k in 0..=100 {
+                let phase = (k as f64 / 100.0 - 0.5) * step;
+                let y = |j: f64| (phase + j * step).cos();
+                let crest = peak_between(y(-1.0), y(0.0), y(1.0));
+                assert!(
+                    (crest - 1.0).abs() < within,
+                    "{hz} Hz, phase {phase}: {crest}"
+                );
+                assert!(crest >= y(0.0));
+            }
+        }
+        // Not a maximum: the sample itself.
+        assert_eq!(peak_between(1.0, 2.0, 3.0), 2.0);
+    }
 }

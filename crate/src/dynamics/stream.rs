@@ -11,8 +11,8 @@ use std::collections::VecDeque;
 use super::axis::Axes;
 use super::parameters::MachineDynamics;
 use super::simulate::{
-    budget, cancelled, step_axes, steps_to_end, still, table_acceleration, too_long, LayerSums,
-    Outcome, Settings,
+    budget, cancelled, peak_between, step_axes, steps_to_end, still, table_acceleration, too_long,
+    Jumps, LayerSums, Outcome, Settings,
 };
 use super::split::{Half, HalfRun};
 use super::timeline::Emit;
@@ -33,6 +33,15 @@ struct Here {
     layer: u32,
     counted: u32,
     extruding: bool,
+}
+
+/// A deviation sample (mm) of a move: at step `k`, X, Y (mm) and time (s), and where.
+#[derive(Clone, Copy)]
+struct Sample {
+    dev: f64,
+    k: u64,
+    at: [f64; 3],
+    here: Here,
 }
 
 /// The stretch of a timeline a run steps through ([`super::split`]): all of it, or one half.
@@ -77,6 +86,12 @@ pub struct Stream<'w> {
     since: u64,
     /// Steps taken or skipped.
     k: u64,
+    /// The jumps of the commanded velocity within the period being stepped.
+    jumps: Jumps,
+    /// The deviation of the step before the last and the last sample, where both were in
+    /// moves: the crest between samples is found from three in a row ([`peak_between`]).
+    before: Option<f64>,
+    last: Option<Sample>,
     /// Motion time pushed, s (what the run costs: rests are skipped).
     motion_s: f64,
     /// The step budget of the most segments the run can have: an upper bound of the final one.
@@ -116,6 +131,9 @@ impl<'w> Stream<'w> {
             last_v: [0.0; 2],
             since: 0,
             k: 0,
+            jumps: Jumps::default(),
+            before: None,
+            last: None,
             motion_s: 0.0,
             most_steps: budget(max_segments),
             total,
@@ -200,14 +218,31 @@ impl<'w> Stream<'w> {
     /// where it is.
     #[inline]
     fn at(&mut self, t: f64) -> (Command, Option<Here>) {
+        self.seek(t);
+        self.trim();
+        self.command_at(t)
+    }
+
+    /// The cursor moved to the segment `t` falls in, or the next one.
+    #[inline]
+    fn seek(&mut self, t: f64) {
         while self.j < self.pushed && self.get(self.j).is_some_and(|s| s.0.end_s() <= t) {
             self.j += 1;
         }
-        // Only the segment before the cursor's is needed again.
+    }
+
+    /// Only the segment before the cursor's is needed again: the ones before it dropped.
+    #[inline]
+    fn trim(&mut self) {
         while self.base + 1 < self.j {
             self.window.pop_front();
             self.base += 1;
         }
+    }
+
+    /// The command at `t`, the cursor at `t` ([`Stream::seek`]).
+    #[inline]
+    fn command_at(&self, t: f64) -> (Command, Option<Here>) {
         match self.get(self.j) {
             Some((s, counted)) if t >= s.start_s => {
                 let here = Here {
@@ -225,6 +260,37 @@ impl<'w> Stream<'w> {
                 (Command { pos, vel: [0.0; 2] }, None)
             }
         }
+    }
+
+    /// The command at `t1`, one period after `t0`, and the jumps of the commanded velocity
+    /// in `(t0, t1]`: where a segment starts, from the velocity the one before it ended at (a
+    /// rest between two moves is reached and left smoothly: the planner stops before it).
+    /// Most periods have none: the cursor stays in a segment that started before `t0`.
+    #[inline]
+    fn step_to(&mut self, t0: f64, t1: f64) -> (Command, Option<Here>) {
+        let from = self.j;
+        self.seek(t1);
+        self.jumps.clear();
+        let starts_within = |s: &(Segment, u32)| s.0.start_s > t0;
+        if self.j != from || self.get(from).is_some_and(starts_within) {
+            for i in from..=self.j {
+                let Some((s, _)) = self.get(i).filter(|s| starts_within(s)) else {
+                    continue;
+                };
+                if s.start_s > t1 {
+                    break;
+                }
+                let after = s.command(0.0).vel;
+                let before = match i.checked_sub(1).and_then(|p| self.get(p)) {
+                    Some((p, _)) => p.command(p.duration_s).vel,
+                    None => [0.0; 2],
+                };
+                let dv = [after[0] - before[0], after[1] - before[1]];
+                self.jumps.push((t1 - s.start_s) / (t1 - t0), dv);
+            }
+        }
+        self.trim();
+        self.command_at(t1)
     }
 
     /// Steps while `k < total` (when given) and their time is before `horizon`.
@@ -246,7 +312,7 @@ impl<'w> Stream<'w> {
                 self.prev = self.at(self.k as f64 * ts).0;
                 self.primed = true;
             }
-            let (next, here) = self.at(t1);
+            let (next, here) = self.step_to(t1 - ts, t1);
             if !self.step(next, here, t1)? {
                 break;
             }
@@ -269,25 +335,35 @@ impl<'w> Stream<'w> {
     #[inline]
     fn step(&mut self, next: Command, here: Option<Here>, t1: f64) -> Result<bool, Error> {
         let ts = self.settings.ts;
-        step_axes(&mut self.axes, &self.prev, &next, ts)?;
+        step_axes(&mut self.axes, &self.prev, &next, &self.jumps, ts)?;
         self.k += 1;
         // A warm-up step is taken, not counted.
         let counting = self.k > self.steps.counted_after;
         self.out.steps += u64::from(counting);
         let (layer, counted) = here.map_or((NO_LAYER, NO_LAYER), |h| (h.layer, h.counted));
-        if let Some(Here { extruding, .. }) = here.filter(|_| counting) {
+        let sample = here.map(|here| {
             let [dx, dy] = self.axes.table();
             let dev = (dx * dx + dy * dy).sqrt() * 1e3;
-            self.out
-                .add_deviation(dev, [next.pos[0], next.pos[1], t1], extruding, layer);
+            let at = [next.pos[0], next.pos[1], t1];
+            Sample {
+                dev,
+                k: self.k,
+                at,
+                here,
+            }
+        });
+        if let Some(s) = sample.filter(|_| counting) {
+            let extruding = s.here.extruding;
+            self.out.add_deviation(s.dev, s.at, extruding, layer);
             if let Some(l) = self
                 .counted
                 .as_mut()
                 .and_then(|c| c.get_mut(counted as usize))
             {
-                l.add_deviation(dev, extruding);
+                l.add_deviation(s.dev, extruding);
             }
         }
+        self.crest(sample);
         self.since += 1;
         let sampling = self
             .welch
@@ -321,6 +397,7 @@ impl<'w> Stream<'w> {
                 self.axes.rest();
                 self.last_v = [0.0; 2];
                 self.since = 0;
+                (self.before, self.last) = (None, None);
                 jumped = true;
             }
         }
@@ -330,6 +407,35 @@ impl<'w> Stream<'w> {
             next
         };
         Ok(true)
+    }
+
+    /// The sample before `next` raised to the crest between its neighbours where it is a local
+    /// maximum of three in a row ([`peak_between`]). The step a second half starts counting
+    /// after is the first half's last, which has no step after it there: its crest is found
+    /// here, from the warm-up's samples, and merged as the larger peak.
+    #[inline]
+    fn crest(&mut self, next: Option<Sample>) {
+        if let (Some(y0), Some(mid), Some(y2)) = (self.before, self.last, next.map(|s| s.dev)) {
+            let counted_here = mid.k >= self.steps.counted_after.max(1);
+            if mid.dev >= y0 && mid.dev > y2 && counted_here {
+                let peak = peak_between(y0, mid.dev, y2);
+                let Here {
+                    layer,
+                    counted,
+                    extruding,
+                } = mid.here;
+                self.out.raise(peak, mid.at, extruding, layer);
+                if let Some(l) = self
+                    .counted
+                    .as_mut()
+                    .and_then(|c| c.get_mut(counted as usize))
+                {
+                    l.raise(peak, extruding);
+                }
+            }
+        }
+        self.before = self.last.map(|s| s.dev);
+        self.last = next;
     }
 
     /// A half started later holds, of the segments before its first step, only the last (as
