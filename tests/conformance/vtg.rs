@@ -343,12 +343,13 @@ fn corpus_second_half_meets_the_criteria() {
 /// eighth layer of a file of 512 kB and 64 layers or more; the race only picks what to write
 /// whole, and on the corpus files that take it the result is what trying each variant whole
 /// gives, byte for byte. The fabtotum file's rewrites are few: the sample cannot judge its
-/// variants, which are then written whole (its 1.5× variant rings 0.01 % less); the other two
-/// ring more whichever variant is written, and get their original back either way.
+/// variants, which are then written whole (its 1.5× variant rings 0.01 % less); the K1 SE
+/// accessory rings more whichever variant is written, and keeps 27 layers as they were either
+/// way. (The CuraEngine puzzle was a third until the model placed each corner's jump of the
+/// commanded velocity where it happens, 2026-11-29: its first rewrite now keeps the rule.)
 #[test]
 fn racing_the_variants_writes_what_trying_each_whole_writes() {
     for name in [
-        "cura-2.3.1_puzzle_reprap",
         "crealityprint-4.3.8_k1se_accessory_m82_arcs_exclude-object",
         "cura-legacy-15.x_fabtotum_socket-screwdriver",
     ] {
@@ -379,9 +380,11 @@ fn racing_the_variants_writes_what_trying_each_whole_writes() {
 
 /// The race ranks the variants on the sample; a sample is not the file, so every variant that
 /// keeps the rule there is written whole in turn, until one keeps it on the whole file. On the
-/// ribbed tube (not tuned on) the first variant passes on the sample and rings more whole; a
+/// ribbed tube (not tuned on) the first variant passed on the sample and rang more whole; a
 /// race that wrote only that one handed the original back, where trying each whole rounds a
-/// quarter of the corners.
+/// quarter of the corners. Since the model places each corner's jump of the commanded velocity
+/// where it happens (2026-11-29) its first rewrite keeps the rule and no variant is raced: the
+/// test now holds the outcome only.
 #[test]
 fn the_race_writes_whole_every_variant_that_passes_on_the_sample() {
     let path = fixtures_dir().join("race/prusaslicer-2.5.0_ribbed_tube_gyroid.gcode");
