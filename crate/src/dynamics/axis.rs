@@ -40,7 +40,7 @@ pub struct Stepper {
 /// Entries of a bucket's table of jump responses over one period ([`jump_responses`]): a
 /// jump's time is placed to 1/128 of a period by linear interpolation between them (at 1 ms
 /// the presets' fastest modes, near 4.8 kHz, turn 0.47 rad between two entries).
-pub const JUMP_STEPS: usize = 64;
+const JUMP_STEPS: usize = 64;
 
 impl Stepper {
     /// One period: `x ← Φ x + Γ [v, a]` (commanded velocity at the start, m/s, and
@@ -308,7 +308,7 @@ impl Axes {
 
     /// A jump `dv` (m/s, X and Y) in the commanded velocities a share `before_end` (0 to 1) of
     /// the period just stepped before its end: its response added to each state
-    /// ([`jump_responses`]). The step itself took the velocity without the jump.
+    /// (tabulated per bucket). The step itself took the velocity without the jump.
     #[inline]
     pub fn jump(&mut self, before_end: f64, dv: [f64; 2]) -> Option<()> {
         for (lane, &dv) in dv.iter().enumerate() {
