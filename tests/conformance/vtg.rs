@@ -384,7 +384,8 @@ fn racing_the_variants_writes_what_trying_each_whole_writes() {
 /// race that wrote only that one handed the original back, where trying each whole rounds a
 /// quarter of the corners. Since the model places each corner's jump of the commanded velocity
 /// where it happens (2026-11-29) its first rewrite keeps the rule and no variant is raced: the
-/// test now holds the outcome only.
+/// test now holds the outcome only, and the race's choice is unit-tested
+/// (`closed_loop::tests::the_race_writes_whole_every_variant_that_passes_on_the_sample_quietest_first`).
 #[test]
 fn the_race_writes_whole_every_variant_that_passes_on_the_sample() {
     let path = fixtures_dir().join("race/prusaslicer-2.5.0_ribbed_tube_gyroid.gcode");

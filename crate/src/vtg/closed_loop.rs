@@ -320,20 +320,26 @@ fn raced(
             ranked.push((quietness(&b, &a), variant));
         }
     }
-    ranked.sort_by(|x, y| x.0 .0.cmp(&y.0 .0).then(x.0 .1.total_cmp(&y.0 .1)));
-    // Written whole, in turn: those that keep the rule on the sample, quietest there first (a
-    // sample is not the file: the first may still ring more whole); where none does, the
-    // quietest if it rings less there than the first rewrite.
-    let first_score = quietness(&b, &first_sampled);
-    let passing: Vec<_> = ranked.iter().filter(|r| r.0 .0 == 0).map(|r| r.1).collect();
-    let best = ranked.first().filter(|r| r.0 < first_score).map(|r| r.1);
-    let chosen = if passing.is_empty() {
-        best.into_iter().collect()
-    } else {
-        passing
-    };
+    let chosen = to_write_whole(ranked, quietness(&b, &first_sampled));
     let whole = (chosen.into_iter().chain(untold), 0.88, 0.01);
     every_variant(first, whole, orig, options, again)
+}
+
+/// The variants a race writes whole, in turn, from their scores on the sample ([`quietness`]):
+/// those that keep the rule there, quietest there first (a sample is not the file: the first
+/// may still ring more whole, and the next be the one that keeps it); where none does, the
+/// quietest if it rings less there than the first rewrite (`first`).
+fn to_write_whole(
+    mut ranked: Vec<((u8, f64), search::Variant)>,
+    first: (u8, f64),
+) -> Vec<search::Variant> {
+    ranked.sort_by(|x, y| x.0 .0.cmp(&y.0 .0).then(x.0 .1.total_cmp(&y.0 .1)));
+    let passing: Vec<_> = ranked.iter().filter(|r| r.0 .0 == 0).map(|r| r.1).collect();
+    if !passing.is_empty() {
+        return passing;
+    }
+    let best = ranked.first().filter(|r| r.0 < first).map(|r| r.1);
+    best.into_iter().collect()
 }
 
 /// Why the original is handed back: the quietest rewrite's deviation `a` against the
@@ -585,6 +591,34 @@ mod tests {
             },
             layers,
         }
+    }
+
+    #[test]
+    fn the_race_writes_whole_every_variant_that_passes_on_the_sample_quietest_first() {
+        let v = |feed_cap_scale: f64| search::Variant {
+            feed_cap_scale,
+            ..search::Variant::default()
+        };
+        // Two pass on the sample (no figure rose), the quieter first; one that raised the peak
+        // is not written while any passes.
+        let ranked = vec![
+            ((1, 0.010), v(1.5)),
+            ((0, 0.014), v(2.0)),
+            ((0, 0.012), v(3.0)),
+        ];
+        let order: Vec<f64> = to_write_whole(ranked, (1, 0.02))
+            .iter()
+            .map(|x| x.feed_cap_scale)
+            .collect();
+        assert_eq!(order, [3.0, 2.0]);
+        // None passes: the quietest alone, where it rings less than the first rewrite did.
+        let ranked = vec![((1, 0.012), v(1.5)), ((2, 0.011), v(2.0))];
+        let chosen = to_write_whole(ranked.clone(), (1, 0.013));
+        assert_eq!(
+            chosen.iter().map(|x| x.feed_cap_scale).collect::<Vec<_>>(),
+            [1.5]
+        );
+        assert!(to_write_whole(ranked, (1, 0.012)).is_empty());
     }
 
     #[test]
