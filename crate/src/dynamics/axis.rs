@@ -37,9 +37,9 @@ pub struct Stepper {
     jumps: Box<[[f64; 12]; JUMP_STEPS + 1]>,
 }
 
-/// Entries of a bucket's table of jump responses over one period ([`jump_responses`]): a
-/// jump's time is placed to 1/128 of a period by linear interpolation between them (at 1 ms
-/// the presets' fastest modes, near 4.8 kHz, turn 0.47 rad between two entries).
+/// Spans of a bucket's table of jump responses over one period ([`jump_responses`]): entries
+/// 1/64 of a period apart, interpolated linearly between (at 1 ms the presets' fastest modes,
+/// near 4.8 kHz, turn 0.47 rad from one entry to the next).
 const JUMP_STEPS: usize = 64;
 
 impl Stepper {
@@ -169,8 +169,8 @@ pub fn stepper(drive: &Drive, position_m: f64, ts: f64) -> Option<Stepper> {
 /// path's commanded velocity jumps at its corners (the junction speed turned through the
 /// corner's angle), an impulse of acceleration that a period's constant acceleration would
 /// spread over the whole period: the ringing it starts then depends on where the corner falls
-/// between two steps (the peak deviation of a layer shifted by a fraction of a millisecond
-/// moved by up to 3 %). The step adds `r(τ) Δv` for each jump instead. `r` follows from one
+/// between two steps (a layer's peak deviation, the layer shifted by a fraction of a
+/// millisecond, moved by up to 8 %). The step adds `r(τ) Δv` for each jump instead. `r` follows from one
 /// discretisation at the table's spacing `h`: `r(τ + h) = Φ(h) r(τ) + Γ_v(h)`, `r(0) = b_a`.
 fn jump_responses(
     a: &DMatrix<f64>,
