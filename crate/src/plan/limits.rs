@@ -320,8 +320,8 @@ impl Limits {
         if let Some(v) = num("VELOCITY") {
             // Klipper's `max_velocity`, the limit of the speed along the path; kept in the X
             // and Y slots (the planner reads it as the vector limit under Klipper's model).
-            for i in 0..2 {
-                set(&mut self.max_feedrate[i], Some(v), src);
+            for limit in &mut self.max_feedrate[..2] {
+                set(limit, Some(v), src);
             }
         }
         if let Some(a) = num("ACCEL") {
