@@ -530,11 +530,11 @@ fn first_stage_not_applied(options: &[&str], file: &Path, stage: &str) -> serde_
     first
 }
 
-/// A file VTG hands back as it was (the corpus ideaMaker plate: rounding any corner would add
+/// A file VTG hands back as it was (the corpus spiral vase: rounding any corner would add
 /// lines): the stage is not applied, and says why in VTG's words.
 #[test]
 fn a_vtg_stage_that_keeps_the_file_says_why() {
-    let file = scratch_copy("vtg-kept", "ideamaker-4.2.0_multi-object.gcode");
+    let file = scratch_copy("vtg-kept", "prusaslicer-2.7.4_spiral-vase.gcode");
     let vtg = first_stage_not_applied(&[], &file, "vtg");
     let why = vtg["message"].as_str().unwrap();
     assert!(why.starts_with("kept the original: "), "{why}");

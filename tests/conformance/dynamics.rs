@@ -173,18 +173,16 @@ fn the_trajectory_built_as_the_planner_times_each_move_is_the_one_from_the_kept_
         let input = file.read();
         let options = quietpath::analyze::AnalyzeOptions::default();
         let path = quietpath::path::extract(&input, &options, true).expect("extract");
-        // The simulation's default step: each layer's first move in X or Y is placed on one.
-        let ts = 1e-3;
-        let kept = trajectory::segments(&path, ts);
+        let kept = trajectory::segments(&path);
         let (streamed, walked) =
-            trajectory::segments_of_file(&input, &options, |_| true, ts).expect("walk");
+            trajectory::segments_of_file(&input, &options, |_| true).expect("walk");
         assert_eq!(walked.moves, path.moves.len(), "{}", file.name);
         assert!(kept.is_some(), "{}: untimed", file.name);
         assert!(streamed == kept, "{}: the trajectories differ", file.name);
         // A sample of the layers, on the whole file's timeline.
         let odd = |layer: u32| layer % 3 == 1;
-        let sample = trajectory::segments_where(&path, odd, ts);
-        let (streamed, _) = trajectory::segments_of_file(&input, &options, odd, ts).expect("walk");
+        let sample = trajectory::segments_where(&path, odd);
+        let (streamed, _) = trajectory::segments_of_file(&input, &options, odd).expect("walk");
         assert!(streamed == sample, "{}: the samples differ", file.name);
     }
 }

@@ -304,7 +304,7 @@ fn simulate_file(
 > {
     let dynamics_for = |name: &str| options.machine_dynamics(name);
     let sim = stream::Simulating::new(dynamics_for, (settings, welch), input, progress);
-    let (sim, timed, file) = timeline::of_file(input, &options.analyze, sim, settings.ts)?;
+    let (sim, timed, file) = timeline::of_file(input, &options.analyze, sim)?;
     if !timed {
         return Err(untimed());
     }
@@ -321,7 +321,7 @@ pub fn vibration_of_path(
     progress: Progress<'_>,
 ) -> Result<VibrationReport, Error> {
     options.validate()?;
-    let segs = planned_segments(path, simulation_settings(options).0.ts)?;
+    let segs = planned_segments(path)?;
     let of = Simulated {
         layers: &path.layers,
         machine: &path.profile.name,
@@ -396,10 +396,9 @@ fn report(
     }
 }
 
-/// The commanded trajectory of a planned path for steps of `period_s`, an error where it has
-/// no timing.
-fn planned_segments(path: &PrintPath, period_s: f64) -> Result<Vec<trajectory::Segment>, Error> {
-    trajectory::segments(path, period_s).ok_or_else(untimed)
+/// The commanded trajectory of a planned path, an error where it has no timing.
+fn planned_segments(path: &PrintPath) -> Result<Vec<trajectory::Segment>, Error> {
+    trajectory::segments(path).ok_or_else(untimed)
 }
 
 /// The error for a path extracted without the planner's timing.

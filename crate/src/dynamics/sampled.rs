@@ -20,11 +20,11 @@ pub fn printing_deviation_in_layers(
 ) -> Result<Deviation, Error> {
     options.validate()?;
     let sampled = |layer: u32| layers.get(layer as usize).copied().unwrap_or(false);
-    let (settings, _) = simulation_settings(options);
-    let (segs, file) = trajectory::segments_of_file(input, &options.analyze, sampled, settings.ts)?;
+    let (segs, file) = trajectory::segments_of_file(input, &options.analyze, sampled)?;
     let segs = segs.ok_or_else(untimed)?;
     let machine = options.machine_dynamics(&file.profile.name)?;
     let runs: Vec<&[Segment]> = segs.chunk_by(|a, b| a.layer == b.layer).collect();
+    let (settings, _) = simulation_settings(options);
     let outcomes = crate::parallel::map_each(&runs, |run| {
         simulate::run(run, 0, &machine, settings, None, &mut |_| true)
     });

@@ -104,7 +104,7 @@ pub(super) fn deviation_run(
         let dynamics_for = |name: &str| options.machine_dynamics(name);
         let mut quiet = |_| true;
         let sim = Simulating::new(dynamics_for, (settings, None), input, &mut quiet).half(half);
-        let (sim, timed, file) = timeline::of_file(input, &options.analyze, sim, settings.ts)?;
+        let (sim, timed, file) = timeline::of_file(input, &options.analyze, sim)?;
         Ok((sim.finish_half()?, timed, file))
     };
     let (second, first) = if crate::parallel::threads() > 1 {

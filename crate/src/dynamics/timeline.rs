@@ -65,15 +65,14 @@ impl<K: Fn(u32) -> bool> Emit for Kept<K> {
     }
 }
 
-/// The segments of `path`'s moves on the layers `keep` accepts, with room for `capacity`, each
-/// layer that starts from rest starting on a step of `period_s` ([`Timeline::put`]); `None`
-/// where a move has no timing.
+/// The segments of `path`'s moves on the layers `keep` accepts, with room for `capacity`;
+/// `None` where a move has no timing.
 pub(super) fn from_path(
     path: &PrintPath,
     keep: impl Fn(u32) -> bool,
-    (capacity, period_s): (usize, f64),
+    capacity: usize,
 ) -> Option<Vec<Segment>> {
-    let mut timeline = Timeline::new(Kept::new(keep, capacity), period_s);
+    let mut timeline = Timeline::new(Kept::new(keep, capacity));
     timeline.latch(&path.print_limits);
     for m in &path.moves {
         if !timeline.place(m, m.timing, (m.layer, m.layer)) {
@@ -84,30 +83,27 @@ pub(super) fn from_path(
 }
 
 /// The segments of `input` on the layers `keep` accepts, with room for `capacity`, built as
-/// the planner times each move on steps of `period_s` (`None` where a move has no timing), and
-/// what the walk learnt.
+/// the planner times each move (`None` where a move has no timing), and what the walk learnt.
 pub(super) fn kept_of_file(
     input: &[u8],
     options: &crate::analyze::AnalyzeOptions,
     keep: impl Fn(u32) -> bool,
-    (capacity, period_s): (usize, f64),
+    capacity: usize,
 ) -> Result<(Option<Vec<Segment>>, Walked), Error> {
-    let (kept, timed, walked) = of_file(input, options, Kept::new(keep, capacity), period_s)?;
+    let (kept, timed, walked) = of_file(input, options, Kept::new(keep, capacity))?;
     let by_markers = matches!(walked.layer_source, crate::read::LayerSource::Markers(_));
     Ok((timed.then(|| kept.finish(by_markers)), walked))
 }
 
 /// `input` read and planned once, its segments emitted into `emit` as the planner times each
-/// move, for a simulation stepping every `period_s` ([`Timeline::put`]). The emitter, whether
-/// every move was timed, and what the walk learnt.
+/// move. The emitter, whether every move was timed, and what the walk learnt.
 pub(super) fn of_file<E: Emit>(
     input: &[u8],
     options: &crate::analyze::AnalyzeOptions,
     emit: E,
-    period_s: f64,
 ) -> Result<(E, bool, Walked), Error> {
     let mut sink = Streamed {
-        timeline: Timeline::new(emit, period_s),
+        timeline: Timeline::new(emit),
         limits: None,
         latched: false,
         waiting: VecDeque::new(),
@@ -144,16 +140,10 @@ struct Timeline<E> {
     xy_feed_limit: f64,
     /// The limits in force when printing, which time homing moves ([`Timeline::homing`]).
     print_limits: Option<Limits>,
-    /// The simulation's step, s: a layer that starts from rest starts on one.
-    period_s: f64,
-    /// The layers (by marker, by counting) of the last segment, and whether the layer has
-    /// had no move in X or Y yet.
-    layers: Option<(u32, u32)>,
-    layer_unmoved: bool,
 }
 
 impl<E: Emit> Timeline<E> {
-    fn new(emit: E, period_s: f64) -> Self {
+    fn new(emit: E) -> Self {
         Timeline {
             emit,
             last: None,
@@ -161,46 +151,6 @@ impl<E: Emit> Timeline<E> {
             planned_end: 0.0,
             xy_feed_limit: f64::NAN,
             print_limits: None,
-            period_s,
-            layers: None,
-            layer_unmoved: false,
-        }
-    }
-
-    /// Where a segment that would start at `start` does start: on the simulation's next step
-    /// where it is the first of its layer to move in X or Y and the table is at rest before it
-    /// (the segment before it does not move it, or stops, and it starts from rest), else at
-    /// `start`. The machine waits for it there, under a step (1 ms by default) at most.
-    ///
-    /// So a layer's moves ring the same whatever the layers before it took, once their ringing
-    /// has died away: a layer kept as it was in a rewrite rings as it did in the original, where
-    /// the steps would otherwise fall on it at another phase (the 34 MB corpus file's loudest
-    /// layer, kept, read 0.001 % above the original's peak; figures in
-    /// `docs/method/dynamics.md`). Nearly every layer starts so: a slicer retracts, lifts or
-    /// unretracts between layers, which moves neither X nor Y.
-    fn aligned(
-        &mut self,
-        start: f64,
-        profile: &Profile,
-        geometry: &super::trajectory::Geometry,
-        layers: (u32, u32),
-    ) -> f64 {
-        if self.layers.is_some_and(|l| l != layers) {
-            self.layer_unmoved = true;
-        }
-        self.layers = Some(layers);
-        if matches!(geometry, super::trajectory::Geometry::Still) || !self.layer_unmoved {
-            return start;
-        }
-        self.layer_unmoved = false;
-        let at_rest = self.last.is_none_or(|s| {
-            matches!(s.geometry, super::trajectory::Geometry::Still)
-                || (s.profile.exit == 0.0 && profile.entry == 0.0)
-        });
-        if at_rest && self.period_s > 0.0 {
-            (start / self.period_s).ceil() * self.period_s
-        } else {
-            start
         }
     }
 
@@ -281,22 +231,19 @@ impl<E: Emit> Timeline<E> {
         self.put(m, start, profile, layers);
     }
 
-    /// Move `m` on the timeline from `start` (or the step after, [`Timeline::aligned`]), run as
-    /// `profile`.
+    /// Move `m` on the timeline from `start`, run as `profile`.
     fn put(&mut self, m: &PathMove, start: f64, profile: Profile, layers: (u32, u32)) {
         let duration = profile.duration();
         if !(duration.is_finite() && duration > 0.0) {
             return;
         }
-        let geometry = geometry(m);
-        let start = self.aligned(start, &profile, &geometry, layers);
         let seg = Segment {
             start_s: start,
             duration_s: duration,
             profile,
             from: [m.from[axis::X], m.from[axis::Y]],
             to: [m.to[axis::X], m.to[axis::Y]],
-            geometry,
+            geometry: geometry(m),
             layer: layers.0,
             extruding: m.is_extruding(),
         };

@@ -123,19 +123,15 @@ pub(super) fn geometry(m: &PathMove) -> Geometry {
 }
 
 /// The timed trajectory of a planned path, or `None` if the path has no planner timing.
-pub fn segments(path: &PrintPath, period_s: f64) -> Option<Vec<Segment>> {
-    super::timeline::from_path(path, |_| true, (path.moves.len(), period_s))
+pub fn segments(path: &PrintPath) -> Option<Vec<Segment>> {
+    super::timeline::from_path(path, |_| true, path.moves.len())
 }
 
 /// The segments of [`segments`] on the layers `keep` accepts (by layer index), on the whole
 /// path's timeline: the trajectory of a sample of the layers without building the rest (a 34 MB
 /// file's whole trajectory takes 190 MB).
-pub fn segments_where(
-    path: &PrintPath,
-    keep: impl Fn(u32) -> bool,
-    period_s: f64,
-) -> Option<Vec<Segment>> {
-    super::timeline::from_path(path, keep, (0, period_s))
+pub fn segments_where(path: &PrintPath, keep: impl Fn(u32) -> bool) -> Option<Vec<Segment>> {
+    super::timeline::from_path(path, keep, 0)
 }
 
 /// The trajectory of `input` read and planned as [`crate::path::extract`] would, on the layers
@@ -147,9 +143,8 @@ pub fn segments_of_file(
     input: &[u8],
     options: &crate::analyze::AnalyzeOptions,
     keep: impl Fn(u32) -> bool,
-    period_s: f64,
 ) -> Result<(Option<Vec<Segment>>, crate::path::Walked), crate::error::Error> {
-    super::timeline::kept_of_file(input, options, keep, (0, period_s))
+    super::timeline::kept_of_file(input, options, keep, 0)
 }
 
 /// Lowest and highest X and Y of a trajectory's segments, mm.
@@ -193,14 +188,11 @@ impl Bounds {
 mod tests {
     use super::*;
 
-    /// The simulation's default step, s.
-    const TS: f64 = 1e-3;
-
     #[test]
     fn a_line_follows_its_trapezoid() {
         let g = b"G21\nG90\nM83\nG1 X0 Y0 F6000\nG1 X30 Y40 E1 F3000\n";
         let path = crate::path::extract(g, &Default::default(), true).unwrap();
-        let segs = segments(&path, TS).unwrap();
+        let segs = segments(&path).unwrap();
         let last = segs.last().unwrap();
         let end = last.command(last.duration_s);
         assert!((end.pos[0] - 30.0).abs() < 1e-9 && (end.pos[1] - 40.0).abs() < 1e-9);
@@ -216,14 +208,11 @@ mod tests {
         let g = b"G21\nG90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2 F600\nG1 X10 Y0 E1 F3000\n\
 ;LAYER_CHANGE\n;Z:0.4\nG3 X0 Y10 I-10 J0 E1 F1200\nG1 X0 Y20 E1\n";
         let path = crate::path::extract(g, &Default::default(), true).unwrap();
-        let whole = segments(&path, TS).unwrap();
+        let whole = segments(&path).unwrap();
         let second: Vec<Segment> = whole.iter().copied().filter(|s| s.layer == 1).collect();
         assert_eq!(second.len(), 2);
         assert!(second[0].profile.entry > 0.0, "{:?}", second[0].profile);
-        assert_eq!(
-            segments_where(&path, |layer| layer == 1, TS).unwrap(),
-            second
-        );
+        assert_eq!(segments_where(&path, |layer| layer == 1).unwrap(), second);
     }
 
     #[test]
@@ -238,8 +227,8 @@ G1 X10 Y0 F6000\nG1 X40 Y40 E1 F3000\nG28 X0\n";
         let home = path.moves.last().unwrap();
         assert!(matches!(home.kind, crate::machine::MoveKind::Home));
         assert!(home.timing.is_none());
-        let whole = segments(&path, TS).unwrap();
-        let (streamed, _) = segments_of_file(g, &options, |_| true, TS).unwrap();
+        let whole = segments(&path).unwrap();
+        let (streamed, _) = segments_of_file(g, &options, |_| true).unwrap();
         assert_eq!(streamed.as_ref(), Some(&whole));
         let (before, last) = (&whole[whole.len() - 2], &whole[whole.len() - 1]);
         assert_eq!((last.from, last.to), ([40.0, 40.0], [0.0, 40.0]));
@@ -257,7 +246,7 @@ G1 X10 Y0 F6000\nG1 X40 Y40 E1 F3000\nG28 X0\n";
     fn an_arc_ends_at_its_end_point() {
         let g = b"G21\nG90\nM83\nG1 X10 Y0 F6000\nG3 X0 Y10 I-10 J0 E1 F1200\n";
         let path = crate::path::extract(g, &Default::default(), true).unwrap();
-        let segs = segments(&path, TS).unwrap();
+        let segs = segments(&path).unwrap();
         let arc = segs.last().unwrap();
         let end = arc.command(arc.duration_s);
         assert!(
@@ -278,18 +267,18 @@ G1 Z0.4\nG1 X0 Y0 E1\nG4 P200\nG1 X5 Y5 E1\n";
         let options = Default::default();
         let path = crate::path::extract(g, &options, true).unwrap();
         assert_eq!(path.print_limits.max_feedrate[axis::X].value, 40.0);
-        let whole = segments(&path, TS).unwrap();
-        let (streamed, walked) = segments_of_file(g, &options, |_| true, TS).unwrap();
+        let whole = segments(&path).unwrap();
+        let (streamed, walked) = segments_of_file(g, &options, |_| true).unwrap();
         assert_eq!(streamed.as_ref(), Some(&whole));
         assert_eq!(walked.moves, path.moves.len());
         // The first arc's 100 mm/s feed is capped by the printing limit (40 mm/s, below the
         // planner's own peak on its firmware segments), not by the 400 mm/s in force there.
         assert!(whole[1].profile.peak < 50.0, "{:?}", whole[1].profile);
         let second = |layer: u32| layer == 1;
-        let sample = segments_where(&path, second, TS).unwrap();
+        let sample = segments_where(&path, second).unwrap();
         assert!(!sample.is_empty() && sample.iter().all(|s| s.layer == 1));
         assert_eq!(
-            segments_of_file(g, &options, second, TS).unwrap().0,
+            segments_of_file(g, &options, second).unwrap().0,
             Some(sample)
         );
     }
