@@ -439,12 +439,13 @@ fn keep_ringing_layers(
 /// The peak: every layer whose printing peak is above the original's file peak (VTG Table 2's
 /// max row). The layer where the original peaked is kept with the layer before it: kept alone,
 /// it starts from the rewritten layer's ringing and reaches above that peak again (on the 34 MB
-/// corpus file 0.011 % above, which cost a round of 3–4 s). A layer kept already that
-/// still rings above it starts from the ringing the rewritten layer before it left (its own
-/// moves are the original's): the nearest layer before it not kept yet is kept instead. The mean: the file's mean deviation is Σ sums /
-/// Σ samples over its layers, so it is at most the original's mean `m` exactly when
-/// Σ (sum − m · samples) ≤ 0. Each layer's
-/// share of that total, rewritten (from `sim`) and as it was (from `original`), says what
+/// corpus file 0.011 % above, which cost a round of 3–4 s). A layer kept already that still
+/// rings above it starts from the ringing the rewritten layer before it left (its own moves are
+/// the original's): the nearest layer before it not kept yet is kept instead.
+///
+/// The mean: the file's mean deviation is Σ sums / Σ samples over its layers, so it is at most
+/// the original's mean `m` exactly when Σ (sum − m · samples) ≤ 0. Each layer's share of that
+/// total, rewritten (from `sim`) and as it was (from `original`), says what
 /// keeping it gives back; the layers that give back most are kept first, until the total is
 /// [`MEAN_MARGIN`] of `m` under zero. A layer that rings less rewritten is never kept for the
 /// mean, so the rest of the file keeps its rounded corners.
