@@ -170,8 +170,9 @@ pub fn stepper(drive: &Drive, position_m: f64, ts: f64) -> Option<Stepper> {
 /// corner's angle), an impulse of acceleration that a period's constant acceleration would
 /// spread over the whole period: the ringing it starts then depends on where the corner falls
 /// between two steps (a layer's peak deviation, the layer shifted by a fraction of a
-/// millisecond, moved by up to 8 %). The step adds `r(τ) Δv` for each jump instead. `r` follows from one
-/// discretisation at the table's spacing `h`: `r(τ + h) = Φ(h) r(τ) + Γ_v(h)`, `r(0) = b_a`.
+/// millisecond, moved by up to 8 %). The step adds `r(τ) Δv` for each jump instead. `r`
+/// follows from one discretisation at the table's spacing `h`:
+/// `r(τ + h) = Φ(h) r(τ) + Γ_v(h)`, `r(0) = b_a`.
 fn jump_responses(
     a: &DMatrix<f64>,
     b_v: &DMatrix<f64>,
