@@ -228,12 +228,7 @@ impl Axis {
     }
 
     fn bucket(&self, position_m: f64) -> usize {
-        let last = self.table.buckets() - 1;
-        if position_m > 0.0 {
-            ((position_m * self.per_bucket) as usize).min(last)
-        } else {
-            0
-        }
+        bucket_of(position_m, self.per_bucket, self.table.buckets() - 1)
     }
 
     /// The stepper for the axis at `position_m`, `None` if the model cannot be discretised.
@@ -297,14 +292,31 @@ impl Axes {
                 self.step_lane(lane, v[lane], a[lane])?;
             }
         }
-        // Every few steps is enough: a state sinks past 1e-200 only slowly, and only a
-        // component that stays subnormal costs time.
-        self.unflushed += 1;
-        if self.unflushed >= FLUSH_EVERY {
-            flush_to_zero(self.z.as_flattened_mut());
-            self.unflushed = 0;
-        }
+        count_to_flush(&mut self.z, &mut self.unflushed);
         Some(())
+    }
+
+    /// Both axes' modal pair taken out for a run of steps ([`PairRun`]), where both current
+    /// buckets have a modal form; [`Axes::end_run`] puts it back.
+    #[inline]
+    pub fn pair_run(&self) -> Option<PairRun<'_>> {
+        if !self.both_modal {
+            return None;
+        }
+        let bucket = |a: &Axis| (a.per_bucket, a.table.buckets() - 1, a.current);
+        Some(PairRun {
+            pair: &self.pair,
+            z: self.z,
+            unflushed: self.unflushed,
+            buckets: [bucket(&self.axes[0]), bucket(&self.axes[1])],
+        })
+    }
+
+    /// The state a [`PairRun`] stepped to, back in the axes.
+    #[inline]
+    pub fn end_run(&mut self, (z, unflushed): ([[f64; 2]; 12], u32)) {
+        self.z = z;
+        self.unflushed = unflushed;
     }
 
     /// A jump `dv` (m/s, X and Y) in the commanded velocities a share `before_end` (0 to 1) of
@@ -393,6 +405,76 @@ impl Axes {
     /// Brings both axes to rest.
     pub fn rest(&mut self) {
         self.z = [[0.0; 2]; 12];
+    }
+}
+
+/// A run of steps of both axes as one modal pair, their state held apart from [`Axes`] (in
+/// registers: a step then reads no memory but the coefficients). Each step is [`Axes::step`]'s
+/// for positions in the buckets the axes are in ([`PairRun::in_buckets`]), operation for
+/// operation.
+#[derive(Debug)]
+pub struct PairRun<'a> {
+    pair: &'a ModalPair,
+    z: [[f64; 2]; 12],
+    unflushed: u32,
+    /// Each axis's `1 / bucket_m`, last bucket and current bucket.
+    buckets: [(f64, usize, usize); 2],
+}
+
+impl PairRun<'_> {
+    /// Whether the nuts at `position_m` are in the buckets the axes are in.
+    #[inline]
+    pub fn in_buckets(&self, position_m: [f64; 2]) -> bool {
+        (self.buckets.iter().zip(position_m))
+            .all(|(&(per_bucket, last, current), p)| bucket_of(p, per_bucket, last) == current)
+    }
+
+    /// One period: [`Axes::step`].
+    #[inline]
+    pub fn step(&mut self, v: [f64; 2], a: [f64; 2]) {
+        self.pair.step(&mut self.z, v, a);
+        count_to_flush(&mut self.z, &mut self.unflushed);
+    }
+
+    /// The tables' deviations and deviation velocities: [`Axes::table`],
+    /// [`Axes::table_velocity`].
+    #[inline]
+    pub fn table(&self) -> [f64; 2] {
+        self.pair.physical_rows(&self.z, 0)
+    }
+
+    /// See [`PairRun::table`].
+    #[inline]
+    pub fn table_velocity(&self) -> [f64; 2] {
+        self.pair.physical_rows(&self.z, 1)
+    }
+
+    /// The state and flush count to put back ([`Axes::end_run`]).
+    #[inline]
+    pub fn done(self) -> ([[f64; 2]; 12], u32) {
+        (self.z, self.unflushed)
+    }
+}
+
+/// The bucket of a nut at `position_m`, `per_bucket` buckets a metre, the last `last`.
+#[inline]
+fn bucket_of(position_m: f64, per_bucket: f64, last: usize) -> usize {
+    if position_m > 0.0 {
+        ((position_m * per_bucket) as usize).min(last)
+    } else {
+        0
+    }
+}
+
+/// A step taken: every [`FLUSH_EVERY`] of them the states `z` flushed to zero. Every few steps
+/// is enough: a state sinks past 1e-200 only slowly, and only a component that stays
+/// subnormal costs time.
+#[inline]
+fn count_to_flush(z: &mut [[f64; 2]; 12], unflushed: &mut u32) {
+    *unflushed += 1;
+    if *unflushed >= FLUSH_EVERY {
+        flush_to_zero(z.as_flattened_mut());
+        *unflushed = 0;
     }
 }
 

@@ -51,7 +51,7 @@ impl Default for Stats {
 }
 
 impl Stats {
-    #[inline]
+    #[inline(always)]
     fn add(&mut self, v: f64) {
         self.count += 1;
         self.sum += v;
@@ -108,7 +108,7 @@ pub struct LayerSums {
 
 impl LayerSums {
     /// A deviation sample `dev` (mm), taken while extruding or not.
-    #[inline]
+    #[inline(always)]
     pub(super) fn add_deviation(&mut self, dev: f64, extruding: bool) {
         self.deviation.add(dev);
         if extruding {
@@ -177,38 +177,22 @@ impl Outcome {
         }
     }
 
-    /// A deviation sample `dev` (mm) at X, Y (mm) and time `at`, in layer `layer`.
+    /// The accumulators the deviation samples of one segment go to (in layer `layer`, while
+    /// extruding or not), with `counted`, its layer's sums by counting, where kept: found once
+    /// for the segment.
     #[inline]
-    pub(super) fn add_deviation(&mut self, dev: f64, at: [f64; 3], extruding: bool, layer: u32) {
-        if dev > self.deviation.max || self.deviation.count == 0 {
-            self.max_at = at;
-        }
-        self.deviation.add(dev);
-        if extruding {
-            if dev > self.printing.max || self.printing.count == 0 {
-                self.printing_max_at = at;
-            }
-            self.printing.add(dev);
-        }
-        if let Some(l) = self.layers.get_mut(layer as usize) {
-            l.add_deviation(dev, extruding);
-        }
-    }
-
-    /// A peak `dev` (mm) met between samples near X, Y (mm) and time `at`, in layer `layer`.
-    pub(super) fn raise(&mut self, dev: f64, at: [f64; 3], extruding: bool, layer: u32) {
-        if dev > self.deviation.max {
-            self.max_at = at;
-        }
-        self.deviation.raise(dev);
-        if extruding {
-            if dev > self.printing.max {
-                self.printing_max_at = at;
-            }
-            self.printing.raise(dev);
-        }
-        if let Some(l) = self.layers.get_mut(layer as usize) {
-            l.raise(dev, extruding);
+    pub(super) fn segment_sums<'a>(
+        &'a mut self,
+        layer: u32,
+        extruding: bool,
+        counted: Option<&'a mut LayerSums>,
+    ) -> SegmentSums<'a> {
+        SegmentSums {
+            deviation: (&mut self.deviation, &mut self.max_at),
+            printing: extruding.then_some((&mut self.printing, &mut self.printing_max_at)),
+            layer: self.layers.get_mut(layer as usize),
+            counted,
+            extruding,
         }
     }
 
@@ -238,6 +222,209 @@ impl Outcome {
         merge_layers(&mut self.layers, &later.layers);
         self.steps += later.steps;
         self.simulated_s += later.simulated_s;
+    }
+}
+
+/// The accumulators of one segment's deviation samples ([`Outcome::segment_sums`]): each
+/// sample and crest goes to the same sums, in the same order, as through [`Outcome`]'s own
+/// methods and the counted layer's.
+pub(super) struct SegmentSums<'a> {
+    deviation: (&'a mut Stats, &'a mut [f64; 3]),
+    /// Where the segment extrudes.
+    printing: Option<(&'a mut Stats, &'a mut [f64; 3])>,
+    layer: Option<&'a mut LayerSums>,
+    counted: Option<&'a mut LayerSums>,
+    extruding: bool,
+}
+
+impl SegmentSums<'_> {
+    /// The least of the largest of every accumulator the samples go to.
+    #[inline]
+    fn lowest_max(&self) -> f64 {
+        let file = [
+            Some(&*self.deviation.0),
+            self.printing.as_ref().map(|p| &*p.0),
+        ];
+        let layers = [self.layer.as_deref(), self.counted.as_deref()]
+            .map(|l| l.map(|l| [Some(&l.deviation), self.extruding.then_some(&l.printing)]));
+        (file
+            .into_iter()
+            .chain(layers.into_iter().flatten().flatten()))
+        .flatten()
+        .map(|s| s.max)
+        .fold(f64::INFINITY, f64::min)
+    }
+
+    /// A deviation sample `dev` (mm) at X, Y (mm) and time `at`: counted, summed, and the
+    /// largest where it is the largest yet (or the first).
+    #[inline(always)]
+    pub(super) fn add(&mut self, dev: f64, at: [f64; 3]) {
+        let (stats, max_at) = &mut self.deviation;
+        if dev > stats.max || stats.count == 0 {
+            **max_at = at;
+        }
+        stats.add(dev);
+        if let Some((stats, max_at)) = &mut self.printing {
+            if dev > stats.max || stats.count == 0 {
+                **max_at = at;
+            }
+            stats.add(dev);
+        }
+        if let Some(l) = &mut self.layer {
+            l.add_deviation(dev, self.extruding);
+        }
+        if let Some(l) = &mut self.counted {
+            l.add_deviation(dev, self.extruding);
+        }
+    }
+
+    /// The samples `devs[i]` at `ats[i]` for `i` in `range` (from 2 on), each added where
+    /// `counting`, then the crest of the sample before it between its neighbours where that
+    /// is a local maximum and `crest_counts(i)`: [`SegmentSums::add`] and [`SegmentSums::raise`]
+    /// in that order, sample by sample, with the same results to the bit (a test in `stream`
+    /// checks it). The sums are run in locals ([`Running`]), each accumulator's samples in the
+    /// same order as one by one, the counts added once, and the smallest and largest, which do
+    /// not depend on the order, taken once over the run.
+    #[inline]
+    pub(super) fn record(
+        &mut self,
+        (devs, ats): (&[f64], &[[f64; 3]]),
+        range: std::ops::Range<usize>,
+        counting: bool,
+        crest_counts: impl Fn(usize) -> bool,
+    ) {
+        let mut r = Running::of(self);
+        for i in range {
+            let dev = devs[i];
+            if counting {
+                for s in r.sums.iter_mut() {
+                    *s += dev;
+                }
+                if dev > r.most || r.empty {
+                    for (max, at) in r.best.iter_mut().flatten() {
+                        if dev > *max || r.empty {
+                            *at = ats[i];
+                        }
+                        *max = max.max(dev);
+                    }
+                    r.empty = false;
+                    r.most = r.most.max(dev);
+                }
+                // A comparison, not `f64::min` (which also weighs NaN, in five instructions
+                // where two do): the same for every sample, none of which is NaN where the
+                // accumulators are not.
+                if dev < r.least {
+                    r.least = dev;
+                }
+                r.added += 1;
+            }
+            // The crest is found for every sample, without a branch (where three samples make
+            // a local maximum is a coin toss to the branch predictor), and raised only where
+            // it is one and above every accumulator's largest.
+            let (y0, mid, y2) = (devs[i - 2], devs[i - 1], dev);
+            let peak = peak_between(y0, mid, y2);
+            if (mid >= y0) & (mid > y2) & (peak > r.most) && crest_counts(i) {
+                for (max, at) in r.best.iter_mut().flatten() {
+                    if peak > *max {
+                        *at = ats[i - 1];
+                    }
+                    *max = max.max(peak);
+                }
+                r.most = peak;
+            }
+        }
+        r.fold_into(self);
+    }
+
+    /// A crest `dev` (mm) met between samples near `at` ([`peak_between`]): the largest where
+    /// it is above it; the count and the sums stay those of the samples.
+    #[inline]
+    pub(super) fn raise(&mut self, dev: f64, at: [f64; 3]) {
+        let (stats, max_at) = &mut self.deviation;
+        if dev > stats.max {
+            **max_at = at;
+        }
+        stats.raise(dev);
+        if let Some((stats, max_at)) = &mut self.printing {
+            if dev > stats.max {
+                **max_at = at;
+            }
+            stats.raise(dev);
+        }
+        if let Some(l) = &mut self.layer {
+            l.raise(dev, self.extruding);
+        }
+        if let Some(l) = &mut self.counted {
+            l.raise(dev, self.extruding);
+        }
+    }
+}
+
+/// What [`SegmentSums::record`] keeps while it runs through its samples.
+struct Running {
+    /// The sums of the file's deviation and printing figures, the layer's and the counted
+    /// layer's (those not kept are summed and dropped).
+    sums: [f64; 6],
+    /// The largest so far of the file's two figures and where it was (what `add` and `raise`
+    /// compare with), and whether the file has no sample yet.
+    best: [Option<(f64, [f64; 3])>; 2],
+    empty: bool,
+    /// The run's smallest sample.
+    least: f64,
+    /// The largest of the run's samples and crests, from the least of the largest of every
+    /// accumulator they go to: none of them is below it, so a sample or crest no larger leaves
+    /// them all as they are and is passed over with one comparison (most are).
+    most: f64,
+    added: u64,
+}
+
+impl Running {
+    /// Starting from the accumulators of `sums`.
+    #[inline]
+    fn of(sums: &SegmentSums<'_>) -> Self {
+        let sums_of = |l: &Option<&mut LayerSums>| {
+            l.as_ref()
+                .map_or([0.0; 2], |l| [l.deviation.sum, l.printing.sum])
+        };
+        let printing = sums.printing.as_ref().map_or(0.0, |p| p.0.sum);
+        let [ld, lp] = sums_of(&sums.layer);
+        let [cd, cp] = sums_of(&sums.counted);
+        Running {
+            sums: [sums.deviation.0.sum, printing, ld, lp, cd, cp],
+            best: [Some(&sums.deviation), sums.printing.as_ref()]
+                .map(|t| t.map(|(stats, at)| (stats.max, **at))),
+            empty: sums.deviation.0.count == 0,
+            least: f64::INFINITY,
+            most: sums.lowest_max(),
+            added: 0,
+        }
+    }
+
+    /// The run's figures into the accumulators of `sums`.
+    #[inline]
+    fn fold_into(self, sums: &mut SegmentSums<'_>) {
+        let fold = |stats: &mut Stats, sum: f64| {
+            stats.count += self.added;
+            stats.sum = sum;
+            stats.min = stats.min.min(self.least);
+            stats.max = stats.max.max(self.most);
+        };
+        let [sd, sp, ld, lp, cd, cp] = self.sums;
+        fold(sums.deviation.0, sd);
+        *sums.deviation.1 = self.best[0].map_or(*sums.deviation.1, |b| b.1);
+        if let (Some((stats, at)), Some(b)) = (&mut sums.printing, self.best[1]) {
+            fold(stats, sp);
+            **at = b.1;
+        }
+        let extruding = sums.extruding;
+        for (l, [d, p]) in [(&mut sums.layer, [ld, lp]), (&mut sums.counted, [cd, cp])] {
+            if let Some(l) = l {
+                fold(&mut l.deviation, d);
+                if extruding {
+                    fold(&mut l.printing, p);
+                }
+            }
+        }
     }
 }
 
@@ -334,16 +521,15 @@ pub(super) fn step_axes(
 }
 
 /// The table's mean acceleration (X, Y, m/s²) over the `dt` since its velocity was `last_v`,
-/// which becomes its velocity now.
+/// which becomes its velocity now (`table`: its deviation velocity now, m/s).
 #[inline]
 pub(super) fn table_acceleration(
     next: &Command,
-    axes: &Axes,
+    table: [f64; 2],
     last_v: &mut [f64; 2],
     dt: f64,
 ) -> [f64; 2] {
     let mut acc = [0.0; 2];
-    let table = axes.table_velocity();
     for ax in 0..2 {
         let v = next.vel[ax] * 1e-3 + table[ax];
         acc[ax] = (v - last_v[ax]) / dt;

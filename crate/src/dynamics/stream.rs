@@ -12,7 +12,7 @@ use super::axis::Axes;
 use super::parameters::MachineDynamics;
 use super::simulate::{
     budget, cancelled, peak_between, step_axes, steps_to_end, still, table_acceleration, too_long,
-    Jumps, LayerSums, Outcome, Settings,
+    Jumps, LayerSums, Outcome, SegmentSums, Settings,
 };
 use super::split::{Half, HalfRun};
 use super::timeline::Emit;
@@ -22,6 +22,30 @@ use crate::error::Error;
 use crate::path::NO_LAYER;
 use crate::plan::MachineProfile;
 use crate::progress::Progress;
+
+/// Most steps [`Stream::run_within`] takes at once.
+const RUN: usize = 64;
+
+/// The samples of a run of [`Stream::run_within`], kept with the stream so that a run does not
+/// clear them first: the deviation (mm), X, Y (mm) and time of each step, and the table's
+/// acceleration where the spectrum samples it.
+struct RunBuffer {
+    devs: [f64; RUN],
+    ats: [[f64; 3]; RUN],
+    sampled: [bool; RUN],
+    accs: [[f64; 2]; RUN],
+}
+
+impl Default for RunBuffer {
+    fn default() -> Self {
+        RunBuffer {
+            devs: [0.0; RUN],
+            ats: [[0.0; 3]; RUN],
+            sampled: [false; RUN],
+            accs: [[0.0; 2]; RUN],
+        }
+    }
+}
 
 /// Steps between two progress callbacks.
 const PROGRESS_STEPS: u64 = 1 << 20;
@@ -102,6 +126,24 @@ pub struct Stream<'w> {
     /// The stretch stepped through, and whether `prev` is set for its first step.
     steps: Steps,
     primed: bool,
+    buffer: Option<Box<RunBuffer>>,
+    /// Whether steps may be taken in runs ([`Stream::run_within`]); tests take them one by one
+    /// too, to check that both give the same bits.
+    runs: bool,
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Streams made on this thread step one step at a time (no [`Stream::run_within`]).
+    static STEPWISE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Whether streams take steps in runs: always, but in tests that ask otherwise.
+fn in_runs() -> bool {
+    #[cfg(test)]
+    return !STEPWISE.with(|s| s.get());
+    #[cfg(not(test))]
+    true
 }
 
 impl<'w> Stream<'w> {
@@ -140,6 +182,8 @@ impl<'w> Stream<'w> {
             next_progress: PROGRESS_STEPS,
             steps: Steps::default(),
             primed: true,
+            buffer: Some(Box::default()),
+            runs: in_runs(),
         }
     }
 
@@ -312,9 +356,11 @@ impl<'w> Stream<'w> {
                 self.prev = self.at(self.k as f64 * ts).0;
                 self.primed = true;
             }
-            let (next, here) = self.step_to(t1 - ts, t1);
-            if !self.step(next, here, t1)? {
-                break;
+            if !self.run_within(total, horizon) {
+                let (next, here) = self.step_to(t1 - ts, t1);
+                if !self.step(next, here, t1)? {
+                    break;
+                }
             }
             if self.out.steps as f64 > 2.0 * self.most_steps {
                 // Rests that never settle (an undamped mode excited): still bounded.
@@ -328,6 +374,178 @@ impl<'w> Stream<'w> {
             }
         }
         Ok(())
+    }
+
+    /// Up to [`RUN`] steps inside the cursor's segment at once, where nothing but the step
+    /// changes between them: no segment starts or ends within them, both axes step as one modal
+    /// pair in the buckets they are in ([`PairRun`]), and whether they are counted stays the
+    /// same. The steps are taken first and their samples recorded after, each accumulator
+    /// seeing the same samples in the same order as [`Stream::step`] would give them: the same
+    /// bits, the stepping a loop of its own whose state stays in registers. `false` where no
+    /// step could be taken so.
+    #[inline]
+    fn run_within(&mut self, total: Option<u64>, horizon: f64) -> bool {
+        if !self.runs {
+            return false;
+        }
+        let ts = self.settings.ts;
+        let Some(&(seg, counted)) = self.get(self.j) else {
+            return false;
+        };
+        if seg.start_s > self.k as f64 * ts {
+            return false;
+        }
+        let counting = self.k >= self.steps.counted_after;
+        let mut last = total
+            .unwrap_or(u64::MAX)
+            .min(self.steps.until.unwrap_or(u64::MAX));
+        if !counting {
+            last = last.min(self.steps.counted_after);
+        }
+        let Some(mut run) = self.axes.pair_run() else {
+            return false;
+        };
+        let end = seg.end_s();
+        let k0 = self.k;
+        // Taken out while the run records its samples, which borrows the stream.
+        let mut buffer = self.buffer.take().unwrap_or_default();
+        let RunBuffer {
+            devs,
+            ats,
+            sampled,
+            accs,
+        } = &mut *buffer;
+        let (mut since, mut last_v) = (self.since, self.last_v);
+        let decimation = (self.welch.is_some() && counting).then_some(self.settings.decimation);
+        let mut n = 0;
+        let mut prev = self.prev;
+        while n < RUN && k0 + (n as u64) < last {
+            let t1 = (k0 + n as u64 + 1) as f64 * ts;
+            if !(t1 < end && t1 < horizon && run.in_buckets(prev.pos.map(|p| p * 1e-3))) {
+                break;
+            }
+            let next = seg.command(t1 - seg.start_s);
+            let v0 = prev.vel.map(|v| v * 1e-3);
+            let change: [f64; 2] = core::array::from_fn(|ax| next.vel[ax] - prev.vel[ax]);
+            run.step(v0, change.map(|c| c * 1e-3 / ts));
+            let [dx, dy] = run.table();
+            // Squared here, the root taken for the whole run after it ([`Stream::record_run`]).
+            devs[n] = dx * dx + dy * dy;
+            ats[n] = [next.pos[0], next.pos[1], t1];
+            since += 1;
+            if decimation.is_some_and(|d| since >= d) {
+                let dt = since as f64 * ts;
+                let table = run.table_velocity();
+                accs[n] = table_acceleration(&next, table, &mut last_v, dt);
+                sampled[n] = true;
+                since = 0;
+            } else {
+                sampled[n] = false;
+            }
+            prev = next;
+            n += 1;
+        }
+        self.axes.end_run(run.done());
+        if n > 0 {
+            for d in &mut buffer.devs[..n] {
+                *d = d.sqrt() * 1e3;
+            }
+            self.record_run(n, &buffer, (prev, since, last_v), (seg, counted, counting));
+        }
+        self.buffer = Some(buffer);
+        n > 0
+    }
+
+    /// The `n` steps [`Stream::run_within`] took in segment `seg` (`counted`: its layer by
+    /// counting), their samples in `buffer`, recorded; `prev`, `since` and `last_v` as the
+    /// last step left them.
+    #[inline]
+    fn record_run(
+        &mut self,
+        n: usize,
+        buffer: &RunBuffer,
+        (prev, since, last_v): (Command, u64, [f64; 2]),
+        (seg, counted, counting): (Segment, u32, bool),
+    ) {
+        let RunBuffer {
+            devs,
+            ats,
+            sampled,
+            accs,
+        } = buffer;
+        let k0 = self.k;
+        (self.k, self.prev, self.since, self.last_v) = (k0 + n as u64, prev, since, last_v);
+        self.out.steps += if counting { n as u64 } else { 0 };
+        let here = Here {
+            layer: seg.layer,
+            counted,
+            extruding: seg.extruding,
+        };
+        let sample = |i: usize| Sample {
+            dev: devs[i],
+            k: k0 + 1 + i as u64,
+            at: ats[i],
+            here,
+        };
+        // The first two samples' crests look back at samples before the run.
+        let head = n.min(2);
+        for i in 0..head {
+            if counting {
+                self.sums(here).add(devs[i], ats[i]);
+            }
+            self.crest(Some(sample(i)));
+            if sampled[i] {
+                self.sample_acceleration(&accs[i], here.layer, counted);
+            }
+        }
+        if n > head {
+            self.record_rest(head..n, (devs, ats), (sampled, accs), (here, k0, counting));
+            (self.before, self.last) = (Some(devs[n - 2]), Some(sample(n - 1)));
+        }
+    }
+
+    /// The accumulators of the samples of a segment `here`.
+    #[inline]
+    fn sums(&mut self, here: Here) -> SegmentSums<'_> {
+        let counted = (self.counted.as_mut()).and_then(|c| c.get_mut(here.counted as usize));
+        self.out.segment_sums(here.layer, here.extruding, counted)
+    }
+
+    /// Samples `range` (from the third on) of a run of [`Stream::run_within`], with their
+    /// crests (the sample before each, between its neighbours: [`Stream::crest`]) and
+    /// acceleration samples, each as [`Stream::step`] records it.
+    #[inline]
+    fn record_rest(
+        &mut self,
+        range: std::ops::Range<usize>,
+        (devs, ats): (&[f64; RUN], &[[f64; 3]; RUN]),
+        (sampled, accs): (&[bool; RUN], &[[f64; 2]; RUN]),
+        (here, k0, counting): (Here, u64, bool),
+    ) {
+        let counted_after = self.steps.counted_after.max(1);
+        let crest_counts = |i: usize| k0 + i as u64 >= counted_after;
+        (self.sums(here)).record((devs, ats), range.clone(), counting, crest_counts);
+        // The spectrum's and the layers' acceleration sums are apart from the deviation's.
+        for i in range.filter(|&i| sampled[i]) {
+            self.sample_acceleration(&accs[i], here.layer, here.counted);
+        }
+    }
+
+    /// An acceleration sample `acc` of the table (X, Y, m/s²) in the layers `layer` (by
+    /// marker) and `counted`, into the spectrum and the layers' sums.
+    #[inline]
+    fn sample_acceleration(&mut self, acc: &[f64; 2], layer: u32, counted: u32) {
+        if let Some(welch) = self.welch.as_deref_mut() {
+            welch.push(acc);
+        }
+        self.out.add_acceleration(acc, layer);
+        if let Some(l) = self
+            .counted
+            .as_mut()
+            .and_then(|c| c.get_mut(counted as usize))
+        {
+            l.add_acceleration(acc);
+        }
     }
 
     /// One step to the command `next` at `t1`, in segment `seg`; `false` where the machine is
@@ -353,15 +571,7 @@ impl<'w> Stream<'w> {
             }
         });
         if let Some(s) = sample.filter(|_| counting) {
-            let extruding = s.here.extruding;
-            self.out.add_deviation(s.dev, s.at, extruding, layer);
-            if let Some(l) = self
-                .counted
-                .as_mut()
-                .and_then(|c| c.get_mut(counted as usize))
-            {
-                l.add_deviation(s.dev, extruding);
-            }
+            self.sums(s.here).add(s.dev, s.at);
         }
         self.crest(sample);
         self.since += 1;
@@ -369,18 +579,11 @@ impl<'w> Stream<'w> {
             .welch
             .as_deref_mut()
             .filter(|_| counting && self.since >= self.settings.decimation);
-        if let Some(welch) = sampling {
+        if sampling.is_some() {
             let dt = self.since as f64 * ts;
-            let acc = table_acceleration(&next, &self.axes, &mut self.last_v, dt);
-            welch.push(&acc);
-            self.out.add_acceleration(&acc, layer);
-            if let Some(l) = self
-                .counted
-                .as_mut()
-                .and_then(|c| c.get_mut(counted as usize))
-            {
-                l.add_acceleration(&acc);
-            }
+            let table = self.axes.table_velocity();
+            let acc = table_acceleration(&next, table, &mut self.last_v, dt);
+            self.sample_acceleration(&acc, layer, counted);
             self.since = 0;
         }
         let mut jumped = false;
@@ -419,19 +622,7 @@ impl<'w> Stream<'w> {
             let counted_here = mid.k >= self.steps.counted_after.max(1);
             if mid.dev >= y0 && mid.dev > y2 && counted_here {
                 let peak = peak_between(y0, mid.dev, y2);
-                let Here {
-                    layer,
-                    counted,
-                    extruding,
-                } = mid.here;
-                self.out.raise(peak, mid.at, extruding, layer);
-                if let Some(l) = self
-                    .counted
-                    .as_mut()
-                    .and_then(|c| c.get_mut(counted as usize))
-                {
-                    l.raise(peak, extruding);
-                }
+                self.sums(mid.here).raise(peak, mid.at);
             }
         }
         self.before = self.last.map(|s| s.dev);
@@ -647,6 +838,90 @@ impl<F: FnOnce(&str) -> Result<MachineDynamics, Error>> Emit for Simulating<'_, 
                 self.machine = Some(machine);
             }
             Err(e) => self.error = Some(e),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::trajectory;
+
+    /// Three layers of lines and arcs, travels between, a dwell and a stop.
+    const PART: &[u8] = b"G21\nG90\nM83\n;LAYER_CHANGE\n;Z:0.2\nG1 Z0.2 F600\nG1 X30 Y30 F6000\n\
+G1 X60 Y30 E1 F2400\nG2 X70 Y40 I0 J10 E0.5\nG1 X70 Y70 E1\nG3 X40 Y70 I-15 J0 E1\n\
+G1 X30 Y31 E1\nG1 X31 Y30 E0.1\n;LAYER_CHANGE\n;Z:0.4\nG1 Z0.4\nG4 P1500\n\
+G1 X120 Y100 F9000\nG1 X140 Y100 E1 F1800\nG1 X140 Y101 E0.1\nG1 X120 Y101 E1\n\
+G2 X120 Y121 I0 J10 E1.5\n;LAYER_CHANGE\n;Z:0.6\nG1 Z0.6\nG1 X10 Y10 F9000\n\
+G1 X200 Y12 E9 F4800\nG1 X200 Y40 E1\nG1 X10 Y40 E9\n";
+
+    /// `segs` simulated through `steps`, one step at a time or in runs, with a spectrum.
+    fn simulated(segs: &[Segment], steps: Steps, stepwise: bool) -> (Outcome, Vec<f64>) {
+        STEPWISE.with(|s| s.set(stepwise));
+        let machine = MachineDynamics::preset("desktop-belt").unwrap();
+        let settings = Settings {
+            ts: 1e-3,
+            decimation: 5,
+            bucket_m: 5e-3,
+        };
+        let mut welch = Welch::new(64, 200.0, crate::dynamics::Window::Hamming, 2);
+        let layers = (segs.iter().filter(|s| s.layer != NO_LAYER)).map(|s| s.layer as usize + 1);
+        let sizes = (Some(layers.max().unwrap_or(0)), segs.len(), None);
+        let mut stream = Stream::new(&machine, settings, Some(&mut welch), sizes).stepping(steps);
+        for s in segs {
+            stream.push(*s, s.layer, &mut |_| true).unwrap();
+        }
+        let (out, _) = stream.finish(&mut |_| true).unwrap();
+        STEPWISE.with(|s| s.set(false));
+        (out, welch.finish().power)
+    }
+
+    /// Both ways of stepping through `steps` of `segs` give the same outcome and spectrum.
+    fn same_both_ways(segs: &[Segment], steps: Steps) {
+        let (runs, runs_psd) = simulated(segs, steps, false);
+        let (one_by_one, psd) = simulated(segs, steps, true);
+        assert!(
+            runs.deviation.count > 1000,
+            "{steps:?}: {:?}",
+            runs.deviation
+        );
+        assert_eq!(runs.deviation, one_by_one.deviation, "{steps:?}");
+        assert_eq!(runs.printing, one_by_one.printing, "{steps:?}");
+        assert_eq!(runs.max_at, one_by_one.max_at, "{steps:?}");
+        assert_eq!(
+            runs.printing_max_at, one_by_one.printing_max_at,
+            "{steps:?}"
+        );
+        assert_eq!(runs.layers, one_by_one.layers, "{steps:?}");
+        assert_eq!(runs.steps, one_by_one.steps, "{steps:?}");
+        assert_eq!(runs_psd, psd, "{steps:?}");
+    }
+
+    #[test]
+    fn steps_taken_in_runs_give_the_bits_of_steps_taken_one_by_one() {
+        // The playground's demo: a PrusaSlicer part of 20 minutes.
+        let demo = include_bytes!("../../../www/demo/demo.gcode");
+        let path = crate::path::extract(demo, &Default::default(), true).unwrap();
+        same_both_ways(&trajectory::segments(&path).unwrap(), Steps::default());
+        let path = crate::path::extract(PART, &Default::default(), true).unwrap();
+        let segs = trajectory::segments(&path).unwrap();
+        let end = segs.last().unwrap().end_s();
+        let at = |share: f64| (end * share / 1e-3) as u64;
+        let stretches = [
+            Steps::default(),
+            // A first half, and a second one warmed up over a layer before it counts.
+            Steps {
+                until: Some(at(0.6)),
+                ..Steps::default()
+            },
+            Steps {
+                from: at(0.2),
+                until: None,
+                counted_after: at(0.6),
+            },
+        ];
+        for steps in stretches {
+            same_both_ways(&segs, steps);
         }
     }
 }

@@ -63,11 +63,13 @@ pub struct Command {
 
 impl Segment {
     /// Distance and speed along the path `tau` seconds into the segment.
+    #[inline]
     fn along(&self, tau: f64) -> (f64, f64) {
         self.profile.at_time(tau)
     }
 
     /// The commanded state `tau` seconds into the segment.
+    #[inline]
     pub fn command(&self, tau: f64) -> Command {
         let (s, v) = self.along(tau);
         match self.geometry {

@@ -61,6 +61,7 @@ impl Profile {
 
     /// Distance covered (mm) and speed (mm/s) `tau` seconds into the move: accelerating,
     /// cruising, then braking (`tau` is clamped to the move).
+    #[inline]
     pub fn at_time(&self, tau: f64) -> (f64, f64) {
         let a = self.acceleration;
         if tau <= self.accel_s {
