@@ -71,7 +71,7 @@ pub(super) fn with_simulated_deviation(
         return Ok(best.report);
     }
     let before = best.report.before.clone();
-    if let Some(kept) = with_layers_kept(&orig, best, &before, options, again)? {
+    if let Some(kept) = with_layers_kept(&orig, best, &before, again)? {
         return Ok(kept);
     }
     // Every rewrite tried rings more than the original: the original is handed back.
@@ -88,7 +88,6 @@ fn with_layers_kept(
     orig: &Simulated,
     tried: Tried,
     before: &Report,
-    options: &VtgOptions,
     again: &mut dyn Again,
 ) -> Result<Option<VtgReport>, Error> {
     let b = orig.deviation;
@@ -97,7 +96,7 @@ fn with_layers_kept(
         sim: a,
         layers,
         why,
-    }) = keep_ringing_layers(orig, tried.sim, tried.variant, before, options, again)?
+    }) = keep_ringing_layers(orig, tried.sim, tried.variant, before, again)?
     else {
         return Ok(None);
     };
@@ -159,7 +158,8 @@ fn simulate_first(
     options: &VtgOptions,
 ) -> (Option<SampledPair>, Option<Simulated>) {
     let output = &first.output[..];
-    let whole = || printing_deviation(output, first.after.time_s, options);
+    // Split where the original's run is (every rewrite's run is: `Again::simulated`).
+    let whole = || printing_deviation(output, first.before.time_s, options);
     let race = race_layers(input.len(), layers, options).filter(|_| crate::parallel::threads() > 1);
     let Some(sample) = race else {
         return (None, whole());
@@ -208,7 +208,7 @@ fn quietest(
         }
         None => {
             let variants = (search::quieter_variants(), 0.7, 0.04);
-            every_variant(first, variants, orig, options, again)
+            every_variant(first, variants, orig, again)
         }
     }
 }
@@ -220,7 +220,6 @@ fn every_variant(
     mut best: Tried,
     (variants, from, step): (impl IntoIterator<Item = search::Variant>, f64, f64),
     orig: &Simulated,
-    options: &VtgOptions,
     again: &mut dyn Again,
 ) -> Result<Tried, Error> {
     let b = &orig.deviation;
@@ -230,14 +229,14 @@ fn every_variant(
             break;
         }
         let f = from + step * k as f64;
-        let report = again.report(variant, &[], best.report.before.clone(), f)?;
+        let (report, sim) = again.simulated(variant, &[], best.report.before.clone(), f)?;
         if report.paths.rewrote_nothing() {
             // The original as it is (every path kept for lines, say): it rings as the original
             // does, which keeps the rule trivially, but it is no rewrite to hand back as one.
             // Where no rewrite keeps the rule, the original comes back with the reason.
             continue;
         }
-        let Some(sim) = printing_deviation(&report.output, report.after.time_s, options) else {
+        let Some(sim) = sim else {
             break;
         };
         let score = quietness(b, &sim.deviation);
@@ -310,8 +309,8 @@ fn raced(
     let mut untold = Vec::new();
     for (k, variant) in search::quieter_variants().enumerate() {
         let f = 0.7 + 0.03 * k as f64;
-        let trial = again.output(variant, &others, &first.report.before, f)?;
-        let Some(a) = sampled(&trial) else {
+        let measured = again.measured(variant, &others, &first.report.before, (f, &sampled))?;
+        let Some(a) = measured else {
             break;
         };
         if a == b {
@@ -322,7 +321,7 @@ fn raced(
     }
     let chosen = to_write_whole(ranked, quietness(&b, &first_sampled));
     let whole = (chosen.into_iter().chain(untold), 0.88, 0.01);
-    every_variant(first, whole, orig, options, again)
+    every_variant(first, whole, orig, again)
 }
 
 /// The variants a race writes whole, in turn, from their scores on the sample ([`quietness`]):
@@ -371,17 +370,34 @@ pub(super) trait Again {
         from: f64,
     ) -> Result<VtgReport, Error>;
 
-    /// The same rewrite's bytes alone, neither analysed nor measured: all a race's trial
-    /// simulates (on the 34 MB file the analysis and metrics it skips cost 0.3–0.5 s a trial
-    /// natively, more in a single-threaded worker).
-    fn output(
+    /// [`Again::report`] with the rewrite simulated whole ([`printing_deviation`]) beside its
+    /// analysis.
+    fn simulated(
+        &mut self,
+        variant: search::Variant,
+        kept: &[bool],
+        before: Report,
+        from: f64,
+    ) -> Result<(VtgReport, Option<Simulated>), Error>;
+
+    /// The same rewrite measured by `measure` alone, not analysed for a report (on the 34 MB
+    /// file the report's analysis and metrics cost 0.3–0.5 s a trial natively, more in a
+    /// single-threaded worker): all a race's trial simulates. Where the time allowance analyses
+    /// the rewrite, `measure` runs beside that analysis, on the output it keeps.
+    fn measured(
         &mut self,
         variant: search::Variant,
         kept: &[bool],
         before: &Report,
-        from: f64,
-    ) -> Result<Vec<u8>, Error>;
+        from_and_measure: (f64, Measure<'_>),
+    ) -> Result<Sampled, Error>;
 }
+
+/// What a race's trial measures of its output ([`Again::measured`]): its deviation on the sample.
+pub(super) type Measure<'m> = search::Beside<'m, Sampled>;
+
+/// A race's trial simulated on the sample ([`on_sample`]), `None` where the model cannot run.
+pub(super) type Sampled = Option<Deviation>;
 
 /// Rounds of [`keep_ringing_layers`].
 const KEEP_ROUNDS: usize = 3;
@@ -401,7 +417,6 @@ fn keep_ringing_layers(
     mut sim: Simulated,
     variant: search::Variant,
     before: &Report,
-    options: &VtgOptions,
     again: &mut dyn Again,
 ) -> Result<Option<LayersKept>, Error> {
     let b = original.deviation;
@@ -414,8 +429,8 @@ fn keep_ringing_layers(
         }
         why.peak += marked.peak;
         why.mean += marked.mean;
-        let next = again.report(variant, &kept, before.clone(), 0.95)?;
-        let Some(a) = printing_deviation(&next.output, next.after.time_s, options) else {
+        let (next, a) = again.simulated(variant, &kept, before.clone(), 0.95)?;
+        let Some(a) = a else {
             return Ok(None);
         };
         if a.deviation.mean <= b.mean && a.deviation.max <= b.max {
@@ -536,9 +551,11 @@ struct LayerRinging {
     samples: u64,
 }
 
-/// The dynamics model run on a file that plans to `expected_s` seconds (its analysis' time:
-/// a long print is run in two halves, [`crate::dynamics::split`]), `None` when it cannot run
-/// on it (a print too long to simulate, for instance).
+/// The dynamics model run on a file that plans to about `expected_s` seconds (a long print is
+/// run in two halves split at a share of it, [`crate::dynamics::split`]: the original's time,
+/// for the original and every rewrite of it, so that the split depends on the input alone and
+/// a rewrite's run can start before its own analysis is done), `None` when it cannot run on
+/// it (a print too long to simulate, for instance).
 pub(super) fn printing_deviation(
     bytes: &[u8],
     expected_s: f64,

@@ -269,7 +269,7 @@ pub fn vtg_with_progress(
                 .dynamics
                 .then(|| closed_loop::printing_deviation(input, expected_s, options))
         },
-        || run.attempt(first, &[], before, &mut |f| progress(0.3 + 0.4 * f)),
+        || run.report((first, &[]), before, &mut |f| progress(0.3 + 0.4 * f)),
     );
     let mut report = report?;
     if !progress(0.7) {
@@ -325,19 +325,22 @@ struct Run<'a> {
     smoothings: std::sync::Mutex<smoothings::Smoothings>,
 }
 
+/// What a rewrite's attempt measures of its output beside its analysis ([`Run::attempt`]).
+type Also<'a, X> = &'a (dyn Fn(&[u8]) -> X + Sync);
+
 /// A rewrite's metrics ([`metrics::from_input`]): the file's, and by feature.
 type Metrics = Result<(ToolpathMetrics, Vec<ToolpathMetrics>), Error>;
 
 impl Run<'_> {
     /// One rewrite tried as `variant`, the layers `kept` marks left as they are, analysed and
-    /// reported (`before`: the original's analysis).
-    fn attempt(
+    /// reported (`before`: the original's analysis), and what `also` measures of its output,
+    /// beside its analysis.
+    fn attempt<X: Send>(
         &self,
-        variant: search::Variant,
-        kept: &[bool],
+        (variant, kept): (search::Variant, &[bool]),
         before: Report,
-        progress: Progress<'_>,
-    ) -> Result<VtgReport, Error> {
+        (progress, also): (Progress<'_>, Also<'_, X>),
+    ) -> Result<(VtgReport, X), Error> {
         let Run {
             path,
             options,
@@ -349,21 +352,22 @@ impl Run<'_> {
         let metrics = |output: &[u8]| -> Metrics {
             metrics::from_input(output, &options.analyze, options.critical_angle_deg)
         };
+        let beside = |output: &[u8]| crate::parallel::join(|| also(output), || metrics(output));
         let (rewritten, measured) =
-            self.rewrite((variant, kept), &before, Some(&metrics), progress)?;
-        let (after, kept, after_metrics) = match measured {
-            Some((after, kept, Some(beside))) => (after, Some(kept), beside?),
-            Some((after, kept, None)) => (after, Some(kept), metrics(&rewritten.output)?),
+            self.rewrite((variant, kept), &before, Some(&beside), progress)?;
+        let (after, kept, (also, after_metrics)) = match measured {
+            Some((after, kept, Some(beside))) => (after, Some(kept), beside),
+            Some((after, kept, None)) => (after, Some(kept), beside(&rewritten.output)),
             // Analysed even where [`finish`] analyses the file again with its estimates
             // refreshed: the clock and the segments kept here spare it a planning walk for
             // each, which take longer on one thread than this pass takes on two.
             None => {
-                let (analysed, after_metrics) = crate::parallel::join(
+                let (analysed, alongside) = crate::parallel::join(
                     || search::analysed(&rewritten.output, self.input, options),
-                    || metrics(&rewritten.output),
+                    || beside(&rewritten.output),
                 );
                 let (after, kept) = analysed?;
-                (after, Some(kept), after_metrics?)
+                (after, Some(kept), alongside)
             }
         };
         let mut report = report::build(
@@ -372,10 +376,21 @@ impl Run<'_> {
             before,
             after,
             path,
-            after_metrics,
+            after_metrics?,
             rewritten,
         );
         report.output_kept = kept;
+        Ok((report, also))
+    }
+
+    /// [`Run::attempt`] with nothing measured beside the analysis.
+    fn report(
+        &self,
+        tried: (search::Variant, &[bool]),
+        before: Report,
+        progress: Progress<'_>,
+    ) -> Result<VtgReport, Error> {
+        let (report, ()) = self.attempt(tried, before, (progress, &|_: &[u8]| ()))?;
         Ok(report)
     }
 
@@ -396,13 +411,13 @@ impl Run<'_> {
     /// The file rewritten as `variant`, the layers `kept` marks left as they are, within the
     /// time and lines allowed (`before`: the original's analysis), and its analysis where the
     /// allowance measured it, with what `beside` measured of it meanwhile; progress to 0.8.
-    fn rewrite(
+    fn rewrite<T>(
         &self,
         (variant, kept): (search::Variant, &[bool]),
         before: &Report,
-        beside: Option<search::Beside<'_, Metrics>>,
+        beside: Option<search::Beside<'_, T>>,
         progress: Progress<'_>,
-    ) -> Result<(rewrite::Rewritten, Option<search::Measured<Metrics>>), Error> {
+    ) -> Result<(rewrite::Rewritten, Option<search::Measured<T>>), Error> {
         let mut offers = match self.known_offers(variant, kept) {
             Some(offers) => offers,
             None => {
@@ -446,23 +461,43 @@ impl closed_loop::Again for Retry<'_, '_> {
         before: Report,
         from: f64,
     ) -> Result<VtgReport, Error> {
-        let progress = &mut *self.progress;
-        self.run
-            .attempt(variant, kept, before, &mut |g| progress(from + 0.05 * g))
+        let progress = &mut |g| (self.progress)(from + 0.05 * g);
+        self.run.report((variant, kept), before, progress)
     }
 
-    fn output(
+    fn simulated(
+        &mut self,
+        variant: search::Variant,
+        kept: &[bool],
+        before: Report,
+        from: f64,
+    ) -> Result<(VtgReport, Option<closed_loop::Simulated>), Error> {
+        // The split of a long print's run depends on the original alone: a rewrite plans within
+        // a percent of its time, and its own is known only once the analysis beside it is done.
+        let expected_s = before.time_s;
+        let options = self.run.options;
+        let simulate = |output: &[u8]| closed_loop::printing_deviation(output, expected_s, options);
+        let progress = &mut |g| (self.progress)(from + 0.05 * g);
+        (self.run).attempt((variant, kept), before, (progress, &simulate))
+    }
+
+    fn measured(
         &mut self,
         variant: search::Variant,
         kept: &[bool],
         before: &Report,
-        from: f64,
-    ) -> Result<Vec<u8>, Error> {
+        (from, measure): (f64, closed_loop::Measure<'_>),
+    ) -> Result<closed_loop::Sampled, Error> {
         let progress = &mut *self.progress;
-        let (rewritten, _) = self.run.rewrite((variant, kept), before, None, &mut |g| {
-            progress(from + 0.05 * g)
-        })?;
-        Ok(rewritten.output)
+        let (rewritten, measured) =
+            self.run
+                .rewrite((variant, kept), before, Some(measure), &mut |g| {
+                    progress(from + 0.05 * g)
+                })?;
+        Ok(match measured {
+            Some((_, _, Some(sampled))) => sampled,
+            _ => measure(&rewritten.output),
+        })
     }
 }
 
