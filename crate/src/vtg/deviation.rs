@@ -73,7 +73,22 @@ pub(crate) fn polyline_deviation(
             (false, None) => f64::INFINITY,
         };
     }
-    let o = Original::new(orig);
+    deviation_from_segments(out, &Segments::new(orig).0, step, accept)
+}
+
+/// [`polyline_deviation`] from `out` to an original of at least one segment, prepared once
+/// ([`Segments`]): a caller that measures many short pieces against stretches of one
+/// original (the thinning's joins) prepares it once and passes a slice of it.
+pub(crate) fn deviation_from_segments(
+    out: &[[f64; 3]],
+    segments: &[Segment],
+    step: f64,
+    accept: f64,
+) -> f64 {
+    if segments.is_empty() {
+        return f64::INFINITY;
+    }
+    let o = Original { segments };
     let mut worst = 0.0f64;
     let mut cursor = 0usize;
     let mut prev: Option<([f64; 3], usize, f64)> = None;
@@ -111,14 +126,37 @@ pub(crate) fn polyline_deviation(
 /// squared length are computed once: a measurement asks for the distance to each original
 /// segment a dozen times or more, and the searches compare squared distances, taking one
 /// square root for the nearest (this was a seventh of `vtg`'s time on the 34 MB corpus file).
-struct Original {
+struct Original<'s> {
     /// At least one.
-    segments: Vec<Segment>,
+    segments: &'s [Segment],
+}
+
+/// A polyline's segments, prepared for [`deviation_from_segments`]: segment `j` runs from
+/// point `j` to point `j + 1`.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Segments(pub(crate) Vec<Segment>);
+
+impl Segments {
+    pub(crate) fn new(poly: &[[f64; 3]]) -> Self {
+        Segments(
+            poly.windows(2)
+                .map(|w| {
+                    let d = sub(w[1], w[0]);
+                    let l2 = dot(d, d);
+                    Segment {
+                        a: w[0],
+                        d,
+                        inv: if l2 > 0.0 { 1.0 / l2 } else { 0.0 },
+                    }
+                })
+                .collect(),
+        )
+    }
 }
 
 /// A segment `a`–`a + d`, with `1 / |d|²` (0 for a point).
-#[derive(Clone, Copy)]
-struct Segment {
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Segment {
     a: [f64; 3],
     d: [f64; 3],
     inv: f64,
@@ -139,23 +177,7 @@ impl Segment {
     }
 }
 
-impl Original {
-    fn new(orig: &[[f64; 3]]) -> Self {
-        let segments: Vec<Segment> = orig
-            .windows(2)
-            .map(|w| {
-                let d = sub(w[1], w[0]);
-                let l2 = dot(d, d);
-                Segment {
-                    a: w[0],
-                    d,
-                    inv: if l2 > 0.0 { 1.0 / l2 } else { 0.0 },
-                }
-            })
-            .collect();
-        Self { segments }
-    }
-
+impl Original<'_> {
     /// Distance from `p` to segment `j`.
     fn seg_dist(&self, p: &[f64; 3], j: usize) -> f64 {
         self.segments[j].distance_sq(p).sqrt()

@@ -718,10 +718,12 @@ fn thinned(
         return (walked, points);
     }
     let arc = arc_lengths(path.pts);
+    let segments = crate::vtg::deviation::Segments::new(path.pts);
     let followed = Followed {
         pts: path.pts,
         arc: &arc,
         feed: path.feed,
+        segments: &segments.0,
     };
     let t = Thin {
         budget_mm: budget,

@@ -22,7 +22,7 @@
 //! The path as a whole is checked again by the caller, as the walk was.
 
 use crate::vec3::{dot, norm, sub};
-use crate::vtg::deviation::{point_segment, polyline_deviation};
+use crate::vtg::deviation::{deviation_from_segments, point_segment, Segment};
 
 /// What the thinning may do.
 #[derive(Debug, Clone, Copy)]
@@ -41,13 +41,16 @@ pub(crate) struct Thin {
 /// Most walked steps joined into one segment: bounds the work per segment.
 const MAX_JOINED: usize = 64;
 
-/// The original a walk followed: its polyline, the arc length at each of its points and the
-/// feed of each of its segments (mm/s).
+/// The original a walk followed: its polyline, the arc length at each of its points, the
+/// feed of each of its segments (mm/s), and the segments prepared for the deviation checks
+/// (`crate::vtg::deviation::Segments` of `pts`: every join is checked against a stretch of
+/// them, a few dozen joins a kept point).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Followed<'a> {
     pub(crate) pts: &'a [[f64; 3]],
     pub(crate) arc: &'a [f64],
     pub(crate) feed: &'a [f64],
+    pub(crate) segments: &'a [Segment],
 }
 
 impl Followed<'_> {
@@ -69,10 +72,10 @@ impl Followed<'_> {
     fn covers(&self, a: &[f64; 3], b: &[f64; 3], ua: f64, ub: f64, t: &Thin) -> bool {
         let lo = self.segment(ua).saturating_sub(1);
         let hi = (self.segment(ub) + 3).min(self.pts.len());
-        let Some(window) = self.pts.get(lo..hi) else {
+        let Some(window) = self.segments.get(lo..hi.saturating_sub(1)) else {
             return false;
         };
-        if window.len() < 2 {
+        if window.is_empty() {
             return false;
         }
         let inner = self
@@ -87,7 +90,7 @@ impl Followed<'_> {
                 return false;
             }
         }
-        polyline_deviation(&[*a, *b], window, t.step_mm, t.budget_mm) <= t.budget_mm
+        deviation_from_segments(&[*a, *b], window, t.step_mm, t.budget_mm) <= t.budget_mm
     }
 }
 
@@ -196,10 +199,12 @@ mod tests {
         let (fine, u) = circle(20.0, 400, std::f64::consts::FRAC_PI_2);
         let (orig, arc) = circle(20.0, 1000, std::f64::consts::FRAC_PI_2);
         let feed = vec![50.0; orig.len() - 1];
+        let segments = crate::vtg::deviation::Segments::new(&orig);
         let o = Followed {
             pts: &orig,
             arc: &arc,
             feed: &feed,
+            segments: &segments.0,
         };
         let t = thin_settings(0.02);
         let keep = thin(&fine, &u, &o, &t);
@@ -233,10 +238,12 @@ mod tests {
         let (fine, u) = circle(0.3, 4, std::f64::consts::FRAC_PI_2);
         let (orig, arc) = circle(0.3, 400, std::f64::consts::FRAC_PI_2);
         let feed = vec![50.0; orig.len() - 1];
+        let segments = crate::vtg::deviation::Segments::new(&orig);
         let o = Followed {
             pts: &orig,
             arc: &arc,
             feed: &feed,
+            segments: &segments.0,
         };
         let keep = thin(&fine, &u, &o, &thin_settings(0.02));
         assert_eq!(keep, (0..fine.len()).collect::<Vec<_>>());
