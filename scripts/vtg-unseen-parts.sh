@@ -24,6 +24,13 @@
 #
 #   bash scripts/vtg-unseen-parts.sh [extra quietpath vtg options...]
 #   UNSEEN_KEEP=/tmp/unseen bash scripts/vtg-unseen-parts.sh   # keep the sliced files there
+#   UNSEEN_SLICES=/tmp/unseen bash scripts/vtg-unseen-parts.sh # measure kept slices again
+#
+# The models are rendered with scripts/openscad-stl.sh (facets in a fixed order), and Slic3r
+# slices the same STL to the same bytes every time; PrusaSlicer 2.5 does not (where a hole's
+# loop starts moves from run to run, even on one thread with the seam at the rear), so two
+# builds are compared on one set of slices: keep them once with UNSEEN_KEEP and measure each
+# build on them with UNSEEN_SLICES.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 quietpath="$root/target/release/quietpath"
@@ -31,20 +38,23 @@ quietpath="$root/target/release/quietpath"
 for tool in openscad prusa-slicer slic3r CuraEngine python3; do
   command -v "$tool" >/dev/null || { echo "missing: $tool (see the comment at the top)" >&2; exit 1; }
 done
-work="${UNSEEN_KEEP:-$(mktemp -d)}"
+scratch="$(mktemp -d)"
+trap 'rm -rf "$scratch"' EXIT
+work="${UNSEEN_SLICES:-${UNSEEN_KEEP:-$scratch}}"
 mkdir -p "$work"
-[ -n "${UNSEEN_KEEP:-}" ] || trap 'rm -rf "$work"' EXIT
 
+# Renders and slices every part into $work, adding the slices to `files` (the body is not
+# indented: the PrusaSlicer start G-code below is a string across lines).
+slice_all() {
 resources=/usr/share/cura/resources
 if [ ! -f "$resources/definitions/fdmprinter.def.json" ]; then
-  (cd "$work" && apt-get download cura >/dev/null 2>&1 && dpkg -x cura_*.deb cura)
-  resources="$work/cura/usr/share/cura/resources"
+  (cd "$scratch" && apt-get download cura >/dev/null 2>&1 && dpkg -x cura_*.deb cura)
+  resources="$scratch/cura/usr/share/cura/resources"
 fi
 export CURA_ENGINE_SEARCH_PATH="$resources/definitions:$resources/extruders"
 
-files=()
 for model in gear hexgrid tall_fins; do
-  openscad -o "$work/$model.stl" "$root/tests/fixtures/models/unseen/$model.scad" >/dev/null 2>&1
+  "$root/scripts/openscad-stl.sh" "$work/$model.stl" "$root/tests/fixtures/models/unseen/$model.scad"
   CuraEngine slice -j "$resources/definitions/fdmprinter.def.json" \
     -s machine_width=220 -s machine_depth=220 -s machine_height=250 -s center_object=true \
     -s machine_gcode_flavor="RepRap (Marlin/Sprinkler)" -s layer_height=0.2 \
@@ -69,7 +79,7 @@ done
 
 # One more part, an L-bracket with ribs, a bored boss, a slot, a cross hole and a separate
 # tube, under settings the tuning never met: each slicer's less common options.
-openscad -o "$work/bracket.stl" "$root/tests/fixtures/models/unseen/bracket.scad" >/dev/null 2>&1
+"$root/scripts/openscad-stl.sh" "$work/bracket.stl" "$root/tests/fixtures/models/unseen/bracket.scad"
 cura() { # output name, settings...
   local name="$1"
   shift
@@ -106,6 +116,23 @@ slic3r --no-gui --gcode-flavor reprap --use-firmware-retraction --use-relative-e
 files+=("$work/prusaslicer_bracket_fwretract_fuzzy_sequential.gcode"
   "$work/prusaslicer_bracket_rrf_ironing_0.1mm.gcode"
   "$work/slic3r_bracket_smoothie_concentric.gcode" "$work/slic3r_bracket_fwretract_hilbert.gcode")
+}
+
+files=()
+if [ -n "${UNSEEN_SLICES:-}" ]; then
+  # The kept slices, in the order they were sliced in.
+  for name in curaengine_gear slic3r_gear prusaslicer-klipper_gear curaengine_hexgrid \
+    slic3r_hexgrid prusaslicer-klipper_hexgrid curaengine_tall_fins slic3r_tall_fins \
+    prusaslicer-klipper_tall_fins curaengine_bracket_volumetric_gyroid_zhop \
+    curaengine_bracket_concentric_ironing curaengine_bracket_lightning_coasting \
+    prusaslicer_bracket_fwretract_fuzzy_sequential prusaslicer_bracket_rrf_ironing_0.1mm \
+    slic3r_bracket_smoothie_concentric slic3r_bracket_fwretract_hilbert; do
+    [ -f "$work/$name.gcode" ] || { echo "missing kept slice: $work/$name.gcode" >&2; exit 1; }
+    files+=("$work/$name.gcode")
+  done
+else
+  slice_all
+fi
 
 run() { # title, extra options...
   local title="$1"
@@ -113,7 +140,7 @@ run() { # title, extra options...
   echo
   echo "**$title**"
   echo
-  python3 - "$quietpath" "$work" "$@" "${files[@]}" <<'PY'
+  python3 - "$quietpath" "$scratch" "$@" "${files[@]}" <<'PY'
 import json, subprocess, sys, time
 quietpath, work, rest = sys.argv[1], sys.argv[2], sys.argv[3:]
 options = [a for a in rest if not a.endswith(".gcode")]
