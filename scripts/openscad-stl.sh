@@ -13,8 +13,9 @@ out="$1"
 model="$2"
 shift 2
 raw="$(mktemp --suffix=.stl)"
-trap 'rm -f "$raw"' EXIT
-openscad "$@" -o "$raw" "$model" >/dev/null 2>&1
+log="$(mktemp)"
+trap 'rm -f "$raw" "$log"' EXIT
+openscad "$@" -o "$raw" "$model" >"$log" 2>&1 || { cat "$log" >&2; exit 1; }
 python3 - "$raw" "$out" <<'PY'
 import sys
 src, dst = sys.argv[1], sys.argv[2]
