@@ -193,21 +193,32 @@ mod tests {
         }
     }
 
+    /// [`thin`] of `fine` (walked at `u`) along the original `orig` (arc lengths `arc`)
+    /// printed at 50 mm/s throughout.
+    fn thin_at_50(
+        fine: &[[f64; 3]],
+        u: &[f64],
+        (orig, arc): (&[[f64; 3]], &[f64]),
+        t: &Thin,
+    ) -> Vec<usize> {
+        let feed = vec![50.0; orig.len() - 1];
+        let segments = crate::vtg::deviation::Segments::new(orig);
+        let o = Followed {
+            pts: orig,
+            arc,
+            feed: &feed,
+            segments: &segments.0,
+        };
+        thin(fine, u, &o, t)
+    }
+
     #[test]
     fn a_finely_walked_gentle_curve_is_joined_within_the_budget_and_turn() {
         // A 20 mm radius quarter circle in 400 steps of 0.08 mm, the original a 1000-gon.
         let (fine, u) = circle(20.0, 400, std::f64::consts::FRAC_PI_2);
         let (orig, arc) = circle(20.0, 1000, std::f64::consts::FRAC_PI_2);
-        let feed = vec![50.0; orig.len() - 1];
-        let segments = crate::vtg::deviation::Segments::new(&orig);
-        let o = Followed {
-            pts: &orig,
-            arc: &arc,
-            feed: &feed,
-            segments: &segments.0,
-        };
         let t = thin_settings(0.02);
-        let keep = thin(&fine, &u, &o, &t);
+        let keep = thin_at_50(&fine, &u, (&orig, &arc), &t);
         let kept: Vec<[f64; 3]> = keep.iter().map(|&i| fine[i]).collect();
         assert_eq!(kept.first(), fine.first());
         assert_eq!(kept.last(), fine.last());
@@ -237,15 +248,7 @@ mod tests {
         // turn 45° and sag further than the budget allows.
         let (fine, u) = circle(0.3, 4, std::f64::consts::FRAC_PI_2);
         let (orig, arc) = circle(0.3, 400, std::f64::consts::FRAC_PI_2);
-        let feed = vec![50.0; orig.len() - 1];
-        let segments = crate::vtg::deviation::Segments::new(&orig);
-        let o = Followed {
-            pts: &orig,
-            arc: &arc,
-            feed: &feed,
-            segments: &segments.0,
-        };
-        let keep = thin(&fine, &u, &o, &thin_settings(0.02));
+        let keep = thin_at_50(&fine, &u, (&orig, &arc), &thin_settings(0.02));
         assert_eq!(keep, (0..fine.len()).collect::<Vec<_>>());
     }
 }
