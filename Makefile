@@ -128,7 +128,8 @@ measure-vtg-w16: cli
 ## VTG on parts and slicers it was not tuned on: four models of tests/fixtures/models/unseen/
 ## sliced with CuraEngine, Slic3r and PrusaSlicer (for Klipper, and under less common settings),
 ## with the defaults and with lines allowed (scripts/vtg-unseen-parts.sh,
-## docs/measurements/vtg.md; about 4 min). Needs the slicers.
+## docs/measurements/vtg.md; about 4 min). Needs the slicers. PrusaSlicer's slices differ from
+## run to run: UNSEEN_KEEP=DIR keeps them, UNSEEN_SLICES=DIR measures kept ones again.
 measure-vtg-unseen: cli
 	bash scripts/vtg-unseen-parts.sh
 
