@@ -4,23 +4,13 @@
 
 use std::time::Instant;
 
+mod common;
+
 use quietpath::dynamics::{printing_deviation, printing_deviation_in_layers, VibrationOptions};
 
 fn main() {
-    let Some(path) = std::env::args().nth(1) else {
-        eprintln!("usage: deviation_speed FILE [RUNS]");
+    let Some((path, input, runs)) = common::file_and_runs("deviation_speed", 3) else {
         return;
-    };
-    let runs: usize = std::env::args()
-        .nth(2)
-        .and_then(|r| r.parse().ok())
-        .unwrap_or(3);
-    let input = match std::fs::read(&path) {
-        Ok(b) => b,
-        Err(e) => {
-            eprintln!("{path}: {e}");
-            return;
-        }
     };
     let options = VibrationOptions::default();
     let planned_s = match quietpath::analyze(&input, &options.analyze) {

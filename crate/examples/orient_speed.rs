@@ -3,21 +3,11 @@
 
 use std::time::Instant;
 
+mod common;
+
 fn main() {
-    let Some(path) = std::env::args().nth(1) else {
-        eprintln!("usage: orient_speed FILE [RUNS]");
+    let Some((path, input, runs)) = common::file_and_runs("orient_speed", 7) else {
         return;
-    };
-    let runs: usize = std::env::args()
-        .nth(2)
-        .and_then(|r| r.parse().ok())
-        .unwrap_or(7);
-    let input = match std::fs::read(&path) {
-        Ok(b) => b,
-        Err(e) => {
-            eprintln!("{path}: {e}");
-            return;
-        }
     };
     let options = quietpath::orient::SmoothOptions::default();
     let mut best = f64::INFINITY;
