@@ -118,20 +118,18 @@ files+=("$work/prusaslicer_bracket_fwretract_fuzzy_sequential.gcode"
   "$work/slic3r_bracket_smoothie_concentric.gcode" "$work/slic3r_bracket_fwretract_hilbert.gcode")
 }
 
+# The slices, in the order they were sliced in: listed in slices.txt beside them, so that
+# UNSEEN_SLICES measures the same files in the same order.
 files=()
 if [ -n "${UNSEEN_SLICES:-}" ]; then
-  # The kept slices, in the order they were sliced in.
-  for name in curaengine_gear slic3r_gear prusaslicer-klipper_gear curaengine_hexgrid \
-    slic3r_hexgrid prusaslicer-klipper_hexgrid curaengine_tall_fins slic3r_tall_fins \
-    prusaslicer-klipper_tall_fins curaengine_bracket_volumetric_gyroid_zhop \
-    curaengine_bracket_concentric_ironing curaengine_bracket_lightning_coasting \
-    prusaslicer_bracket_fwretract_fuzzy_sequential prusaslicer_bracket_rrf_ironing_0.1mm \
-    slic3r_bracket_smoothie_concentric slic3r_bracket_fwretract_hilbert; do
-    [ -f "$work/$name.gcode" ] || { echo "missing kept slice: $work/$name.gcode" >&2; exit 1; }
-    files+=("$work/$name.gcode")
-  done
+  [ -f "$work/slices.txt" ] || { echo "no slices.txt in $work (slice with UNSEEN_KEEP)" >&2; exit 1; }
+  while read -r name; do
+    [ -f "$work/$name" ] || { echo "missing kept slice: $work/$name" >&2; exit 1; }
+    files+=("$work/$name")
+  done <"$work/slices.txt"
 else
   slice_all
+  printf '%s\n' "${files[@]##*/}" >"$work/slices.txt"
 fi
 
 run() { # title, extra options...
