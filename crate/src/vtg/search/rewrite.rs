@@ -26,7 +26,7 @@ use crate::vtg::deviation::both_ways;
 use crate::vtg::feed::Written;
 use crate::vtg::kinematics::KinematicLimits;
 use crate::vtg::resample::WalkStats;
-use crate::vtg::smooth::{smooth_path, Settings, SmoothPath, Smoothed};
+use crate::vtg::smooth::{share_dependence, smooth_path, Settings, SmoothPath, Smoothed};
 use crate::vtg::smoothings::{Pending, Smoothing, SmoothingKey, Smoothings};
 use crate::vtg::source::{MoveSource, Sources};
 use crate::vtg::tuning::TUNING;
@@ -366,15 +366,25 @@ impl Offering<'_> {
             return (offer, Vec::new());
         }
         let mut fresh = Vec::new();
+        // Whether the free rewrite's smoothing is known to be every dearer one's too.
+        let shared = std::cell::Cell::new(false);
         let mut write = |k: u8, s: &Settings| {
             let key = SmoothingKey::new(self.variant, k, i);
             let mut smooth = |path: &SmoothPath<'_>, settings: &Settings| {
                 if let Some(kept) = self.smoothings.get(&key) {
                     return kept.clone();
                 }
-                let made = smooth_path(path, settings).map(std::sync::Arc::new);
+                let (made, depends) = share_dependence(|| smooth_path(path, settings));
+                let made = made.map(std::sync::Arc::new);
+                shared.set(k == 0 && !depends);
                 if self.smoothings.keeps_any() {
                     fresh.push((key, made.clone()));
+                    if shared.get() && self.buy_time {
+                        // Its dearer smoothings, kept as offering nothing more (below).
+                        let dearer = (1..=self.dearer.len() as u8)
+                            .map(|d| (SmoothingKey::new(self.variant, d, i), None));
+                        fresh.extend(dearer);
+                    }
                 }
                 made
             };
@@ -387,7 +397,9 @@ impl Offering<'_> {
         // sharp, too: first those it takes nearly as fast round.
         let mut offer = Offer::default();
         base.into_iter().for_each(|o| offer.push(o));
-        if self.buy_time {
+        // The dearer variants of a path whose smoothing does not depend on the speed share
+        // would be the free rewrite's outcomes again, which the filter below drops.
+        if self.buy_time && !shared.get() {
             (self.dearer.iter().zip(1..))
                 .filter_map(|(s, k)| write(k, s))
                 .flatten()

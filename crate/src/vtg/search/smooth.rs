@@ -493,7 +493,7 @@ fn pays(curvature: f64, before: Option<&Profile>, s: &Settings) -> bool {
     };
     let a = p.acceleration.min(s.max_normal_accel_mm_s2);
     let on_fillet = (a / curvature).sqrt();
-    on_fillet >= s.min_speed_share * p.exit
+    at_share(on_fillet, p.exit, s)
 }
 
 /// Whether the search takes a replacement costing `cost` at a corner the firmware reached on
@@ -504,9 +504,39 @@ fn accepts(cost: &Cost, before: Option<&Profile>, s: &Settings) -> bool {
         Cost::Planned {
             slowest_mm_s,
             sharp_mm_s,
-        } => slowest_mm_s >= s.min_speed_share * sharp_mm_s,
+        } => at_share(slowest_mm_s, sharp_mm_s, s),
         Cost::Unweighed => true,
     }
+}
+
+/// Whether `speed` is at least [`Settings::min_speed_share`] of `sharp`, noting where one of
+/// `Tuning::dearer_speed_shares` would have decided otherwise ([`share_dependence`]).
+fn at_share(speed: f64, sharp: f64, s: &Settings) -> bool {
+    let taken = speed >= s.min_speed_share * sharp;
+    if (TUNING.dearer_speed_shares.iter()).any(|&d| (speed >= d * sharp) != taken) {
+        SHARE_DECIDED.set(true);
+    }
+    taken
+}
+
+std::thread_local! {
+    /// Whether a corner was decided by [`at_share`] since [`share_dependence`] began in a way
+    /// one of the dearer speed shares would not have.
+    static SHARE_DECIDED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// `f`'s result, and whether any corner it weighed would have been decided otherwise at one
+/// of `Tuning::dearer_speed_shares`. Where none would, a smoothing at the dearer shares is the
+/// same to the bit ([`Settings::min_speed_share`] is read nowhere else), so its dearer
+/// variants offer nothing the free rewrite does not and need not be made (most paths of the
+/// corpus's Klipper files, whose corners are all slow or all fast). A flag of the thread's:
+/// each path is smoothed on one thread, and the decisions are made deep in the corner search.
+pub(crate) fn share_dependence<R>(f: impl FnOnce() -> R) -> (R, bool) {
+    let outer = SHARE_DECIDED.replace(false);
+    let result = f();
+    let depends = SHARE_DECIDED.get();
+    SHARE_DECIDED.set(outer || depends);
+    (result, depends)
 }
 
 impl Settings {
@@ -890,6 +920,50 @@ mod tests {
             ..with(1.0)
         };
         assert!(pays(curvature, Some(&before), &classic));
+    }
+
+    /// A path whose corners are all decided alike at every dearer speed share is smoothed to
+    /// the same bits at those shares (what lets the dearer variants be left out); one whose
+    /// corner is declined at the free share and taken at a dearer one is told apart.
+    #[test]
+    fn a_smoothing_that_no_dearer_share_would_decide_otherwise_is_theirs() {
+        let pts = [[0.0, 0.0, 0.2], [10.0, 0.0, 0.2], [10.0, 10.0, 0.2]];
+        let (e, feed) = ([0.0, 0.4, 0.8], [50.0, 50.0]);
+        let planned = |exit| Profile {
+            entry: 50.0,
+            peak: 50.0,
+            exit,
+            acceleration: 1000.0,
+            ..Profile::default()
+        };
+        let at = |exit, min_speed_share| {
+            let planned = [planned(exit), planned(exit)];
+            let path = SmoothPath {
+                pts: &pts,
+                e: &e,
+                feed: &feed,
+                planned: &planned,
+            };
+            let s = Settings {
+                min_speed_share,
+                ..settings()
+            };
+            share_dependence(|| smooth_path(&path, &s).map(|r| r.points))
+        };
+        // Slow into the corner (5 mm/s): every fillet keeps up at any share.
+        let (free, depends) = at(5.0, 1.0);
+        assert!(!depends && free.is_some());
+        for &share in &TUNING.dearer_speed_shares {
+            assert_eq!(at(5.0, share).0, free);
+        }
+        // Fast into it (500 mm/s): kept sharp at the free share, rounded at a dearer one.
+        let (free, depends) = at(500.0, 1.0);
+        assert!(depends);
+        let dearest = TUNING
+            .dearer_speed_shares
+            .iter()
+            .fold(1.0, |a: f64, &b| a.min(b));
+        assert_ne!(at(500.0, dearest).0, free);
     }
 
     /// A right angle between long legs is walked on the racing line: out past the first leg,

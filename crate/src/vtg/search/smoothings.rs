@@ -42,7 +42,9 @@ impl SmoothingKey {
     }
 }
 
-/// A smoothing's result: `None` where the path could not be smoothed.
+/// A smoothing's result: `None` where the path could not be smoothed, or for a dearer
+/// setting's key, where it is the free rewrite's smoothing (`smooth::share_dependence`) and so
+/// offers nothing more.
 pub(crate) type Smoothing = Option<Arc<Smoothed>>;
 
 /// The smoothed paths of a run, up to a bound in bytes.
