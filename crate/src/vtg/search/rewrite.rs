@@ -376,7 +376,9 @@ impl Offering<'_> {
                 }
                 let (made, depends) = share_dependence(|| smooth_path(path, settings));
                 let made = made.map(std::sync::Arc::new);
-                shared.set(k == 0 && !depends);
+                if k == 0 {
+                    shared.set(!depends);
+                }
                 if self.smoothings.keeps_any() {
                     fresh.push((key, made.clone()));
                     if shared.get() && self.buy_time {

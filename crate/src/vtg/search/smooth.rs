@@ -959,10 +959,7 @@ mod tests {
         // Fast into it (500 mm/s): kept sharp at the free share, rounded at a dearer one.
         let (free, depends) = at(500.0, 1.0);
         assert!(depends);
-        let dearest = TUNING
-            .dearer_speed_shares
-            .iter()
-            .fold(1.0, |a: f64, &b| a.min(b));
+        let dearest = TUNING.dearer_speed_shares.into_iter().fold(1.0, f64::min);
         assert_ne!(at(500.0, dearest).0, free);
     }
 
