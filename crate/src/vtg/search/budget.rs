@@ -167,10 +167,13 @@ pub(crate) fn free_within_lines(offers: &[Offer], allowed: i64) -> LineChoice {
             (corners, lines) => adding.push((k, lines, corners)),
         }
     }
-    savers.sort_by_key(|&(k, lines, _)| (lines, k));
+    let mut savers = Savers::new(savers);
     // Lines left plus those the savers not yet drawn would free: drawing a saver moves its
     // lines from one to the other, so only a rewrite taken changes it.
-    let mut room = savers.iter().fold(pool.left, |r, s| r.saturating_sub(s.1));
+    let mut room = savers
+        .list
+        .iter()
+        .fold(pool.left, |r, s| r.saturating_sub(s.1));
     if !pool.draw(&mut savers, (0, [0.0; 2]), &mut keep_free) {
         // The savings do not cover the header the estimates add: the file stays as it was.
         return LineChoice {
@@ -221,7 +224,7 @@ impl Pool {
     /// is written.
     fn draw(
         &mut self,
-        savers: &mut Vec<(usize, i64, [f64; 2])>,
+        savers: &mut Savers,
         (lines, added): (i64, [f64; 2]),
         keep: &mut [bool],
     ) -> bool {
@@ -230,10 +233,11 @@ impl Pool {
             slack: [self.slack[0] - added[0], self.slack[1] - added[1]],
         };
         let mut drawn = Vec::new();
-        for (k, &(_, saved, cost)) in savers.iter().enumerate() {
+        for k in savers.left() {
             if trial.left >= lines {
                 break;
             }
+            let (_, saved, cost) = savers.list[k];
             if cost[0] <= trial.slack[0].max(0.0) && cost[1] <= trial.slack[1].max(0.0) {
                 trial.take(saved, cost);
                 drawn.push(k);
@@ -243,11 +247,46 @@ impl Pool {
             return false;
         }
         for &k in drawn.iter().rev() {
-            let (path, saved, cost) = savers.remove(k);
+            let (path, saved, cost) = savers.draw(k);
             keep[path] = true;
             self.take(saved, cost);
         }
         true
+    }
+}
+
+/// The rewrites that only save lines (path, lines, cost), largest saving first, and which of
+/// them are drawn: marked, not removed, so drawing from the 34 MB corpus file's 5 000 moves
+/// no list (removing them one by one was 0.2 s of its run on one thread).
+struct Savers {
+    list: Vec<(usize, i64, [f64; 2])>,
+    drawn: Vec<bool>,
+    /// Every saver before it is drawn.
+    head: usize,
+}
+
+impl Savers {
+    fn new(mut list: Vec<(usize, i64, [f64; 2])>) -> Self {
+        list.sort_by_key(|&(k, lines, _)| (lines, k));
+        Savers {
+            drawn: vec![false; list.len()],
+            list,
+            head: 0,
+        }
+    }
+
+    /// The savers not drawn, in order.
+    fn left(&self) -> impl Iterator<Item = usize> + '_ {
+        (self.head..self.list.len()).filter(|&k| !self.drawn[k])
+    }
+
+    /// Draws saver `k`.
+    fn draw(&mut self, k: usize) -> (usize, i64, [f64; 2]) {
+        self.drawn[k] = true;
+        while self.drawn.get(self.head) == Some(&true) {
+            self.head += 1;
+        }
+        self.list[k]
     }
 }
 
