@@ -237,9 +237,14 @@ pub fn vtg_with_progress(
             let sources = source::move_sources(input, &options.analyze)?;
             Ok::<_, Error>((before, kept.segments, sources))
         },
-        || crate::path::extract(input, &options.analyze, options.limit_feed),
+        // The original's trajectory metrics from its moves, while the other side reads on.
+        || {
+            let path = crate::path::extract(input, &options.analyze, options.limit_feed)?;
+            let metrics = metrics::from_path(&path, options.critical_angle_deg);
+            Ok::<_, Error>((path, metrics))
+        },
     );
-    let ((before, before_segments, sources), path) = (read?, path?);
+    let ((before, before_segments, sources), (path, path_metrics)) = (read?, path?);
     if !progress(0.3) {
         return Err(cancelled());
     }
@@ -251,6 +256,7 @@ pub fn vtg_with_progress(
     let run = Run {
         input,
         path: &path,
+        path_metrics,
         sources: &sources,
         options,
         limits: rewrite::limits_for(&path, options),
@@ -287,12 +293,19 @@ pub fn vtg_with_progress(
         report.message = report.paths.nothing_rewritten(options.critical_angle_deg);
     }
     // The move lists and the offers kept are done with (the estimates and the firmware's
-    // figures stream): on the 34 MB file the lists are 450 MB of the peak.
+    // figures stream): on the 34 MB file the lists are 450 MB of the peak, freed beside the
+    // finish where there are threads (90 ms on one).
     let budget =
         firmware::SegmentBudget::for_file(input, path.junction_model, options.min_segment_time_ms);
-    drop(run);
-    drop((path, sources));
-    let report = finish(input, report, options, (budget, before_segments))?;
+    let Run {
+        known, smoothings, ..
+    } = run;
+    let done_with = (known, smoothings, path, sources);
+    let ((), report) = crate::parallel::join(
+        move || drop(done_with),
+        || finish(input, report, options, (budget, before_segments)),
+    );
+    let report = report?;
     progress(1.0);
     Ok(report)
 }
@@ -314,6 +327,8 @@ fn smoothings_bound(input: &[u8], options: &VtgOptions) -> usize {
 struct Run<'a> {
     input: &'a [u8],
     path: &'a crate::path::PrintPath,
+    /// The original's trajectory metrics, file and layers ([`metrics::from_path`]).
+    path_metrics: (ToolpathMetrics, Vec<ToolpathMetrics>),
     sources: &'a source::Sources,
     options: &'a VtgOptions,
     limits: KinematicLimits,
@@ -342,10 +357,7 @@ impl Run<'_> {
         (progress, also): (Progress<'_>, Also<'_, X>),
     ) -> Result<(VtgReport, X), Error> {
         let Run {
-            path,
-            options,
-            limits,
-            ..
+            options, limits, ..
         } = *self;
         // The output's metrics streamed, not from a kept move list: rounding corners can
         // multiply the moves tenfold.
@@ -373,9 +385,8 @@ impl Run<'_> {
         let mut report = report::build(
             options,
             &limits,
-            before,
-            after,
-            path,
+            (before, after),
+            &self.path_metrics,
             after_metrics?,
             rewritten,
         );

@@ -4,12 +4,10 @@
 use serde::Serialize;
 
 use super::kinematics::KinematicLimits;
-use super::metrics::from_path;
 use super::rewrite::Rewritten;
 use super::VtgOptions;
 use crate::analyze::toolpath::ToolpathMetrics;
 use crate::analyze::Report;
-use crate::path::PrintPath;
 
 /// A figure before and after, and the relative change.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -277,17 +275,16 @@ pub(crate) fn table2(
     }
 }
 
-/// Assembles the report.
+/// Assembles the report from the two files' analyses and trajectory metrics (the original's
+/// measured once per run, [`super::metrics::from_path`]).
 pub(crate) fn build(
     options: &VtgOptions,
     limits: &KinematicLimits,
-    before: Report,
-    after: Report,
-    path: &PrintPath,
+    (before, after): (Report, Report),
+    (mb, lb): &(ToolpathMetrics, Vec<ToolpathMetrics>),
     (ma, la): (ToolpathMetrics, Vec<ToolpathMetrics>),
     rewritten: Rewritten,
 ) -> VtgReport {
-    let (mb, lb) = from_path(path, options.critical_angle_deg);
     let c = Comparison::new;
     let table1 = Table1 {
         l_total_mm: c(mb.l_total_mm, ma.l_total_mm),
@@ -300,7 +297,8 @@ pub(crate) fn build(
     };
     let table2 = table2(&before, &after, None);
     let layers = lb
-        .into_iter()
+        .iter()
+        .cloned()
         .zip(la)
         .enumerate()
         .map(|(index, (before, after))| LayerMetrics {
