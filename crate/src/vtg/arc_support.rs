@@ -64,10 +64,14 @@ fn arc_capable_flavor(flavor: Option<&str>) -> bool {
 /// The file already has arc moves: its slicer (or ArcWelder) was set up for a firmware that
 /// runs them.
 fn has_arcs(input: &[u8]) -> bool {
-    input.split(|&b| b == b'\n').any(|l| {
-        let l = l.trim_ascii_start();
-        (l.starts_with(b"G2") || l.starts_with(b"G3"))
-            && l.get(2).is_none_or(|c| !c.is_ascii_digit())
+    // Found by `memmem` and checked line by line from there: a byte-wise split of the 34 MB
+    // corpus file's lines took 40 ms of `vtg`'s run on one thread.
+    [b"G2", b"G3"].iter().any(|code| {
+        memchr::memmem::find_iter(input, code).any(|at| {
+            let line_start = memchr::memrchr(b'\n', &input[..at]).map_or(0, |i| i + 1);
+            input[line_start..at].iter().all(u8::is_ascii_whitespace)
+                && input.get(at + 2).is_none_or(|c| !c.is_ascii_digit())
+        })
     })
 }
 
@@ -80,6 +84,29 @@ mod tests {
         assert!(has_arcs(b"G1 X1\nG2 X1 Y1 I1 J0\n"));
         assert!(has_arcs(b"G3"));
         assert!(!has_arcs(b"G1 X1\nG28\nG29\n"));
+        assert!(has_arcs(b"G1 X1\n \tG3 X1 Y1 I1 J0\n"));
+        assert!(!has_arcs(b"G1 X1 ; G2 X1\nM117 G3\n"));
+    }
+
+    proptest::proptest! {
+        /// The search finds an arc exactly where reading every line does.
+        #[test]
+        fn the_search_agrees_with_reading_every_line(
+            parts in proptest::collection::vec(
+                proptest::sample::select(vec![
+                    "G2", "G3", "G1", "G28", "2", " ", "\t", "\r", "\n", ";", "X1", "M117 ",
+                ]),
+                0..40,
+            ),
+        ) {
+            let text: String = parts.concat();
+            let every_line = text.as_bytes().split(|&b| b == b'\n').any(|l| {
+                let l = l.trim_ascii_start();
+                (l.starts_with(b"G2") || l.starts_with(b"G3"))
+                    && l.get(2).is_none_or(|c| !c.is_ascii_digit())
+            });
+            proptest::prop_assert_eq!(has_arcs(text.as_bytes()), every_line, "{:?}", text);
+        }
     }
 
     #[test]
