@@ -31,7 +31,7 @@ pub(super) fn compact_path(
     let o = Polyline::of(run, src)?;
     let (pts, e, feed) = (&o.pts, &o.e, &o.feed);
     let fit = TUNING.compact_share * settings.tolerance_mm;
-    let (pieces, deviation) = fit_arcs((pts, feed), fit, pts, settings, machine)?;
+    let (pieces, deviation) = fit_arcs((pts, feed), fit, (pts, 0.0), settings, machine)?;
     let original = machine.cost(pts[0], &pts[1..], &e[1..], feed);
     let (s, j) = machine.cost_pieces(pts[0], &pts[1..], &e[1..], &pieces);
     if !(s.is_finite() && j.is_finite()) {
