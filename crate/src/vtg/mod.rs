@@ -223,28 +223,13 @@ pub fn vtg_with_progress(
 ) -> Result<VtgReport, Error> {
     options.validate()?;
     let cancelled = || Error::new(0, 0, ErrorKind::Cancelled);
-    // Independent reads of the same bytes, side by side where there are threads: extracting the
-    // planned path costs as much as the other two together (34 MB: 550 ms, 150 + 220 ms).
-    let (read, path) = crate::parallel::join(
-        || {
-            // The original's firmware figures are counted in its analysis' pass.
-            let min_segment_s = firmware::min_segment_time_s(input, options.min_segment_time_ms);
-            let keep = crate::analyze::Keep {
-                starts: false,
-                min_segment_s: Some(min_segment_s),
-            };
-            let (before, kept) = crate::analyze::analyze_keeping(input, &options.analyze, keep)?;
-            let sources = source::move_sources(input, &options.analyze)?;
-            Ok::<_, Error>((before, kept.segments, sources))
-        },
-        // The original's trajectory metrics from its moves, while the other side reads on.
-        || {
-            let path = crate::path::extract(input, &options.analyze, options.limit_feed)?;
-            let metrics = metrics::from_path(&path, options.critical_angle_deg);
-            Ok::<_, Error>((path, metrics))
-        },
-    );
-    let ((before, before_segments, sources), (path, path_metrics)) = (read?, path?);
+    let Original {
+        before,
+        before_segments,
+        sources,
+        path,
+        path_metrics,
+    } = read_original(input, options)?;
     if !progress(0.3) {
         return Err(cancelled());
     }
@@ -308,6 +293,48 @@ pub fn vtg_with_progress(
     let report = report?;
     progress(1.0);
     Ok(report)
+}
+
+/// The original as every rewrite reads it: its analysis (with the firmware's segment figures
+/// counted in its pass), its moves' sources, its planned path and that path's trajectory
+/// metrics.
+struct Original {
+    before: Report,
+    before_segments: Option<SegmentCounts>,
+    sources: source::Sources,
+    path: crate::path::PrintPath,
+    path_metrics: (ToolpathMetrics, Vec<ToolpathMetrics>),
+}
+
+/// Reads [`Original`]: independent reads of the same bytes, side by side where there are
+/// threads. Extracting the planned path costs as much as the other two together (34 MB:
+/// 550 ms, 150 + 220 ms), so the path's metrics are measured on its side.
+fn read_original(input: &[u8], options: &VtgOptions) -> Result<Original, Error> {
+    let (read, path) = crate::parallel::join(
+        || {
+            let min_segment_s = firmware::min_segment_time_s(input, options.min_segment_time_ms);
+            let keep = crate::analyze::Keep {
+                starts: false,
+                min_segment_s: Some(min_segment_s),
+            };
+            let (before, kept) = crate::analyze::analyze_keeping(input, &options.analyze, keep)?;
+            let sources = source::move_sources(input, &options.analyze)?;
+            Ok::<_, Error>((before, kept.segments, sources))
+        },
+        || {
+            let path = crate::path::extract(input, &options.analyze, options.limit_feed)?;
+            let metrics = metrics::from_path(&path, options.critical_angle_deg);
+            Ok::<_, Error>((path, metrics))
+        },
+    );
+    let ((before, before_segments, sources), (path, path_metrics)) = (read?, path?);
+    Ok(Original {
+        before,
+        before_segments,
+        sources,
+        path,
+        path_metrics,
+    })
 }
 
 /// The bytes of smoothed paths a run keeps for its later variants ([`smoothings`]): none
