@@ -331,11 +331,19 @@ impl CurvatureIndex {
         let spans = breaks.len().saturating_sub(1);
         let mut samples: Vec<[f64; SPAN_SAMPLES]> = Vec::with_capacity(spans);
         let mut points = Vec::with_capacity(spans);
+        // A span's last sample is the next one's first wherever the two parameters are the
+        // same to the bit (nearly always): evaluated once, a sixth of the index's evaluations.
+        let mut last: Option<(f64, Eval)> = None;
         for w in breaks.windows(2) {
-            let e: [Eval; SPAN_SAMPLES] = std::array::from_fn(|i| {
+            let u: [f64; SPAN_SAMPLES] = std::array::from_fn(|i| {
                 let t = i as f64 / (SPAN_SAMPLES - 1) as f64;
-                curve.eval(w[0] + (w[1] - w[0]) * t)
+                w[0] + (w[1] - w[0]) * t
             });
+            let e: [Eval; SPAN_SAMPLES] = std::array::from_fn(|i| match last {
+                Some((at, e)) if i == 0 && at.to_bits() == u[0].to_bits() => e,
+                _ => curve.eval(u[i]),
+            });
+            last = Some((u[SPAN_SAMPLES - 1], e[SPAN_SAMPLES - 1]));
             samples.push(std::array::from_fn(|i| e[i].curvature()));
             points.push(std::array::from_fn(|i| e[i].p));
         }
