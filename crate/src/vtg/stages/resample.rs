@@ -319,6 +319,13 @@ pub(crate) struct CurvatureIndex {
 /// Samples per span (its ends included).
 const SPAN_SAMPLES: usize = 6;
 
+/// The parameter of sample `j` of the span `s0..s1`: where [`CurvatureIndex::new`] evaluates
+/// it and where its lookups place it, one formula for both.
+#[inline]
+fn sample_param(s0: f64, s1: f64, j: usize) -> f64 {
+    s0 + (s1 - s0) * (j as f64 / (SPAN_SAMPLES - 1) as f64)
+}
+
 impl CurvatureIndex {
     /// Samples every span of `curve`.
     pub(crate) fn new(curve: &Curve) -> Self {
@@ -335,10 +342,7 @@ impl CurvatureIndex {
         // same to the bit (nearly always): evaluated once, a sixth of the index's evaluations.
         let mut last: Option<(f64, Eval)> = None;
         for w in breaks.windows(2) {
-            let u: [f64; SPAN_SAMPLES] = std::array::from_fn(|i| {
-                let t = i as f64 / (SPAN_SAMPLES - 1) as f64;
-                w[0] + (w[1] - w[0]) * t
-            });
+            let u: [f64; SPAN_SAMPLES] = std::array::from_fn(|j| sample_param(w[0], w[1], j));
             let e: [Eval; SPAN_SAMPLES] = std::array::from_fn(|i| match last {
                 Some((at, e)) if i == 0 && at.to_bits() == u[0].to_bits() => e,
                 _ => curve.eval(u[i]),
@@ -399,8 +403,7 @@ impl CurvatureIndex {
     /// The parameter of sample `j` of span `i`, as the lookups place it.
     #[inline]
     fn sample_at(&self, i: usize, j: usize) -> f64 {
-        let (s0, s1) = (self.breaks[i], self.breaks[i + 1]);
-        s0 + (s1 - s0) * j as f64 / (SPAN_SAMPLES - 1) as f64
+        sample_param(self.breaks[i], self.breaks[i + 1], j)
     }
 
     /// Largest curvature on `[a, b]`.
