@@ -6,7 +6,7 @@ use quietpath::analyze::{analyze, AnalyzeOptions, ExtrusionModeOption, LayerSour
 use quietpath::error::Warnings;
 use quietpath::gcode::{apply_edits, for_each_line, Edit, Lines, Strictness};
 use quietpath::machine::{ExtrusionMode, ModeSource};
-use quietpath_conformance::{corpus, CorpusFile};
+use quietpath_conformance::{corpus, fixtures_dir, CorpusFile};
 
 fn file(name_prefix: &str) -> CorpusFile {
     corpus()
@@ -402,4 +402,47 @@ fn the_analysis_counts_the_firmware_figures_a_planning_walk_gives() {
             );
         }
     }
+}
+
+/// The analysis of a file with its estimates refreshed, read off the analysis before the
+/// refresh with its lines moved (what `vtg` hands back instead of analysing its output again),
+/// is, to the bit, a fresh analysis of the refreshed file: on every corpus file and fixture,
+/// refreshed once (the header added) and again (the first header replaced).
+#[test]
+fn the_refreshed_file_s_analysis_is_the_earlier_one_with_its_lines_moved() {
+    use quietpath::analyze::analyze_with_starts;
+    use quietpath::estimate::{analysis_of_refreshed, has_estimates, rewrite_by_clock, Clock};
+    let options = AnalyzeOptions::default();
+    let mut files: Vec<(String, Vec<u8>)> = corpus()
+        .iter()
+        .map(|f| (f.name.clone(), f.read()))
+        .collect();
+    let mut fixtures: Vec<_> = std::fs::read_dir(fixtures_dir().join("gcode"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    fixtures.sort();
+    files.extend(
+        fixtures
+            .iter()
+            .map(|p| (p.display().to_string(), std::fs::read(p).unwrap())),
+    );
+    let mut refreshed = 0;
+    for (name, bytes) in files {
+        let mut file = bytes;
+        for round in 0..2 {
+            if !has_estimates(&file) {
+                break;
+            }
+            let (report, starts) = analyze_with_starts(&file, &options).unwrap();
+            let clock = Clock::from_analysis(&report, starts);
+            let e = rewrite_by_clock(&file, &clock, &["a job".to_string()]);
+            let moved = analysis_of_refreshed(&report, &file, &e.output, &e.moved);
+            let fresh = analyze(&e.output, &options).unwrap();
+            assert!(moved.as_ref() == Some(&fresh), "{name}, round {round}");
+            refreshed += 1;
+            file = e.output;
+        }
+    }
+    assert!(refreshed >= 40, "{refreshed} refreshes");
 }

@@ -569,7 +569,8 @@ fn finish(
             // Where the file carries estimates: `refresh_beside` asks (on a file without any
             // it reads every line).
             if options.estimates && report.output != input {
-                let job = (note.as_str(), kept.as_ref().and_then(|k| k.clock.as_ref()));
+                let clock = kept.as_ref().and_then(|k| k.clock.as_ref());
+                let job = (note.as_str(), clock, Some(&report.after));
                 crate::estimate::refresh_beside(
                     &report.output,
                     &options.analyze,
