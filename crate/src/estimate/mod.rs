@@ -132,28 +132,47 @@ pub fn has_estimates(input: &[u8]) -> bool {
 
 /// [`rewrite_estimates`], and `analyze` of the file it writes: what a job hands back (the
 /// header shifts the lines, so the report is of the written file, not the one before).
+/// `analysis`: `input`'s analysis with `options`, where the caller has it: the written file's
+/// is read off it ([`analysis_of_refreshed`]) instead of a pass of its own.
 pub fn rewrite_and_analyze(
     input: &[u8],
     options: &AnalyzeOptions,
     notes: &[String],
+    analysis: Option<&crate::analyze::Report>,
 ) -> Result<(Estimated, crate::analyze::Report), Error> {
     let e = rewrite_estimates(input, options, notes)?;
-    let after = crate::analyze::analyze(&e.output, options)?;
+    let after = analysis_after(&e, input, options, analysis)?;
     Ok((e, after))
 }
 
+/// The analysis of `e.output`, the file `input` (analysed as `analysis`, where given) with
+/// its estimates refreshed: read off `analysis` where it can be, else a pass of its own.
+fn analysis_after(
+    e: &Estimated,
+    input: &[u8],
+    options: &AnalyzeOptions,
+    analysis: Option<&crate::analyze::Report>,
+) -> Result<crate::analyze::Report, Error> {
+    match analysis.and_then(|a| analysis_of_refreshed(a, input, &e.output, &e.moved)) {
+        Some(after) => Ok(after),
+        None => crate::analyze::analyze(&e.output, options),
+    }
+}
+
 /// What a rewriting job hands back: its output with true estimates and a header naming `job`,
-/// and the output's analysis; `None` when the file carries no estimate to correct (nothing is
+/// and the output's analysis (read off `analysis`, `output`'s own with `options`, where given:
+/// [`rewrite_and_analyze`]); `None` when the file carries no estimate to correct (nothing is
 /// added then).
 pub fn refresh(
     output: &[u8],
     options: &AnalyzeOptions,
     job: &str,
+    analysis: Option<&crate::analyze::Report>,
 ) -> Result<Option<Refreshed>, Error> {
     if !has_estimates(output) {
         return Ok(None);
     }
-    let (e, after) = rewrite_and_analyze(output, options, &[job.to_string()])?;
+    let (e, after) = rewrite_and_analyze(output, options, &[job.to_string()], analysis)?;
     Ok(Some((e.output, after)))
 }
 
@@ -182,6 +201,7 @@ pub fn refresh_beside<T>(
     let moved = analysis.and_then(|a| analysis_of_refreshed(a, output, &e.output, &e.moved));
     let (after, measured) = match moved {
         Some(after) => (after, beside(&e.output)),
+        // The pass [`analysis_after`] would make, beside `beside`.
         None => {
             let (after, measured) = crate::parallel::join(
                 || crate::analyze::analyze(&e.output, options),

@@ -689,7 +689,8 @@ fn with_estimates(
         best.angle_deg,
         best.rotation_deg
     );
-    Ok(crate::estimate::refresh(&output, &options.analyze, &note)?.unwrap_or((output, after)))
+    let refreshed = crate::estimate::refresh(&output, &options.analyze, &note, Some(&after))?;
+    Ok(refreshed.unwrap_or((output, after)))
 }
 
 /// Whether the written file beats the original on the objective, both as `analyze` costs

@@ -141,7 +141,8 @@ impl Stage {
         stages: &[StageReport],
         analyze: &AnalyzeOptions,
     ) -> Result<(EstimateReport, StageReport), Error> {
-        let (e, after) = rewrite_and_analyze(&self.file, analyze, &notes(stages))?;
+        let notes = notes(stages);
+        let (e, after) = rewrite_and_analyze(&self.file, analyze, &notes, Some(&self.report))?;
         let done = format!(
             "{} M73 lines and {} time comments rewritten",
             e.report.progress_lines, e.report.time_comments

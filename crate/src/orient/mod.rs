@@ -297,10 +297,16 @@ pub fn smooth_with_progress(
                     "smooth: tool orientation within a {}° cone",
                     options.cone_deg
                 );
-                if let Some((output, _)) =
-                    crate::estimate::refresh(&report.output, &options.analyze, &note)?
-                {
-                    report.output = output;
+                // The job reports no analysis of its output: the estimates alone, no pass to
+                // analyse the file they are written into.
+                if crate::estimate::has_estimates(&report.output) {
+                    let notes = [note];
+                    let e = crate::estimate::rewrite_estimates(
+                        &report.output,
+                        &options.analyze,
+                        &notes,
+                    )?;
+                    report.output = e.output;
                 }
             }
             Ok(report)
