@@ -18,9 +18,14 @@ fn main() {
     let start = Instant::now();
     let mut last = -1.0;
     let report = quietpath::vtg::vtg_with_progress(&input, &options, &mut |f| {
-        // Progress moves in small steps within a stage: one line per hundredth.
-        if f - last >= 0.01 {
-            println!("{:7.2} s  {:.3}", start.elapsed().as_secs_f64(), f);
+        // Progress moves in small steps within a stage: one line per hundredth, and any step
+        // back (a bar that went back would mislead).
+        let at = start.elapsed().as_secs_f64();
+        if f < last {
+            println!("{at:7.2} s  {f:.3}  back from {last:.3}");
+            last = f;
+        } else if f - last >= 0.01 {
+            println!("{at:7.2} s  {f:.3}");
             last = f;
         }
         true

@@ -454,6 +454,35 @@ fn the_dynamics_model_closes_the_loop() {
     assert!(closed.table2.energy_j.change_pct < 0.0);
 }
 
+/// The progress `vtg` reports never goes back, and ends at 1: on a file whose closed loop
+/// keeps layers as they were over its rounds (the K1 SE accessory) and on one where it tries
+/// its variants and hands the original back (the star). Each attempt of the loop used to
+/// report over a twentieth of the job from where it started, and the next started below where
+/// the last had reached: a progress bar went back from 99 % to 95 %.
+#[test]
+fn vtg_s_progress_never_goes_back() {
+    let files = [
+        corpus_dir().join("crealityprint-4.3.8_k1se_accessory_m82_arcs_exclude-object.gcode"),
+        fixtures_dir().join("gcode/prusaslicer-2.5.0_star_fast_jerk15.gcode"),
+    ];
+    for path in files {
+        let bytes = std::fs::read(&path).unwrap();
+        let mut seen: Vec<f64> = Vec::new();
+        let report = quietpath::vtg::vtg_with_progress(&bytes, &VtgOptions::default(), &mut |f| {
+            seen.push(f);
+            true
+        })
+        .unwrap();
+        let name = path.display();
+        // The closed loop ran: the file's rewrite was simulated and judged.
+        assert!(report.table2.deviation.is_some(), "{name}");
+        let back = seen.windows(2).find(|w| w[1] < w[0]);
+        assert!(back.is_none(), "{name}: {back:?}");
+        assert!(seen.iter().all(|f| (0.0..=1.0).contains(f)), "{name}");
+        assert_eq!(seen.last(), Some(&1.0), "{name}");
+    }
+}
+
 /// `inside_corners` keeps every corner on the inside line: on the thesis triangle, whose infill
 /// tips the racing line rounds with room to spare and the inside line only within loops or not
 /// at all, fewer sharp corners go; both stay within the tolerance. Geometry alone, without the

@@ -75,7 +75,7 @@ pub(super) fn with_simulated_deviation(
         return Ok(kept);
     }
     // Every rewrite tried rings more than the original: the original is handed back.
-    let mut kept = again.report(search::Variant::original(), &[], before, 0.95)?;
+    let mut kept = again.report(search::Variant::original(), &[], before, (0.99, 0.01))?;
     kept.table2.deviation = Some(rows(&b));
     kept.message = Some(handed_back(&b, &best_a));
     Ok(kept)
@@ -228,8 +228,8 @@ fn every_variant(
         if best_score.0 == 0 {
             break;
         }
-        let f = from + step * k as f64;
-        let (report, sim) = again.simulated(variant, &[], best.report.before.clone(), f)?;
+        let span = (from + step * k as f64, step);
+        let (report, sim) = again.simulated(variant, &[], best.report.before.clone(), span)?;
         if report.paths.rewrote_nothing() {
             // The original as it is (every path kept for lines, say): it rings as the original
             // does, which keeps the rule trivially, but it is no rewrite to hand back as one.
@@ -308,8 +308,8 @@ fn raced(
     // from the original's (a file with few rewrites), so they ring there exactly as it does.
     let mut untold = Vec::new();
     for (k, variant) in search::quieter_variants().enumerate() {
-        let f = 0.7 + 0.03 * k as f64;
-        let measured = again.measured(variant, &others, &first.report.before, (f, &sampled))?;
+        let span = (0.7 + 0.03 * k as f64, 0.03);
+        let measured = again.measured(variant, &others, &first.report.before, (span, &sampled))?;
         let Some(a) = measured else {
             break;
         };
@@ -358,16 +358,21 @@ fn handed_back(b: &Deviation, a: &Deviation) -> String {
     )
 }
 
+/// The share of the job's progress a whole-file rewrite of the loop reports over: where it
+/// starts and how wide it is. The loop's attempts take spans one after the other, so that the
+/// progress a user sees never goes back.
+pub(super) type Span = (f64, f64);
+
 /// Whole-file rewrites tried again, as the closed loop asks for them.
 pub(super) trait Again {
     /// The file rewritten as `variant`, the layers `kept` marks left as they are, analysed and
-    /// reported against `before` (the original's analysis); its progress starts at `from`.
+    /// reported against `before` (the original's analysis); its progress over `span`.
     fn report(
         &mut self,
         variant: search::Variant,
         kept: &[bool],
         before: Report,
-        from: f64,
+        span: Span,
     ) -> Result<VtgReport, Error>;
 
     /// [`Again::report`] with the rewrite simulated whole ([`printing_deviation`]) beside its
@@ -377,7 +382,7 @@ pub(super) trait Again {
         variant: search::Variant,
         kept: &[bool],
         before: Report,
-        from: f64,
+        span: Span,
     ) -> Result<(VtgReport, Option<Simulated>), Error>;
 
     /// The same rewrite measured by `measure` alone, not analysed for a report (on the 34 MB
@@ -389,7 +394,7 @@ pub(super) trait Again {
         variant: search::Variant,
         kept: &[bool],
         before: &Report,
-        from_and_measure: (f64, Measure<'_>),
+        span_and_measure: (Span, Measure<'_>),
     ) -> Result<Sampled, Error>;
 }
 
@@ -422,14 +427,18 @@ fn keep_ringing_layers(
     let b = original.deviation;
     let mut kept = vec![false; original.layers.len().max(sim.layers.len())];
     let mut why = Marked::default();
-    for _ in 0..KEEP_ROUNDS {
+    for round in 0..KEEP_ROUNDS {
         let marked = mark_ringing_layers(original, &sim, &mut kept);
         if marked.peak + marked.mean == 0 {
             return Ok(None);
         }
         why.peak += marked.peak;
         why.mean += marked.mean;
-        let (next, a) = again.simulated(variant, &kept, before.clone(), 0.95)?;
+        // The rounds share the job's progress from 0.95 to 0.99 (the original handed back,
+        // where none keeps the rule, takes the rest).
+        let width = 0.04 / KEEP_ROUNDS as f64;
+        let span = (0.95 + width * round as f64, width);
+        let (next, a) = again.simulated(variant, &kept, before.clone(), span)?;
         let Some(a) = a else {
             return Ok(None);
         };

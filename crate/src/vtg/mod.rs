@@ -222,6 +222,14 @@ pub fn vtg_with_progress(
     progress: Progress<'_>,
 ) -> Result<VtgReport, Error> {
     options.validate()?;
+    // The closed loop's attempts report over spans of their own, but how many it makes is
+    // known only as it goes: what the caller sees is the furthest any has reached, so that a
+    // progress bar never goes back.
+    let mut reached = 0.0f64;
+    let progress = &mut |f: f64| {
+        reached = reached.max(f);
+        progress(reached)
+    };
     let cancelled = || Error::new(0, 0, ErrorKind::Cancelled);
     let Original {
         before,
@@ -485,7 +493,7 @@ impl Run<'_> {
 }
 
 /// The closed loop's rewrites of one file ([`closed_loop::Again`]), each reporting its progress
-/// as a twentieth of the job's from where the loop says.
+/// over the span of the job's the loop gives it.
 struct Retry<'r, 'p> {
     run: &'r Run<'r>,
     progress: Progress<'p>,
@@ -497,9 +505,9 @@ impl closed_loop::Again for Retry<'_, '_> {
         variant: search::Variant,
         kept: &[bool],
         before: Report,
-        from: f64,
+        (from, width): closed_loop::Span,
     ) -> Result<VtgReport, Error> {
-        let progress = &mut |g| (self.progress)(from + 0.05 * g);
+        let progress = &mut |g| (self.progress)(from + width * g);
         self.run.report((variant, kept), before, progress)
     }
 
@@ -508,14 +516,14 @@ impl closed_loop::Again for Retry<'_, '_> {
         variant: search::Variant,
         kept: &[bool],
         before: Report,
-        from: f64,
+        (from, width): closed_loop::Span,
     ) -> Result<(VtgReport, Option<closed_loop::Simulated>), Error> {
         // The split of a long print's run depends on the original alone: a rewrite plans within
         // a percent of its time, and its own is known only once the analysis beside it is done.
         let expected_s = before.time_s;
         let options = self.run.options;
         let simulate = |output: &[u8]| closed_loop::printing_deviation(output, expected_s, options);
-        let progress = &mut |g| (self.progress)(from + 0.05 * g);
+        let progress = &mut |g| (self.progress)(from + width * g);
         (self.run).attempt((variant, kept), before, (progress, &simulate))
     }
 
@@ -524,13 +532,13 @@ impl closed_loop::Again for Retry<'_, '_> {
         variant: search::Variant,
         kept: &[bool],
         before: &Report,
-        (from, measure): (f64, closed_loop::Measure<'_>),
+        ((from, width), measure): (closed_loop::Span, closed_loop::Measure<'_>),
     ) -> Result<closed_loop::Sampled, Error> {
         let progress = &mut *self.progress;
         let (rewritten, measured) =
             self.run
                 .rewrite((variant, kept), before, Some(measure), &mut |g| {
-                    progress(from + 0.05 * g)
+                    progress(from + width * g)
                 })?;
         Ok(match measured {
             Some((_, _, Some(sampled))) => sampled,
