@@ -215,21 +215,25 @@ pub fn vtg(input: &[u8], options: &VtgOptions) -> Result<VtgReport, Error> {
     vtg_with_progress(input, options, &mut |_| true)
 }
 
-/// [`vtg`] with progress reports (fraction done; return `false` to cancel).
+/// [`vtg`] with progress reports (fraction done; return `false` to cancel). The fraction never
+/// goes back: the closed loop's attempts report over spans of their own, but how many it makes
+/// is known only as it goes, so the caller sees the furthest any has reached.
 pub fn vtg_with_progress(
     input: &[u8],
     options: &VtgOptions,
     progress: Progress<'_>,
 ) -> Result<VtgReport, Error> {
     options.validate()?;
-    // The closed loop's attempts report over spans of their own, but how many it makes is
-    // known only as it goes: what the caller sees is the furthest any has reached, so that a
-    // progress bar never goes back.
-    let mut reached = 0.0f64;
-    let progress = &mut |f: f64| {
-        reached = reached.max(f);
-        progress(reached)
-    };
+    let mut furthest = crate::progress::Furthest::new(progress);
+    rewrite_file(input, options, &mut |f| furthest.report(f))
+}
+
+/// [`vtg_with_progress`] once the options are checked.
+fn rewrite_file(
+    input: &[u8],
+    options: &VtgOptions,
+    progress: Progress<'_>,
+) -> Result<VtgReport, Error> {
     let cancelled = || Error::new(0, 0, ErrorKind::Cancelled);
     let Original {
         before,
