@@ -359,8 +359,9 @@ fn handed_back(b: &Deviation, a: &Deviation) -> String {
 }
 
 /// The share of the job's progress a whole-file rewrite of the loop reports over: where it
-/// starts and how wide it is. The loop's attempts take spans one after the other, so that the
-/// progress a user sees never goes back.
+/// starts and how wide it is. The loop's attempts take spans one after the other; where more
+/// variants are written whole than their spans allow for, [`super::vtg_with_progress`] still
+/// reports only the furthest fraction reached.
 pub(super) type Span = (f64, f64);
 
 /// Whole-file rewrites tried again, as the closed loop asks for them.
