@@ -344,18 +344,29 @@ fn to_write_whole(
 /// Why the original is handed back: the quietest rewrite's deviation `a` against the
 /// original's `b`.
 fn handed_back(b: &Deviation, a: &Deviation) -> String {
-    let change = |before: f64, after: f64| {
-        format!(
-            "{:+.1} % ({before:.4} → {after:.4} mm)",
-            (after / before - 1.0) * 100.0
-        )
-    };
     format!(
         "kept the original: the quietest rewrite tried changed the dynamics model's mean \
          deviation by {} and its peak by {}, and neither may rise",
         change(b.mean, a.mean),
         change(b.max, a.max)
     )
+}
+
+/// A deviation's change from `before` to `after` (mm), as a percentage and both figures, with
+/// the digits it takes to tell them apart: a rewrite refused for a mean that rose by a
+/// millionth must not read "+0.0 % (0.0161 → 0.0161 mm)", as if nothing had changed.
+fn change(before: f64, after: f64) -> String {
+    let pct = (after / before - 1.0) * 100.0;
+    let pct_digits = if pct == 0.0 || !pct.is_finite() || pct.abs() >= 0.05 {
+        1
+    } else {
+        // Two significant digits.
+        ((-pct.abs().log10()).ceil() as usize + 1).min(12)
+    };
+    let mm_digits = (4..12)
+        .find(|&d| format!("{before:.d$}") != format!("{after:.d$}"))
+        .unwrap_or(4);
+    format!("{pct:+.pct_digits$} % ({before:.mm_digits$} → {after:.mm_digits$} mm)")
 }
 
 /// The share of the job's progress a whole-file rewrite of the loop reports over: where it
@@ -628,6 +639,18 @@ mod tests {
             },
             layers,
         }
+    }
+
+    #[test]
+    fn a_change_is_written_with_the_digits_that_tell_it_apart() {
+        assert_eq!(change(0.0246, 0.0281), "+14.2 % (0.0246 → 0.0281 mm)");
+        assert_eq!(change(0.5, 0.5), "+0.0 % (0.5000 → 0.5000 mm)");
+        // A mean that rose by two parts in a million.
+        assert_eq!(
+            change(0.0160749, 0.01607493),
+            "+0.00019 % (0.01607490 → 0.01607493 mm)"
+        );
+        assert_eq!(change(0.4, 0.399), "-0.2 % (0.4000 → 0.3990 mm)");
     }
 
     #[test]
