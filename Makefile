@@ -8,7 +8,7 @@ export PATH := $(CURDIR)/node_modules/.bin:$(HOME)/.cargo/bin:$(PATH)
 CORPUS ?= $(CURDIR)/../shared/corpus
 LARGE := $(CORPUS)/curaengine-4.13.0_extruder-idler-x2.5_large.gcode
 
-.PHONY: all setup setup-test pkg wasm-plain wasm-web wasm-web-threads wasm-node wasm-bundler serve test typecheck test-rust test-js fuzz-smoke lint cli bench measurements measure-vtg-w16 measure-vtg-unseen fuzz clean
+.PHONY: all setup setup-test pkg wasm-plain wasm-web wasm-web-threads wasm-node wasm-bundler serve test typecheck test-rust test-js fuzz-smoke lint cli bench measurements measure-vtg-w16 measure-vtg-unseen measure-vtg-fresh fuzz clean
 
 all: pkg cli
 
@@ -132,6 +132,11 @@ measure-vtg-w16: cli
 ## run to run: UNSEEN_KEEP=DIR keeps them, UNSEEN_SLICES=DIR measures kept ones again.
 measure-vtg-unseen: cli
 	bash scripts/vtg-unseen-parts.sh
+
+## Two more unseen models sliced eight more ways, each vtg output checked by analyze and
+## vibration runs of its own, not by vtg's report (scripts/vtg-fresh-parts.sh; about 1 min).
+measure-vtg-fresh: cli
+	bash scripts/vtg-fresh-parts.sh
 
 ## Short, reproducible (seeded, fixed-count) cargo-fuzz run of every target: a nightly build of
 ## about 3 minutes, so `make test` runs the same checks on mutated seeds on stable instead
