@@ -29,9 +29,9 @@ pub struct Args {
     #[arg(long)]
     pub no_dynamics: bool,
     /// Write runs of new points that lie on a circle as arcs (G2/G3): fewer lines. auto:
-    /// where the firmware runs them (the file has arcs already; Marlin, RepRapFirmware and
-    /// Smoothieware flavours; Klipper only with [gcode_arcs] in --klipper-config). `--arcs`
-    /// alone is `on`.
+    /// where the firmware runs them (the file has arcs already; Marlin, RepRapFirmware,
+    /// Smoothieware and Repetier flavours; Klipper only with [gcode_arcs] in
+    /// --klipper-config). `--arcs` alone is `on`.
     #[arg(long, value_enum, value_name = "WHEN", num_args = 0..=1, default_value = "auto", default_missing_value = "on")]
     pub arcs: ArcsArg,
     /// Print time the rewrite may add to round corners that cost time, percent of the

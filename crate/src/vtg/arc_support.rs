@@ -12,9 +12,10 @@ use crate::plan::JunctionModel;
 #[serde(rename_all = "snake_case")]
 pub enum ArcsMode {
     /// Where the firmware runs them: a file that already has arcs; Marlin (its default
-    /// configuration enables `ARC_SUPPORT`, and Prusa's firmware has them), RepRapFirmware and
-    /// Smoothieware; Klipper only with `[gcode_arcs]` in the printer config given (Klipper
-    /// lacks them unless configured).
+    /// configuration enables `ARC_SUPPORT`, and Prusa's firmware has them), RepRapFirmware,
+    /// Smoothieware and Repetier-Firmware (its shipped configurations set `ARC_SUPPORT 1`);
+    /// Klipper only with `[gcode_arcs]` in the printer config given (Klipper lacks them unless
+    /// configured).
     #[default]
     Auto,
     /// Always.
@@ -56,7 +57,7 @@ impl ArcsMode {
 fn arc_capable_flavor(flavor: Option<&str>) -> bool {
     let Some(f) = flavor else { return false };
     let f = f.to_ascii_lowercase();
-    ["marlin", "reprap", "rrf", "smoothie", "prusa"]
+    ["marlin", "reprap", "rrf", "smoothie", "prusa", "repetier"]
         .iter()
         .any(|k| f.contains(k))
 }
@@ -113,6 +114,8 @@ mod tests {
     fn flavours() {
         assert!(arc_capable_flavor(Some("marlin2")));
         assert!(arc_capable_flavor(Some("RepRapFirmware")));
+        assert!(arc_capable_flavor(Some("repetier")));
+        assert!(!arc_capable_flavor(Some("teacup")));
         assert!(!arc_capable_flavor(Some("klipper")));
         assert!(!arc_capable_flavor(None));
     }

@@ -92,8 +92,8 @@ pub struct VtgOptions {
     pub dynamics: bool,
     /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`) to cut the line
     /// count: `auto` (default) where the firmware runs them ([`ArcsMode::Auto`]: a file that
-    /// already has arcs, Marlin, RepRapFirmware and Smoothieware flavours, Klipper only with
-    /// `[gcode_arcs]` in the printer config given), `on` or `off`.
+    /// already has arcs, Marlin, RepRapFirmware, Smoothieware and Repetier flavours, Klipper
+    /// only with `[gcode_arcs]` in the printer config given), `on` or `off`.
     pub arcs: ArcsMode,
     /// Print time the rewrite may add to round corners that cost time, percent of the
     /// original's (default [`DEFAULT_ALLOW_SLOWER_PCT`], the bar). On a machine whose

@@ -2938,8 +2938,8 @@ export type VtgOptions = Partial<{
   /**
    * Write runs of new points that lie on a circle as arcs (`G2`/`G3`) to cut the line
    * count: `auto` (default) where the firmware runs them ([`ArcsMode::Auto`]: a file that
-   * already has arcs, Marlin, RepRapFirmware and Smoothieware flavours, Klipper only with
-   * `[gcode_arcs]` in the printer config given), `on` or `off`.
+   * already has arcs, Marlin, RepRapFirmware, Smoothieware and Repetier flavours, Klipper
+   * only with `[gcode_arcs]` in the printer config given), `on` or `off`.
    */
   arcs: ArcsMode,
   /**
