@@ -20,11 +20,7 @@ for tool in openscad prusa-slicer slic3r CuraEngine python3; do
 done
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-resources=/usr/share/cura/resources
-if [ ! -f "$resources/definitions/fdmprinter.def.json" ]; then
-  (cd "$work" && apt-get download cura >/dev/null 2>&1 && dpkg -x cura_*.deb cura)
-  resources="$work/cura/usr/share/cura/resources"
-fi
+resources="$("$root/scripts/cura-resources.sh" "$work")"
 export CURA_ENGINE_SEARCH_PATH="$resources/definitions:$resources/extruders"
 for model in manifold comb; do
   "$root/scripts/openscad-stl.sh" "$work/$model.stl" "$root/tests/fixtures/models/unseen/$model.scad"

@@ -46,11 +46,7 @@ mkdir -p "$work"
 # Renders and slices every part into $work, adding the slices to `files` (the body is not
 # indented: the PrusaSlicer start G-code below is a string across lines).
 slice_all() {
-resources=/usr/share/cura/resources
-if [ ! -f "$resources/definitions/fdmprinter.def.json" ]; then
-  (cd "$scratch" && apt-get download cura >/dev/null 2>&1 && dpkg -x cura_*.deb cura)
-  resources="$scratch/cura/usr/share/cura/resources"
-fi
+resources="$("$root/scripts/cura-resources.sh" "$scratch")"
 export CURA_ENGINE_SEARCH_PATH="$resources/definitions:$resources/extruders"
 
 for model in gear hexgrid tall_fins; do

@@ -10,11 +10,7 @@ set -euo pipefail
 cd "$(dirname "$0")"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-resources=/usr/share/cura/resources
-if [ ! -f "$resources/definitions/fdmprinter.def.json" ]; then
-  (cd "$tmp" && apt-get download cura >/dev/null 2>&1 && dpkg -x cura_*.deb cura)
-  resources="$tmp/cura/usr/share/cura/resources"
-fi
+resources="$(../../../scripts/cura-resources.sh "$tmp")"
 export CURA_ENGINE_SEARCH_PATH="$resources/definitions:$resources/extruders"
 echo 'difference() { cube([20, 14, 2]); translate([10, 7, -1]) cylinder(r = 2.5, h = 4, $fn = 48); }' > "$tmp/plate.scad"
 openscad -o "$tmp/plate.stl" "$tmp/plate.scad" 2>/dev/null
