@@ -1,5 +1,6 @@
-//! Paths without sharp corners written with arcs where the firmware runs them, to pay in lines
-//! for the corners rounded elsewhere (the file's line budget, [`super::budget`]).
+//! Paths without sharp corners written with fewer lines, to pay for the corners rounded
+//! elsewhere (the file's line budget, [`super::budget`]): with arcs where the firmware runs
+//! them, and with nearly collinear lines joined ([`super::straights`]) everywhere.
 //!
 //! A slicer writes a curved wall as a chain of short chords; ArcWelder's observation is that
 //! most of those chains lie on circles within a few hundredths of a millimetre and can be sent
@@ -9,7 +10,8 @@
 //! is offered as a rewrite that removes no corners and saves lines, written only where the
 //! budget needs its lines and the time and energy other rewrites save pay for what it costs
 //! through the firmware's own arc cutting (a little either way), and that stays within the
-//! tolerance of the original both ways.
+//! tolerance of the original both ways. Where no run lies on a circle, or the firmware runs no
+//! arcs, chains of lines that bend by less than the same share are joined instead.
 
 use super::budget::Outcome;
 use super::rewrite::{edits, fit_arcs, lines_added, notes, PlanContext, Polyline, Rewritten};
@@ -19,8 +21,9 @@ use crate::vtg::smooth::Settings;
 use crate::vtg::source::MoveSource;
 use crate::vtg::tuning::TUNING;
 
-/// The path `run` (its lines `src`) with its runs on a circle written as arcs, if that saves
-/// lines; what it adds in time and energy comes with it, for the budget to pay.
+/// The path `run` (its lines `src`) with its runs on a circle written as arcs where
+/// `settings.arcs`, and its nearly collinear lines joined, if that saves lines; what it adds in
+/// time and energy comes with it, for the budget to pay.
 pub(super) fn compact_path(
     input: &[u8],
     run: &[PathMove],
@@ -31,7 +34,18 @@ pub(super) fn compact_path(
     let o = Polyline::of(run, src)?;
     let (pts, e, feed) = (&o.pts, &o.e, &o.feed);
     let fit = TUNING.compact_share * settings.tolerance_mm;
-    let (pieces, deviation) = fit_arcs((pts, feed), fit, (pts, 0.0), settings, machine)?;
+    let arcs = settings
+        .arcs
+        .then(|| fit_arcs((pts, feed), fit, (pts, 0.0), settings, machine))
+        .flatten();
+    let (pieces, deviation) = arcs.unwrap_or_else(|| (crate::vtg::arcs::lines(feed), 0.0));
+    // Arcs are fitted within `fit` of the path and joined lines stay within `fit` of theirs,
+    // on separate stretches: the larger of the two bounds the whole (both ways).
+    let (pieces, joined) = super::straights::joined(pts, e, &pieces, fit);
+    let deviation = deviation.max(joined);
+    if pieces.len() >= run.len() {
+        return None;
+    }
     let original = machine.cost(pts[0], &pts[1..], &e[1..], feed);
     let (s, j) = machine.cost_pieces(pts[0], &pts[1..], &e[1..], &pieces);
     if !(s.is_finite() && j.is_finite()) {

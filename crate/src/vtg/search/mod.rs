@@ -29,6 +29,7 @@ mod compact;
 pub(crate) mod rewrite;
 pub(crate) mod smooth;
 pub(crate) mod smoothings;
+pub(crate) mod straights;
 
 /// What a whole-file rewrite is tried with; [`crate::vtg::vtg`] tries others where the dynamics
 /// model finds the first one ringing more than the original.

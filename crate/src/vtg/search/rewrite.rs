@@ -178,8 +178,9 @@ pub(crate) fn offers(
     );
     let cos_critical = crate::math::cos(settings.critical_rad);
     // The candidates first (cheap), then the paths rewritten ([`Offering::offer_all`]).
-    // Where arcs are written, the paths without sharp corners too: they can save lines.
-    let mut candidates = candidates(moves, sources, cos_critical, settings.arcs);
+    // The paths without sharp corners too: written with arcs, or their nearly collinear lines
+    // joined, they can save lines.
+    let mut candidates = candidates(moves, sources, cos_critical);
     // Layers kept as they are (where a rewrite rang above the original's peak).
     candidates.retain(|&(i, _, _)| {
         let layer = moves.get(i).map_or(u32::MAX, |m| m.layer) as usize;
@@ -256,13 +257,12 @@ fn file_settings(
 }
 
 /// The paths worth rewriting, as move ranges `i..j` and whether they have a sharp corner:
-/// those that do, and with `plain` those of at least [`arcs::MIN_SEGMENTS`] moves that do not
-/// (written with arcs, they save lines).
+/// those that do, and those of at least two moves that do not (written with arcs or their
+/// lines joined, they save lines: [`super::compact`]).
 fn candidates(
     moves: &[PathMove],
     sources: &[MoveSource],
     cos_critical: f64,
-    plain: bool,
 ) -> Vec<(usize, usize, bool)> {
     let mut candidates = Vec::new();
     let mut i = 0usize;
@@ -274,7 +274,7 @@ fn candidates(
         let run = &moves[i..j];
         if run.len() >= 2 && has_sharp_corner(run, cos_critical) {
             candidates.push((i, j, true));
-        } else if plain && run.len() >= arcs::MIN_SEGMENTS {
+        } else if run.len() >= 2 {
             candidates.push((i, j, false));
         }
         i = j;
