@@ -329,10 +329,15 @@ fn raced(
 /// may still ring more whole, and the next be the one that keeps it); where none does, the
 /// quietest if it rings less there than the first rewrite (`first`).
 fn to_write_whole(
-    mut ranked: Vec<((u8, f64), search::Variant)>,
-    first: (u8, f64),
+    mut ranked: Vec<(Quietness, search::Variant)>,
+    first: Quietness,
 ) -> Vec<search::Variant> {
-    ranked.sort_by(|x, y| x.0 .0.cmp(&y.0 .0).then(x.0 .1.total_cmp(&y.0 .1)));
+    ranked.sort_by(|x, y| {
+        let ((rose_x, peak_x, mean_x), (rose_y, peak_y, mean_y)) = (x.0, y.0);
+        (rose_x, peak_x)
+            .cmp(&(rose_y, peak_y))
+            .then(mean_x.total_cmp(&mean_y))
+    });
     let passing: Vec<_> = ranked.iter().filter(|r| r.0 .0 == 0).map(|r| r.1).collect();
     if !passing.is_empty() {
         return passing;
@@ -416,8 +421,13 @@ pub(super) type Measure<'m> = search::Beside<'m, Sampled>;
 /// A race's trial simulated on the sample ([`on_sample`]), `None` where the model cannot run.
 pub(super) type Sampled = Option<Deviation>;
 
-/// Rounds of [`keep_ringing_layers`].
-const KEEP_ROUNDS: usize = 3;
+/// Rounds of [`keep_ringing_layers`]. The mean is settled in the first round or two; the rest
+/// are for a peak that a kept layer still reaches by a few nanometres: where the model's 1 ms
+/// steps fall on that layer depends on when the rewritten layers before it end, so each round
+/// that keeps more of them is another placement of its samples as much as a quieter start (on
+/// the 34 MB corpus file, with lines joined, the fourth round kept the layer and the 15 before
+/// it and read 38 nm under the original's peak, after 2 and 39 nm over).
+const KEEP_ROUNDS: usize = 5;
 
 /// The share of the original's mean deviation the layers kept by [`mark_ringing_layers`] aim
 /// to bring the rewrite's under: a layer kept as it was starts from the ringing the layer
@@ -440,7 +450,7 @@ fn keep_ringing_layers(
     let mut kept = vec![false; original.layers.len().max(sim.layers.len())];
     let mut why = Marked::default();
     for round in 0..KEEP_ROUNDS {
-        let marked = mark_ringing_layers(original, &sim, &mut kept);
+        let marked = mark_ringing_layers(original, &sim, &mut kept, round);
         if marked.peak + marked.mean == 0 {
             return Ok(None);
         }
@@ -476,8 +486,11 @@ fn keep_ringing_layers(
 /// max row). The layer where the original peaked is kept with the layer before it: kept alone,
 /// it starts from the rewritten layer's ringing and reaches above that peak again (on the 34 MB
 /// corpus file 0.011 % above, which cost a round of 3–4 s). A layer kept already that still
-/// rings above it starts from the ringing the rewritten layer before it left (its own moves are
-/// the original's): the nearest layer before it not kept yet is kept instead.
+/// rings above it starts from the ringing the rewritten layers before it left (its own moves
+/// are the original's): the nearest layers before it not kept yet are kept instead, two in the
+/// second round (`round` 1), then twice as many each round, since through a nearly undamped
+/// mode the ringing it starts with carries every earlier layer's (on the 34 MB file, with one
+/// more a round, three rounds ended 2 nm above the original's peak).
 ///
 /// The mean: the file's mean deviation is Σ sums / Σ samples over its layers, so it is at most
 /// the original's mean `m` exactly when Σ (sum − m · samples) ≤ 0. Each layer's share of that
@@ -485,7 +498,12 @@ fn keep_ringing_layers(
 /// keeping it gives back; the layers that give back most are kept first, until the total is
 /// [`MEAN_MARGIN`] of `m` under zero. A layer that rings less rewritten is never kept for the
 /// mean, so the rest of the file keeps its rounded corners.
-fn mark_ringing_layers(original: &Simulated, sim: &Simulated, kept: &mut [bool]) -> Marked {
+fn mark_ringing_layers(
+    original: &Simulated,
+    sim: &Simulated,
+    kept: &mut [bool],
+    round: usize,
+) -> Marked {
     let b = original.deviation;
     let excess = |s: &Simulated, l: usize| {
         s.layers
@@ -503,24 +521,9 @@ fn mark_ringing_layers(original: &Simulated, sim: &Simulated, kept: &mut [bool])
         0.0
     };
     let mut marked = Marked::default();
-    for l in 0..kept.len() {
-        if !sim.layers.get(l).is_some_and(|r| r.peak > b.max) {
-            continue;
-        }
-        // The layer itself, or the nearest before it not kept yet; with the one before it
-        // where the original peaked in it.
-        let loudest = original.layers.get(l).is_some_and(|r| r.peak >= b.max);
-        let last_unkept = |kept: &[bool], to: usize| (0..to).rev().find(|&k| !kept[k]);
-        let first = last_unkept(kept, l + 1);
-        let second = match first {
-            Some(k) if k == l && loudest => last_unkept(kept, l),
-            _ => None,
-        };
-        for k in [first, second].into_iter().flatten() {
-            kept[k] = true;
-            marked.peak += 1;
-            total -= gain(k);
-        }
+    for k in mark_for_peak(original, sim, kept, round) {
+        marked.peak += 1;
+        total -= gain(k);
     }
     let mut candidates: Vec<(f64, usize)> = (0..kept.len())
         .filter(|&l| !kept[l])
@@ -535,6 +538,35 @@ fn mark_ringing_layers(original: &Simulated, sim: &Simulated, kept: &mut [bool])
         kept[l] = true;
         marked.mean += 1;
         total -= g;
+    }
+    marked
+}
+
+/// Marks in `kept` the layers [`mark_ringing_layers`] keeps for the peak, and returns them.
+fn mark_for_peak(
+    original: &Simulated,
+    sim: &Simulated,
+    kept: &mut [bool],
+    round: usize,
+) -> Vec<usize> {
+    let b = original.deviation;
+    let mut marked = Vec::new();
+    for l in 0..kept.len() {
+        if !sim.layers.get(l).is_some_and(|r| r.peak > b.max) {
+            continue;
+        }
+        // The layer itself, with the one before it where the original peaked in it; or, kept
+        // already, the nearest before it not kept yet, more each round.
+        let loudest = original.layers.get(l).is_some_and(|r| r.peak >= b.max);
+        let count = match kept[l] {
+            false => 1 + usize::from(loudest),
+            true => 1usize << round.min(16),
+        };
+        let nearest: Vec<usize> = (0..=l).rev().filter(|&k| !kept[k]).take(count).collect();
+        for k in nearest {
+            kept[k] = true;
+            marked.push(k);
+        }
     }
     marked
 }
@@ -607,11 +639,21 @@ fn vibration_options(options: &VtgOptions) -> crate::dynamics::VibrationOptions 
 
 /// How a rewrite's simulated deviation `a` compares with the original's `b`, lower is
 /// quieter: first how many of the two figures the no-dearer rule checks rose (the mean, and
-/// the peak: VTG Table 2's max row, which the paper's VTG lowers by 19 %), then the mean.
-fn quietness(b: &Deviation, a: &Deviation) -> (u8, f64) {
-    let rose = u8::from(a.mean >= b.mean) + u8::from(a.max > b.max);
-    (rose, a.mean)
+/// the peak: VTG Table 2's max row, which the paper's VTG lowers by 19 %), then whether the
+/// peak is one of them, then the mean. Of two rewrites that each raise one figure, the one
+/// that raises only the mean is nearer the rule: keeping the layers that raised it most brings
+/// a mean down reliably ([`keep_ringing_layers`]), while a peak a hair above the original's
+/// depends on the timing of everything printed before it (on the K1 SE accessory, a variant
+/// 0.012 % over the peak with the mean 0.4 % under failed three rounds, where the first
+/// rewrite, its peak 10 % under and its mean 0.5 % over, is what rounds can mend).
+fn quietness(b: &Deviation, a: &Deviation) -> Quietness {
+    let peak_rose = a.max > b.max;
+    let rose = u8::from(a.mean >= b.mean) + u8::from(peak_rose);
+    (rose, peak_rose, a.mean)
 }
+
+/// [`quietness`]: figures risen, the peak among them, the mean (mm).
+type Quietness = (u8, bool, f64);
 
 #[cfg(test)]
 mod tests {
@@ -662,23 +704,44 @@ mod tests {
         // Two pass on the sample (no figure rose), the quieter first; one that raised the peak
         // is not written while any passes.
         let ranked = vec![
-            ((1, 0.010), v(1.5)),
-            ((0, 0.014), v(2.0)),
-            ((0, 0.012), v(3.0)),
+            ((1, true, 0.010), v(1.5)),
+            ((0, false, 0.014), v(2.0)),
+            ((0, false, 0.012), v(3.0)),
         ];
-        let order: Vec<f64> = to_write_whole(ranked, (1, 0.02))
+        let order: Vec<f64> = to_write_whole(ranked, (1, false, 0.02))
             .iter()
             .map(|x| x.feed_cap_scale)
             .collect();
         assert_eq!(order, [3.0, 2.0]);
         // None passes: the quietest alone, where it rings less than the first rewrite did.
-        let ranked = vec![((1, 0.012), v(1.5)), ((2, 0.011), v(2.0))];
-        let chosen = to_write_whole(ranked.clone(), (1, 0.013));
+        let ranked = vec![((1, false, 0.012), v(1.5)), ((2, true, 0.011), v(2.0))];
+        let chosen = to_write_whole(ranked.clone(), (1, false, 0.013));
         assert_eq!(
             chosen.iter().map(|x| x.feed_cap_scale).collect::<Vec<_>>(),
             [1.5]
         );
-        assert!(to_write_whole(ranked, (1, 0.012)).is_empty());
+        assert!(to_write_whole(ranked, (1, false, 0.012)).is_empty());
+    }
+
+    #[test]
+    fn a_rewrite_that_raises_only_the_mean_is_quieter_than_one_that_raises_the_peak() {
+        let d = |max: f64, mean: f64| Deviation {
+            max,
+            min: 0.0,
+            mean,
+            max_at: [0.0; 3],
+            samples: 1000,
+        };
+        let original = d(1.5747, 0.10629);
+        // The K1 SE accessory's first rewrite and its quietest variant by the mean alone.
+        let mean_over = quietness(&original, &d(1.4099, 0.10679));
+        let peak_over = quietness(&original, &d(1.5748, 0.10589));
+        assert_eq!((mean_over.0, peak_over.0), (1, 1));
+        assert!(mean_over < peak_over);
+        // Either is quieter than a rewrite that raises both, and none than one raising neither.
+        assert!(peak_over < quietness(&original, &d(1.58, 0.10630)));
+        assert!(quietness(&original, &d(1.5, 0.2)) > quietness(&original, &d(1.5, 0.1)));
+        assert_eq!(quietness(&original, &d(1.5, 0.1)).0, 0);
     }
 
     #[test]
@@ -688,28 +751,48 @@ mod tests {
         let rewrite = simulated(&[(0.4, 0.015, 1000), (0.6, 0.018, 1000), (0.2, 0.015, 1000)]);
         let mut kept = vec![false; 3];
         assert_eq!(
-            mark_ringing_layers(&original, &rewrite, &mut kept),
+            mark_ringing_layers(&original, &rewrite, &mut kept, 0),
             Marked { peak: 1, mean: 0 }
         );
         assert_eq!(kept, [false, true, false]);
         // Nothing left to mark once it is kept and the rewrite rings so.
         let again = simulated(&[(0.4, 0.015, 1000), (0.4, 0.02, 1000), (0.2, 0.015, 1000)]);
         assert_eq!(
-            mark_ringing_layers(&original, &again, &mut kept.clone()),
+            mark_ringing_layers(&original, &again, &mut kept.clone(), 1),
             Marked::default()
         );
         // Kept, it still rings above the peak: the ringing comes from the layer before it,
         // which is kept too; with every layer before it kept, there is nothing left to mark.
         let carried = simulated(&[(0.4, 0.015, 1000), (0.55, 0.02, 1000), (0.2, 0.015, 1000)]);
         assert_eq!(
-            mark_ringing_layers(&original, &carried, &mut kept),
+            mark_ringing_layers(&original, &carried, &mut kept, 1),
             Marked { peak: 1, mean: 0 }
         );
         assert_eq!(kept, [true, true, false]);
         assert_eq!(
-            mark_ringing_layers(&original, &carried, &mut kept),
+            mark_ringing_layers(&original, &carried, &mut kept, 1),
             Marked::default()
         );
+    }
+
+    #[test]
+    fn a_kept_layer_still_above_the_peak_keeps_twice_as_many_before_it_each_round() {
+        // Eight layers; the last one, kept already, still rings above the original's peak.
+        let original = simulated(&[(0.3, 0.02, 1000); 8]);
+        let mut layers = [(0.2, 0.02, 1000); 8];
+        layers[7] = (0.31, 0.02, 1000);
+        let carried = simulated(&layers);
+        let mut kept = [false, false, false, false, false, false, false, true];
+        assert_eq!(
+            mark_ringing_layers(&original, &carried, &mut kept, 1).peak,
+            2
+        );
+        assert_eq!(kept, [false, false, false, false, false, true, true, true]);
+        assert_eq!(
+            mark_ringing_layers(&original, &carried, &mut kept, 2).peak,
+            4
+        );
+        assert_eq!(kept, [false, true, true, true, true, true, true, true]);
     }
 
     #[test]
@@ -720,7 +803,7 @@ mod tests {
         let rewrite = simulated(&[(0.2, 0.015, 1000), (0.52, 0.015, 1000), (0.3, 0.015, 1000)]);
         let mut kept = vec![false; 3];
         assert_eq!(
-            mark_ringing_layers(&original, &rewrite, &mut kept),
+            mark_ringing_layers(&original, &rewrite, &mut kept, 0),
             Marked { peak: 2, mean: 0 }
         );
         assert_eq!(kept, [true, true, false]);
@@ -729,7 +812,7 @@ mod tests {
         let louder = simulated(&[(0.52, 0.015, 1000), (0.2, 0.015, 1000), (0.3, 0.015, 1000)]);
         let mut kept = vec![false; 3];
         assert_eq!(
-            mark_ringing_layers(&first, &louder, &mut kept),
+            mark_ringing_layers(&first, &louder, &mut kept, 0),
             Marked { peak: 1, mean: 0 }
         );
         assert_eq!(kept, [true, false, false]);
@@ -750,7 +833,7 @@ mod tests {
         ]);
         let mut kept = vec![false; 4];
         assert_eq!(
-            mark_ringing_layers(&original, &rewrite, &mut kept),
+            mark_ringing_layers(&original, &rewrite, &mut kept, 0),
             Marked { peak: 0, mean: 1 }
         );
         assert_eq!(kept, [true, false, false, false]);
@@ -763,7 +846,7 @@ mod tests {
         ]);
         let mut none = vec![false; 4];
         assert_eq!(
-            mark_ringing_layers(&original, &quiet, &mut none),
+            mark_ringing_layers(&original, &quiet, &mut none, 0),
             Marked::default()
         );
         assert_eq!(none, [false; 4]);
@@ -777,7 +860,7 @@ mod tests {
         let rewrite = simulated(&[(0.3, 0.021, 1000), (0.3, 0.022, 1000), (0.3, 0.019, 1000)]);
         let mut kept = vec![false; 3];
         assert_eq!(
-            mark_ringing_layers(&original, &rewrite, &mut kept),
+            mark_ringing_layers(&original, &rewrite, &mut kept, 0),
             Marked { peak: 0, mean: 2 }
         );
         assert_eq!(kept, [true, true, false]);
