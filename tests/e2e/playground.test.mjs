@@ -340,8 +340,9 @@ test('the URL hash restores the view on load', async () => {
 
 const cli = process.env.QUIETPATH_CLI ?? path.join(repoRoot, 'target', 'release', 'quietpath');
 const MULTIAXIS = 'multiaxis-xyzbc_zhang-ral2021_model1.gcode';
-/** A small file VTG keeps as it was: rounding any of its corners would add lines. */
-const KEPT_BY_VTG = 'ideamaker-4.2.0_multi-object.gcode';
+/** A small file VTG keeps as it was: rounding any of its corners would add lines (a spiral
+ * vase has no other paths to save them on). */
+const KEPT_BY_VTG = 'prusaslicer-2.7.4_spiral-vase.gcode';
 const JOB_TIMEOUT = 180_000;
 
 // Runs the CLI; returns { ok, json, output (Buffer | null), ms, stderr }.
