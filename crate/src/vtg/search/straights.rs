@@ -11,6 +11,7 @@
 //! wall gets the same plastic where it was even already, and no less where it was not.
 
 use crate::vtg::arcs::Piece;
+use crate::vtg::deviation::point_segment;
 
 /// Largest relative difference in filament per millimetre between lines joined: a hundredth,
 /// well under what a printer's own extrusion varies by, and above the rounding of five-decimal
@@ -30,9 +31,8 @@ const MOST_JOINED: usize = 64;
 pub(crate) fn joined(pts: &[[f64; 3]], e: &[f64], pieces: &[Piece], tol: f64) -> (Vec<Piece>, f64) {
     let mut out: Vec<Piece> = Vec::with_capacity(pieces.len());
     let mut worst = 0.0f64;
-    // The run being joined: where it starts (a point index), its first line's flow, and how
-    // far its inner points are from it.
-    let mut run: Option<(usize, f64, f64)> = None;
+    // The run being joined: where it starts (a point index) and its first line's flow.
+    let mut run: Option<(usize, f64)> = None;
     let mut start = 0usize;
     for piece in pieces {
         let (from, to) = (start, piece.end);
@@ -43,7 +43,7 @@ pub(crate) fn joined(pts: &[[f64; 3]], e: &[f64], pieces: &[Piece], tol: f64) ->
             out.push(*piece);
             continue;
         };
-        let extended = run.and_then(|(s, f0, d)| {
+        let extended = run.and_then(|(s, f0)| {
             let last = out.last()?;
             let fits = last.arc.is_none()
                 && last.feed == piece.feed
@@ -52,18 +52,16 @@ pub(crate) fn joined(pts: &[[f64; 3]], e: &[f64], pieces: &[Piece], tol: f64) ->
             fits.then(|| farthest_inside(pts, s, to))
                 .flatten()
                 .filter(|&far| far <= tol)
-                .map(|far| (s, f0, d.max(far)))
         });
         match extended {
-            Some(joined) => {
+            Some(far) => {
                 if let Some(last) = out.last_mut() {
                     last.end = to;
                 }
-                run = Some(joined);
-                worst = worst.max(joined.2);
+                worst = worst.max(far);
             }
             None => {
-                run = Some((from, flow, 0.0));
+                run = Some((from, flow));
                 out.push(*piece);
             }
         }
@@ -90,21 +88,8 @@ fn farthest_inside(pts: &[[f64; 3]], from: usize, to: usize) -> Option<f64> {
     }
     let inner = pts.get(from + 1..to)?;
     inner.iter().try_fold(0.0f64, |far, p| {
-        level(p).then(|| far.max(distance_to_segment(p, &a, &b)))
+        level(p).then(|| far.max(point_segment(p, &a, &b)))
     })
-}
-
-/// Distance from `p` to the segment `a`–`b`.
-fn distance_to_segment(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    use crate::vec3::{dot, norm, sub};
-    let (d, ap) = (sub(*b, *a), sub(*p, *a));
-    let l2 = dot(d, d);
-    let t = if l2 > 0.0 {
-        (dot(ap, d) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    norm([ap[0] - d[0] * t, ap[1] - d[1] * t, ap[2] - d[2] * t])
 }
 
 #[cfg(test)]
