@@ -16,7 +16,7 @@ use super::simulate::{
 };
 use super::split::{Half, HalfRun};
 use super::timeline::Emit;
-use super::trajectory::{Bounds, Command, Segment};
+use super::trajectory::{Bounds, Clock, Command, Segment};
 use super::welch::Welch;
 use crate::error::Error;
 use crate::path::NO_LAYER;
@@ -46,6 +46,10 @@ impl Default for RunBuffer {
         }
     }
 }
+
+/// The shortest gap between two segments that is a rest rather than rounding, s
+/// ([`Stream::on_grid`]).
+const GAP_S: f64 = 1e-6;
 
 /// Steps between two progress callbacks.
 const PROGRESS_STEPS: u64 = 1 << 20;
@@ -127,6 +131,12 @@ pub struct Stream<'w> {
     steps: Steps,
     primed: bool,
     buffer: Option<Box<RunBuffer>>,
+    /// The clock of the last segment pushed, and its end on the timeline it came from.
+    last_clock: Clock,
+    last_duration_s: f64,
+    timeline_end_s: f64,
+    /// The X/Y velocity the last segment pushed ends at, mm/s.
+    last_exit: [f64; 2],
     /// Whether steps may be taken in runs ([`Stream::run_within`]); tests take them one by one
     /// too, to check that both give the same bits.
     runs: bool,
@@ -183,6 +193,10 @@ impl<'w> Stream<'w> {
             steps: Steps::default(),
             primed: true,
             buffer: Some(Box::default()),
+            last_clock: Clock::default(),
+            last_duration_s: 0.0,
+            timeline_end_s: 0.0,
+            last_exit: [0.0; 2],
             runs: in_runs(),
         }
     }
@@ -208,6 +222,7 @@ impl<'w> Stream<'w> {
         counted: u32,
         progress: Progress<'_>,
     ) -> Result<(), Error> {
+        let seg = self.on_grid(seg);
         self.motion_s += seg.duration_s;
         // Motion beyond the largest budget the run can have: refused now, as the whole list's
         // run would refuse it before its first step.
@@ -227,12 +242,53 @@ impl<'w> Stream<'w> {
         self.window.push_back((seg, counted));
         self.pushed += 1;
         if self.pushed == 1 && self.primed {
-            self.prev = self.at(0.0).0;
+            self.prev = self.at(0).0;
         }
         if !self.primed {
             self.drop_before_start();
         }
         self.advance(None, self.end_s, progress)
+    }
+
+    /// `seg` on the run's clock. Where the table is at rest as it starts (after a dwell or a
+    /// retract, at a lift, from a full stop), it sets off on the next whole step, and
+    /// the segments after it until the next rest are timed from that step by their own
+    /// durations ([`Clock`]). The same moves after a rest are then sampled at the same instants
+    /// of their motion, to the bit, wherever they fall in the print: a layer a rewrite keeps
+    /// as it was rings as it did in the original once the ringing carried into it has died
+    /// away, where before it rang a few tens of nanometres higher or lower as the 1 ms
+    /// samples happened to fall (which decided the closed loop's peak by chance). Physically
+    /// the hold is a rest under one step longer, through which the free response goes on.
+    fn on_grid(&mut self, mut seg: Segment) -> Segment {
+        let ts = self.settings.ts;
+        // Zero where the timeline put the segment straight after the last one: a gap under
+        // a microsecond is the planner's absolute clock rounding (at 25 000 s, a few ps), not
+        // a rest, and would move every sample after it by as much.
+        let gap = seg.start_s - self.timeline_end_s;
+        let gap = if gap > GAP_S { gap } else { 0.0 };
+        self.timeline_end_s = seg.end_s();
+        let previous_end = self.last_clock.from_step as f64 * ts
+            + (self.last_clock.after_s + self.last_duration_s);
+        let rest_step = (previous_end + gap) / ts;
+        // At rest between the two: a dwell or a move the timeline does not hold (a gap), a
+        // full stop, or a segment that starts still (a lift; from zero speed).
+        let at_rest = gap > 0.0 || self.last_exit == [0.0; 2] || seg.command(0.0).vel == [0.0; 2];
+        let clock = if at_rest && rest_step.is_finite() && rest_step < 1e15 {
+            Clock {
+                from_step: rest_step.ceil().max(0.0) as u64,
+                after_s: 0.0,
+            }
+        } else {
+            Clock {
+                after_s: self.last_clock.after_s + self.last_duration_s + gap,
+                ..self.last_clock
+            }
+        };
+        seg.start_s = clock.from_step as f64 * ts + clock.after_s;
+        seg.clock = clock;
+        (self.last_clock, self.last_duration_s) = (clock, seg.duration_s);
+        self.last_exit = seg.command(seg.duration_s).vel;
+        seg
     }
 
     /// The run's outcome once every segment is pushed: the checks a whole list's run makes
@@ -258,13 +314,13 @@ impl<'w> Stream<'w> {
         i.checked_sub(self.base).and_then(|w| self.window.get(w))
     }
 
-    /// Command at `t` (non-decreasing between calls) and what the segment it is in says of
-    /// where it is.
+    /// Command at step `k` (non-decreasing between calls) and what the segment it is in says
+    /// of where it is.
     #[inline]
-    fn at(&mut self, t: f64) -> (Command, Option<Here>) {
-        self.seek(t);
+    fn at(&mut self, k: u64) -> (Command, Option<Here>) {
+        self.seek(k as f64 * self.settings.ts);
         self.trim();
-        self.command_at(t)
+        self.command_at(k)
     }
 
     /// The cursor moved to the segment `t` falls in, or the next one.
@@ -284,9 +340,10 @@ impl<'w> Stream<'w> {
         }
     }
 
-    /// The command at `t`, the cursor at `t` ([`Stream::seek`]).
+    /// The command at step `k`, the cursor at its time ([`Stream::seek`]).
     #[inline]
-    fn command_at(&self, t: f64) -> (Command, Option<Here>) {
+    fn command_at(&self, k: u64) -> (Command, Option<Here>) {
+        let t = k as f64 * self.settings.ts;
         match self.get(self.j) {
             Some((s, counted)) if t >= s.start_s => {
                 let here = Here {
@@ -294,7 +351,7 @@ impl<'w> Stream<'w> {
                     counted: *counted,
                     extruding: s.extruding,
                 };
-                (s.command(t - s.start_s), Some(here))
+                (s.command(s.clock.tau(k, self.settings.ts)), Some(here))
             }
             _ => {
                 let pos = match self.j.checked_sub(1).and_then(|i| self.get(i)) {
@@ -306,12 +363,14 @@ impl<'w> Stream<'w> {
         }
     }
 
-    /// The command at `t1`, one period after `t0`, and the jumps of the commanded velocity
-    /// in `(t0, t1]`: where a segment starts, from the velocity the one before it ended at (a
+    /// The command at step `k1`, and the jumps of the commanded velocity in the period before
+    /// it: where a segment starts, from the velocity the one before it ended at (a
     /// rest between two moves is reached and left smoothly: the planner stops before it).
     /// Most periods have none: the cursor stays in a segment that started before `t0`.
     #[inline]
-    fn step_to(&mut self, t0: f64, t1: f64) -> (Command, Option<Here>) {
+    fn step_to(&mut self, k1: u64) -> (Command, Option<Here>) {
+        let ts = self.settings.ts;
+        let (t0, t1) = (k1.saturating_sub(1) as f64 * ts, k1 as f64 * ts);
         let from = self.j;
         self.seek(t1);
         self.jumps.clear();
@@ -330,11 +389,11 @@ impl<'w> Stream<'w> {
                     None => [0.0; 2],
                 };
                 let dv = [after[0] - before[0], after[1] - before[1]];
-                self.jumps.push((t1 - s.start_s) / (t1 - t0), dv);
+                self.jumps.push(s.clock.tau(k1, ts) / ts, dv);
             }
         }
         self.trim();
-        self.command_at(t1)
+        self.command_at(k1)
     }
 
     /// Steps while `k < total` (when given) and their time is before `horizon`.
@@ -353,11 +412,11 @@ impl<'w> Stream<'w> {
             if !self.primed {
                 // A half started later: the command its first step starts from, now that the
                 // segments around it are known.
-                self.prev = self.at(self.k as f64 * ts).0;
+                self.prev = self.at(self.k).0;
                 self.primed = true;
             }
             if !self.run_within(total, horizon) {
-                let (next, here) = self.step_to(t1 - ts, t1);
+                let (next, here) = self.step_to(self.k + 1);
                 if !self.step(next, here, t1)? {
                     break;
                 }
@@ -420,11 +479,13 @@ impl<'w> Stream<'w> {
         let mut n = 0;
         let mut prev = self.prev;
         while n < RUN && k0 + (n as u64) < last {
-            let t1 = (k0 + n as u64 + 1) as f64 * ts;
+            let k1 = k0 + n as u64 + 1;
+            // Signed: the same value, converted in one instruction ([`Clock::tau`]).
+            let t1 = (k1 as i64) as f64 * ts;
             if !(t1 < end && t1 < horizon && run.in_buckets(prev.pos.map(|p| p * 1e-3))) {
                 break;
             }
-            let next = seg.command(t1 - seg.start_s);
+            let next = seg.command(seg.clock.tau(k1, ts));
             let v0 = prev.vel.map(|v| v * 1e-3);
             let change: [f64; 2] = core::array::from_fn(|ax| next.vel[ax] - prev.vel[ax]);
             run.step(v0, change.map(|c| c * 1e-3 / ts));
@@ -604,11 +665,7 @@ impl<'w> Stream<'w> {
                 jumped = true;
             }
         }
-        self.prev = if jumped {
-            self.at(self.k as f64 * ts).0
-        } else {
-            next
-        };
+        self.prev = if jumped { self.at(self.k).0 } else { next };
         Ok(true)
     }
 

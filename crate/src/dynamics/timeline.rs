@@ -5,7 +5,7 @@
 
 use std::collections::VecDeque;
 
-use super::trajectory::{geometry, Segment};
+use super::trajectory::{geometry, Clock, Segment};
 use crate::error::Error;
 use crate::machine::{axis, MoveKind};
 use crate::path::{MoveSink, MoveTiming, PathFeature, PathMove, PrintPath, Walked};
@@ -246,6 +246,7 @@ impl<E: Emit> Timeline<E> {
             geometry: geometry(m),
             layer: layers.0,
             extruding: m.is_extruding(),
+            clock: Clock::default(),
         };
         self.cursor = seg.end_s();
         self.last = Some(seg);

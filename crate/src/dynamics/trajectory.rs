@@ -50,6 +50,31 @@ pub struct Segment {
     pub layer: u32,
     /// Whether the move lays down material.
     pub extruding: bool,
+    /// Where it falls on the simulation's clock ([`Clock`]): set as the run takes it.
+    pub(super) clock: Clock,
+}
+
+/// A segment's place on a run's clock: the step its stretch of motion set off on from rest,
+/// and its start after that, s. The command at a step is evaluated from these, not from the
+/// absolute time: the same moves after a rest are then sampled at the same instants, to the
+/// bit, wherever in the print they fall (see `Stream::on_grid`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct Clock {
+    /// The step the stretch starts on.
+    pub(super) from_step: u64,
+    /// The segment's start after it, s.
+    pub(super) after_s: f64,
+}
+
+impl Clock {
+    /// Time into the segment at step `k` of period `ts`, s (negative before it starts).
+    #[inline]
+    pub(super) fn tau(&self, k: u64, ts: f64) -> f64 {
+        // Signed: one instruction to convert where an unsigned count takes a branch (steps
+        // stay far below 2⁶³, [`super::simulate::budget`]).
+        let steps = (k as i64).wrapping_sub(self.from_step as i64);
+        steps as f64 * ts - self.after_s
+    }
 }
 
 /// Commanded state of X and Y at one instant.
