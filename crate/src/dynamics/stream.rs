@@ -131,12 +131,10 @@ pub struct Stream<'w> {
     steps: Steps,
     primed: bool,
     buffer: Option<Box<RunBuffer>>,
-    /// The clock of the last segment pushed, and its end on the timeline it came from.
-    last_clock: Clock,
-    last_duration_s: f64,
+    /// The last segment pushed, on the run's clock ([`Stream::on_grid`]), and its end on the
+    /// timeline it came from.
+    last_pushed: Option<Segment>,
     timeline_end_s: f64,
-    /// The X/Y velocity the last segment pushed ends at, mm/s.
-    last_exit: [f64; 2],
     /// Whether steps may be taken in runs ([`Stream::run_within`]); tests take them one by one
     /// too, to check that both give the same bits.
     runs: bool,
@@ -193,10 +191,8 @@ impl<'w> Stream<'w> {
             steps: Steps::default(),
             primed: true,
             buffer: Some(Box::default()),
-            last_clock: Clock::default(),
-            last_duration_s: 0.0,
+            last_pushed: None,
             timeline_end_s: 0.0,
-            last_exit: [0.0; 2],
             runs: in_runs(),
         }
     }
@@ -267,12 +263,16 @@ impl<'w> Stream<'w> {
         let gap = seg.start_s - self.timeline_end_s;
         let gap = if gap > GAP_S { gap } else { 0.0 };
         self.timeline_end_s = seg.end_s();
-        let previous_end = self.last_clock.from_step as f64 * ts
-            + (self.last_clock.after_s + self.last_duration_s);
+        let (last_clock, last_duration_s, last_exit) = match self.last_pushed {
+            Some(l) => (l.clock, l.duration_s, l.command(l.duration_s).vel),
+            None => (Clock::default(), 0.0, [0.0; 2]),
+        };
+        let previous_end =
+            last_clock.from_step as f64 * ts + (last_clock.after_s + last_duration_s);
         let rest_step = (previous_end + gap) / ts;
         // At rest between the two: a dwell or a move the timeline does not hold (a gap), a
         // full stop, or a segment that starts still (a lift; from zero speed).
-        let at_rest = gap > 0.0 || self.last_exit == [0.0; 2] || seg.command(0.0).vel == [0.0; 2];
+        let at_rest = gap > 0.0 || last_exit == [0.0; 2] || seg.command(0.0).vel == [0.0; 2];
         let clock = if at_rest && rest_step.is_finite() && rest_step < 1e15 {
             Clock {
                 from_step: rest_step.ceil().max(0.0) as u64,
@@ -280,14 +280,13 @@ impl<'w> Stream<'w> {
             }
         } else {
             Clock {
-                after_s: self.last_clock.after_s + self.last_duration_s + gap,
-                ..self.last_clock
+                after_s: last_clock.after_s + last_duration_s + gap,
+                ..last_clock
             }
         };
         seg.start_s = clock.from_step as f64 * ts + clock.after_s;
         seg.clock = clock;
-        (self.last_clock, self.last_duration_s) = (clock, seg.duration_s);
-        self.last_exit = seg.command(seg.duration_s).vel;
+        self.last_pushed = Some(seg);
         seg
     }
 

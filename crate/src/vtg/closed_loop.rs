@@ -101,8 +101,9 @@ fn rounder_of(
     again: &mut dyn Again,
 ) -> Result<VtgReport, Error> {
     let (first_sim, first_corners) = first;
+    // The first rewrite itself passing leaves as many corners as it: nothing to try.
     let corners = passing.report.table1.n_turning.after;
-    if passing.variant == search::Variant::default() || first_corners >= corners {
+    if first_corners >= corners {
         return Ok(passing.report);
     }
     let first = (first_sim, search::Variant::default());
