@@ -141,20 +141,13 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<(Curve, Vec
         n,
         ends: [q0, qm],
     };
-    let mut add_row = |coef: &[(usize, f64)], target: [f64; 3]| eq.add_row(coef, target);
     let inv = reciprocals(knots);
     let mut bases = Vec::with_capacity(data.len());
     for (q, &u) in data.iter().zip(params) {
         let span = find_span(knots, n, u);
         let b = basis_by_degree(knots, inv.get(span)?, span, u)[2];
         bases.push((span, b));
-        let coef: [(usize, f64); 4] = [
-            (span - 3, b[0]),
-            (span - 2, b[1]),
-            (span - 1, b[2]),
-            (span, b[3]),
-        ];
-        add_row(&coef, *q);
+        eq.add_row(span - 3, b, *q);
     }
     // The penalty acts on the control points of C'' (P&T eq. 3.8 applied twice), each scaled
     // by its knot span squared so a row is a length, like a residual. A plain second difference
@@ -171,14 +164,8 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<(Curve, Vec
         }
         let (a, b, c) = (3.0 / s1, 3.0 / s2, 2.0 / s12);
         let scale = w * s12 * s12;
-        add_row(
-            &[
-                (i, scale * c * a),
-                (i + 1, -scale * c * (a + b)),
-                (i + 2, scale * c * b),
-            ],
-            [0.0; 3],
-        );
+        let coef = [scale * c * a, -scale * c * (a + b), scale * c * b];
+        eq.add_row(i, coef, [0.0; 3]);
     }
     let x = cholesky_band_solve(&mut eq.band, &mut eq.rhs)?;
     let mut ctrl = Vec::with_capacity(n + 1);
@@ -203,36 +190,36 @@ struct Normal {
 }
 
 impl Normal {
-    /// Adds one least-squares row Σ c_j P_j ≈ target (control indices 0..=n).
+    /// Adds one least-squares row Σ c_j P_j ≈ target over the consecutive control points
+    /// `first..first + N` (indices 0..=n; those outside are ignored). A fixed stride of
+    /// `N`, not a list of indices: the loops unroll (a list was 7 % of `vtg`'s instructions
+    /// on the first 4 MB of the 34 MB corpus file; this is 2 %), summing in the same order.
     #[allow(clippy::needless_range_loop)] // per axis, as the rows below are indexed
-    fn add_row(&mut self, coef: &[(usize, f64)], target: [f64; 3]) {
+    fn add_row<const N: usize>(&mut self, first: usize, coef: [f64; N], target: [f64; 3]) {
         let n = self.n;
         let mut t = target;
-        for &(j, c) in coef {
-            let fixed = if j == 0 {
-                Some(self.ends[0])
-            } else if j == n {
-                Some(self.ends[1])
-            } else {
-                None
+        for (a, &c) in coef.iter().enumerate() {
+            let fixed = match first + a {
+                0 => self.ends[0],
+                j if j == n => self.ends[1],
+                _ => continue,
             };
-            if let Some(p) = fixed {
-                for k in 0..3 {
-                    t[k] -= c * p[k];
-                }
+            for k in 0..3 {
+                t[k] -= c * fixed[k];
             }
         }
-        for &(j, cj) in coef {
+        for a in 0..N {
+            let j = first + a;
             if j == 0 || j >= n {
                 continue;
             }
-            let row = j - 1;
+            let (row, cj) = (j - 1, coef[a]);
             for k in 0..3 {
                 self.rhs[row][k] += cj * t[k];
             }
-            for &(l, cl) in coef {
-                if l >= j && l < n && l - j <= DEGREE {
-                    self.band[row][l - j] += cj * cl;
+            for b in a..N {
+                if first + b < n && b - a <= DEGREE {
+                    self.band[row][b - a] += cj * coef[b];
                 }
             }
         }

@@ -382,19 +382,27 @@ impl CurvatureIndex {
     ) -> Option<(f64, f64)> {
         let first = self.breaks.partition_point(|&k| k <= u).saturating_sub(1);
         let (mut k_max, mut reached) = (kappa, 0.0f64);
+        // `step_for(k_max)`, worked out again only where a sample raises `k_max`.
+        let mut allowed_max = step_for(k_max, w);
         for i in first..self.samples.len() {
             for j in 0..SPAN_SAMPLES {
-                if self.sample_at(i, j) <= u {
+                // Past the first span every sample is past `u` (`breaks[first + 1] > u`).
+                if i == first && self.sample_at(i, j) <= u {
                     continue;
                 }
-                let (k_before, k_here) = (k_max, k_max.max(self.samples[i][j]));
+                let sample = self.samples[i][j];
+                let (k_before, k_here) = (k_max, k_max.max(sample));
                 let chord = norm(sub(self.points[i][j], *p));
-                let allowed = step_for(k_here, w);
+                let allowed = if sample > k_max {
+                    step_for(k_here, w)
+                } else {
+                    allowed_max
+                };
                 if chord > allowed {
                     let sure = allowed.max(reached);
                     return Some((crossing([reached, chord], [k_before, k_here], w), sure));
                 }
-                (k_max, reached) = (k_here, chord);
+                (k_max, reached, allowed_max) = (k_here, chord, allowed);
             }
         }
         None
