@@ -87,6 +87,19 @@ pub(crate) struct Eval {
 }
 
 impl Eval {
+    /// The cubic `τ` past this point, its third derivative `jerk` (one knot span of the
+    /// curve, [`Curve::third_derivative`]): its Taylor polynomial, which is the cubic itself.
+    pub(crate) fn ahead(&self, jerk: &[f64; 3], tau: f64) -> Eval {
+        let (t2, t3) = (tau * tau / 2.0, tau * tau * tau / 6.0);
+        Eval {
+            p: std::array::from_fn(|k| {
+                self.p[k] + self.d1[k] * tau + self.d2[k] * t2 + jerk[k] * t3
+            }),
+            d1: std::array::from_fn(|k| self.d1[k] + self.d2[k] * tau + jerk[k] * t2),
+            d2: std::array::from_fn(|k| self.d2[k] + jerk[k] * tau),
+        }
+    }
+
     /// Curvature `|C' × C''| / |C'|³`.
     pub(crate) fn curvature(&self) -> f64 {
         let c = cross(self.d1, self.d2);
@@ -130,10 +143,21 @@ fn diff<const D: usize>(
 impl Curve {
     /// The curve with these knots and control points (derivative control points computed here;
     /// a zero-length knot interval gives a zero difference, P&T's 0/0 = 0).
+    #[cfg(test)]
     pub(crate) fn new(knots: Vec<f64>, ctrl: Vec<[f64; 3]>) -> Self {
+        let inv = reciprocals(&knots);
+        Self::with_reciprocals(knots, ctrl, inv)
+    }
+
+    /// [`Curve::new`] with the knots' [`reciprocals`] already worked out (the fit's).
+    pub(crate) fn with_reciprocals(
+        knots: Vec<f64>,
+        ctrl: Vec<[f64; 3]>,
+        inv: Vec<[f64; 6]>,
+    ) -> Self {
         Self {
             ctrl: Net::new(&knots, ctrl),
-            inv: reciprocals(&knots),
+            inv,
             knots,
             weights: None,
             last_span: std::cell::Cell::new(DEGREE),
@@ -211,6 +235,19 @@ impl Curve {
     /// Last parameter.
     pub(crate) fn end(&self) -> f64 {
         self.knots.last().copied().unwrap_or(0.0)
+    }
+
+    /// The third derivative of the cubic in the knot span that starts at `u0` (a break of the
+    /// knot vector), constant across it: the span's `C''` runs linearly from `R_{s−3}` to
+    /// `R_{s−2}`. `None` on a rational curve or outside the knots.
+    pub(crate) fn third_derivative(&self, u0: f64) -> Option<[f64; 3]> {
+        if self.weights.is_some() || self.knots.len() != self.ctrl.p.len() + DEGREE + 1 {
+            return None;
+        }
+        let s = self.span(u0.clamp(self.start(), self.end()));
+        let h = self.knots.get(s + 1)? - self.knots.get(s)?;
+        let (r0, r1) = (self.ctrl.r.get(s.checked_sub(3)?)?, self.ctrl.r.get(s - 2)?);
+        (h > 0.0).then(|| std::array::from_fn(|k| (r1[k] - r0[k]) / h))
     }
 
     /// Point and derivatives at `u` (clamped to the curve's range): one pass of A2.2 gives
@@ -315,6 +352,23 @@ pub(crate) fn basis_by_degree(knots: &[f64], inv: &[f64; 6], span: usize, u: f64
         out[j - 1] = n;
     }
     out
+}
+
+/// [`find_span`] for parameters met in increasing order: from the span `hint` found for the
+/// one before, a few knots forward before searching them all (the fit's data lie a span or
+/// two apart). The same span either way.
+pub(crate) fn find_span_from(knots: &[f64], n: usize, u: f64, hint: usize) -> usize {
+    if hint >= DEGREE && hint <= n && knots.get(hint).is_some_and(|&k| k <= u) {
+        let mut s = hint;
+        for _ in 0..8 {
+            match knots.get(s + 1) {
+                Some(&next) if s < n && u >= next => s += 1,
+                Some(_) => return s,
+                None => break,
+            }
+        }
+    }
+    find_span(knots, n, u)
 }
 
 /// Index of the knot span holding `u` (A2.1), for `n + 1` control points.
@@ -525,6 +579,63 @@ mod tests {
                 assert!((e.p[k] - sum(&d[0])).abs() < 1e-12, "u {u}");
                 assert!((e.d1[k] - sum(&d[1])).abs() < 1e-10 * scale, "u {u}");
                 assert!((e.d2[k] - sum(&d[2])).abs() < 1e-9 * scale, "u {u}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_span_found_forward_is_the_span_searched() {
+        let knots = [
+            0.0, 0.0, 0.0, 0.0, 0.3, 0.35, 0.35, 0.9, 1.4, 2.0, 2.0, 2.0, 2.0,
+        ];
+        let n = knots.len() - DEGREE - 2;
+        // Increasing, with repeats, a jump over several spans, the end and past it; then
+        // from a hint past `u` and from nonsense hints.
+        let us = [0.0, 0.0, 0.1, 0.3, 0.3, 0.34, 0.35, 0.36, 1.9, 2.0, 2.5];
+        let mut hint = DEGREE;
+        for &u in &us {
+            hint = find_span_from(&knots, n, u, hint);
+            assert_eq!(hint, find_span(&knots, n, u), "u {u}");
+        }
+        for hint in [0, 5, 7, n, n + 3] {
+            assert_eq!(
+                find_span_from(&knots, n, 0.2, hint),
+                find_span(&knots, n, 0.2)
+            );
+        }
+        assert_eq!(
+            find_span_from(&knots, n, f64::NAN, 4),
+            find_span(&knots, n, f64::NAN)
+        );
+    }
+
+    #[test]
+    fn inside_a_span_the_curve_is_the_taylor_cubic_of_its_start() {
+        // Knots with a double knot (0.35), where C'' jumps: each span's own jerk is used.
+        let knots = vec![
+            0.0, 0.0, 0.0, 0.0, 0.3, 0.35, 0.35, 0.9, 1.4, 2.0, 2.0, 2.0, 2.0,
+        ];
+        let ctrl: Vec<[f64; 3]> = (0..9)
+            .map(|i| {
+                let t = i as f64;
+                [t, (1.3 * t).sin() * 2.0, 0.1 * t * t]
+            })
+            .collect();
+        let c = Curve::new(knots, ctrl);
+        for w in [0.0, 0.3, 0.35, 0.9, 1.4, 2.0].windows(2) {
+            let (u0, u1) = (w[0], w[1]);
+            let (start, jerk) = (c.eval(u0), c.third_derivative(u0).expect("inside"));
+            for i in 0..=20 {
+                let tau = (u1 - u0) * i as f64 / 20.0;
+                let (e, t) = (c.eval(u0 + tau), start.ahead(&jerk, tau));
+                for k in 0..3 {
+                    assert!((e.p[k] - t.p[k]).abs() < 1e-12, "u {}", u0 + tau);
+                    assert!((e.d1[k] - t.d1[k]).abs() < 1e-10, "u {}", u0 + tau);
+                    // At the span's end C'' may jump (the double knot): inside it may not.
+                    if i < 20 {
+                        assert!((e.d2[k] - t.d2[k]).abs() < 1e-9, "u {}", u0 + tau);
+                    }
+                }
             }
         }
     }

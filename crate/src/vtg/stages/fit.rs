@@ -8,7 +8,7 @@
 //! points are interpolated (the path keeps its end points).
 
 use crate::vec3::{norm, sub};
-use crate::vtg::bspline::{basis_by_degree, find_span, reciprocals, Curve, DEGREE};
+use crate::vtg::bspline::{basis_by_degree, find_span, find_span_from, reciprocals, Curve, DEGREE};
 use crate::vtg::tuning::TUNING;
 
 /// A fitted curve with the data it was fitted to.
@@ -143,8 +143,9 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<(Curve, Vec
     };
     let inv = reciprocals(knots);
     let mut bases = Vec::with_capacity(data.len());
+    let mut span = DEGREE;
     for (q, &u) in data.iter().zip(params) {
-        let span = find_span(knots, n, u);
+        span = find_span_from(knots, n, u, span);
         let b = basis_by_degree(knots, inv.get(span)?, span, u)[2];
         bases.push((span, b));
         eq.add_row(span - 3, b, *q);
@@ -172,7 +173,7 @@ fn solve(data: &[[f64; 3]], params: &[f64], knots: &[f64]) -> Option<(Curve, Vec
     ctrl.push(q0);
     ctrl.extend(x);
     ctrl.push(qm);
-    Some((Curve::new(knots.to_vec(), ctrl), bases))
+    Some((Curve::with_reciprocals(knots.to_vec(), ctrl, inv), bases))
 }
 
 /// A datum's knot span and degree-3 basis functions, as [`solve`] weighed it.

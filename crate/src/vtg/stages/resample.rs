@@ -341,10 +341,19 @@ impl CurvatureIndex {
         // A span's last sample is the next one's first wherever the two parameters are the
         // same to the bit (nearly always): evaluated once, a sixth of the index's evaluations.
         let mut last: Option<(f64, Eval)> = None;
+        // Inside a span the curve is one cubic: its samples there are the first one's Taylor
+        // polynomial, a fifth of the cost of evaluating each (the index was two thirds of the
+        // walk's evaluations).
         for w in breaks.windows(2) {
             let u: [f64; SPAN_SAMPLES] = std::array::from_fn(|j| sample_param(w[0], w[1], j));
-            let e: [Eval; SPAN_SAMPLES] = std::array::from_fn(|i| match last {
-                Some((at, e)) if i == 0 && at.to_bits() == u[0].to_bits() => e,
+            let first = match last {
+                Some((at, e)) if at.to_bits() == u[0].to_bits() => e,
+                _ => curve.eval(u[0]),
+            };
+            let jerk = curve.third_derivative(u[0]);
+            let e: [Eval; SPAN_SAMPLES] = std::array::from_fn(|i| match (i, jerk) {
+                (0, _) => first,
+                (i, Some(j)) if i < SPAN_SAMPLES - 1 => first.ahead(&j, u[i] - u[0]),
                 _ => curve.eval(u[i]),
             });
             last = Some((u[SPAN_SAMPLES - 1], e[SPAN_SAMPLES - 1]));
