@@ -237,6 +237,25 @@ impl Curve {
         self.knots.last().copied().unwrap_or(0.0)
     }
 
+    /// [`Curve::eval`]'s point alone, to the bit: without the derivatives' sums (the fit's
+    /// residuals between its data, nearly a million evaluations on the first 4 MB of the
+    /// 34 MB corpus file).
+    pub(crate) fn point(&self, u: f64) -> [f64; 3] {
+        let n = self.ctrl.p.len();
+        if self.weights.is_some() || n < DEGREE + 1 || self.knots.len() != n + DEGREE + 1 {
+            return self.eval(u).p;
+        }
+        let u = u.clamp(self.start(), self.end());
+        let span = self.span(u);
+        let Some(inv) = self.inv.get(span) else {
+            return self.eval(u).p;
+        };
+        let basis = basis_by_degree(&self.knots, inv, span, u);
+        self.ctrl
+            .point(span, &basis[2])
+            .unwrap_or_else(|| self.eval(u).p)
+    }
+
     /// The third derivative of the cubic in the knot span that starts at `u0` (a break of the
     /// knot vector), constant across it: the span's `C''` runs linearly from `R_{s−3}` to
     /// `R_{s−2}`. `None` on a rational curve or outside the knots.
@@ -628,6 +647,7 @@ mod tests {
             for i in 0..=20 {
                 let tau = (u1 - u0) * i as f64 / 20.0;
                 let (e, t) = (c.eval(u0 + tau), start.ahead(&jerk, tau));
+                assert_eq!(c.point(u0 + tau), e.p);
                 for k in 0..3 {
                     assert!((e.p[k] - t.p[k]).abs() < 1e-12, "u {}", u0 + tau);
                     assert!((e.d1[k] - t.d1[k]).abs() < 1e-10, "u {}", u0 + tau);

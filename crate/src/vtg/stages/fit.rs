@@ -96,7 +96,7 @@ fn residuals(
     let last = curve.ctrl().len() - 1;
     let mut check = |q: &[f64; 3], u: f64, basis: Option<&Basis>| {
         let at = basis.and_then(|(span, n3)| curve.point_in_span(*span, n3));
-        let r = norm(sub(at.unwrap_or_else(|| curve.eval(u).p), q));
+        let r = norm(sub(at.unwrap_or_else(|| curve.point(u)), q));
         worst = worst.max(r);
         if r > tol_mm {
             let s = find_span(curve.knots(), last, u);
