@@ -570,20 +570,26 @@ mod tests {
         }
     }
 
-    /// The derivative control points agree with A2.3's basis derivatives everywhere, interior
-    /// double knot and ends included.
-    #[test]
-    #[allow(clippy::needless_range_loop)] // three coordinates, indexed in step
-    fn evaluation_matches_the_general_derivative_recursion() {
+    /// The knots (an interior double knot at 0.35) and control points of a wavy test curve.
+    fn wavy() -> (Vec<f64>, Vec<[f64; 3]>) {
         let knots = vec![
             0.0, 0.0, 0.0, 0.0, 0.3, 0.35, 0.35, 0.9, 1.4, 2.0, 2.0, 2.0, 2.0,
         ];
-        let ctrl: Vec<[f64; 3]> = (0..9)
+        let ctrl = (0..9)
             .map(|i| {
                 let t = i as f64;
                 [t, (1.3 * t).sin() * 2.0, 0.1 * t * t]
             })
             .collect();
+        (knots, ctrl)
+    }
+
+    /// The derivative control points agree with A2.3's basis derivatives everywhere, interior
+    /// double knot and ends included.
+    #[test]
+    #[allow(clippy::needless_range_loop)] // three coordinates, indexed in step
+    fn evaluation_matches_the_general_derivative_recursion() {
+        let (knots, ctrl) = wavy();
         let c = Curve::new(knots.clone(), ctrl.clone());
         for i in 0..=200 {
             let u = i as f64 * 0.01;
@@ -631,15 +637,7 @@ mod tests {
     #[test]
     fn inside_a_span_the_curve_is_the_taylor_cubic_of_its_start() {
         // Knots with a double knot (0.35), where C'' jumps: each span's own jerk is used.
-        let knots = vec![
-            0.0, 0.0, 0.0, 0.0, 0.3, 0.35, 0.35, 0.9, 1.4, 2.0, 2.0, 2.0, 2.0,
-        ];
-        let ctrl: Vec<[f64; 3]> = (0..9)
-            .map(|i| {
-                let t = i as f64;
-                [t, (1.3 * t).sin() * 2.0, 0.1 * t * t]
-            })
-            .collect();
+        let (knots, ctrl) = wavy();
         let c = Curve::new(knots, ctrl);
         for w in [0.0, 0.3, 0.35, 0.9, 1.4, 2.0].windows(2) {
             let (u0, u1) = (w[0], w[1]);
