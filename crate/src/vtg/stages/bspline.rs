@@ -241,19 +241,27 @@ impl Curve {
     /// residuals between its data, nearly a million evaluations on the first 4 MB of the
     /// 34 MB corpus file).
     pub(crate) fn point(&self, u: f64) -> [f64; 3] {
-        let n = self.ctrl.p.len();
-        if self.weights.is_some() || n < DEGREE + 1 || self.knots.len() != n + DEGREE + 1 {
+        if self.weights.is_some() {
             return self.eval(u).p;
+        }
+        // Where evaluation finds nothing, its point is zero.
+        self.basis_at(u)
+            .and_then(|(span, basis)| self.ctrl.point(span, &basis[2]))
+            .unwrap_or([0.0; 3])
+    }
+
+    /// The span of `u` (clamped to the curve's range) and its basis functions of degrees 1–3,
+    /// what [`Curve::eval`] and [`Curve::point`] weigh; `None` where the knots do not fit the
+    /// control points.
+    fn basis_at(&self, u: f64) -> Option<(usize, [[f64; 4]; 3])> {
+        let n = self.ctrl.p.len();
+        if n < DEGREE + 1 || self.knots.len() != n + DEGREE + 1 {
+            return None;
         }
         let u = u.clamp(self.start(), self.end());
         let span = self.span(u);
-        let Some(inv) = self.inv.get(span) else {
-            return self.eval(u).p;
-        };
-        let basis = basis_by_degree(&self.knots, inv, span, u);
-        self.ctrl
-            .point(span, &basis[2])
-            .unwrap_or_else(|| self.eval(u).p)
+        let inv = self.inv.get(span)?;
+        Some((span, basis_by_degree(&self.knots, inv, span, u)))
     }
 
     /// The third derivative of the cubic in the knot span that starts at `u0` (a break of the
@@ -272,21 +280,14 @@ impl Curve {
     /// Point and derivatives at `u` (clamped to the curve's range): one pass of A2.2 gives
     /// the basis functions of degrees 1, 2 and 3, which weigh `R`, `Q` and `P`.
     pub(crate) fn eval(&self, u: f64) -> Eval {
-        let n = self.ctrl.p.len();
         let zero = Eval {
             p: [0.0; 3],
             d1: [0.0; 3],
             d2: [0.0; 3],
         };
-        if n < DEGREE + 1 || self.knots.len() != n + DEGREE + 1 {
-            return zero;
-        }
-        let u = u.clamp(self.start(), self.end());
-        let span = self.span(u);
-        let Some(inv) = self.inv.get(span) else {
+        let Some((span, basis)) = self.basis_at(u) else {
             return zero;
         };
-        let basis = basis_by_degree(&self.knots, inv, span, u);
         let Some([a, a1, a2]) = self.ctrl.at(span, &basis) else {
             return zero;
         };
