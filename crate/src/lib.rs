@@ -187,6 +187,9 @@
 //! - [`vec3`]: 3-vector helpers shared by [`vtg`] and [`orient`].
 //! - [`progress`]: the progress callback every long job takes.
 
+// No unsafe code in the library, whatever the workspace allows its binary.
+#![forbid(unsafe_code)]
+
 pub mod analyze;
 pub mod dynamics;
 pub mod energy;

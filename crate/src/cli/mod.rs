@@ -1,6 +1,7 @@
 //! The `quietpath` command-line tool: a thin shell over the library. Every subcommand's
 //! `--json` output is the serde form of the same type the JS API returns.
 
+mod allocator;
 mod bench;
 mod calibrate;
 mod estimate;
@@ -284,6 +285,7 @@ const PROGRESS_MIN_BYTES: usize = 4 << 20;
 
 /// Runs the CLI.
 pub fn main() -> ExitCode {
+    allocator::cap_arenas(quietpath::parallel::threads());
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
