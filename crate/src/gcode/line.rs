@@ -566,88 +566,112 @@ pub fn parse_line_into<'a>(text: &'a [u8], line: &mut Line<'a>) -> Result<(), Li
     line.comment = None;
     line.line_number = None;
     line.checksum = None;
-    let err = |pos: usize, kind: ErrorKind| LineError {
-        column: u32::try_from(pos + 1).unwrap_or(u32::MAX),
-        kind,
-    };
 
     // Comment: everything after the first ';' (a ';' never appears inside a command).
-    let code_end = match memchr::memchr(b';', text) {
+    let mut end = match memchr::memchr(b';', text) {
         Some(p) => {
             line.comment = Some(&text[p + 1..]);
             p
         }
         None => text.len(),
     };
-    let mut end = code_end;
     if end > MAX_COMMAND_BYTES {
-        return Err(err(
-            MAX_COMMAND_BYTES,
-            ErrorKind::LineTooLong {
-                max: MAX_COMMAND_BYTES,
-            },
-        ));
+        let max = MAX_COMMAND_BYTES;
+        return Err(error_at(max, ErrorKind::LineTooLong { max }));
     }
-
-    let mut pos = 0;
     // UTF-8 byte-order mark at the start of a file.
-    if text.starts_with(&[0xEF, 0xBB, 0xBF]) {
-        pos = 3;
-    }
-    while pos < end && is_space(text[pos]) {
-        pos += 1;
-    }
-    if pos >= end {
-        return Ok(());
-    }
+    let bom = if text.starts_with(&[0xEF, 0xBB, 0xBF]) {
+        3
+    } else {
+        0
+    };
+    let mut pos = skip_spaces(text, bom, end);
     // `%` marks program start/end in CNC-style files; nothing else may follow it.
-    if text[pos] == b'%' {
+    if pos >= end || text[pos] == b'%' {
         return Ok(());
     }
-
-    // Checksum: `*nn` at the end of the command part. The host protocol puts checksums only
-    // on numbered lines (`N123 ... *nn`), so only those are searched for one.
-    let numbered = matches!(text[pos], b'N' | b'n');
-    if let Some(star) = numbered
-        .then(|| memchr::memrchr(b'*', &text[..end]))
-        .flatten()
-    {
-        let digits = trim(&text[star + 1..end]);
-        if !digits.is_empty() && digits.iter().all(u8::is_ascii_digit) && digits.len() <= 9 {
-            let found = digits
-                .iter()
-                .fold(0u32, |a, d| a * 10 + u32::from(d - b'0'));
-            let computed = checksum(&text[..star]);
-            if found != u32::from(computed) {
-                return Err(err(star, ErrorKind::ChecksumMismatch { found, computed }));
-            }
+    if matches!(text[pos], b'N' | b'n') {
+        if let Some((star, found)) = checksum_of(text, end)? {
             line.checksum = Some(found);
             end = star;
         }
-    }
-
-    // `N` line number.
-    if matches!(text[pos], b'N' | b'n')
-        && text
-            .get(pos + 1)
-            .is_some_and(|b| b.is_ascii_digit() || *b == b'-')
-    {
-        let len = scan_number(&text[pos + 1..end], true);
-        let n = parse_f64(&text[pos + 1..pos + 1 + len]).unwrap_or(0.0);
-        line.line_number = Some(n as i64);
-        pos += 1 + len;
-        while pos < end && is_space(text[pos]) {
-            pos += 1;
-        }
+        pos = line_number(text, pos, end, line);
         if pos >= end {
             return Ok(());
         }
     }
+    match command(text, pos, end, line)? {
+        Some((pos, is_g)) => words(text, pos, end, is_g, line),
+        None => Ok(()),
+    }
+}
 
-    // Command.
+/// A [`LineError`] at byte `pos` of the line (its column is `pos + 1`).
+fn error_at(pos: usize, kind: ErrorKind) -> LineError {
+    LineError {
+        column: u32::try_from(pos + 1).unwrap_or(u32::MAX),
+        kind,
+    }
+}
+
+/// The first byte at or after `pos` (before `end`) that is not a space or tab.
+#[inline]
+fn skip_spaces(text: &[u8], mut pos: usize, end: usize) -> usize {
+    while pos < end && is_space(text[pos]) {
+        pos += 1;
+    }
+    pos
+}
+
+/// The checksum `*nn` at the end of a numbered line's command part `text[..end]`: where its
+/// `*` is and the value, checked against the line. The host protocol puts checksums only on
+/// numbered lines (`N123 ... *nn`), so only those are searched for one.
+fn checksum_of(text: &[u8], end: usize) -> Result<Option<(usize, u32)>, LineError> {
+    let Some(star) = memchr::memrchr(b'*', &text[..end]) else {
+        return Ok(None);
+    };
+    let digits = trim(&text[star + 1..end]);
+    if digits.is_empty() || !digits.iter().all(u8::is_ascii_digit) || digits.len() > 9 {
+        return Ok(None);
+    }
+    let found = digits
+        .iter()
+        .fold(0u32, |a, d| a * 10 + u32::from(d - b'0'));
+    let computed = checksum(&text[..star]);
+    if found != u32::from(computed) {
+        return Err(error_at(
+            star,
+            ErrorKind::ChecksumMismatch { found, computed },
+        ));
+    }
+    Ok(Some((star, found)))
+}
+
+/// The `N` line number at `pos`, if there is one, into `line`; where the command starts.
+fn line_number(text: &[u8], pos: usize, end: usize, line: &mut Line<'_>) -> usize {
+    let numbered = text
+        .get(pos + 1)
+        .is_some_and(|b| b.is_ascii_digit() || *b == b'-');
+    if !numbered {
+        return pos;
+    }
+    let len = scan_number(&text[pos + 1..end], true);
+    let n = parse_f64(&text[pos + 1..pos + 1 + len]).unwrap_or(0.0);
+    line.line_number = Some(n as i64);
+    skip_spaces(text, pos + 1 + len, end)
+}
+
+/// The command at `pos` into `line`: where its words start and whether they are a G-code's
+/// (strictly checked), or `None` where the line has no words to read (a Klipper extended
+/// command or a message, whose text is kept as it is).
+fn command<'a>(
+    text: &'a [u8],
+    pos: usize,
+    end: usize,
+    line: &mut Line<'a>,
+) -> Result<Option<(usize, bool)>, LineError> {
     let first = text[pos];
     let second = text.get(pos + 1).copied().unwrap_or(b' ');
-    let mut is_g = false;
     if first.is_ascii_alphabetic() && (second.is_ascii_alphabetic() || second == b'_') {
         // Klipper extended command / macro: NAME args...
         let name_end = text[pos..end]
@@ -656,165 +680,171 @@ pub fn parse_line_into<'a>(text: &'a [u8], line: &mut Line<'a>) -> Result<(), Li
             .map_or(end, |p| pos + p);
         line.command = Command::Extended(&text[pos..name_end]);
         line.text = trim(&text[name_end..end]);
-        return Ok(());
+        return Ok(None);
     }
     let up = first.to_ascii_uppercase();
-    if matches!(up, b'G' | b'M' | b'T') && (second.is_ascii_digit()) {
-        let mut i = pos + 1;
-        let mut number: u32 = 0;
-        while i < end && text[i].is_ascii_digit() {
-            number = number
-                .saturating_mul(10)
-                .saturating_add(u32::from(text[i] - b'0'));
-            i += 1;
-        }
-        let mut sub = None;
-        if i + 1 < end && text[i] == b'.' && text[i + 1].is_ascii_digit() {
-            let mut s: u32 = 0;
-            i += 1;
-            while i < end && text[i].is_ascii_digit() {
-                s = s
-                    .saturating_mul(10)
-                    .saturating_add(u32::from(text[i] - b'0'));
-                i += 1;
-            }
-            sub = Some(u8::try_from(s).unwrap_or(u8::MAX));
-        }
-        let code = Code {
-            letter: up,
-            number: u16::try_from(number).unwrap_or(u16::MAX),
-            sub,
-        };
+    if matches!(up, b'G' | b'M' | b'T') && second.is_ascii_digit() {
+        let (code, after) = code_at(text, pos + 1, end, up);
         line.command = Command::Code(code);
-        is_g = up == b'G';
-        pos = i;
         if takes_text(code) {
             // The message starts after one separating space; keep the rest verbatim.
-            line.text = trim(&text[pos..end]);
-            return Ok(());
+            line.text = trim(&text[after..end]);
+            return Ok(None);
         }
-    } else if first.is_ascii_alphabetic() {
-        line.command = Command::Bare;
-        is_g = true;
-    } else if first != b'(' {
-        return Err(err(
-            pos,
-            ErrorKind::UnexpectedCharacter {
-                found: display_char(first),
-            },
-        ));
+        return Ok(Some((after, up == b'G')));
     }
+    if first.is_ascii_alphabetic() {
+        line.command = Command::Bare;
+        return Ok(Some((pos, true)));
+    }
+    if first == b'(' {
+        return Ok(Some((pos, false)));
+    }
+    let found = display_char(first);
+    Err(error_at(pos, ErrorKind::UnexpectedCharacter { found }))
+}
 
-    // Words.
-    let code = &text[..end];
-    pos = plain_words(code, pos, &mut line.params);
+/// The code `letter` whose digits start at `i` (`G1`, `M486`, `G38.2`), and where it ends.
+fn code_at(text: &[u8], mut i: usize, end: usize, letter: u8) -> (Code, usize) {
+    let digits = |i: &mut usize| {
+        let mut n: u32 = 0;
+        while *i < end && text[*i].is_ascii_digit() {
+            n = n
+                .saturating_mul(10)
+                .saturating_add(u32::from(text[*i] - b'0'));
+            *i += 1;
+        }
+        n
+    };
+    let number = digits(&mut i);
+    let mut sub = None;
+    if i + 1 < end && text[i] == b'.' && text[i + 1].is_ascii_digit() {
+        i += 1;
+        sub = Some(u8::try_from(digits(&mut i)).unwrap_or(u8::MAX));
+    }
+    let code = Code {
+        letter,
+        number: u16::try_from(number).unwrap_or(u16::MAX),
+        sub,
+    };
+    (code, i)
+}
+
+/// The words of the command part `text[..end]` from `pos` into `line.params`: the plain ones
+/// at once ([`plain_words`]), the rest one by one with comments in brackets between them. In a
+/// G-code (`is_g`) anything else is an error; in an M-code a token that is no word is a string
+/// argument, and skipped.
+fn words<'a>(
+    text: &'a [u8],
+    pos: usize,
+    end: usize,
+    is_g: bool,
+    line: &mut Line<'a>,
+) -> Result<(), LineError> {
+    let mut pos = plain_words(&text[..end], pos, &mut line.params);
     while pos < end {
-        let b = code[pos];
+        let b = text[pos];
         if is_space(b) {
             pos += 1;
-            continue;
-        }
-        if b == b'(' {
+        } else if b == b'(' {
             let close = memchr::memchr(b')', &text[pos..end])
-                .ok_or_else(|| err(pos, ErrorKind::UnclosedComment))?;
+                .ok_or_else(|| error_at(pos, ErrorKind::UnclosedComment))?;
             if line.comment.is_none() {
                 line.comment = Some(&text[pos + 1..pos + close]);
             }
             pos += close + 1;
-            continue;
-        }
-        if !b.is_ascii_alphabetic() {
-            if is_g {
-                return Err(err(
-                    pos,
-                    ErrorKind::UnexpectedCharacter {
-                        found: display_char(b),
-                    },
-                ));
-            }
-            // Inside an M-code's string argument: skip the token.
-            while pos < end && !is_space(text[pos]) {
-                pos += 1;
-            }
-            continue;
-        }
-        let letter_pos = pos;
-        let letter = b.to_ascii_uppercase();
-        pos += 1;
-        let mut vpos = pos;
-        while vpos < end && (text[vpos] == b' ' || text[vpos] == b'\t') {
-            vpos += 1;
-        }
-        let (len, parsed) = parse_number(&text[vpos..end], b.is_ascii_uppercase());
-        if len == 0 && spells_non_finite(&text[vpos..end]) {
-            return Err(err(
-                vpos,
-                ErrorKind::NonFiniteNumber {
-                    letter: letter as char,
-                },
-            ));
-        }
-        let value = if len > 0 {
-            let v = parsed.ok_or_else(|| {
-                err(
-                    vpos,
-                    ErrorKind::InvalidNumber {
-                        letter: letter as char,
-                    },
-                )
-            })?;
-            if !v.is_finite() {
-                return Err(err(
-                    vpos,
-                    ErrorKind::NonFiniteNumber {
-                        letter: letter as char,
-                    },
-                ));
-            }
-            pos = vpos + len;
-            Some(v)
+        } else if b.is_ascii_alphabetic() {
+            pos = word(text, pos, end, is_g, &mut line.params)?;
+        } else if is_g {
+            let found = display_char(b);
+            return Err(error_at(pos, ErrorKind::UnexpectedCharacter { found }));
         } else {
-            None
-        };
-        // What follows a word must be a separator, another word or a comment.
-        let next = text.get(pos).copied().filter(|_| pos < end);
-        // In a G-code, a letter glued to a word that has no number (`Xabc`) is a typo, not two
-        // words; bare words must be separated (`G28 X Y`).
-        let clean_end = match next {
-            None => true,
-            Some(n) if n.is_ascii_alphabetic() => value.is_some() || !is_g,
-            Some(n) => is_space(n) || n == b'(',
-        };
-        if !clean_end {
-            if is_g {
-                let kind = if next.is_some_and(|n| n.is_ascii_alphanumeric() || n == b'.')
-                    || value.is_none()
-                {
-                    ErrorKind::InvalidNumber {
-                        letter: letter as char,
-                    }
-                } else {
-                    ErrorKind::UnexpectedCharacter {
-                        found: display_char(next.unwrap_or(b'?')),
-                    }
-                };
-                return Err(err(if value.is_some() { pos } else { vpos }, kind));
-            }
-            while pos < end && !is_space(text[pos]) {
-                pos += 1;
-            }
-            continue;
-        }
-        if !line.params.insert(letter, value) && is_g {
-            return Err(err(
-                letter_pos,
-                ErrorKind::DuplicateWord {
-                    letter: letter as char,
-                },
-            ));
+            // Inside an M-code's string argument: skip the token.
+            pos = skip_token(text, pos, end);
         }
     }
     Ok(())
+}
+
+/// The first space or tab at or after `pos` (before `end`).
+fn skip_token(text: &[u8], mut pos: usize, end: usize) -> usize {
+    while pos < end && !is_space(text[pos]) {
+        pos += 1;
+    }
+    pos
+}
+
+/// The word whose letter is at `letter_pos`, into `params`; where the next token starts.
+fn word(
+    text: &[u8],
+    letter_pos: usize,
+    end: usize,
+    is_g: bool,
+    params: &mut Params,
+) -> Result<usize, LineError> {
+    let b = text[letter_pos];
+    let letter = b.to_ascii_uppercase();
+    // Only spaces and tabs between a letter and its number (`X 10`).
+    let mut vpos = letter_pos + 1;
+    while vpos < end && (text[vpos] == b' ' || text[vpos] == b'\t') {
+        vpos += 1;
+    }
+    let number = word_value(text, vpos, end, b.is_ascii_uppercase(), letter as char)?;
+    let pos = number.map_or(letter_pos + 1, |(_, len)| vpos + len);
+    let value = number.map(|(v, _)| v);
+    // What follows a word must be a separator, another word or a comment.
+    let next = text.get(pos).copied().filter(|_| pos < end);
+    // In a G-code, a letter glued to a word that has no number (`Xabc`) is a typo, not two
+    // words; bare words must be separated (`G28 X Y`).
+    let clean_end = match next {
+        None => true,
+        Some(n) if n.is_ascii_alphabetic() => value.is_some() || !is_g,
+        Some(n) => is_space(n) || n == b'(',
+    };
+    if !clean_end {
+        if !is_g {
+            return Ok(skip_token(text, pos, end));
+        }
+        let glued = next.is_some_and(|n| n.is_ascii_alphanumeric() || n == b'.');
+        let kind = if glued || value.is_none() {
+            ErrorKind::InvalidNumber {
+                letter: letter as char,
+            }
+        } else {
+            ErrorKind::UnexpectedCharacter {
+                found: display_char(next.unwrap_or(b'?')),
+            }
+        };
+        return Err(error_at(if value.is_some() { pos } else { vpos }, kind));
+    }
+    if !params.insert(letter, value) && is_g {
+        let letter = letter as char;
+        return Err(error_at(letter_pos, ErrorKind::DuplicateWord { letter }));
+    }
+    Ok(pos)
+}
+
+/// The number of the word `letter` starting at `vpos` and its length in bytes, `None` where
+/// none follows the letter; a number that does not parse or is not finite is an error.
+fn word_value(
+    text: &[u8],
+    vpos: usize,
+    end: usize,
+    upper_letter: bool,
+    letter: char,
+) -> Result<Option<(f64, usize)>, LineError> {
+    let (len, parsed) = parse_number(&text[vpos..end], upper_letter);
+    if len == 0 {
+        if spells_non_finite(&text[vpos..end]) {
+            return Err(error_at(vpos, ErrorKind::NonFiniteNumber { letter }));
+        }
+        return Ok(None);
+    }
+    let v = parsed.ok_or_else(|| error_at(vpos, ErrorKind::InvalidNumber { letter }))?;
+    if !v.is_finite() {
+        return Err(error_at(vpos, ErrorKind::NonFiniteNumber { letter }));
+    }
+    Ok(Some((v, len)))
 }
 
 fn display_char(b: u8) -> char {
