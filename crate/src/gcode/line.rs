@@ -614,7 +614,8 @@ fn error_at(pos: usize, kind: ErrorKind) -> LineError {
     }
 }
 
-/// The first byte at or after `pos` (before `end`) that is not a space or tab.
+/// The first byte at or after `pos` (before `end`) that is not blank ([`is_space`]: space,
+/// tab, CR, VT or FF).
 #[inline]
 fn skip_spaces(text: &[u8], mut pos: usize, end: usize) -> usize {
     while pos < end && is_space(text[pos]) {

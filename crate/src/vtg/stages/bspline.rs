@@ -211,10 +211,16 @@ impl Curve {
     /// [`basis_by_degree`] gives them): [`Curve::eval`]'s point, to the bit, for a caller that
     /// already has the basis (the fit, at its data). Non-rational curves only.
     pub(crate) fn point_in_span(&self, span: usize, n3: &[f64; 4]) -> Option<[f64; 3]> {
-        if self.weights.is_some() || self.knots.len() != self.ctrl.p.len() + DEGREE + 1 {
+        if self.weights.is_some() || !self.knots_fit() {
             return None;
         }
         self.ctrl.point(span, n3)
+    }
+
+    /// Whether there are as many knots as the control points of a cubic need (`n + 5` for
+    /// `n + 1` points).
+    fn knots_fit(&self) -> bool {
+        self.knots.len() == self.ctrl.p.len() + DEGREE + 1
     }
 
     /// Knot vector.
@@ -255,7 +261,7 @@ impl Curve {
     /// control points.
     fn basis_at(&self, u: f64) -> Option<(usize, [[f64; 4]; 3])> {
         let n = self.ctrl.p.len();
-        if n < DEGREE + 1 || self.knots.len() != n + DEGREE + 1 {
+        if n < DEGREE + 1 || !self.knots_fit() {
             return None;
         }
         let u = u.clamp(self.start(), self.end());
@@ -268,7 +274,7 @@ impl Curve {
     /// knot vector), constant across it: the span's `C''` runs linearly from `R_{s−3}` to
     /// `R_{s−2}`. `None` on a rational curve or outside the knots.
     pub(crate) fn third_derivative(&self, u0: f64) -> Option<[f64; 3]> {
-        if self.weights.is_some() || self.knots.len() != self.ctrl.p.len() + DEGREE + 1 {
+        if self.weights.is_some() || !self.knots_fit() {
             return None;
         }
         let s = self.span(u0.clamp(self.start(), self.end()));
