@@ -413,20 +413,7 @@ fn the_refreshed_file_s_analysis_is_the_earlier_one_with_its_lines_moved() {
     use quietpath::analyze::analyze_with_starts;
     use quietpath::estimate::{analysis_of_refreshed, has_estimates, rewrite_by_clock, Clock};
     let options = AnalyzeOptions::default();
-    let mut files: Vec<(String, Vec<u8>)> = corpus()
-        .iter()
-        .map(|f| (f.name.clone(), f.read()))
-        .collect();
-    let mut fixtures: Vec<_> = std::fs::read_dir(fixtures_dir().join("gcode"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    fixtures.sort();
-    files.extend(
-        fixtures
-            .iter()
-            .map(|p| (p.display().to_string(), std::fs::read(p).unwrap())),
-    );
+    let files = corpus_and_fixtures();
     let mut refreshed = 0;
     for (name, bytes) in files {
         let mut file = bytes;
@@ -445,4 +432,129 @@ fn the_refreshed_file_s_analysis_is_the_earlier_one_with_its_lines_moved() {
         }
     }
     assert!(refreshed >= 40, "{refreshed} refreshes");
+}
+
+/// Every corpus file and fixture, by name, fixtures last.
+fn corpus_and_fixtures() -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = corpus()
+        .iter()
+        .map(|f| (f.name.clone(), f.read()))
+        .collect();
+    let mut fixtures: Vec<_> = std::fs::read_dir(fixtures_dir().join("gcode"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    fixtures.sort();
+    files.extend(
+        fixtures
+            .iter()
+            .map(|p| (p.display().to_string(), std::fs::read(p).unwrap())),
+    );
+    files
+}
+
+/// The path and its moves' sources read in one pass (what `vtg` reads of every file it
+/// rewrites) are, to the bit, those of two passes (`path::extract` and `move_sources`), on
+/// every corpus file and fixture, planned (and not, where small): pairing the two folds changes
+/// neither. The flavour and junction model it reads are the analysis' (`vtg` decides on arcs by
+/// them).
+#[test]
+fn the_path_and_its_sources_read_in_one_pass_are_those_of_two() {
+    use quietpath::path::extract;
+    use quietpath::vtg::source::{move_sources, path_and_sources};
+    let options = AnalyzeOptions::default();
+    let files = corpus_and_fixtures();
+    let mut annotated = 0;
+    for (name, bytes) in &files {
+        // Unplanned on the small files only: planning changes nothing the pairing touches,
+        // and the 34 MB file takes seconds a pass.
+        let plans: &[bool] = if bytes.len() < 8 << 20 {
+            &[false, true]
+        } else {
+            &[true]
+        };
+        for &plan in plans {
+            let read = path_and_sources(bytes, &options, plan).unwrap();
+            let (path, sources) = (read.path, read.sources);
+            let alone = extract(bytes, &options, plan).unwrap();
+            let apart = move_sources(bytes, &options).unwrap();
+            // Debug prints a NaN feed as NaN on both sides (`==` would call them different).
+            let same = |a: &dyn std::fmt::Debug, b: &dyn std::fmt::Debug| {
+                format!("{a:?}") == format!("{b:?}")
+            };
+            assert_eq!(path.moves.len(), alone.moves.len(), "{name}");
+            for (k, (a, b)) in path.moves.iter().zip(&alone.moves).enumerate() {
+                assert!(same(a, b), "{name}, plan {plan}: move {k}");
+            }
+            assert!(same(&path.layers, &alone.layers), "{name}: layers");
+            assert!(same(&path.features, &alone.features), "{name}: features");
+            assert!(same(&path.warnings, &alone.warnings), "{name}: warnings");
+            assert_eq!(path.time_s.to_bits(), alone.time_s.to_bits(), "{name}");
+            assert_eq!(sources.moves.len(), apart.moves.len(), "{name}");
+            for (k, (a, b)) in sources.moves.iter().zip(&apart.moves).enumerate() {
+                assert!(same(a, b), "{name}: source {k}");
+            }
+            assert_eq!(sources.limits, apart.limits, "{name}: limits");
+            annotated += usize::from(sources.moves.iter().any(|s| !s.notes.range().is_empty()));
+            // What `vtg` decides arcs by, before the analysis is done.
+            let report = analyze(bytes, &options).unwrap();
+            assert_eq!(read.flavor, report.file.flavor, "{name}: flavour");
+            assert_eq!(path.junction_model, report.machine.junction_model, "{name}");
+        }
+    }
+    // The pairing matters where the sources fold skips lines: files with `;WIDTH:` notes.
+    assert!(annotated >= 4, "{annotated} files with annotations");
+}
+
+/// The trajectory metrics an analysis takes on its timing side (what `vtg` reports of each
+/// rewrite) are, to the bit, those of a pass of their own over the file
+/// (`vtg::metrics::from_input`), for the file and every layer, at two critical angles: on
+/// every corpus file and fixture, and on rewrites with arcs and with lines.
+#[test]
+fn the_analysis_takes_the_trajectory_metrics_a_pass_of_their_own_gives() {
+    use quietpath::analyze::{analyze_keeping, Keep};
+    use quietpath::vtg::metrics::from_input;
+    use quietpath::vtg::{vtg, ArcsMode, VtgOptions};
+    let options = AnalyzeOptions::default();
+    let mut files = corpus_and_fixtures();
+    let fixtures = files.len() - corpus().len();
+    // Rewrites of the small fixtures: arcs and rounded corners the slicers never write.
+    let mut rewrites = Vec::new();
+    for (name, bytes) in files.iter().rev().take(fixtures) {
+        if bytes.len() < 2 << 20 {
+            for arcs in [ArcsMode::On, ArcsMode::Off] {
+                let o = VtgOptions {
+                    arcs,
+                    dynamics: false,
+                    ..VtgOptions::default()
+                };
+                let out = vtg(bytes, &o).unwrap().output;
+                rewrites.push((format!("{name} rewritten, {arcs:?}"), out));
+            }
+        }
+    }
+    files.extend(rewrites);
+    let bits = |m: &quietpath::analyze::toolpath::ToolpathMetrics| format!("{m:?}");
+    for (name, bytes) in &files {
+        for deg in [30.0, 12.5] {
+            let keep = Keep {
+                layer_metrics_deg: Some(deg),
+                ..Keep::default()
+            };
+            let (report, kept) = analyze_keeping(bytes, &options, keep).unwrap();
+            let (file, layers) = kept.layer_metrics.unwrap();
+            let (own_file, own_layers) = from_input(bytes, &options, deg).unwrap();
+            assert_eq!(bits(&file), bits(&own_file), "{name} at {deg}°");
+            assert_eq!(layers.len(), own_layers.len(), "{name} at {deg}°");
+            for (l, (a, b)) in layers.iter().zip(&own_layers).enumerate() {
+                assert_eq!(bits(a), bits(b), "{name} at {deg}°, layer {l}");
+            }
+            assert!(layers.len() as u64 <= report.layers, "{name}");
+        }
+    }
+    assert!(files.len() >= 40, "{} files", files.len());
+    let with_arcs = (files.iter())
+        .filter(|(n, b)| n.ends_with("On") && b.windows(3).any(|w| w == b"\nG2" || w == b"\nG3"))
+        .count();
+    assert!(with_arcs >= 3, "{with_arcs} rewrites with arcs");
 }

@@ -7,6 +7,7 @@
 
 use std::collections::{HashMap, VecDeque};
 
+use super::layered::LayeredMetrics;
 use super::report::{Bounds, FanEvent, FeatureSummary, TemperatureEvent};
 use super::toolpath::{MetricsAccumulator, MoveTrace, PathEnd, DEFAULT_CRITICAL_ANGLE_DEG};
 use crate::energy::Accumulator;
@@ -304,6 +305,9 @@ pub struct TimeBook {
     /// The planned blocks counted against a minimum segment time, when asked
     /// ([`Timing::counting_segments`]).
     pub segments: Option<SegmentCounter>,
+    /// The file's and its layers' trajectory metrics, when asked
+    /// ([`Timing::keeping_layer_metrics`]).
+    pub layered: Option<LayeredMetrics>,
 }
 
 /// The line and planned start (s) of every timed move, in file order, an arc's firmware
@@ -347,6 +351,13 @@ impl Timing {
         self
     }
 
+    /// Takes the file's and its layers' trajectory metrics at `critical_angle_deg`
+    /// ([`LayeredMetrics`]) from the moves' [`MoveTrace`]s.
+    pub fn keeping_layer_metrics(mut self, critical_angle_deg: f64) -> Self {
+        self.book.layered = Some(LayeredMetrics::new(critical_angle_deg));
+        self
+    }
+
     /// Counts the planned blocks against `min_segment_s` ([`SegmentCounter::timed`]).
     pub fn counting_segments(mut self, min_segment_s: f64) -> Self {
         self.book.segments = Some(SegmentCounter::new(min_segment_s));
@@ -372,6 +383,9 @@ impl Timing {
                 if let Some(t) = &mut book.toolpath {
                     t.push_chord(chord(&delta), None, slot, trace);
                 }
+                if let Some(l) = &mut book.layered {
+                    l.push_chord(chord(&delta), None, slot, (trace, layers));
+                }
                 let seq = *moves;
                 *moves += 1;
                 book.tags.push_back((seq, slot, layers));
@@ -392,6 +406,9 @@ impl Timing {
             } => {
                 if let Some(t) = &mut book.toolpath {
                     t.push_chord(chord(&m.delta), m.arc.as_ref(), slot, trace);
+                }
+                if let Some(l) = &mut book.layered {
+                    l.push_chord(chord(&m.delta), m.arc.as_ref(), slot, (trace, layers));
                 }
                 let seq = *moves;
                 *moves += 1;
@@ -434,6 +451,7 @@ impl TimeBook {
             toolpath: None,
             starts: None,
             segments: None,
+            layered: None,
         }
     }
 

@@ -3,6 +3,7 @@
 
 mod accounting;
 pub mod apart;
+pub mod layered;
 mod pipeline;
 pub mod report;
 pub mod toolpath;
@@ -19,6 +20,7 @@ use crate::read::{At, Flow, Fold, Reader, Setup};
 pub use accounting::MoveStarts;
 use accounting::{Accounts, TimeBook, TimeMsg};
 pub use report::*;
+use toolpath::ToolpathMetrics;
 
 /// Default filament diameter when the file does not declare one, mm.
 pub const DEFAULT_FILAMENT_DIAMETER_MM: f64 = 1.75;
@@ -138,6 +140,7 @@ pub fn analyze_with_starts(
     let keep = Keep {
         starts: true,
         min_segment_s: None,
+        layer_metrics_deg: None,
     };
     let (report, kept) = analyze_keeping(input, options, keep)?;
     Ok((report, kept.starts.unwrap_or_default()))
@@ -151,6 +154,9 @@ pub struct Keep {
     pub starts: bool,
     /// The segments counted against this minimum segment time, s ([`SegmentCounts`]).
     pub min_segment_s: Option<f64>,
+    /// The file's and its layers' trajectory metrics at this critical angle, degrees
+    /// ([`layered::LayeredMetrics`]).
+    pub layer_metrics_deg: Option<f64>,
 }
 
 /// What [`analyze_keeping`] kept.
@@ -160,6 +166,8 @@ pub struct Kept {
     pub starts: Option<MoveStarts>,
     /// The segment counts, where [`Keep::min_segment_s`] asked.
     pub segments: Option<SegmentCounts>,
+    /// The file's metrics and its layers', where [`Keep::layer_metrics_deg`] asked.
+    pub layer_metrics: Option<(ToolpathMetrics, Vec<ToolpathMetrics>)>,
 }
 
 /// [`analyze`], keeping what `keep` asks of the same pass.
@@ -186,6 +194,9 @@ fn analyze_timed(
     if let Some(min_segment_s) = keep.min_segment_s {
         timing = timing.counting_segments(min_segment_s);
     }
+    if let Some(deg) = keep.layer_metrics_deg {
+        timing = timing.keeping_layer_metrics(deg);
+    }
     let mut info = SlicerInfo::default();
     let mut acc = Accounts::new();
     let mut moves = None;
@@ -199,12 +210,15 @@ fn analyze_timed(
     timing.finish();
     progress(1.0);
     let time_s = timing.planner.elapsed_s();
-    let kept = Kept {
+    let layered = timing.book.layered.take();
+    let mut kept = Kept {
         starts: timing.book.starts.take().map(|(starts, _)| starts),
         segments: (moves.as_ref().zip(timing.book.segments.as_ref()))
             .map(|(moves, blocks)| SegmentCounter::merged(moves, blocks)),
+        layer_metrics: None,
     };
     let report = report(input, options, reader, acc, (time_s, timing.book), info);
+    kept.layer_metrics = layered.map(|l| l.finish(&report.layer_source, report.layers as usize));
     Ok((report, kept))
 }
 

@@ -26,7 +26,7 @@ use crate::gcode::{feature_kind, FeatureKind, Line, RawLine};
 use crate::machine::{Event, ExtrusionMode, Machine, MoveKind, Pos};
 use crate::plan::{JunctionModel, Limits, MachineProfile, Motion, PlannedMove, Planner, Profile};
 use crate::read::{AnalyzeOptions, LayerSource};
-use crate::read::{At, Flow, Fold, Reader};
+use crate::read::{At, Both, Flow, Fold, Reader};
 
 /// Feature index of moves before the file names any feature.
 pub const NO_FEATURE: u16 = u16::MAX;
@@ -287,7 +287,21 @@ pub fn walk(
     plan: bool,
     sink: &mut impl MoveSink,
 ) -> Result<Walked, Error> {
+    walk_also(input, options, plan, sink, |_| ()).map(|(walked, ())| walked)
+}
+
+/// [`walk`], with the fold `also` makes from the pass's reader fed by the same pass (told of
+/// each line after the walk): a caller that needs the moves and something else of the file
+/// reads and parses it once.
+pub(crate) fn walk_also<F: Fold>(
+    input: &[u8],
+    options: &AnalyzeOptions,
+    plan: bool,
+    sink: &mut impl MoveSink,
+    also: impl FnOnce(&Reader) -> F,
+) -> Result<(Walked, F), Error> {
     let mut reader = Reader::new(input, options)?;
+    let mut also = also(&reader);
     sink.machine(&reader.setup.profile);
     sink.limits(&reader.setup.limits);
     let mut fold = Walk {
@@ -297,7 +311,7 @@ pub fn walk(
         current_feature: NO_FEATURE,
         count: 0,
     };
-    reader.read(input, &mut fold)?;
+    reader.read(input, &mut Both(&mut fold, &mut also))?;
     let Walk {
         sink,
         planner,
@@ -323,7 +337,7 @@ pub fn walk(
         })
         .collect();
     let (warnings, _) = setup.warnings.into_parts();
-    Ok(Walked {
+    let walked = Walked {
         layers,
         layer_source,
         features,
@@ -334,7 +348,8 @@ pub fn walk(
         time_s,
         warnings,
         moves: count,
-    })
+    };
+    Ok((walked, also))
 }
 
 /// [`MoveSink`] keeping every move (for [`extract`]).
@@ -367,12 +382,23 @@ impl MoveSink for Collect {
 /// commands applied where they appear, dwells and heater waits flushing the queue as firmware
 /// does). [`walk`] reads the same moves without keeping them.
 pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<PrintPath, Error> {
+    extract_also(input, options, plan, |_| ()).map(|(path, ())| path)
+}
+
+/// [`extract`], with the fold `also` makes from the pass's reader fed by the same pass (see
+/// [`walk_also`]).
+pub(crate) fn extract_also<F: Fold>(
+    input: &[u8],
+    options: &AnalyzeOptions,
+    plan: bool,
+    also: impl FnOnce(&Reader) -> F,
+) -> Result<(PrintPath, F), Error> {
     let expected = crate::gcode::command_lines(input);
     let mut kept = Collect {
         moves: Vec::with_capacity(expected),
         layer_pairs: Vec::with_capacity(expected),
     };
-    let walked = walk(input, options, plan, &mut kept)?;
+    let (walked, also) = walk_also(input, options, plan, &mut kept, also)?;
     let Collect {
         mut moves,
         layer_pairs,
@@ -416,7 +442,7 @@ pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<Pri
             layer.end = next;
         }
     }
-    Ok(PrintPath {
+    let path = PrintPath {
         moves,
         layers,
         layer_source,
@@ -427,7 +453,8 @@ pub fn extract(input: &[u8], options: &AnalyzeOptions, plan: bool) -> Result<Pri
         extrusion_mode,
         time_s,
         warnings,
-    })
+    };
+    Ok((path, also))
 }
 
 #[cfg(test)]

@@ -88,6 +88,50 @@ pub(crate) trait Fold {
     }
 }
 
+/// The fold that keeps nothing (the other of a [`Both`] where one is wanted).
+impl Fold for () {}
+
+/// Two folds fed by one pass, the first told of each thing before the second: a caller that
+/// needs two folds of the same file reads and parses it once. A line is read where either fold
+/// reads it; the one that asked to skip it is then told of it as well, so a fold paired here
+/// must take a line it would skip as it takes any other line of its kind.
+pub(crate) struct Both<'a, A, B>(pub &'a mut A, pub &'a mut B);
+
+impl<A: Fold, B: Fold> Fold for Both<'_, A, B> {
+    fn line(&mut self, raw: &RawLine<'_>, line: Option<&Line<'_>>) -> Result<Flow, Error> {
+        let (a, b) = (self.0.line(raw, line)?, self.1.line(raw, line)?);
+        Ok(if a == Flow::Read || b == Flow::Read {
+            Flow::Read
+        } else {
+            Flow::Skip
+        })
+    }
+    fn layer_marker(&mut self, machine: &Machine) {
+        self.0.layer_marker(machine);
+        self.1.layer_marker(machine);
+    }
+    fn feature(&mut self, name: &str, machine: &Machine) {
+        self.0.feature(name, machine);
+        self.1.feature(name, machine);
+    }
+    fn comment(&mut self, comment: &[u8]) {
+        self.0.comment(comment);
+        self.1.comment(comment);
+    }
+    fn limits(&mut self, limits: &Limits, machine: &Machine) {
+        self.0.limits(limits, machine);
+        self.1.limits(limits, machine);
+    }
+    fn command(&mut self, line: &Line<'_>, machine: &Machine) {
+        self.0.command(line, machine);
+        self.1.command(line, machine);
+    }
+    fn event(&mut self, line: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
+        self.0.event(line, event, at)?;
+        self.1.event(line, event, at)
+    }
+}
+
 /// Set-up and state of one pass over a file.
 #[derive(Debug)]
 pub(crate) struct Reader {

@@ -237,6 +237,7 @@ pub fn analysed_figures(
     let keep = crate::analyze::Keep {
         starts: false,
         min_segment_s: Some(budget.min_segment_time_s),
+        layer_metrics_deg: None,
     };
     let (report, kept) = crate::analyze::analyze_keeping(input, options, keep)?;
     let counts = kept.segments.unwrap_or_default();

@@ -235,21 +235,27 @@ fn rewrite_file(
     progress: Progress<'_>,
 ) -> Result<VtgReport, Error> {
     let cancelled = || Error::new(0, 0, ErrorKind::Cancelled);
+    let first = search::Variant::default();
+    // The original's analysis (and with the model its simulation, timed by it) on one side;
+    // on the other the path read and the first rewrite's offers made, which need none of it.
+    let (analysed, read) = crate::parallel::join(
+        || analyse_original(input, options),
+        || read_and_offer(input, options, first, &mut |f| progress(0.3 * f)),
+    );
     let Original {
         before,
         before_segments,
-        sources,
+        original_deviation,
+    } = analysed?;
+    let ReadAndOffered {
         path,
+        sources,
         path_metrics,
-    } = read_original(input, options)?;
-    if !progress(0.3) {
-        return Err(cancelled());
-    }
-    // Arcs where the firmware runs them, decided once for every variant tried.
-    let options = &VtgOptions {
-        arcs: options.arcs.resolved(input, &before, &options.analyze),
-        ..options.clone()
-    };
+        options,
+        offers,
+        smoothings,
+    } = read?;
+    let options = &options;
     let run = Run {
         input,
         path: &path,
@@ -257,23 +263,10 @@ fn rewrite_file(
         sources: &sources,
         options,
         limits: rewrite::limits_for(&path, options),
-        known: std::sync::Mutex::new(None),
-        smoothings: std::sync::Mutex::new(smoothings::Smoothings::new(smoothings_bound(
-            input, options,
-        ))),
+        known: std::sync::Mutex::new(Some((offers, Vec::new()))),
+        smoothings: std::sync::Mutex::new(smoothings),
     };
-    let first = search::Variant::default();
-    // The original's simulated deviation does not depend on the rewrite: where there are
-    // threads, it runs beside the first one (on a long print it takes as long).
-    let expected_s = before.time_s;
-    let (original_deviation, report) = crate::parallel::join(
-        || {
-            options
-                .dynamics
-                .then(|| closed_loop::printing_deviation(input, expected_s, options))
-        },
-        || run.report((first, &[]), before, &mut |f| progress(0.3 + 0.4 * f)),
-    );
+    let report = run.report((first, &[]), before, &mut |f| progress(0.3 + 0.4 * f));
     let mut report = report?;
     if !progress(0.7) {
         return Err(cancelled());
@@ -313,39 +306,89 @@ fn rewrite_file(
 struct Original {
     before: Report,
     before_segments: Option<SegmentCounts>,
-    sources: source::Sources,
-    path: crate::path::PrintPath,
-    path_metrics: (ToolpathMetrics, Vec<ToolpathMetrics>),
+    /// The model's simulation of the original, with the model.
+    original_deviation: Option<Option<closed_loop::Simulated>>,
 }
 
-/// Reads [`Original`]: independent reads of the same bytes, side by side where there are
-/// threads. Extracting the planned path costs as much as the other two together (34 MB:
-/// 550 ms, 150 + 220 ms), so the path's metrics are measured on its side.
-fn read_original(input: &[u8], options: &VtgOptions) -> Result<Original, Error> {
-    let (read, path) = crate::parallel::join(
-        || {
-            let min_segment_s = firmware::min_segment_time_s(input, options.min_segment_time_ms);
-            let keep = crate::analyze::Keep {
-                starts: false,
-                min_segment_s: Some(min_segment_s),
-            };
-            let (before, kept) = crate::analyze::analyze_keeping(input, &options.analyze, keep)?;
-            let sources = source::move_sources(input, &options.analyze)?;
-            Ok::<_, Error>((before, kept.segments, sources))
-        },
-        || {
-            let path = crate::path::extract(input, &options.analyze, options.limit_feed)?;
-            let metrics = metrics::from_path(&path, options.critical_angle_deg);
-            Ok::<_, Error>((path, metrics))
-        },
-    );
-    let ((before, before_segments, sources), (path, path_metrics)) = (read?, path?);
+/// The original's analysis, and with the dynamics model its simulated deviation: the
+/// simulation splits a long print where the analysis' planned time puts it.
+fn analyse_original(input: &[u8], options: &VtgOptions) -> Result<Original, Error> {
+    let min_segment_s = firmware::min_segment_time_s(input, options.min_segment_time_ms);
+    let keep = crate::analyze::Keep {
+        starts: false,
+        min_segment_s: Some(min_segment_s),
+        layer_metrics_deg: None,
+    };
+    let (before, kept) = crate::analyze::analyze_keeping(input, &options.analyze, keep)?;
+    let expected_s = before.time_s;
+    let original_deviation = options
+        .dynamics
+        .then(|| closed_loop::printing_deviation(input, expected_s, options));
     Ok(Original {
         before,
-        before_segments,
-        sources,
+        before_segments: kept.segments,
+        original_deviation,
+    })
+}
+
+/// What [`read_and_offer`] reads of the file and makes of it.
+struct ReadAndOffered {
+    path: crate::path::PrintPath,
+    sources: source::Sources,
+    path_metrics: (ToolpathMetrics, Vec<ToolpathMetrics>),
+    /// The options with arcs decided for the file, once for every variant tried.
+    options: VtgOptions,
+    /// The first rewrite's offers.
+    offers: rewrite::Offers,
+    /// The paths it smoothed, for the variants that smooth them the same way.
+    smoothings: smoothings::Smoothings,
+}
+
+/// Reads the original's path, its sources and its metrics in one pass, decides on arcs from
+/// what the file declares, and makes `variant`'s offers: none of it waits for the analysis.
+fn read_and_offer(
+    input: &[u8],
+    options: &VtgOptions,
+    variant: search::Variant,
+    progress: Progress<'_>,
+) -> Result<ReadAndOffered, Error> {
+    let read = source::path_and_sources(input, &options.analyze, options.limit_feed)?;
+    let path = read.path;
+    if !progress(1.0 / 3.0) {
+        return Err(Error::new(0, 0, ErrorKind::Cancelled));
+    }
+    let declared = (path.junction_model, read.flavor.as_deref());
+    let options = VtgOptions {
+        arcs: (options.arcs).resolved_declared(input, declared, &options.analyze),
+        ..options.clone()
+    };
+    let limits = rewrite::limits_for(&path, &options);
+    let mut smoothings = smoothings::Smoothings::new(smoothings_bound(input, &options));
+    // The path's metrics are wanted only by the report: measured beside the offers, where
+    // the reading's last stretch ran on one thread.
+    let (path_metrics, offers) = crate::parallel::join(
+        || metrics::from_path(&path, options.critical_angle_deg),
+        || {
+            rewrite::offers(
+                input,
+                &path,
+                &read.sources,
+                (&options, &limits),
+                (variant, &[]),
+                (&mut smoothings, &mut |f: f64| {
+                    progress((1.0 + 2.0 * f) / 3.0)
+                }),
+            )
+        },
+    );
+    let offers = offers?;
+    Ok(ReadAndOffered {
         path,
+        sources: read.sources,
         path_metrics,
+        options,
+        offers,
+        smoothings,
     })
 }
 
@@ -382,9 +425,6 @@ struct Run<'a> {
 /// What a rewrite's attempt measures of its output beside its analysis ([`Run::attempt`]).
 type Also<'a, X> = &'a (dyn Fn(&[u8]) -> X + Sync);
 
-/// A rewrite's metrics ([`metrics::from_input`]): the file's, and by feature.
-type Metrics = Result<(ToolpathMetrics, Vec<ToolpathMetrics>), Error>;
-
 impl Run<'_> {
     /// One rewrite tried as `variant`, the layers `kept` marks left as they are, analysed and
     /// reported (`before`: the original's analysis), and what `also` measures of its output,
@@ -398,38 +438,36 @@ impl Run<'_> {
         let Run {
             options, limits, ..
         } = *self;
-        // The output's metrics streamed, not from a kept move list: rounding corners can
-        // multiply the moves tenfold.
-        let metrics = |output: &[u8]| -> Metrics {
-            metrics::from_input(output, &options.analyze, options.critical_angle_deg)
-        };
-        let beside = |output: &[u8]| crate::parallel::join(|| also(output), || metrics(output));
+        let beside = |output: &[u8]| also(output);
         let (rewritten, measured) =
             self.rewrite((variant, kept), &before, Some(&beside), progress)?;
-        let (after, kept, (also, after_metrics)) = match measured {
-            Some((after, kept, Some(beside))) => (after, Some(kept), beside),
-            Some((after, kept, None)) => (after, Some(kept), beside(&rewritten.output)),
+        let (after, mut kept, also) = match measured {
+            Some((after, kept, Some(beside))) => (after, kept, beside),
+            Some((after, kept, None)) => (after, kept, also(&rewritten.output)),
             // Analysed even where [`finish`] analyses the file again with its estimates
             // refreshed: the clock and the segments kept here spare it a planning walk for
             // each, which take longer on one thread than this pass takes on two.
             None => {
                 let (analysed, alongside) = crate::parallel::join(
                     || search::analysed(&rewritten.output, self.input, options),
-                    || beside(&rewritten.output),
+                    || also(&rewritten.output),
                 );
                 let (after, kept) = analysed?;
-                (after, Some(kept), alongside)
+                (after, kept, alongside)
             }
         };
+        // The output's metrics, taken by its analysis (streamed: rounding corners can
+        // multiply the moves tenfold).
+        let after_metrics = std::mem::take(&mut kept.metrics);
         let mut report = report::build(
             options,
             &limits,
             (before, after),
             &self.path_metrics,
-            after_metrics?,
+            after_metrics,
             rewritten,
         );
-        report.output_kept = kept;
+        report.output_kept = Some(kept);
         Ok((report, also))
     }
 

@@ -255,6 +255,8 @@ pub(crate) struct OutputKept {
     pub(crate) clock: Option<crate::estimate::Clock>,
     /// Its segments, counted against the input's minimum segment time.
     pub(crate) segments: crate::plan::segments::SegmentCounts,
+    /// Its trajectory metrics, the file's and its layers', at the run's critical angle.
+    pub(crate) metrics: (ToolpathMetrics, Vec<ToolpathMetrics>),
 }
 
 /// Table 2 of the analyses `before` and `after`, with the dynamics model's `deviation` rows

@@ -6,7 +6,7 @@
 //! with the path's.
 
 use crate::error::Error;
-use crate::gcode::{Command, Line, RawLine};
+use crate::gcode::{Command, Line, RawLine, SlicerInfo};
 use crate::machine::{axis, Event, ExtrusionMode, Machine};
 use crate::plan::Limits;
 use crate::read::{AnalyzeOptions, At, Flow, Fold, Reader};
@@ -123,7 +123,9 @@ impl Sources {
     }
 }
 
-/// The fold of [`move_sources`].
+/// The fold of [`move_sources`]. Paired with the path's walk ([`path_and_sources`]) it is also
+/// told of the annotation lines it skips; it takes them as comments, of which it keeps nothing
+/// (their `command` sets `before`, which the next command sets again before any move).
 struct Read {
     sources: Sources,
     /// Annotation lines since the last other line.
@@ -134,6 +136,22 @@ struct Read {
     f_modal: Option<f64>,
     /// What the line's move needs of the state before it: mode, logical E, modal `F`.
     before: (ExtrusionMode, f64, Option<f64>),
+}
+
+impl Read {
+    /// The fold of a pass over `input` by `reader`, before its first line.
+    fn new(input: &[u8], reader: &Reader) -> Self {
+        Read {
+            sources: Sources {
+                moves: Vec::with_capacity(crate::gcode::command_lines(input)),
+                limits: vec![(0, reader.limits.clone())],
+            },
+            notes: Notes::default(),
+            line_notes: Notes::default(),
+            f_modal: None,
+            before: (ExtrusionMode::Absolute, 0.0, None),
+        }
+    }
 }
 
 impl Fold for Read {
@@ -195,18 +213,70 @@ impl Fold for Read {
 /// Reads the source of every move and the limits along the file.
 pub fn move_sources(input: &[u8], options: &AnalyzeOptions) -> Result<Sources, Error> {
     let mut reader = Reader::new(input, options)?;
-    let mut fold = Read {
-        sources: Sources {
-            moves: Vec::with_capacity(crate::gcode::command_lines(input)),
-            limits: vec![(0, reader.limits.clone())],
-        },
-        notes: Notes::default(),
-        line_notes: Notes::default(),
-        f_modal: None,
-        before: (ExtrusionMode::Absolute, 0.0, None),
-    };
+    let mut fold = Read::new(input, &reader);
     reader.read(input, &mut fold)?;
     Ok(fold.sources)
+}
+
+/// What `vtg` reads of the file it rewrites besides the analysis, in one pass.
+#[derive(Debug)]
+pub struct PathAndSources {
+    /// The path ([`crate::path::extract`]).
+    pub path: crate::path::PrintPath,
+    /// Its moves' sources ([`move_sources`]).
+    pub sources: Sources,
+    /// The firmware flavour the file declares, as the analysis reports it (`file.flavor`):
+    /// with it `vtg` decides on arcs without waiting for the analysis.
+    pub flavor: Option<String>,
+}
+
+/// The file's path and its moves' sources from one pass: the same results as
+/// [`crate::path::extract`] and [`move_sources`], read and parsed once (`vtg` needs both of
+/// every file it rewrites; on the 34 MB corpus file the second pass was a sixth of the
+/// reading's CPU time).
+pub fn path_and_sources(
+    input: &[u8],
+    options: &AnalyzeOptions,
+    plan: bool,
+) -> Result<PathAndSources, Error> {
+    let (path, (read, declared)) = crate::path::extract_also(input, options, plan, |reader| {
+        let declared = Declared {
+            info: SlicerInfo::default(),
+            prescanned: reader.setup.pre.flavor.clone(),
+        };
+        (Read::new(input, reader), declared)
+    })?;
+    Ok(PathAndSources {
+        path,
+        sources: read.sources,
+        flavor: declared.info.flavor.or(declared.prescanned),
+    })
+}
+
+/// The slicer's declarations, read from the comments as the analysis reads them (its
+/// `SlicerInfo`, the prescan's flavour where the comments name none).
+struct Declared {
+    info: SlicerInfo,
+    prescanned: Option<String>,
+}
+
+impl Fold for (Read, Declared) {
+    fn line(&mut self, raw: &RawLine<'_>, line: Option<&Line<'_>>) -> Result<Flow, Error> {
+        self.0.line(raw, line)
+    }
+    fn comment(&mut self, comment: &[u8]) {
+        self.0.comment(comment);
+        self.1.info.observe(comment);
+    }
+    fn limits(&mut self, limits: &Limits, machine: &Machine) {
+        self.0.limits(limits, machine);
+    }
+    fn command(&mut self, line: &Line<'_>, machine: &Machine) {
+        self.0.command(line, machine);
+    }
+    fn event(&mut self, line: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
+        self.0.event(line, event, at)
+    }
 }
 
 fn is_plain(line: &Line<'_>, to: &crate::machine::Pos) -> bool {

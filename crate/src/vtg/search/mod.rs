@@ -278,6 +278,7 @@ pub(crate) fn analysed(
     let keep = crate::analyze::Keep {
         starts: !options.dynamics,
         min_segment_s: Some(min_s),
+        layer_metrics_deg: Some(options.critical_angle_deg),
     };
     let (after, kept) = crate::analyze::analyze_keeping(output, &options.analyze, keep)?;
     let output_kept = OutputKept {
@@ -285,6 +286,8 @@ pub(crate) fn analysed(
             .starts
             .map(|starts| crate::estimate::Clock::from_analysis(&after, starts)),
         segments: kept.segments.unwrap_or_default(),
+        // Asked for above, so always there.
+        metrics: kept.layer_metrics.unwrap_or_default(),
     };
     Ok((after, output_kept))
 }
