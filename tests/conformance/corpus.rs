@@ -453,53 +453,55 @@ fn corpus_and_fixtures() -> Vec<(String, Vec<u8>)> {
     files
 }
 
-/// The path and its moves' sources read in one pass (what `vtg` reads of every file it
-/// rewrites) are, to the bit, those of two passes (`path::extract` and `move_sources`), on
-/// every corpus file and fixture, planned (and not, where small): pairing the two folds changes
-/// neither. The flavour and junction model it reads are the analysis' (`vtg` decides on arcs by
-/// them).
+/// The path and its moves' sources read in one pass, the path unplanned and then timed from
+/// the analysis' planning pass (what `vtg` reads of every file it rewrites), are, to the bit,
+/// the planned path of `path::extract` and the sources of `move_sources`, on every corpus file
+/// and fixture, with the default machine and with Klipper's (whose homing the planner does
+/// not time): pairing the two folds changes neither, and the analysis plans what the path's
+/// own planning would.
 #[test]
 fn the_path_and_its_sources_read_in_one_pass_are_those_of_two() {
+    use quietpath::analyze::{analyze_keeping, Keep};
     use quietpath::path::extract;
     use quietpath::vtg::source::{move_sources, path_and_sources};
-    let options = AnalyzeOptions::default();
-    let files = corpus_and_fixtures();
+    let klipper = AnalyzeOptions {
+        machine: Some("voron-klipper".into()),
+        ..AnalyzeOptions::default()
+    };
+    // Debug prints a NaN feed as NaN on both sides (`==` would call them different).
+    let same =
+        |a: &dyn std::fmt::Debug, b: &dyn std::fmt::Debug| format!("{a:?}") == format!("{b:?}");
     let mut annotated = 0;
-    for (name, bytes) in &files {
-        // Unplanned on the small files only: planning changes nothing the pairing touches,
-        // and the 34 MB file takes seconds a pass.
-        let plans: &[bool] = if bytes.len() < 8 << 20 {
-            &[false, true]
-        } else {
-            &[true]
-        };
-        for &plan in plans {
-            let read = path_and_sources(bytes, &options, plan).unwrap();
-            let (path, sources) = (read.path, read.sources);
-            let alone = extract(bytes, &options, plan).unwrap();
-            let apart = move_sources(bytes, &options).unwrap();
-            // Debug prints a NaN feed as NaN on both sides (`==` would call them different).
-            let same = |a: &dyn std::fmt::Debug, b: &dyn std::fmt::Debug| {
-                format!("{a:?}") == format!("{b:?}")
+    for (name, bytes) in &corpus_and_fixtures() {
+        // Klipper's machine on the smaller files only: the 34 MB file takes seconds a pass.
+        let machines = if bytes.len() < 8 << 20 { 2 } else { 1 };
+        for options in [AnalyzeOptions::default(), klipper.clone()]
+            .iter()
+            .take(machines)
+        {
+            let (mut path, sources) = path_and_sources(bytes, options, false).unwrap();
+            let keep = Keep {
+                timed_moves: true,
+                ..Keep::default()
             };
+            let (report, kept) = analyze_keeping(bytes, options, keep).unwrap();
+            path.set_timing(&kept.timed_moves.unwrap(), report.time_s);
+            let alone = extract(bytes, options, true).unwrap();
             assert_eq!(path.moves.len(), alone.moves.len(), "{name}");
             for (k, (a, b)) in path.moves.iter().zip(&alone.moves).enumerate() {
-                assert!(same(a, b), "{name}, plan {plan}: move {k}");
+                assert!(same(a, b), "{name}: move {k}");
             }
             assert!(same(&path.layers, &alone.layers), "{name}: layers");
             assert!(same(&path.features, &alone.features), "{name}: features");
             assert!(same(&path.warnings, &alone.warnings), "{name}: warnings");
             assert_eq!(path.time_s.to_bits(), alone.time_s.to_bits(), "{name}");
+            let apart = move_sources(bytes, options).unwrap();
             assert_eq!(sources.moves.len(), apart.moves.len(), "{name}");
             for (k, (a, b)) in sources.moves.iter().zip(&apart.moves).enumerate() {
                 assert!(same(a, b), "{name}: source {k}");
             }
             assert_eq!(sources.limits, apart.limits, "{name}: limits");
             annotated += usize::from(sources.moves.iter().any(|s| !s.notes.range().is_empty()));
-            // What `vtg` decides arcs by, before the analysis is done.
-            let report = analyze(bytes, &options).unwrap();
-            assert_eq!(read.flavor, report.file.flavor, "{name}: flavour");
-            assert_eq!(path.junction_model, report.machine.junction_model, "{name}");
         }
     }
     // The pairing matters where the sources fold skips lines: files with `;WIDTH:` notes.

@@ -16,7 +16,7 @@ use crate::gcode::{feature_kind, FeatureKind};
 use crate::machine::{Heater, Move};
 use crate::math::Bound;
 use crate::plan::segments::SegmentCounter;
-use crate::plan::{Limits, Motion, PlannedMove, Planner};
+use crate::plan::{Limits, Motion, PlannedMove, Planner, Profile};
 use crate::read::{LayerTracker, NO_LAYER};
 
 /// Feature slot of travel moves.
@@ -308,6 +308,24 @@ pub struct TimeBook {
     /// The file's and its layers' trajectory metrics, when asked
     /// ([`Timing::keeping_layer_metrics`]).
     pub layered: Option<LayeredMetrics>,
+    /// Every timed move, when kept ([`Timing::keeping_timed_moves`]), and the tag of the move
+    /// recorded last.
+    pub timed: Option<(Vec<TimedMove>, Option<u64>)>,
+}
+
+/// One timed move as the planner ran it: its line, start and end (s from the start of the
+/// file) and its speed profile. An arc's firmware segments are one move: the first one's
+/// start, the last one's end and profile.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimedMove {
+    /// 1-based line.
+    pub line: u32,
+    /// Start, s.
+    pub start_s: f64,
+    /// End, s.
+    pub end_s: f64,
+    /// Speed profile (an arc's last segment's).
+    pub profile: Profile,
 }
 
 /// The line and planned start (s) of every timed move, in file order, an arc's firmware
@@ -355,6 +373,13 @@ impl Timing {
     /// ([`LayeredMetrics`]) from the moves' [`MoveTrace`]s.
     pub fn keeping_layer_metrics(mut self, critical_angle_deg: f64) -> Self {
         self.book.layered = Some(LayeredMetrics::new(critical_angle_deg));
+        self
+    }
+
+    /// Keeps every timed move ([`TimedMove`], `capacity` expected): what a path read without
+    /// planning takes its timing from ([`crate::path::PrintPath::set_timing`]).
+    pub fn keeping_timed_moves(mut self, capacity: usize) -> Self {
+        self.book.timed = Some((Vec::with_capacity(capacity), None));
         self
     }
 
@@ -452,6 +477,7 @@ impl TimeBook {
             starts: None,
             segments: None,
             layered: None,
+            timed: None,
         }
     }
 
@@ -464,6 +490,19 @@ impl TimeBook {
         }
         if let Some(segments) = &mut self.segments {
             segments.timed(pm);
+        }
+        if let Some((timed, last)) = &mut self.timed {
+            let end_s = pm.start_s + pm.duration();
+            match timed.last_mut() {
+                Some(t) if *last == Some(pm.tag) => (t.end_s, t.profile) = (end_s, pm.profile),
+                _ => timed.push(TimedMove {
+                    line: pm.line,
+                    start_s: pm.start_s,
+                    end_s,
+                    profile: pm.profile,
+                }),
+            }
+            *last = Some(pm.tag);
         }
         let joules = self.energy.planned(pm);
         self.stamp_until(pm.tag, pm.start_s);

@@ -18,6 +18,7 @@ use crate::progress::Progress;
 pub use crate::read::{prescan, AnalyzeOptions, ExtrusionModeOption};
 use crate::read::{At, Flow, Fold, Reader, Setup};
 pub use accounting::MoveStarts;
+pub use accounting::TimedMove;
 use accounting::{Accounts, TimeBook, TimeMsg};
 pub use report::*;
 use toolpath::ToolpathMetrics;
@@ -141,6 +142,7 @@ pub fn analyze_with_starts(
         starts: true,
         min_segment_s: None,
         layer_metrics_deg: None,
+        timed_moves: false,
     };
     let (report, kept) = analyze_keeping(input, options, keep)?;
     Ok((report, kept.starts.unwrap_or_default()))
@@ -157,6 +159,8 @@ pub struct Keep {
     /// The file's and its layers' trajectory metrics at this critical angle, degrees
     /// ([`layered::LayeredMetrics`]).
     pub layer_metrics_deg: Option<f64>,
+    /// Every timed move ([`TimedMove`]).
+    pub timed_moves: bool,
 }
 
 /// What [`analyze_keeping`] kept.
@@ -168,6 +172,8 @@ pub struct Kept {
     pub segments: Option<SegmentCounts>,
     /// The file's metrics and its layers', where [`Keep::layer_metrics_deg`] asked.
     pub layer_metrics: Option<(ToolpathMetrics, Vec<ToolpathMetrics>)>,
+    /// Every timed move, where [`Keep::timed_moves`] asked.
+    pub timed_moves: Option<Vec<TimedMove>>,
 }
 
 /// [`analyze`], keeping what `keep` asks of the same pass.
@@ -197,6 +203,9 @@ fn analyze_timed(
     if let Some(deg) = keep.layer_metrics_deg {
         timing = timing.keeping_layer_metrics(deg);
     }
+    if keep.timed_moves {
+        timing = timing.keeping_timed_moves(crate::gcode::command_lines(input));
+    }
     let mut info = SlicerInfo::default();
     let mut acc = Accounts::new();
     let mut moves = None;
@@ -216,6 +225,7 @@ fn analyze_timed(
         segments: (moves.as_ref().zip(timing.book.segments.as_ref()))
             .map(|(moves, blocks)| SegmentCounter::merged(moves, blocks)),
         layer_metrics: None,
+        timed_moves: timing.book.timed.take().map(|(timed, _)| timed),
     };
     let report = report(input, options, reader, acc, (time_s, timing.book), info);
     kept.layer_metrics = layered.map(|l| l.finish(&report.layer_source, report.layers as usize));

@@ -352,6 +352,28 @@ pub(crate) fn walk_also<F: Fold>(
     Ok((walked, also))
 }
 
+impl PrintPath {
+    /// The timing of a path read without planning, from the moves an analysis of the same
+    /// file timed ([`crate::analyze::Keep::timed_moves`]) and its planned time `time_s`: what
+    /// [`extract`] with planning gives, from a planning pass that ran anyway. Each timed move
+    /// is the next move of its line (a line makes at most one move; a move the planner does
+    /// not time, Klipper's homing, keeps none).
+    pub fn set_timing(&mut self, timed: &[crate::analyze::TimedMove], time_s: f64) {
+        let mut moves = self.moves.iter_mut();
+        for t in timed {
+            let Some(m) = moves.find(|m| m.line == t.line) else {
+                break;
+            };
+            m.timing = Some(MoveTiming {
+                start_s: t.start_s,
+                duration_s: t.end_s - t.start_s,
+                profile: t.profile,
+            });
+        }
+        self.time_s = time_s;
+    }
+}
+
 /// [`MoveSink`] keeping every move (for [`extract`]).
 struct Collect {
     moves: Vec<PathMove>,

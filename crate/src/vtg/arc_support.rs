@@ -34,35 +34,8 @@ impl ArcsMode {
         }
     }
 
-    /// [`ArcsMode::resolve_declared`] as `On` or `Off`.
-    pub fn resolved_declared(
-        self,
-        input: &[u8],
-        declared: (JunctionModel, Option<&str>),
-        options: &AnalyzeOptions,
-    ) -> Self {
-        if self.resolve_declared(input, declared, options) {
-            ArcsMode::On
-        } else {
-            ArcsMode::Off
-        }
-    }
-
     /// The decision for `input` (analysed as `report`).
     pub fn resolve(self, input: &[u8], report: &Report, options: &AnalyzeOptions) -> bool {
-        let declared = (report.machine.junction_model, report.file.flavor.as_deref());
-        self.resolve_declared(input, declared, options)
-    }
-
-    /// [`ArcsMode::resolve`] from what it reads of the analysis: the planner's junction model
-    /// and the flavour the file declares (`report.machine.junction_model` and
-    /// `report.file.flavor`), known before the analysis is done.
-    pub fn resolve_declared(
-        self,
-        input: &[u8],
-        (model, flavor): (JunctionModel, Option<&str>),
-        options: &AnalyzeOptions,
-    ) -> bool {
         match self {
             ArcsMode::On => true,
             ArcsMode::Off => false,
@@ -70,7 +43,10 @@ impl ArcsMode {
                 has_arcs(input)
                     || match &options.klipper_config {
                         Some(c) => c.arc_resolution.is_some(),
-                        None => model != JunctionModel::Klipper && arc_capable_flavor(flavor),
+                        None => {
+                            report.machine.junction_model != JunctionModel::Klipper
+                                && arc_capable_flavor(report.file.flavor.as_deref())
+                        }
                     }
             }
         }

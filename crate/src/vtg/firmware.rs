@@ -238,6 +238,7 @@ pub fn analysed_figures(
         starts: false,
         min_segment_s: Some(budget.min_segment_time_s),
         layer_metrics_deg: None,
+        timed_moves: false,
     };
     let (report, kept) = crate::analyze::analyze_keeping(input, options, keep)?;
     let counts = kept.segments.unwrap_or_default();

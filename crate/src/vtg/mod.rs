@@ -235,27 +235,21 @@ fn rewrite_file(
     progress: Progress<'_>,
 ) -> Result<VtgReport, Error> {
     let cancelled = || Error::new(0, 0, ErrorKind::Cancelled);
-    let first = search::Variant::default();
-    // The original's analysis (and with the model its simulation, timed by it) on one side;
-    // on the other the path read and the first rewrite's offers made, which need none of it.
-    let (analysed, read) = crate::parallel::join(
-        || analyse_original(input, options),
-        || read_and_offer(input, options, first, &mut |f| progress(0.3 * f)),
-    );
     let Original {
         before,
         before_segments,
-        original_deviation,
-    } = analysed?;
-    let ReadAndOffered {
-        path,
         sources,
+        path,
         path_metrics,
-        options,
-        offers,
-        smoothings,
-    } = read?;
-    let options = &options;
+    } = read_original(input, options)?;
+    if !progress(0.3) {
+        return Err(cancelled());
+    }
+    // Arcs where the firmware runs them, decided once for every variant tried.
+    let options = &VtgOptions {
+        arcs: options.arcs.resolved(input, &before, &options.analyze),
+        ..options.clone()
+    };
     let run = Run {
         input,
         path: &path,
@@ -263,10 +257,23 @@ fn rewrite_file(
         sources: &sources,
         options,
         limits: rewrite::limits_for(&path, options),
-        known: std::sync::Mutex::new(Some((offers, Vec::new()))),
-        smoothings: std::sync::Mutex::new(smoothings),
+        known: std::sync::Mutex::new(None),
+        smoothings: std::sync::Mutex::new(smoothings::Smoothings::new(smoothings_bound(
+            input, options,
+        ))),
     };
-    let report = run.report((first, &[]), before, &mut |f| progress(0.3 + 0.4 * f));
+    let first = search::Variant::default();
+    // The original's simulated deviation does not depend on the rewrite: where there are
+    // threads, it runs beside the first one (on a long print it takes as long).
+    let expected_s = before.time_s;
+    let (original_deviation, report) = crate::parallel::join(
+        || {
+            options
+                .dynamics
+                .then(|| closed_loop::printing_deviation(input, expected_s, options))
+        },
+        || run.report((first, &[]), before, &mut |f| progress(0.3 + 0.4 * f)),
+    );
     let mut report = report?;
     if !progress(0.7) {
         return Err(cancelled());
@@ -306,89 +313,44 @@ fn rewrite_file(
 struct Original {
     before: Report,
     before_segments: Option<SegmentCounts>,
-    /// The model's simulation of the original, with the model.
-    original_deviation: Option<Option<closed_loop::Simulated>>,
+    sources: source::Sources,
+    path: crate::path::PrintPath,
+    path_metrics: (ToolpathMetrics, Vec<ToolpathMetrics>),
 }
 
-/// The original's analysis, and with the dynamics model its simulated deviation: the
-/// simulation splits a long print where the analysis' planned time puts it.
-fn analyse_original(input: &[u8], options: &VtgOptions) -> Result<Original, Error> {
-    let min_segment_s = firmware::min_segment_time_s(input, options.min_segment_time_ms);
-    let keep = crate::analyze::Keep {
-        starts: false,
-        min_segment_s: Some(min_segment_s),
-        layer_metrics_deg: None,
-    };
-    let (before, kept) = crate::analyze::analyze_keeping(input, &options.analyze, keep)?;
-    let expected_s = before.time_s;
-    let original_deviation = options
-        .dynamics
-        .then(|| closed_loop::printing_deviation(input, expected_s, options));
+/// Reads [`Original`] in two passes side by side where there are threads: the analysis, which
+/// plans the file and keeps each move's timing, and one pass for the path (unplanned), its
+/// moves' sources and its metrics. The path takes its timing from the analysis: the same
+/// planner fed the same moves, so the same timing to the bit as planning it again, which took
+/// a sixth of the reading's CPU time on one thread while the analysis' threads were done.
+fn read_original(input: &[u8], options: &VtgOptions) -> Result<Original, Error> {
+    let (read, path) = crate::parallel::join(
+        || {
+            let min_segment_s = firmware::min_segment_time_s(input, options.min_segment_time_ms);
+            let keep = crate::analyze::Keep {
+                starts: false,
+                min_segment_s: Some(min_segment_s),
+                layer_metrics_deg: None,
+                timed_moves: options.limit_feed,
+            };
+            crate::analyze::analyze_keeping(input, &options.analyze, keep)
+        },
+        || {
+            let (path, sources) = source::path_and_sources(input, &options.analyze, false)?;
+            let metrics = metrics::from_path(&path, options.critical_angle_deg);
+            Ok::<_, Error>((path, sources, metrics))
+        },
+    );
+    let ((before, kept), (mut path, sources, path_metrics)) = (read?, path?);
+    if let Some(timed) = &kept.timed_moves {
+        path.set_timing(timed, before.time_s);
+    }
     Ok(Original {
         before,
         before_segments: kept.segments,
-        original_deviation,
-    })
-}
-
-/// What [`read_and_offer`] reads of the file and makes of it.
-struct ReadAndOffered {
-    path: crate::path::PrintPath,
-    sources: source::Sources,
-    path_metrics: (ToolpathMetrics, Vec<ToolpathMetrics>),
-    /// The options with arcs decided for the file, once for every variant tried.
-    options: VtgOptions,
-    /// The first rewrite's offers.
-    offers: rewrite::Offers,
-    /// The paths it smoothed, for the variants that smooth them the same way.
-    smoothings: smoothings::Smoothings,
-}
-
-/// Reads the original's path, its sources and its metrics in one pass, decides on arcs from
-/// what the file declares, and makes `variant`'s offers: none of it waits for the analysis.
-fn read_and_offer(
-    input: &[u8],
-    options: &VtgOptions,
-    variant: search::Variant,
-    progress: Progress<'_>,
-) -> Result<ReadAndOffered, Error> {
-    let read = source::path_and_sources(input, &options.analyze, options.limit_feed)?;
-    let path = read.path;
-    if !progress(1.0 / 3.0) {
-        return Err(Error::new(0, 0, ErrorKind::Cancelled));
-    }
-    let declared = (path.junction_model, read.flavor.as_deref());
-    let options = VtgOptions {
-        arcs: (options.arcs).resolved_declared(input, declared, &options.analyze),
-        ..options.clone()
-    };
-    let limits = rewrite::limits_for(&path, &options);
-    let mut smoothings = smoothings::Smoothings::new(smoothings_bound(input, &options));
-    // The path's metrics are wanted only by the report: measured beside the offers, where
-    // the reading's last stretch ran on one thread.
-    let (path_metrics, offers) = crate::parallel::join(
-        || metrics::from_path(&path, options.critical_angle_deg),
-        || {
-            rewrite::offers(
-                input,
-                &path,
-                &read.sources,
-                (&options, &limits),
-                (variant, &[]),
-                (&mut smoothings, &mut |f: f64| {
-                    progress((1.0 + 2.0 * f) / 3.0)
-                }),
-            )
-        },
-    );
-    let offers = offers?;
-    Ok(ReadAndOffered {
+        sources,
         path,
-        sources: read.sources,
         path_metrics,
-        options,
-        offers,
-        smoothings,
     })
 }
 

@@ -6,7 +6,7 @@
 //! with the path's.
 
 use crate::error::Error;
-use crate::gcode::{Command, Line, RawLine, SlicerInfo};
+use crate::gcode::{Command, Line, RawLine};
 use crate::machine::{axis, Event, ExtrusionMode, Machine};
 use crate::plan::Limits;
 use crate::read::{AnalyzeOptions, At, Flow, Fold, Reader};
@@ -218,65 +218,17 @@ pub fn move_sources(input: &[u8], options: &AnalyzeOptions) -> Result<Sources, E
     Ok(fold.sources)
 }
 
-/// What `vtg` reads of the file it rewrites besides the analysis, in one pass.
-#[derive(Debug)]
-pub struct PathAndSources {
-    /// The path ([`crate::path::extract`]).
-    pub path: crate::path::PrintPath,
-    /// Its moves' sources ([`move_sources`]).
-    pub sources: Sources,
-    /// The firmware flavour the file declares, as the analysis reports it (`file.flavor`):
-    /// with it `vtg` decides on arcs without waiting for the analysis.
-    pub flavor: Option<String>,
-}
-
-/// The file's path and its moves' sources from one pass: the same results as
-/// [`crate::path::extract`] and [`move_sources`], read and parsed once (`vtg` needs both of
-/// every file it rewrites; on the 34 MB corpus file the second pass was a sixth of the
-/// reading's CPU time).
+/// The file's path ([`crate::path::extract`]) and its moves' sources ([`move_sources`]) from
+/// one pass: the same two results, read and parsed once (`vtg` needs both of every file it
+/// rewrites; on the 34 MB corpus file the second pass was a sixth of the reading's CPU time).
 pub fn path_and_sources(
     input: &[u8],
     options: &AnalyzeOptions,
     plan: bool,
-) -> Result<PathAndSources, Error> {
-    let (path, (read, declared)) = crate::path::extract_also(input, options, plan, |reader| {
-        let declared = Declared {
-            info: SlicerInfo::default(),
-            prescanned: reader.setup.pre.flavor.clone(),
-        };
-        (Read::new(input, reader), declared)
-    })?;
-    Ok(PathAndSources {
-        path,
-        sources: read.sources,
-        flavor: declared.info.flavor.or(declared.prescanned),
-    })
-}
-
-/// The slicer's declarations, read from the comments as the analysis reads them (its
-/// `SlicerInfo`, the prescan's flavour where the comments name none).
-struct Declared {
-    info: SlicerInfo,
-    prescanned: Option<String>,
-}
-
-impl Fold for (Read, Declared) {
-    fn line(&mut self, raw: &RawLine<'_>, line: Option<&Line<'_>>) -> Result<Flow, Error> {
-        self.0.line(raw, line)
-    }
-    fn comment(&mut self, comment: &[u8]) {
-        self.0.comment(comment);
-        self.1.info.observe(comment);
-    }
-    fn limits(&mut self, limits: &Limits, machine: &Machine) {
-        self.0.limits(limits, machine);
-    }
-    fn command(&mut self, line: &Line<'_>, machine: &Machine) {
-        self.0.command(line, machine);
-    }
-    fn event(&mut self, line: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
-        self.0.event(line, event, at)
-    }
+) -> Result<(crate::path::PrintPath, Sources), Error> {
+    let (path, read) =
+        crate::path::extract_also(input, options, plan, |reader| Read::new(input, reader))?;
+    Ok((path, read.sources))
 }
 
 fn is_plain(line: &Line<'_>, to: &crate::machine::Pos) -> bool {

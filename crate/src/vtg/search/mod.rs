@@ -279,6 +279,7 @@ pub(crate) fn analysed(
         starts: !options.dynamics,
         min_segment_s: Some(min_s),
         layer_metrics_deg: Some(options.critical_angle_deg),
+        timed_moves: false,
     };
     let (after, kept) = crate::analyze::analyze_keeping(output, &options.analyze, keep)?;
     let output_kept = OutputKept {
