@@ -133,8 +133,8 @@ measure-vtg-w16: cli
 measure-vtg-unseen: cli
 	bash scripts/vtg-unseen-parts.sh
 
-## Two more unseen models sliced eight more ways, each vtg output checked by analyze and
-## vibration runs of its own, not by vtg's report (scripts/vtg-fresh-parts.sh; about 1 min).
+## Four more unseen models sliced fourteen more ways, each vtg output checked by analyze and
+## vibration runs of its own, not by vtg's report (scripts/vtg-fresh-parts.sh; about 2 min).
 measure-vtg-fresh: cli
 	bash scripts/vtg-fresh-parts.sh
 

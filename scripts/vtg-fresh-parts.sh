@@ -4,7 +4,11 @@
 # comb.scad: 24 thin teeth on a spine, a star-shaped grip and an oval ring), sliced eight ways
 # under settings the other measurements did not use (support, cubic-subdivision, 3-D honeycomb,
 # Archimedean-chords, adaptive-cubic and zigzag infill, a 0.6 mm nozzle with 2.85 mm filament,
-# Repetier and RepRap flavours, a Klipper printer, random seams), then each output checked by
+# Repetier and RepRap flavours, a Klipper printer, random seams), and two added on 2026-12-06
+# (knob.scad: a 36-point knurled ring, a D-shaft bore and a pointer rib; hook.scad: a plate with
+# two countersunk holes, a quarter-torus arm and a gusset) sliced six ways (lines, octet, stars,
+# concentric and rectilinear infill; Griffin, RepRapFirmware with relative E, Teacup and
+# Smoothieware flavours; 0.1 mm layers), then each output checked by
 # runs of its own (scripts/vtg-check-independently.py: the input and the output analysed and
 # simulated apart from the rewrite). Extra arguments are passed on to `quietpath vtg`.
 # Results: docs/measurements/vtg.md ("Parts it was not tuned on").
@@ -22,7 +26,7 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 resources="$("$root/scripts/cura-resources.sh" "$work")"
 export CURA_ENGINE_SEARCH_PATH="$resources/definitions:$resources/extruders"
-for model in manifold comb; do
+for model in manifold comb knob hook; do
   "$root/scripts/openscad-stl.sh" "$work/$model.stl" "$root/tests/fixtures/models/unseen/$model.scad"
 done
 
@@ -71,6 +75,23 @@ slic3r manifold slic3r_manifold_repetier_3dhoneycomb_support --gcode-flavor repe
 slic3r comb slic3r_comb_archimedeanchords --gcode-flavor marlin --layer-height 0.2 \
   --perimeters 3 --fill-density 25% --fill-pattern archimedeanchords
 
+cura knob curaengine_knob_lines_accel3000 "${marlin[@]}" -s layer_height=0.2 \
+  -s wall_line_count=3 -s infill_pattern=lines -s infill_sparse_density=15 -s speed_print=70 \
+  -s acceleration_enabled=true -s acceleration_print=3000 -s jerk_enabled=true -s jerk_print=8
+cura hook curaengine_hook_octet_griffin -s machine_gcode_flavor="Griffin" -s layer_height=0.15 \
+  -s infill_pattern=octet -s infill_sparse_density=30 -s speed_print=45 -s retraction_combing=off
+prusa-slicer --export-gcode --gcode-flavor reprapfirmware --use-relative-e-distances \
+  --layer-height 0.2 --fill-density 20% --fill-pattern stars --perimeters 3 \
+  --output "$work/prusaslicer_knob_stars_rrf_relE.gcode" "$work/knob.stl" >/dev/null 2>&1
+prusa-slicer --export-gcode --gcode-flavor marlin2 --layer-height 0.1 --fill-density 40% \
+  --fill-pattern concentric --perimeters 2 --external-perimeters-first --infill-speed 90 \
+  --max-print-speed 150 \
+  --output "$work/prusaslicer_hook_concentric_0.1.gcode" "$work/hook.stl" >/dev/null 2>&1
+slic3r knob slic3r_knob_teacup_line --gcode-flavor teacup --layer-height 0.25 --perimeters 2 \
+  --fill-density 30% --fill-pattern line
+slic3r hook slic3r_hook_smoothie_rect --gcode-flavor smoothie --layer-height 0.2 \
+  --perimeters 3 --fill-density 15% --fill-pattern rectilinear
+
 files=("$work"/*.gcode)
-[ "${#files[@]}" -eq 8 ] || { echo "expected 8 slices, got ${#files[@]}" >&2; exit 1; }
+[ "${#files[@]}" -eq 14 ] || { echo "expected 14 slices, got ${#files[@]}" >&2; exit 1; }
 python3 "$root/scripts/vtg-check-independently.py" "${files[@]}" ${1:+-- "$@"}
