@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# VTG on two more models no tuning has seen (tests/fixtures/models/unseen/manifold.scad: a block
+# VTG on four more models no tuning has seen (tests/fixtures/models/unseen/manifold.scad: a block
 # with six bores of three sizes, two bored bosses, a 0.9 mm wall 30 mm tall and a separate tube;
 # comb.scad: 24 thin teeth on a spine, a star-shaped grip and an oval ring), sliced eight ways
 # under settings the other measurements did not use (support, cubic-subdivision, 3-D honeycomb,
