@@ -730,8 +730,9 @@ fn k1_meets_every_bar_with_a_tenth_of_a_percent_of_time() {
     assert!(o.mean_deviation_pct < 0.0, "{o:?}");
 }
 
-/// Printing `G1` segments of `bytes` (lines with X or Y and a positive E word, relative or
-/// absolute by `M82`/`M83`) and how many are shorter than 0.1 mm, read straight from the text.
+/// Printing moves of `bytes` (`G1` lines with X or Y and a positive E word, relative or
+/// absolute by `M82`/`M83`, and arcs, each one move as long as its arc) and how many are
+/// shorter than 0.1 mm, read straight from the text.
 fn printing_segments(bytes: &[u8]) -> (u64, u64) {
     let (mut x, mut y, mut e, mut absolute) = (0.0f64, 0.0f64, 0.0f64, true);
     let (mut n, mut short) = (0u64, 0u64);
@@ -749,14 +750,16 @@ fn printing_segments(bytes: &[u8]) -> (u64, u64) {
                     }
                 }
             }
-            "G0" | "G1" => {
-                let (mut nx, mut ny, mut de) = (x, y, 0.0);
+            "G0" | "G1" | "G2" | "G3" => {
+                let (mut nx, mut ny, mut de, mut ij) = (x, y, 0.0, [0.0f64; 2]);
                 for w in words {
                     let (k, v) = w.split_at(1);
                     let v: f64 = v.parse().unwrap_or(f64::NAN);
                     match k {
                         "X" => nx = v,
                         "Y" => ny = v,
+                        "I" => ij[0] = v,
+                        "J" => ij[1] = v,
                         "E" if absolute => {
                             de = v - e;
                             e = v;
@@ -765,7 +768,22 @@ fn printing_segments(bytes: &[u8]) -> (u64, u64) {
                         _ => {}
                     }
                 }
-                let len = (nx - x).hypot(ny - y);
+                let len = if head == "G2" || head == "G3" {
+                    // One move of the file, as long as its arc (centre at the offsets).
+                    let (cx, cy) = (x + ij[0], y + ij[1]);
+                    let a0 = (y - cy).atan2(x - cx);
+                    let mut sweep = (ny - cy).atan2(nx - cx) - a0;
+                    let tau = std::f64::consts::TAU;
+                    if head == "G3" && sweep <= 0.0 {
+                        sweep += tau;
+                    }
+                    if head == "G2" && sweep >= 0.0 {
+                        sweep -= tau;
+                    }
+                    ij[0].hypot(ij[1]) * sweep.abs()
+                } else {
+                    (nx - x).hypot(ny - y)
+                };
                 if de > 0.0 && len > 0.0 {
                     n += 1;
                     short += u64::from(len < 0.1);

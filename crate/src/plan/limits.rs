@@ -43,6 +43,32 @@ pub enum JunctionModel {
     Klipper,
 }
 
+/// How a Marlin-family firmware cuts `G2`/`G3` into straight segments (Klipper's
+/// `[gcode_arcs]` cuts by its own rule, [`super::ArcCutting`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(test, derive(ts_rs::TS))]
+#[serde(rename_all = "snake_case")]
+pub enum ArcRule {
+    /// Prusa's firmware: segments short enough to keep each chord within
+    /// [`super::MAX_ARC_DEVIATION_MM`] of the arc and to run at least
+    /// [`super::ARC_SEGMENTS_PER_SEC`], between [`super::MIN_ARC_SEGMENT_MM`] and
+    /// `arc_segment_mm` ([`super::arc_segments`]).
+    #[default]
+    ChordDeviation,
+    /// Upstream Marlin 2.1 as shipped (`MIN_ARC_SEGMENT_MM 0.1`, `MAX_ARC_SEGMENT_MM` the
+    /// `arc_segment_mm`, `MIN_CIRCLE_SEGMENTS 72`, no `ARC_SEGMENTS_PER_SEC`): at least 72
+    /// segments a full circle, no longer than the maximum, and where that makes them shorter
+    /// than the minimum, as many of the minimum as fit ([`super::marlin_arc_segments`]).
+    CircleSegments,
+}
+
+impl ArcRule {
+    /// Whether it is the default (left out of reports, which then read as before it existed).
+    pub fn is_default(&self) -> bool {
+        *self == ArcRule::default()
+    }
+}
+
 /// One limit value with its origin.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(test, derive(ts_rs::TS))]
@@ -104,6 +130,9 @@ pub struct Limits {
     pub min_travel_feedrate: Limit,
     /// Length of the straight segments arcs are split into, mm.
     pub arc_segment_mm: Limit,
+    /// How a Marlin-family firmware cuts arcs into segments of at most `arc_segment_mm`.
+    #[serde(default, skip_serializing_if = "ArcRule::is_default")]
+    pub arc_rule: ArcRule,
     /// Klipper's `[extruder] instantaneous_corner_velocity`, mm/s: the largest step in filament
     /// speed a junction may ask of the extruder. Unset: Klipper's default,
     /// [`KLIPPER_INSTANT_CORNER_V`](super::junction::KLIPPER_INSTANT_CORNER_V) (and not in the

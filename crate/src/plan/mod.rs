@@ -14,9 +14,10 @@
 //! `accel_to_decel` (the minimum cruise ratio), so the window's cruise speeds and junctions are
 //! capped by each chain's peak before the trapezoids are built.
 //!
-//! Arcs are split into straight segments as the firmware splits them: Marlin 2 by chord
-//! deviation and segment rate up to `arc_segment_mm`, Klipper into pieces of `arc_segment_mm`
-//! (its `[gcode_arcs] resolution`).
+//! Arcs are split into straight segments as the firmware splits them: Prusa's firmware by chord
+//! deviation and segment rate up to `arc_segment_mm`, upstream Marlin 2.1 into at least 72
+//! segments a circle of 0.1 mm to `arc_segment_mm` ([`ArcRule`]), Klipper into pieces of
+//! `arc_segment_mm` (its `[gcode_arcs] resolution`).
 
 pub mod junction;
 pub mod klipper_config;
@@ -31,7 +32,7 @@ use crate::machine::{axis, Move};
 use crate::math::Bound;
 use junction::Segment;
 pub use klipper_config::{KlipperConfig, KlipperConfigError, KlipperVersion};
-pub use limits::{FeedUnits, JunctionModel, Limit, LimitSource, Limits};
+pub use limits::{ArcRule, FeedUnits, JunctionModel, Limit, LimitSource, Limits};
 pub use profiles::MachineProfile;
 pub use trapezoid::Profile;
 
@@ -139,8 +140,11 @@ pub const MAX_ARC_DEVIATION_MM: f64 = 0.02;
 pub const MIN_ARC_SEGMENT_MM: f64 = 0.1;
 /// Segments per second the firmware aims for at least (Marlin 2's `ARC_SEGMENTS_PER_SEC`).
 pub const ARC_SEGMENTS_PER_SEC: f64 = 50.0;
+/// Fewest segments of a full circle in upstream Marlin 2.1 (`MIN_CIRCLE_SEGMENTS`).
+pub const MIN_CIRCLE_SEGMENTS: f64 = 72.0;
 
-/// Number of straight segments an arc is split into, as Marlin 2's `plan_arc` does: segments
+/// Number of straight segments an arc is split into, as Prusa's Marlin 2 does
+/// ([`ArcRule::ChordDeviation`]): segments
 /// short enough to keep the chord within [`MAX_ARC_DEVIATION_MM`] and to run at least
 /// [`ARC_SEGMENTS_PER_SEC`] at the feed rate, but between [`MIN_ARC_SEGMENT_MM`] and the
 /// machine's `arc_segment_mm`.
@@ -163,22 +167,71 @@ fn segment_count(n: f64) -> usize {
     }
 }
 
-/// Number of straight segments the firmware of a junction model cuts an arc into: Klipper's
-/// `[gcode_arcs]` makes pieces of `resolution` (the machine's `arc_segment_mm`, 1 mm unless
-/// set) along the helix (`rise`: along its axis), `floor(length / resolution)` of them;
-/// Marlin 2 as in [`arc_segments`], by the planar length.
-pub fn firmware_arc_segments(
-    model: JunctionModel,
-    radius: f64,
-    (planar_length, rise): (f64, f64),
-    feed_mm_s: f64,
-    max_segment_mm: f64,
-) -> usize {
-    if model == JunctionModel::Klipper {
-        let length = planar_length.hypot(rise);
-        segment_count((length / max_segment_mm.at_least(1e-3)).floor())
+/// Number of straight segments upstream Marlin 2.1's `plan_arc` cuts an arc of `radius` and
+/// `planar_length` into, with `MAX_ARC_SEGMENT_MM` `max_segment_mm` ([`ArcRule::CircleSegments`]):
+/// `max(⌊l / max⌋, ⌈72 · sweep / 2π⌉)` segments, unless that makes them longer than the
+/// maximum (then `⌈l / max⌉`) or shorter than [`MIN_ARC_SEGMENT_MM`] (then `⌊l / 0.1⌋`, at
+/// least 1). A hairpin of radius 0.225 mm (half a circle, 0.71 mm) is 7 chords of 25.7°.
+pub fn marlin_arc_segments(radius: f64, planar_length: f64, max_segment_mm: f64) -> usize {
+    let max = max_segment_mm.at_least(MIN_ARC_SEGMENT_MM);
+    let portion = planar_length / (radius * std::f64::consts::TAU);
+    let min_segments = (MIN_CIRCLE_SEGMENTS * portion).ceil();
+    let nominal = (planar_length / max).floor().max(min_segments);
+    let nominal_mm = planar_length / nominal;
+    let n = if nominal_mm > max {
+        (planar_length / max).ceil()
+    } else if nominal_mm < MIN_ARC_SEGMENT_MM {
+        (planar_length / MIN_ARC_SEGMENT_MM).floor().max(1.0)
     } else {
-        arc_segments(radius, planar_length, feed_mm_s, max_segment_mm)
+        nominal
+    };
+    segment_count(n)
+}
+
+/// How a firmware cuts arcs: its junction model (Klipper's `[gcode_arcs]` has a rule of its
+/// own), the Marlin-family rule, and the longest segment, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArcCutting {
+    /// The planner's junction model.
+    pub model: JunctionModel,
+    /// The Marlin-family rule (not read under Klipper).
+    pub rule: ArcRule,
+    /// The longest segment (Marlin's `MAX_ARC_SEGMENT_MM`, Klipper's `resolution`), mm.
+    pub max_segment_mm: f64,
+}
+
+impl ArcCutting {
+    /// The cutting the planner applies under `limits` with junction model `model`.
+    pub fn of(model: JunctionModel, limits: &Limits) -> Self {
+        ArcCutting {
+            model,
+            rule: limits.arc_rule,
+            max_segment_mm: limits.arc_segment_mm.value,
+        }
+    }
+
+    /// Number of straight segments an arc of `radius` is cut into: Klipper's `[gcode_arcs]`
+    /// makes pieces of `resolution` (`max_segment_mm`, 1 mm unless set) along the helix
+    /// (`rise`: along its axis), `floor(length / resolution)` of them; a Marlin-family firmware
+    /// by its [`ArcRule`], by the planar length.
+    pub fn segments(
+        &self,
+        radius: f64,
+        (planar_length, rise): (f64, f64),
+        feed_mm_s: f64,
+    ) -> usize {
+        match (self.model, self.rule) {
+            (JunctionModel::Klipper, _) => {
+                let length = planar_length.hypot(rise);
+                segment_count((length / self.max_segment_mm.at_least(1e-3)).floor())
+            }
+            (_, ArcRule::ChordDeviation) => {
+                arc_segments(radius, planar_length, feed_mm_s, self.max_segment_mm)
+            }
+            (_, ArcRule::CircleSegments) => {
+                marlin_arc_segments(radius, planar_length, self.max_segment_mm)
+            }
+        }
     }
 }
 
@@ -293,12 +346,10 @@ impl Planner {
         match m.arc {
             Some(arc) => {
                 let (p0, p1, h) = arc.plane.axes();
-                let n = firmware_arc_segments(
-                    self.model,
+                let n = ArcCutting::of(self.model, &self.limits).segments(
                     arc.radius,
                     (arc.planar_length(), m.delta[h]),
                     m.feed_mm_s,
-                    self.limits.arc_segment_mm.value,
                 );
                 let mut prev = [0.0f64; 4];
                 for k in 1..=n {
@@ -1115,6 +1166,33 @@ mod tests {
         // The machine's maximum segment length caps it, 0.1 mm floors it.
         assert_eq!(arc_segments(1000.0, 100.0, 1000.0, 1.0), 100);
         assert_eq!(arc_segments(0.001, 1.0, 0.01, 1.0), 10);
+    }
+
+    #[test]
+    fn arcs_are_split_like_upstream_marlin_2_1() {
+        use std::f64::consts::{PI, TAU};
+        // Marlin 2.1's plan_arc with its shipped defaults, worked by hand:
+        // a 0.225 mm hairpin (half a circle, 0.707 mm): ⌈72 / 2⌉ = 36 segments of 0.02 mm are
+        // under the 0.1 mm minimum, so ⌊0.707 / 0.1⌋ = 7.
+        assert_eq!(marlin_arc_segments(0.225, 0.225 * PI, 1.0), 7);
+        // A full circle of radius 10 (62.83 mm): max(⌊62.83⌋, 72) = 72 of 0.87 mm.
+        assert_eq!(marlin_arc_segments(10.0, 10.0 * TAU, 1.0), 72);
+        // A quarter of radius 100 (157.08 mm): ⌊157.08⌋ = 157 segments are 1.0005 mm, over the
+        // maximum, so ⌈157.08⌉ = 158.
+        assert_eq!(marlin_arc_segments(100.0, 50.0 * PI, 1.0), 158);
+        // A tiny quarter (0.079 mm): one segment.
+        assert_eq!(marlin_arc_segments(0.05, 0.025 * PI, 1.0), 1);
+        // The planner cuts a file's arcs by the rule in its limits.
+        let limits = Limits {
+            arc_rule: ArcRule::CircleSegments,
+            ..test_limits()
+        };
+        let p = plan_on(
+            limits,
+            "G1 X10 Y0 F600\nG2 X10 Y0 I-10 J0",
+            JunctionModel::JunctionDeviation,
+        );
+        assert_eq!(p.len(), 1 + 72);
     }
 
     #[test]

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::limits::{JunctionModel, Limit, Limits};
+use super::limits::{ArcRule, JunctionModel, Limit, Limits};
 
 /// A machine profile.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -43,7 +43,18 @@ fn limits(
         min_feedrate: Limit::profile(0.0),
         min_travel_feedrate: Limit::profile(0.0),
         arc_segment_mm: Limit::profile(1.0),
+        arc_rule: ArcRule::ChordDeviation,
         instantaneous_corner_velocity: None,
+    }
+}
+
+impl Limits {
+    /// These limits with arcs cut by `rule`.
+    fn with_arc_rule(self, rule: ArcRule) -> Self {
+        Limits {
+            arc_rule: rule,
+            ..self
+        }
     }
 }
 
@@ -62,7 +73,7 @@ impl MachineProfile {
     /// - `prusa-mk3s`: Prusa firmware 3.x (classic jerk), normal mode, as in PrusaSlicer's
     ///   MK3S profile.
     /// - `creality-ender3`: Marlin 2 as configured by Creality for the Ender-3 (junction
-    ///   deviation 0.08 mm, Marlin's default).
+    ///   deviation 0.08 mm, Marlin's default; arcs cut as upstream Marlin 2.1 cuts them).
     /// - `voron-klipper`: a Voron 2.4 on Klipper (`max_velocity 300`, `max_accel 3000`,
     ///   `square_corner_velocity 5`, `minimum_cruise_ratio 0.5`).
     /// - `vtg-ldam-servo`: the large-format ball-screw servo printer of the VTG paper (1000 ×
@@ -93,7 +104,8 @@ impl MachineProfile {
                     0.08,
                     5.0,
                     0.5,
-                ),
+                )
+                .with_arc_rule(ArcRule::CircleSegments),
             ),
             "voron-klipper" => (
                 "Voron 2.4 on Klipper (square-corner velocity)",

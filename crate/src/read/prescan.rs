@@ -19,6 +19,22 @@ pub struct Prescan {
     pub limit_settings: Vec<(String, String)>,
     /// The slicer's own print-time estimate, s.
     pub slicer_time_s: Option<f64>,
+    /// The printer model the slicer's profile names (PrusaSlicer's `printer_model`).
+    pub printer_model: Option<String>,
+}
+
+impl Prescan {
+    /// Whether the file was sliced for one of Prusa's printers (PrusaSlicer's `printer_model`
+    /// of the MINI, MK2 to MK4, XL or CORE One families), whose firmware cuts arcs by chord
+    /// deviation ([`crate::plan::ArcRule::ChordDeviation`]).
+    pub fn for_prusa_printer(&self) -> bool {
+        self.printer_model.as_deref().is_some_and(|m| {
+            let m = m.to_ascii_uppercase();
+            ["MK2", "MK3", "MK4", "MINI", "XL", "COREONE", "IX"]
+                .iter()
+                .any(|family| m.starts_with(family))
+        })
+    }
 }
 
 /// Reads the head and tail of `input`.
@@ -56,6 +72,9 @@ pub fn prescan(input: &[u8]) -> Prescan {
                 } else if key == "gcode_flavor" {
                     p.flavor
                         .get_or_insert_with(|| value.trim().to_ascii_lowercase());
+                } else if key == "printer_model" && !value.trim().is_empty() {
+                    p.printer_model
+                        .get_or_insert_with(|| value.trim().to_string());
                 } else if key == "estimated printing time (normal mode)" {
                     p.slicer_time_s = parse_duration(value);
                 }

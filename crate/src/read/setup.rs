@@ -9,7 +9,7 @@ use crate::error::{Error, ErrorKind, Warnings};
 use crate::gcode::{self, Strictness};
 use crate::machine::{self, ExtrusionMode, Machine, MachineConfig};
 use crate::plan::klipper_config::{self, KlipperConfig, KlipperVersion};
-use crate::plan::{FeedUnits, JunctionModel, Limit, LimitSource, MachineProfile};
+use crate::plan::{ArcRule, FeedUnits, JunctionModel, Limit, LimitSource, MachineProfile};
 
 /// Options of `analyze`, and of how every other job reads its input. Every field is optional
 /// in JSON.
@@ -187,6 +187,16 @@ pub(crate) fn prepare(input: &[u8], options: &AnalyzeOptions) -> Result<Setup, E
     let pre = prescan::prescan(input);
     let (profile, model, model_reason) = choose_machine(options, &pre)?;
     let mut limits = starting_limits(options, &profile, &pre)?;
+    let machine_given = options.machine_profile.is_some() || options.machine.is_some();
+    if !machine_given && model != JunctionModel::Klipper {
+        // The default profile's planner, with arcs cut as the file's own firmware cuts them:
+        // upstream Marlin 2.1 unless the file was sliced for a Prusa printer.
+        limits.arc_rule = if pre.for_prusa_printer() {
+            ArcRule::ChordDeviation
+        } else {
+            ArcRule::CircleSegments
+        };
+    }
     let klipper_version = options
         .klipper_config
         .as_ref()
@@ -307,4 +317,35 @@ fn validate_options(o: &AnalyzeOptions) -> Result<(), Error> {
         ));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rule_of(text: &str, options: &AnalyzeOptions) -> ArcRule {
+        prepare(text.as_bytes(), options)
+            .expect("setup")
+            .limits
+            .arc_rule
+    }
+
+    #[test]
+    fn arcs_are_cut_as_the_files_firmware_cuts_them() {
+        let o = AnalyzeOptions::default();
+        let generic = "; gcode_flavor = marlin2\nG1 X1 E1\n";
+        let mk4 = "; gcode_flavor = marlin2\n; printer_model = MK4S\nG1 X1 E1\n";
+        let unnamed = "; gcode_flavor = marlin2\n; printer_model = \nG1 X1 E1\n";
+        assert_eq!(rule_of(generic, &o), ArcRule::CircleSegments);
+        assert_eq!(rule_of(unnamed, &o), ArcRule::CircleSegments);
+        assert_eq!(rule_of(mk4, &o), ArcRule::ChordDeviation);
+        // A machine given keeps its own rule; Klipper cuts by its resolution (the rule unread).
+        let given = AnalyzeOptions {
+            machine: Some("prusa-mk3s".into()),
+            ..AnalyzeOptions::default()
+        };
+        assert_eq!(rule_of(generic, &given), ArcRule::ChordDeviation);
+        let klipper = "; gcode_flavor = klipper\nG1 X1 E1\n";
+        assert_eq!(rule_of(klipper, &o), ArcRule::default());
+    }
 }

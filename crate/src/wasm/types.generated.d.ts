@@ -64,6 +64,12 @@ export type AnalyzeOptions = Partial<{
 }>;
 
 /**
+ * How a Marlin-family firmware cuts `G2`/`G3` into straight segments (Klipper's
+ * `[gcode_arcs]` cuts by its own rule, [`super::ArcCutting`]).
+ */
+export type ArcRule = "chord_deviation" | "circle_segments";
+
+/**
  * Arcs in the output.
  */
 export type ArcsMode = "auto" | "on" | "off";
@@ -1653,6 +1659,10 @@ export type Limits = {
    * Length of the straight segments arcs are split into, mm.
    */
   arc_segment_mm: Limit,
+  /**
+   * How a Marlin-family firmware cuts arcs into segments of at most `arc_segment_mm`.
+   */
+  arc_rule?: ArcRule,
   /**
    * Klipper's `[extruder] instantaneous_corner_velocity`, mm/s: the largest step in filament
    * speed a junction may ask of the extruder. Unset: Klipper's default,

@@ -23,11 +23,18 @@ use crate::vtg::tuning::TUNING;
 pub(crate) const MIN_SEGMENTS: usize = 3;
 /// Most steps one arc replaces (bounds the search).
 const MAX_SEGMENTS: usize = 256;
-/// Largest sweep of one arc, rad (under a half turn, where `I`/`J` from a rounded start point
-/// still place the centre on the right side).
-const MAX_SWEEP: f64 = 0.95 * std::f64::consts::PI;
+/// Largest sweep of one arc, rad: a half turn, a hairpin's. `I`/`J` place the centre and
+/// `G2`/`G3` the direction, so where rounding moves the centre a little off the chord the
+/// firmware (Marlin's and Klipper's `plan_arc` alike) still takes the half turn the way
+/// written.
+const MAX_SWEEP: f64 = std::f64::consts::PI + 1e-9;
 /// Largest relative mismatch between the start and end radius as written.
 const RADIUS_MISMATCH: f64 = 0.002;
+/// Largest mismatch between them in any case, mm: the 3-decimal rounding of the end point
+/// alone moves it up to 0.0007 mm, more than the relative bound on a hairpin's 0.2 mm radius;
+/// the firmware runs the last chord to the end point as written, within the room the
+/// tolerance keeps for rounding.
+const RADIUS_MISMATCH_MM: f64 = 0.001;
 
 /// A circle an arc runs on.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -107,6 +114,17 @@ impl std::fmt::Debug for Firmware<'_> {
     }
 }
 
+/// Why a run of points is not written as one arc ([`arc_over`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Unfit {
+    /// Its points are not on one circle as an arc asks (nor would a longer run's be).
+    Shape,
+    /// They are, but the firmware would cut the arc into chords that turn more than the walk's
+    /// steps: a longer run on the same circle may be cut finely enough (upstream Marlin 2.1
+    /// cuts 45° of a 0.225 mm circle into one chord and 180° into seven).
+    Coarse,
+}
+
 /// Whether points `pts[i..=j]` (feeds `feed[i..j]` of the segments between them) make one arc
 /// within `tol` of the circle through the first, middle and last; its shape if so.
 fn arc_over(
@@ -115,22 +133,22 @@ fn arc_over(
     (i, j): (usize, usize),
     tol: f64,
     firmware: &Firmware<'_>,
-) -> Option<ArcShape> {
-    let run = pts.get(i..=j)?;
-    let (first, last) = (run.first()?, run.last()?);
-    let (center, r) = circle_through(first, &run[run.len() / 2], last)?;
+) -> Result<ArcShape, Unfit> {
+    let run = pts.get(i..=j).ok_or(Unfit::Shape)?;
+    let (first, last) = (&run[0], &run[run.len() - 1]);
+    let (center, r) = circle_through(first, &run[run.len() / 2], last).ok_or(Unfit::Shape)?;
     if !(TUNING.arc_min_radius_mm..=TUNING.arc_max_radius_mm).contains(&r) {
-        return None;
+        return Err(Unfit::Shape);
     }
     if run.iter().any(|p| (p[2] - first[2]).abs() > 1e-9) {
-        return None;
+        return Err(Unfit::Shape);
     }
-    let speeds = feed.get(i..j)?;
+    let speeds = feed.get(i..j).ok_or(Unfit::Shape)?;
     let (lo, hi) = speeds.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &f| {
         (lo.min(f), hi.max(f))
     });
     if !(lo > 0.0 && hi <= lo * TUNING.arc_feed_spread) {
-        return None;
+        return Err(Unfit::Shape);
     }
     // Every point on the circle, every step turning the same way by less than a quarter turn.
     // (The arc runs outside the chords between the points by their sagittas: closer to the
@@ -148,20 +166,16 @@ fn arc_over(
             sign = step.signum();
         }
         if step.signum() != sign || step.abs() >= std::f64::consts::FRAC_PI_2 {
-            return None;
+            return Err(Unfit::Shape);
         }
         sweep += step.abs();
-    }
-    let cuts = (firmware.segments)(r, r * sweep, lo).max(1);
-    if sweep / cuts as f64 > firmware.max_turn_rad {
-        return None;
     }
     if sweep > MAX_SWEEP
         || run
             .iter()
             .any(|p| (norm(sub(p, [center[0], center[1], p[2]])) - r).abs() > tol)
     {
-        return None;
+        return Err(Unfit::Shape);
     }
     // As written (the block writer's rounding): the end stays on the circle the start and the
     // offsets define.
@@ -170,10 +184,14 @@ fn arc_over(
     let (ex, ey) = (rounded(last[0], 3), rounded(last[1], 3));
     let r_start = ci.hypot(cj);
     let r_end = (ex - sx - ci).hypot(ey - sy - cj);
-    if (r_end - r_start).abs() > RADIUS_MISMATCH * r_start {
-        return None;
+    if (r_end - r_start).abs() > (RADIUS_MISMATCH * r_start).max(RADIUS_MISMATCH_MM) {
+        return Err(Unfit::Shape);
     }
-    Some(ArcShape {
+    let cuts = (firmware.segments)(r, r * sweep, lo).max(1);
+    if sweep / cuts as f64 > firmware.max_turn_rad {
+        return Err(Unfit::Coarse);
+    }
+    Ok(ArcShape {
         center,
         ccw: sign > 0.0,
     })
@@ -208,10 +226,11 @@ pub(crate) fn pieces(
         let mut best: Option<(usize, ArcShape)> = None;
         let mut j = i + MIN_SEGMENTS;
         while j <= n && j - i <= MAX_SEGMENTS {
-            let Some(shape) = arc_over(pts, feed, (i, j), tol, firmware) else {
-                break;
-            };
-            best = Some((j, shape));
+            match arc_over(pts, feed, (i, j), tol, firmware) {
+                Ok(shape) => best = Some((j, shape)),
+                Err(Unfit::Coarse) => {}
+                Err(Unfit::Shape) => break,
+            }
             j += 1;
         }
         match best {

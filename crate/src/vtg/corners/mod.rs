@@ -6,6 +6,7 @@
 //! |---|---|---|---|
 //! | `blend::Fillets` | every sharp corner, first | a fillet tangent to the legs, or the racing line out and back (`Fillet`: the `Blend` that `blend::plan` lays out at the vertex); none where it cannot be walked in steps under the critical angle (the corner is then *tight*) | its peak curvature: the machine runs it at `√(a/κ)`, against the original's speed at the corner; a corner whose fillet is accepted is rounded alone |
 //! | `klipper::Polygons` | on a Klipper path with planned speeds, first of all: each sharp corner whose fillet is not accepted at no loss of speed | a polygon placed for Klipper's look-ahead, written as it is (`Written`) | the slowest planned speed through it against the sharp corner's, at least `Settings::min_speed_share` of it |
+//! | `arc_hairpin::ArcHairpins` | where arcs are written and the firmware cuts a hairpin's arc into chords under the walk's turn: two sharp corners across a short connector | one arc for the two (`Written`, 2 corners), written as one `G2`/`G3` in place of the connector | not weighed: the rewrite's planned time and energy decide |
 //! | `hairpin::Hairpins` | two sharp corners across a short leg that are not both rounded alone | one arc for the two (`Fitted`, 2 corners), sought again within the smaller blend share of a retry | not weighed: taken wherever it fits |
 //! | `keyhole::Keyholes` | a tight corner not already replaced, where keyholes are on | a loop round it (`Fitted`, 1 corner) | the loop's curvature (its radius is always the smallest the walk follows, so the cost is known before the loop is sought), likewise |
 //!
@@ -16,6 +17,7 @@
 //! Every replacement but the fillet is a `Hairpin`: points between where it leaves the path
 //! and where it rejoins it, spliced in by `hairpin::substitute` before the fit.
 
+pub(crate) mod arc_hairpin;
 pub(crate) mod arcs;
 pub(crate) mod blend;
 pub(crate) mod hairpin;
@@ -32,6 +34,12 @@ pub(crate) trait CornerKind {
     /// search asks a kind about no corner of a path it does not apply to.
     fn applies(&self, _path: &SmoothPath<'_>, _s: &Settings) -> bool {
         true
+    }
+
+    /// Whether its replacements stand for what they replace without a line more (by default
+    /// they add lines): asked in a path's lean rewrite ([`crate::vtg::smooth::Settings::lean`]).
+    fn adds_no_lines(&self) -> bool {
+        false
     }
 
     /// Whether the search asks about corner `i` of `site` at all, given what it has decided of

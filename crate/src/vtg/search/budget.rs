@@ -50,6 +50,10 @@ pub(crate) struct Offer {
     pub(crate) free: Option<Outcome>,
     /// Ones that cost time or energy; at most one is bought.
     pub(crate) dearer: Vec<Outcome>,
+    /// Where the free one adds lines: one that costs nothing and adds none, the corners
+    /// replaced without a line more (hairpins written as arcs) and the rest left sharp; written
+    /// where the lines do not stretch to the free one.
+    pub(crate) lean: Option<Outcome>,
 }
 
 impl Offer {
@@ -132,6 +136,8 @@ struct Step {
 pub(crate) struct LineChoice {
     /// Per offer: its free rewrite is written.
     pub(crate) keep_free: Vec<bool>,
+    /// Per offer: its lean rewrite ([`Offer::lean`]) is written (its free one is not).
+    pub(crate) keep_lean: Vec<bool>,
     /// Lines the dearer rewrites may still add.
     pub(crate) left: i64,
 }
@@ -174,13 +180,10 @@ pub(crate) fn free_within_lines(offers: &[Offer], allowed: i64) -> LineChoice {
         .list
         .iter()
         .fold(pool.left, |r, s| r.saturating_sub(s.1));
-    if !pool.draw(&mut savers, (0, [0.0; 2]), &mut keep_free) {
-        // The savings do not cover the header the estimates add: the file stays as it was.
-        return LineChoice {
-            keep_free: vec![false; offers.len()],
-            left: allowed,
-        };
-    }
+    // The header the estimates add (a negative `allowed`): covered now by savers that cost
+    // nothing, else by those the first rewrites' savings pay for (each draw below makes room
+    // for what is still owed, too); where nothing covers it, the file stays as it was.
+    pool.draw(&mut savers, (0, [0.0; 2]), &mut keep_free);
     // Corners per line, compared exactly: a.corners / a.lines > b.corners / b.lines.
     adding.sort_by(|a, b| {
         (u128::from(b.2) * a.1 as u128)
@@ -198,9 +201,44 @@ pub(crate) fn free_within_lines(offers: &[Offer], allowed: i64) -> LineChoice {
             room = room.saturating_sub(lines);
         }
     }
+    // The paths whose free rewrite did not fit, with their lean one where it adds no lines.
+    let mut keep_lean = vec![false; offers.len()];
+    for (k, offer) in offers.iter().enumerate() {
+        let Some(lean) = offer.lean.as_ref().filter(|_| !keep_free[k]) else {
+            continue;
+        };
+        let fits = lean.corners_removed > 0 && lean.lines_added <= 0 && !lean.dearer;
+        if fits && pool.draw(&mut savers, (lean.lines_added, lean.added), &mut keep_free) {
+            keep_lean[k] = true;
+            pool.take(lean.lines_added, lean.added);
+        }
+    }
+    if pool.left < 0 {
+        return LineChoice {
+            keep_free: vec![false; offers.len()],
+            keep_lean: vec![false; offers.len()],
+            left: allowed,
+        };
+    }
     LineChoice {
         keep_free,
+        keep_lean,
         left: pool.left,
+    }
+}
+
+impl LineChoice {
+    /// The rewrite of offer `k` of `offers` the lines keep: its free one or its lean one, if
+    /// either (none: it stays as it was, unless a dearer one is bought).
+    pub(crate) fn kept<'o>(&self, offers: &'o [Offer], k: usize) -> Option<&'o Outcome> {
+        let offer = offers.get(k)?;
+        if self.keep_free.get(k).copied().unwrap_or(false) {
+            offer.free.as_ref()
+        } else if self.keep_lean.get(k).copied().unwrap_or(false) {
+            offer.lean.as_ref()
+        } else {
+            None
+        }
     }
 }
 
@@ -303,11 +341,8 @@ pub(crate) fn choose(offers: &[Offer], budget: Budget, lines: &LineChoice) -> Ve
     }
     let mut steps: Vec<Step> = Vec::new();
     for (path, offer) in offers.iter().enumerate() {
-        let (mut added, mut corners, mut lines_added) = offer
-            .free
-            .as_ref()
-            .filter(|_| lines.keep_free.get(path).copied().unwrap_or(false))
-            .map_or(([0.0, 0.0], 0, 0), |f| {
+        let (mut added, mut corners, mut lines_added) =
+            lines.kept(offers, path).map_or(([0.0, 0.0], 0, 0), |f| {
                 (f.added, f.corners_removed, f.lines_added)
             });
         // The lower convex hull of cost against corners, from what the path has for free.

@@ -16,7 +16,7 @@
 //! `corners` through `CornerKind`), is written its free way and its dearer ways (`rewrite`),
 //! and the file-level choice decides what to buy with the time allowed (`budget`).
 
-use super::corners::{hairpin, keyhole, klipper, CornerKind};
+use super::corners::{arc_hairpin, hairpin, keyhole, klipper, CornerKind};
 use super::tuning::TUNING;
 use super::VtgOptions;
 use crate::analyze::Report;
@@ -108,8 +108,10 @@ pub(crate) fn blend_shares() -> impl Iterator<Item = f64> {
 }
 
 /// The corner kinds whose replacements are written as they are, asked first, of the whole
-/// path, about each sharp corner its own fillet does not round at no loss of speed.
-pub(crate) const WRITTEN_KINDS: [&dyn CornerKind; 1] = [&klipper::Polygons];
+/// path: Klipper's polygons about each sharp corner its own fillet does not round at no loss
+/// of speed, then hairpins written as one arc each.
+pub(crate) const WRITTEN_KINDS: [&dyn CornerKind; 2] =
+    [&klipper::Polygons, &arc_hairpin::ArcHairpins];
 
 /// The corner kinds whose replacements are blended and fitted with the path, asked in turn
 /// on each line tried, after each corner's fillet: two corners across a short leg before

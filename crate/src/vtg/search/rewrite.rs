@@ -206,7 +206,14 @@ pub(crate) fn offers(
         // Dearer variants only where they can differ from the free rewrite.
         buy_time: options.allow_slower_pct > 0.0 && settings.speed_share_matters(),
     };
-    let (offers, pending) = offering.offer_all(&candidates, progress)?;
+    let (mut offers, pending) = offering.offer_all(&candidates, progress)?;
+    if settings.arcs {
+        offering.add_leans(
+            &mut offers,
+            &candidates,
+            super::allowed_lines(input, options),
+        );
+    }
     smoothings.keep_all(pending);
     out.offers = offers;
     Ok(out)
@@ -244,6 +251,8 @@ fn file_settings(
         arcs: options.arcs == crate::vtg::ArcsMode::On,
         min_speed_share: 1.0,
         keyholes: variant.keyholes,
+        arc_cutting: None,
+        lean: false,
         klipper_scv_mm_s: (path.junction_model == JunctionModel::Klipper)
             .then(|| square_corner_velocity(&path.print_limits))
             .flatten(),
@@ -335,13 +344,62 @@ impl Offering<'_> {
         Ok((offers, pending))
     }
 
-    /// The ways of writing moves `i..j`: the free rewrite, and with time to spend the dearer
-    /// variants that round more corners; a path without a `sharp` corner only with arcs, as
-    /// its original points lie ([`super::compact`]). With them, the smoothings made for it
-    /// that were not kept before.
-    fn offer(&self, i: usize, j: usize, sharp: bool) -> (Offer, Vec<(SmoothingKey, Smoothing)>) {
+    /// The lean rewrites ([`Offer::lean`]) of the paths whose free rewrite the line budget
+    /// (`allowed_lines`) does not stretch to, in parallel: made after the offers, for those
+    /// paths only (on a file whose savings pay for every path's lines, none).
+    fn add_leans(
+        &self,
+        offers: &mut [Offer],
+        candidates: &[(usize, usize, bool)],
+        allowed_lines: i64,
+    ) {
+        let lines = budget::free_within_lines(offers, allowed_lines);
+        let starved: Vec<usize> = (0..offers.len())
+            .filter(|&k| {
+                let adds_lines = offers[k].free.as_ref().is_none_or(|f| f.lines_added > 0);
+                candidates[k].2 && !lines.keep_free[k] && adds_lines
+            })
+            .collect();
+        let leans = crate::parallel::map_chunks(&starved, |chunk| {
+            chunk
+                .iter()
+                .map(|&k| self.lean(candidates[k].0, candidates[k].1))
+                .collect()
+        });
+        for (&k, lean) in starved.iter().zip(leans) {
+            offers[k].lean = lean;
+        }
+    }
+
+    /// The lean rewrite of moves `i..j`: only the corners replaced without a line more, at no
+    /// cost in time or energy; `None` where there are none.
+    fn lean(&self, i: usize, j: usize) -> Option<Outcome> {
         let (moves, sources) = (&self.path.moves, &self.all.moves[..]);
-        let machine = PlanContext {
+        let machine = self.context(i, j);
+        let settings = Settings {
+            lean: true,
+            ..self.settings
+        };
+        let mut smooth =
+            |path: &SmoothPath<'_>, s: &Settings| smooth_path(path, s).map(std::sync::Arc::new);
+        let outcomes = rewrite_path(
+            self.input,
+            (&moves[i..j], &sources[i..j]),
+            &settings,
+            &machine,
+            &mut smooth,
+        )?;
+        outcomes
+            .into_iter()
+            .next()
+            .filter(|o| !o.dearer && o.lines_added <= 0 && o.corners_removed > 0)
+    }
+
+    /// What the planner knows around moves `i..j`: the limits in force, the junction model, the
+    /// energy model and the moves either side.
+    fn context(&self, i: usize, j: usize) -> PlanContext<'_> {
+        let moves = &self.path.moves;
+        PlanContext {
             limits: self.all.limits_at(i),
             model: self.path.junction_model,
             energy: self.energy,
@@ -349,7 +407,16 @@ impl Offering<'_> {
                 i.checked_sub(1).map(|k| motion_of(&moves[k])),
                 moves.get(j).map(motion_of),
             ],
-        };
+        }
+    }
+
+    /// The ways of writing moves `i..j`: the free rewrite, and with time to spend the dearer
+    /// variants that round more corners; a path without a `sharp` corner only with arcs, as
+    /// its original points lie ([`super::compact`]). With them, the smoothings made for it
+    /// that were not kept before.
+    fn offer(&self, i: usize, j: usize, sharp: bool) -> (Offer, Vec<(SmoothingKey, Smoothing)>) {
+        let (moves, sources) = (&self.path.moves, &self.all.moves[..]);
+        let machine = self.context(i, j);
         if !sharp {
             let settings = machine.settings(&self.settings);
             let compact = super::compact::compact_path(
@@ -361,7 +428,7 @@ impl Offering<'_> {
             );
             let offer = Offer {
                 free: compact,
-                dearer: Vec::new(),
+                ..Offer::default()
             };
             return (offer, Vec::new());
         }
@@ -468,7 +535,7 @@ impl Offers {
                     out.kept_for_lines += 1;
                 }
             }
-            if let Some(o) = written(offer, chosen, lines.keep_free[k]) {
+            if let Some(o) = written(&self.offers, k, chosen, &lines) {
                 out.add(&o.part);
                 edits.extend(&o.edits);
             }
@@ -486,7 +553,7 @@ impl Offers {
         mean_power_w: f64,
     ) -> (budget::LineChoice, Vec<Option<usize>>) {
         let lines = budget::free_within_lines(&self.offers, allowed_lines);
-        let free = |k: usize| self.offers[k].free.as_ref().filter(|_| lines.keep_free[k]);
+        let free = |k: usize| lines.kept(&self.offers, k);
         let saved = (0..self.offers.len())
             .filter_map(free)
             .fold([0.0, 0.0], |s, f| [s[0] - f.added[0], s[1] - f.added[1]]);
@@ -502,8 +569,8 @@ impl Offers {
     pub(crate) fn forecast(&self, allowed: (f64, i64), mean_power_w: f64) -> [f64; 2] {
         let (lines, choice) = self.choice(allowed, mean_power_w);
         let mut sum = [0.0, 0.0];
-        for (k, (offer, chosen)) in self.offers.iter().zip(choice).enumerate() {
-            if let Some(o) = written(offer, chosen, lines.keep_free[k]) {
+        for (k, chosen) in choice.into_iter().enumerate() {
+            if let Some(o) = written(&self.offers, k, chosen, &lines) {
                 sum = [sum[0] + o.added[0], sum[1] + o.added[1]];
             }
         }
@@ -511,12 +578,17 @@ impl Offers {
     }
 }
 
-/// The outcome of `offer` the choice writes: the dearer one `chosen`, else its free one where
-/// the lines `keep_free` it, else none (the path stays as it was).
-fn written(offer: &Offer, chosen: Option<usize>, keep_free: bool) -> Option<&Outcome> {
+/// The outcome of offer `k` of `offers` the choice writes: the dearer one `chosen`, else the
+/// one the `lines` keep, else none (the path stays as it was).
+fn written<'o>(
+    offers: &'o [Offer],
+    k: usize,
+    chosen: Option<usize>,
+    lines: &budget::LineChoice,
+) -> Option<&'o Outcome> {
     match chosen {
-        Some(d) => offer.dearer.get(d),
-        None => offer.free.as_ref().filter(|_| keep_free),
+        Some(d) => offers.get(k)?.dearer.get(d),
+        None => lines.kept(offers, k),
     }
 }
 
@@ -648,6 +720,9 @@ impl PlanContext<'_> {
             if s.klipper_scv_mm_s.is_some() {
                 s.klipper_scv_mm_s = square_corner_velocity(l);
             }
+            if s.arcs {
+                s.arc_cutting = Some(crate::plan::ArcCutting::of(self.model, l));
+            }
         }
         s
     }
@@ -748,6 +823,7 @@ fn rewrite_path(
     let (scale, written, written_cost) = cheapest?;
     let cos_critical = crate::math::cos(settings.critical_rad);
     let draft = Draft {
+        original: costs,
         sharp_before: sharp_turns(pts, cos_critical),
         cos_critical,
         input,
@@ -900,6 +976,8 @@ fn cheapest_and_fastest(
 
 /// A path and its smoothed form, to be written one way or another.
 struct Draft<'a> {
+    /// The original's cost.
+    original: Costs,
     input: &'a [u8],
     run: &'a [PathMove],
     src: &'a [MoveSource],
@@ -916,6 +994,47 @@ struct Draft<'a> {
 }
 
 impl Draft<'_> {
+    /// The pieces `written` is written in: its runs on a circle as arcs, if asked for and if the
+    /// path with them still keeps the tolerance both ways (measured on the arcs themselves);
+    /// their distance from the original, and what they add over it and whether that is dearer
+    /// (`priced`, the lines' own, unless the arcs are written at a cost of their own,
+    /// [`with_arcs`]).
+    fn pieces(
+        &self,
+        written: &Written,
+        written_cost: (f64, f64),
+        priced: ([f64; 2], bool),
+    ) -> (Vec<Piece>, f64, [f64; 2], bool) {
+        let (added, dearer) = priced;
+        let (pts, settings) = (self.pts, self.settings);
+        let lines = arcs::lines(&written.feed_mm_s);
+        if !settings.arcs {
+            return (lines, self.smoothed.deviation_mm, added, dearer);
+        }
+        let all: Vec<[f64; 3]> = std::iter::once(pts[0])
+            .chain(written.points.iter().copied())
+            .collect();
+        let costs = (written_cost, self.original.original);
+        match with_arcs(&all, written, costs, pts, settings, self.machine) {
+            None => (lines, self.smoothed.deviation_mm, added, dearer),
+            Some((pieces, d, cost)) => {
+                let deviation = self.smoothed.deviation_mm.max(d);
+                let Some(cost) = cost else {
+                    return (pieces, deviation, added, dearer);
+                };
+                // The fastest writing is filed as dearer whatever it costs (`rewrite_path`).
+                let dearer_anyway = dearer && !self.original.dearer(&added);
+                let added = self.original.added_by(cost);
+                (
+                    pieces,
+                    deviation,
+                    added,
+                    dearer_anyway || self.original.dearer(&added),
+                )
+            }
+        }
+    }
+
     /// The edits and counts of the path written as `written` (VTG eq. 29 speeds at `scale`),
     /// costing `written_cost` (time s, motor energy J), `added` over the original's.
     fn outcome(
@@ -936,7 +1055,7 @@ impl Draft<'_> {
             cos_critical,
             smoothed,
             settings,
-            machine,
+            ..
         } = *self;
         let (first_src, last_src) = (src.first()?, src.last()?);
         let mode = first_src.mode;
@@ -948,22 +1067,9 @@ impl Draft<'_> {
         ));
         let out = &mut part;
         let notes = notes(input, src, e)?;
-        // Runs on a circle as arcs, if asked for and if the path with them still keeps the
-        // tolerance both ways (measured on the arcs themselves).
-        let all: Vec<[f64; 3]> = std::iter::once(pts[0])
-            .chain(written.points.iter().copied())
-            .collect();
-        let mut pieces = arcs::lines(&written.feed_mm_s);
-        let mut deviation = smoothed.deviation_mm;
-        if settings.arcs {
-            if let Some((with_arcs, d)) =
-                with_arcs(&all, written, written_cost, pts, settings, machine)
-            {
-                out.arcs_written += with_arcs.iter().filter(|p| p.arc.is_some()).count() as u64;
-                deviation = deviation.max(d);
-                pieces = with_arcs;
-            }
-        }
+        let (pieces, deviation, added, dearer) =
+            self.pieces(written, written_cost, (added, dearer));
+        out.arcs_written += pieces.iter().filter(|p| p.arc.is_some()).count() as u64;
         let frame = Frame {
             start: pts[0],
             climbs: run.iter().any(|m| (m.to[2] - m.from[2]).abs() > 1e-9),
@@ -1051,20 +1157,32 @@ pub(super) fn lines_added(edits: &[Edit]) -> i64 {
 fn with_arcs(
     all: &[[f64; 3]],
     written: &Written,
-    lines_cost: (f64, f64),
+    (lines_cost, original_cost): ((f64, f64), (f64, f64)),
     orig: &[[f64; 3]],
     settings: &Settings,
     machine: &PlanContext<'_>,
-) -> Option<(Vec<Piece>, f64)> {
+) -> Option<WithArcs> {
     let fit = TUNING.arc_share * settings.tolerance_mm;
     // The smoothing's own measurement is no bound here: the written path sits near the
     // budget, and with the arcs' offset it settled 136 of 5 158 checks on the 34 MB file.
     let near = (orig, f64::INFINITY);
     let (pieces, d) = fit_arcs((all, &written.feed_mm_s), fit, near, settings, machine)?;
-    let (s_lines, j_lines) = lines_cost;
     let (s, j) = machine.cost_pieces(all[0], &written.points, &written.e, &pieces);
-    (s <= s_lines * (1.0 + 1e-9) && j <= j_lines * (1.0 + 1e-9)).then_some((pieces, d))
+    let within =
+        |(s_max, j_max): (f64, f64)| s <= s_max * (1.0 + 1e-9) && j <= j_max * (1.0 + 1e-9);
+    if within(lines_cost) {
+        return Some((pieces, d, None));
+    }
+    // Slower than the lines (a hairpin's arc cut into chords that turn more than the
+    // polygon's sides), but no dearer than the original: still the way to write it, in
+    // fewer lines, at its own cost.
+    within(original_cost).then_some((pieces, d, Some((s, j))))
 }
+
+/// A path with arcs ([`with_arcs`]): its pieces, their distance from the original, mm, and
+/// their own time (s) and motor energy (J) where these replace the lines' (`None`: the
+/// lines' stand, the arcs costing no more).
+type WithArcs = (Vec<Piece>, f64, Option<(f64, f64)>);
 
 /// The polyline `all` (feed `feed` per segment) with its runs on a circle within `fit` as
 /// arcs, where there are any, the firmware cuts them at least as finely as δθ asks, and the
@@ -1081,13 +1199,9 @@ pub(super) fn fit_arcs(
     machine: &PlanContext<'_>,
 ) -> Option<(Vec<Piece>, f64)> {
     let limits = machine.limits?;
-    let max_segment = limits.arc_segment_mm.value;
-    let model = machine.model;
-    // As the planner times them: Klipper's [gcode_arcs] cuts an arc into pieces of
-    // `resolution` (VTG writes planar arcs), Marlin 2 by chord deviation and segment rate.
-    let segments = move |r: f64, len: f64, feed: f64| {
-        crate::plan::firmware_arc_segments(model, r, (len, 0.0), feed, max_segment)
-    };
+    // As the planner times them ([`crate::plan::ArcCutting`]).
+    let cutting = crate::plan::ArcCutting::of(machine.model, limits);
+    let segments = move |r: f64, len: f64, feed: f64| cutting.segments(r, (len, 0.0), feed);
     let firmware = arcs::Firmware {
         segments: &segments,
         max_turn_rad: TUNING.step_turn_share * settings.critical_rad,

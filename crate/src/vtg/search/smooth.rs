@@ -54,6 +54,14 @@ pub(crate) struct Settings {
     pub(crate) feed_cap_scale: f64,
     /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`crate::vtg::arcs`]).
     pub(crate) arcs: bool,
+    /// How the firmware cuts arcs into chords, where arcs are written (`None` elsewhere):
+    /// hairpins are then written as one arc each where its chords turn gently enough
+    /// ([`crate::vtg::corners::arc_hairpin::ArcHairpins`]).
+    pub(crate) arc_cutting: Option<crate::plan::ArcCutting>,
+    /// Replace only the corners a kind replaces without adding a line (hairpins written as
+    /// arcs), and leave the rest of the path as it is: the path's lean rewrite, for where the
+    /// line budget does not stretch to its free one ([`crate::vtg::search::budget::Offer::lean`]).
+    pub(crate) lean: bool,
     /// The slowest a rounded corner may be run, as a share of the firmware's speed through the
     /// sharp one: 1 rounds only the corners the machine runs round at least as fast (the free
     /// rewrite); below 1, the dearer variants of a path that
@@ -151,7 +159,7 @@ impl<'a> SmoothPath<'a> {
 pub(crate) fn smooth_path(path: &SmoothPath<'_>, s: &Settings) -> Option<Smoothed> {
     let written = written_as_they_are(path, s);
     if written.is_empty() {
-        return super::smooth_cut(path, s, &[]);
+        return (!s.lean).then(|| super::smooth_cut(path, s, &[])).flatten();
     }
     let pins: Vec<Hairpin> = written.iter().map(|t| t.pin.clone()).collect();
     let mut sub = hairpin::substitute(path.pts, path.e, path.feed, path.planned, &pins);
@@ -179,7 +187,14 @@ pub(crate) fn smooth_path(path: &SmoothPath<'_>, s: &Settings) -> Option<Smoothe
         feed: &sub.feed,
         planned: &sub.planned,
     };
-    let mut out = super::smooth_cut(&replaced, s, &cuts)?;
+    let mut out = if s.lean {
+        // The replacements in place, the rest as it was.
+        let mut kept = Smoothed::default();
+        kept.keep(&replaced);
+        kept
+    } else {
+        super::smooth_cut(&replaced, s, &cuts)?
+    };
     for t in &written {
         out.deviation_mm = out.deviation_mm.max(t.deviation_mm);
     }
@@ -202,7 +217,7 @@ struct Taken {
 fn written_as_they_are(path: &SmoothPath<'_>, s: &Settings) -> Vec<Taken> {
     let kinds: Vec<&'static dyn CornerKind> = super::WRITTEN_KINDS
         .into_iter()
-        .filter(|k| k.applies(path, s))
+        .filter(|k| k.applies(path, s) && (k.adds_no_lines() || !s.lean))
         .collect();
     if kinds.is_empty() || path.pts.len() < 3 || !path.consistent() {
         return Vec::new();
@@ -886,6 +901,8 @@ mod tests {
             keyholes: true,
             line: blend::Line::Racing,
             klipper_scv_mm_s: None,
+            arc_cutting: None,
+            lean: false,
             min_segment_s: Some(0.0),
         }
     }
