@@ -303,6 +303,12 @@ const LIMIT_NAMES = {
   instantaneous_corner_velocity: ['Extruder corner velocity (Klipper)', 'mm/s'],
 };
 
+/** How the firmware cuts arcs into segments (the limits' `arc_rule`, left out for Prusa's rule). */
+const ARC_RULES = {
+  chord_deviation: "Prusa's firmware: chords within 0.02 mm of the arc",
+  circle_segments: 'upstream Marlin 2.1: at least 72 segments a circle, 0.1 mm to the arc segment length',
+};
+
 /**
  * Limits the file itself sets (commands or the slicer's settings block).
  * @param {Report | undefined} report
@@ -310,7 +316,7 @@ const LIMIT_NAMES = {
 function fileLimitCount(report) {
   let n = 0;
   for (const v of Object.values(report?.machine?.limits ?? {})) {
-    for (const l of Array.isArray(v) ? v : [v]) if (l && ['command', 'slicer_settings'].includes(l.source)) n++;
+    for (const l of Array.isArray(v) ? v : [v]) if (l && typeof l === 'object' && ['command', 'slicer_settings'].includes(l.source)) n++;
   }
   return n;
 }
@@ -1788,7 +1794,8 @@ function renderLimits(r) {
   const limits = r.machine?.limits ?? {};
   /** @param {Limit} l */
   const source = (l) => (l.source === 'profile' ? `the ${r.machine.profile} preset` : LIMIT_SOURCES[l.source] ?? String(l.source).replaceAll('_', ' '));
-  const rows = Object.entries(limits)
+  const { arc_rule: arcRule, ...values } = limits;
+  const rows = Object.entries(values)
     .filter(([, v]) => v !== null && v !== undefined)
     .map(([k, v]) => {
       const [name, unit] = LIMIT_NAMES[k] ?? [k.replaceAll('_', ' '), ''];
@@ -1797,6 +1804,7 @@ function renderLimits(r) {
       const from = [...new Set(list.map(source))].join('; ');
       return el('tr', { 'data-limit': k }, el('th', { scope: 'row', text: name }), el('td', {}, value, el('small', { class: 'explain', text: `from ${from}` })));
     });
+  if (arcRule) rows.push(el('tr', { 'data-limit': 'arc_rule' }, el('th', { scope: 'row', text: 'Arcs cut as' }), el('td', {}, ARC_RULES[arcRule] ?? arcRule.replaceAll('_', ' '))));
   /** @type {HTMLElement} */ (box.querySelector('tbody')).replaceChildren(...rows);
   const fromFile = fileLimitCount(r);
   /** @type {HTMLElement} */ (box.querySelector('summary')).textContent = `Printer limits and where each came from (${fromFile ? `${fromFile} set by the file` : 'none set by the file'})`;
