@@ -19,7 +19,7 @@
 
 use super::hairpin::{self, Hairpin};
 use super::{CornerKind, Cost, Proposal, Replacement, Site};
-use crate::vec3::{dot, norm, sub};
+use crate::vec3::{norm, sub};
 use crate::vtg::deviation::both_ways;
 use crate::vtg::smooth::{Settings, SmoothPath};
 use crate::vtg::tuning::TUNING;
@@ -51,7 +51,13 @@ impl CornerKind for ArcHairpins {
         let pts = path.pts;
         // Room for the 3-decimal rounding of written coordinates.
         let budget = s.tolerance_mm - 0.001;
-        let pin = hairpin::find(pts, i, budget, TUNING.arc_min_radius_mm, rooms(pts, i)?)?;
+        let pin = hairpin::find(
+            pts,
+            i,
+            budget,
+            TUNING.arc_min_radius_mm,
+            hairpin::rooms(pts, i)?,
+        )?;
         if pin.before_mm < 0.0 || pin.after_mm < 0.0 {
             return None;
         }
@@ -77,19 +83,6 @@ impl CornerKind for ArcHairpins {
     }
 }
 
-/// How far along each long leg of the hairpin at corners `i`, `i + 1` of `pts` its arc may
-/// reach: as the fitted hairpins' ([`hairpin::Hairpins`]), `Tuning::leg_share` of a leg that
-/// ends the path and half that where another corner shares it.
-fn rooms(pts: &[[f64; 3]], i: usize) -> Option<[f64; 2]> {
-    let n = pts.len();
-    let room = |leg: usize, far_end: usize| {
-        let l = norm(sub(*pts.get(leg + 1)?, *pts.get(leg)?));
-        let shared = far_end != 0 && far_end + 1 != n;
-        Some(TUNING.leg_share * l * if shared { 0.5 } else { 1.0 })
-    };
-    Some([room(i.checked_sub(1)?, i - 1)?, room(i + 1, i + 2)?])
-}
-
 /// The angle the arc of `pin` sweeps, rad: the sum of the angles its polygon's sides (chords
 /// of one circle) subtend.
 fn sweep_of(pin: &Hairpin) -> Option<f64> {
@@ -107,9 +100,11 @@ fn sweep_of(pin: &Hairpin) -> Option<f64> {
 fn has_hairpin(pts: &[[f64; 3]], critical_rad: f64) -> bool {
     let cos_critical = crate::math::cos(critical_rad);
     let sharp = |k: usize| {
-        let (a, b) = (sub(pts[k], pts[k - 1]), sub(pts[k + 1], pts[k]));
-        let (la, lb) = (norm(a), norm(b));
-        la > 0.0 && lb > 0.0 && dot(a, b) / (la * lb) < cos_critical
+        crate::vtg::rewrite::is_sharp(
+            &sub(pts[k], pts[k - 1]),
+            &sub(pts[k + 1], pts[k]),
+            cos_critical,
+        )
     };
     (1..pts.len().saturating_sub(2)).any(|k| {
         norm(sub(pts[k + 1], pts[k])) <= TUNING.hairpin_max_connector_mm && sharp(k) && sharp(k + 1)

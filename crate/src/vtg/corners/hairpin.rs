@@ -303,18 +303,22 @@ impl CornerKind for Hairpins {
 
 /// [`find`] at corners `i`, `i + 1` of `pts` within `blend_tol`, for an arc the walk can follow
 /// in steps of at least the minimum step each turning by less than its share of the critical
-/// angle (with 5 % to spare), reaching along each long leg `Tuning::leg_share` of it where the
-/// leg ends the path and half that where another corner shares it.
+/// angle (with 5 % to spare), reaching along each long leg as far as [`rooms`] allows.
 fn within(pts: &[[f64; 3]], i: usize, blend_tol: f64, s: &Settings) -> Option<Hairpin> {
+    find(pts, i, blend_tol, min_radius(s), rooms(pts, i)?)
+}
+
+/// How far along each long leg of the hairpin at corners `i`, `i + 1` of `pts` its arc may
+/// reach: `Tuning::leg_share` of a leg that ends the path, half that where another corner
+/// shares it.
+pub(crate) fn rooms(pts: &[[f64; 3]], i: usize) -> Option<[f64; 2]> {
     let n = pts.len();
     let room = |leg: usize, far_end: usize| {
         let l = norm(sub(pts.get(leg + 1)?, pts.get(leg)?));
         let shared = far_end != 0 && far_end + 1 != n;
         Some(TUNING.leg_share * l * if shared { 0.5 } else { 1.0 })
     };
-    let min_radius = min_radius(s);
-    let rooms = [room(i.checked_sub(1)?, i - 1)?, room(i + 1, i + 2)?];
-    find(pts, i, blend_tol, min_radius, rooms)
+    Some([room(i.checked_sub(1)?, i - 1)?, room(i + 1, i + 2)?])
 }
 
 /// The smallest radius of a loop the walk can follow in steps of at least the minimum step,

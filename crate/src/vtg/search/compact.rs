@@ -36,7 +36,7 @@ pub(super) fn compact_path(
     let fit = TUNING.compact_share * settings.tolerance_mm;
     let arcs = settings
         .arcs
-        .then(|| fit_arcs((pts, feed), fit, (pts, 0.0), settings, machine))
+        .then(|| fit_arcs((pts, feed), fit, (pts, 0.0), settings))
         .flatten();
     let (pieces, deviation) = arcs.unwrap_or_else(|| (crate::vtg::arcs::lines(feed), 0.0));
     // Arcs are fitted within `fit` of the path and joined lines stay within `fit` of theirs,

@@ -1166,7 +1166,7 @@ fn with_arcs(
     // The smoothing's own measurement is no bound here: the written path sits near the
     // budget, and with the arcs' offset it settled 136 of 5 158 checks on the 34 MB file.
     let near = (orig, f64::INFINITY);
-    let (pieces, d) = fit_arcs((all, &written.feed_mm_s), fit, near, settings, machine)?;
+    let (pieces, d) = fit_arcs((all, &written.feed_mm_s), fit, near, settings)?;
     let (s, j) = machine.cost_pieces(all[0], &written.points, &written.e, &pieces);
     let within =
         |(s_max, j_max): (f64, f64)| s <= s_max * (1.0 + 1e-9) && j <= j_max * (1.0 + 1e-9);
@@ -1196,11 +1196,9 @@ pub(super) fn fit_arcs(
     fit: f64,
     (orig, known_mm): (&[[f64; 3]], f64),
     settings: &Settings,
-    machine: &PlanContext<'_>,
 ) -> Option<(Vec<Piece>, f64)> {
-    let limits = machine.limits?;
-    // As the planner times them ([`crate::plan::ArcCutting`]).
-    let cutting = crate::plan::ArcCutting::of(machine.model, limits);
+    // As the planner times them ([`PlanContext::settings`]: the limits in force here).
+    let cutting = settings.arc_cutting?;
     let segments = move |r: f64, len: f64, feed: f64| cutting.segments(r, (len, 0.0), feed);
     let firmware = arcs::Firmware {
         segments: &segments,

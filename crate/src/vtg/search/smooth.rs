@@ -54,8 +54,9 @@ pub(crate) struct Settings {
     pub(crate) feed_cap_scale: f64,
     /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`crate::vtg::arcs`]).
     pub(crate) arcs: bool,
-    /// How the firmware cuts arcs into chords, where arcs are written (`None` elsewhere):
-    /// hairpins are then written as one arc each where its chords turn gently enough
+    /// How the firmware cuts arcs into chords, under the limits in force where the path starts,
+    /// where arcs are written (`None` elsewhere): what the arcs stage writes an arc for only
+    /// where its chords turn gently enough, and hairpins are written as one arc each by
     /// ([`crate::vtg::corners::arc_hairpin::ArcHairpins`]).
     pub(crate) arc_cutting: Option<crate::plan::ArcCutting>,
     /// Replace only the corners a kind replaces without adding a line (hairpins written as
@@ -159,7 +160,11 @@ impl<'a> SmoothPath<'a> {
 pub(crate) fn smooth_path(path: &SmoothPath<'_>, s: &Settings) -> Option<Smoothed> {
     let written = written_as_they_are(path, s);
     if written.is_empty() {
-        return (!s.lean).then(|| super::smooth_cut(path, s, &[])).flatten();
+        // A lean rewrite is its written replacements alone: without any, there is none.
+        if s.lean {
+            return None;
+        }
+        return super::smooth_cut(path, s, &[]);
     }
     let pins: Vec<Hairpin> = written.iter().map(|t| t.pin.clone()).collect();
     let mut sub = hairpin::substitute(path.pts, path.e, path.feed, path.planned, &pins);
