@@ -63,8 +63,10 @@ fn vtg_writes_the_file_and_reports_json() {
     let written = std::fs::read(&out_path).expect("output");
     assert!(!written.is_empty());
 
-    // The closed loop kept scale 1 and the keyhole loops; its first retry writes the steps as
-    // walked (where the joined ones rang more, or peaked higher: see `paths.steps_joined`).
+    // The closed loop kept scale 1 and the keyhole loops: its first retry, without keyholes,
+    // leaves the wedges' tips sharp, and with lines to spare the keyholes with the steps as
+    // walked round them (where the joined ones rang more, or peaked higher: see
+    // `paths.steps_joined`).
     assert_eq!(json["paths"]["feed_cap_scale"], 1.0);
     assert!(json["paths"]["keyholes"].as_u64().expect("keyholes") > 0);
     let joined = json["paths"]["steps_joined"]
