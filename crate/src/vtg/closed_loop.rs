@@ -99,60 +99,57 @@ pub(super) fn with_simulated_deviation(
 /// rewrite's simulation and the sharp corners it left). Both keep the rule; the variant is the
 /// quieter (it was chosen for it), but a variant's speeds or steps can round a good share
 /// fewer corners than the first rewrite does on the layers it keeps (the K1 SE accessory:
-/// −10.5 % against −23 %), and rounded corners are what VTG is for. Only tried where the
-/// first rewrite left fewer corners than the variant.
+/// −10.5 % against −23 %), and rounded corners are what VTG is for.
 fn rounder_of(
     passing: Tried,
-    (orig, first, before): (&Simulated, (Simulated, f64), &Report),
+    at: (&Simulated, (Simulated, f64), &Report),
     again: &mut dyn Again,
 ) -> Result<VtgReport, Error> {
-    let (first_sim, first_corners) = first;
-    // The first rewrite itself passing leaves as many corners as it: nothing to try.
     let corners = passing.report.table1.n_turning.after;
-    if first_corners >= corners {
-        return Ok(passing.report);
-    }
-    let first = (first_sim, search::Variant::default(), KEEP_ROUNDS);
-    Ok(match with_layers_kept(orig, first, before, again)? {
-        Some(kept) if kept.table1.n_turning.after < corners => kept,
-        _ => passing.report,
-    })
+    let rounder = first_if_rounder(corners, at, KEEP_ROUNDS, again)?;
+    Ok(rounder.unwrap_or(passing.report))
 }
 
 /// Where no variant keeps the rule whole: `kept` (the quietest variant with its loud layers
 /// kept as they were, where that keeps it) or the first rewrite likewise, whichever leaves
-/// fewer sharp corners (`first`: the first rewrite's simulation and the corners it left). The
-/// first is tried only where it left fewer corners than `kept` and raised the peak alone: the
-/// layers kept for a peak are the few it rang above the original's in (the islands fixture:
-/// one, against its quietest variant's 64 more corners), while those kept for a risen mean
-/// are as many as it takes (on the 34 MB corpus file 325, a round of 2.5 s and 70 MB more
-/// for a rewrite with more corners than the variant's).
+/// fewer sharp corners. The first is tried only where it raised the peak alone, and for
+/// [`RIVAL_ROUNDS`]: the layers kept for a peak are the few it rang above the original's in
+/// (the islands fixture: one, against its quietest variant's 64 more corners), while those
+/// kept for a risen mean are as many as it takes (on the 34 MB corpus file 325, a round of
+/// 2.5 s and 70 MB more for a rewrite with more corners than the variant's).
 fn rounder_kept(
     kept: Option<VtgReport>,
+    at: (&Simulated, (Simulated, f64), &Report),
+    again: &mut dyn Again,
+) -> Result<Option<VtgReport>, Error> {
+    let (b, a) = (&at.0.deviation, &at.1 .0.deviation);
+    if !(a.max > b.max && a.mean < b.mean) {
+        return Ok(kept);
+    }
+    let corners = kept
+        .as_ref()
+        .map_or(f64::INFINITY, |k| k.table1.n_turning.after);
+    Ok(first_if_rounder(corners, at, RIVAL_ROUNDS, again)?.or(kept))
+}
+
+/// The first rewrite with its loud layers kept as they were over up to `rounds` rounds, where
+/// that keeps the rule and leaves fewer sharp corners than `corners`, those of the rewrite it
+/// would replace (`first`: the first rewrite's simulation and the corners it left; not tried
+/// where that is no fewer).
+fn first_if_rounder(
+    corners: f64,
     (orig, first, before): (&Simulated, (Simulated, f64), &Report),
+    rounds: usize,
     again: &mut dyn Again,
 ) -> Result<Option<VtgReport>, Error> {
     let (first_sim, first_corners) = first;
-    let corners = |k: &Option<VtgReport>| {
-        k.as_ref()
-            .map_or(f64::INFINITY, |k| k.table1.n_turning.after)
-    };
-    let (b, a) = (&orig.deviation, &first_sim.deviation);
-    let peak_alone = a.max > b.max && a.mean < b.mean;
-    if !peak_alone || first_corners >= corners(&kept) {
-        return Ok(kept);
+    // The first rewrite itself passing leaves as many corners as it: nothing to try.
+    if first_corners >= corners {
+        return Ok(None);
     }
-    let first_kept = with_layers_kept(
-        orig,
-        (first_sim, search::Variant::default(), RIVAL_ROUNDS),
-        before,
-        again,
-    )?;
-    Ok(if corners(&first_kept) < corners(&kept) {
-        first_kept
-    } else {
-        kept
-    })
+    let first = (first_sim, search::Variant::default(), rounds);
+    let kept = with_layers_kept(orig, first, before, again)?;
+    Ok(kept.filter(|k| k.table1.n_turning.after < corners))
 }
 
 /// The rewrite as `variant`, simulated as `sim`, written again with the layers that ring more
