@@ -281,16 +281,20 @@ fn quietest(
         None => {
             let variants = (search::quieter_variants(), 0.7, 0.034);
             let best = every_variant(first, variants, orig, again)?;
-            rounder_rival(best, orig, again)
+            rounder_rival(best, (orig, options), again)
         }
     }
 }
 
 /// `best`, or its rival ([`search::Variant::rival`]) where `best` keeps the no-dearer rule,
 /// the rival leaves fewer sharp corners and keeps the rule too. The rival is written first and
-/// simulated only where it is rounder: by default it seldom is, and its simulation would cost
-/// as much again.
-fn rounder_rival(best: Tried, orig: &Simulated, again: &mut dyn Again) -> Result<Tried, Error> {
+/// its output simulated only where it is rounder: by default it seldom is, and its simulation
+/// would cost as much again.
+fn rounder_rival(
+    best: Tried,
+    (orig, options): (&Simulated, &VtgOptions),
+    again: &mut dyn Again,
+) -> Result<Tried, Error> {
     let b = &orig.deviation;
     let Some(rival) = best.variant.rival() else {
         return Ok(best);
@@ -300,12 +304,12 @@ fn rounder_rival(best: Tried, orig: &Simulated, again: &mut dyn Again) -> Result
     }
     let before = best.report.before.clone();
     let corners = best.report.table1.n_turning.after;
-    let span = (0.94, 0.005);
-    let written = again.report(rival, &[], before.clone(), span)?;
-    if written.paths.rewrote_nothing() || written.table1.n_turning.after >= corners {
+    let report = again.report(rival, &[], before, (0.94, 0.01))?;
+    if report.paths.rewrote_nothing() || report.table1.n_turning.after >= corners {
         return Ok(best);
     }
-    let (report, sim) = again.simulated(rival, &[], before, (0.945, 0.005))?;
+    // Split where the original's run is, as every rewrite's ([`Again::simulated`]).
+    let sim = printing_deviation(&report.output, report.before.time_s, options);
     Ok(match sim {
         Some(sim) if quietness(b, &sim.deviation).0 == 0 => Tried {
             report,

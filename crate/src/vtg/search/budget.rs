@@ -43,6 +43,14 @@ pub(crate) struct Outcome {
     pub(crate) lines_added: i64,
 }
 
+impl Outcome {
+    /// Whether it can stand as a path's lean rewrite ([`Offer::lean`]): it removes corners,
+    /// adds no line and costs nothing.
+    pub(crate) fn is_lean(&self) -> bool {
+        self.corners_removed > 0 && self.lines_added <= 0 && !self.dearer
+    }
+}
+
 /// The ways one path can be written.
 #[derive(Debug, Default)]
 pub(crate) struct Offer {
@@ -207,8 +215,8 @@ pub(crate) fn free_within_lines(offers: &[Offer], allowed: i64) -> LineChoice {
         let Some(lean) = offer.lean.as_ref().filter(|_| !keep_free[k]) else {
             continue;
         };
-        let fits = lean.corners_removed > 0 && lean.lines_added <= 0 && !lean.dearer;
-        if fits && pool.draw(&mut savers, (lean.lines_added, lean.added), &mut keep_free) {
+        if lean.is_lean() && pool.draw(&mut savers, (lean.lines_added, lean.added), &mut keep_free)
+        {
             keep_lean[k] = true;
             pool.take(lean.lines_added, lean.added);
         }

@@ -389,10 +389,7 @@ impl Offering<'_> {
             &machine,
             &mut smooth,
         )?;
-        outcomes
-            .into_iter()
-            .next()
-            .filter(|o| !o.dearer && o.lines_added <= 0 && o.corners_removed > 0)
+        outcomes.into_iter().next().filter(Outcome::is_lean)
     }
 
     /// What the planner knows around moves `i..j`: the limits in force, the junction model, the
