@@ -18,6 +18,17 @@ pub fn fixtures_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../fixtures")
 }
 
+/// The G-code fixtures (`tests/fixtures/gcode/*.gcode`), sorted.
+pub fn fixture_gcode() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(fixtures_dir().join("gcode"))
+        .expect("fixtures")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "gcode"))
+        .collect();
+    files.sort();
+    files
+}
+
 /// One row of the table in `SOURCES.md`.
 #[derive(Debug, Clone)]
 pub struct CorpusFile {

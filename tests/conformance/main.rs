@@ -8,6 +8,7 @@
 
 mod corpus;
 mod dynamics;
+mod feeds;
 mod infill;
 mod klipper;
 mod orient;

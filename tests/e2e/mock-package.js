@@ -107,6 +107,7 @@ export function vtg(input, options = {}, progress) {
     firmware: null,
     message: null,
     peak_layers_kept: [],
+    feed_lines_folded: 0,
     options_seen: options,
     output,
   };

@@ -134,6 +134,13 @@ fn print(out: &mut impl Write, r: &VtgReport) -> std::io::Result<()> {
             p.kept_for_lines, p.compacted
         )?;
     }
+    if r.feed_lines_folded > 0 {
+        writeln!(
+            out,
+            "{} feed-only lines folded into the moves after them (the same motion, fewer lines)",
+            r.feed_lines_folded
+        )?;
+    }
     writeln!(
         out,
         "{:<28} {:>14} {:>14} {:>9}",

@@ -28,6 +28,10 @@ pub(crate) struct Frame<'a> {
     pub(crate) f_before: Option<f64>,
     /// The modal feed the original leaves behind, mm/min.
     pub(crate) f_after: Option<f64>,
+    /// Whether anything reads that feed before the next move sets its own
+    /// ([`super::source::MoveSource::feed_overridden`]): else the block need not restore it,
+    /// and saves the line.
+    pub(crate) f_after_read: bool,
     /// Annotation lines with the filament pushed where each stood; each is written before the
     /// first new point past it.
     pub(crate) notes: Vec<(f64, &'a str)>,
@@ -97,8 +101,8 @@ pub(crate) fn write(frame: &Frame<'_>, points: &[[f64; 3]], e: &[f64], pieces: &
         text.push('\n');
         text.push_str(note);
     }
-    // Leave the modal feed where the original left it.
-    if let (Some(now), Some(after)) = (f_now, frame.f_after) {
+    // Leave the modal feed where the original left it, where anything reads it.
+    if let (Some(now), Some(after), true) = (f_now, frame.f_after, frame.f_after_read) {
         if (now - after).abs() > 1e-9 {
             text.push_str("\nG1 F");
             push_trimmed(&mut text, writable_feed(after, 3), 3);

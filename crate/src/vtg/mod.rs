@@ -31,6 +31,7 @@ mod block;
 mod closed_loop;
 mod corners;
 pub mod deviation;
+pub mod feeds;
 pub mod firmware;
 pub mod metrics;
 mod report;
@@ -228,20 +229,25 @@ pub fn vtg_with_progress(
     rewrite_file(input, options, &mut |f| furthest.report(f))
 }
 
-/// [`vtg_with_progress`] once the options are checked.
+/// [`vtg_with_progress`] once the options are checked. Every rewrite starts from the original
+/// with its feed-only lines folded into its moves ([`feeds`]): the same motion in fewer lines,
+/// which the rewrite may spend on rounded corners. Where no path is rewritten the original
+/// itself is handed back.
 fn rewrite_file(
     input: &[u8],
     options: &VtgOptions,
     progress: Progress<'_>,
 ) -> Result<VtgReport, Error> {
     let cancelled = || Error::new(0, 0, ErrorKind::Cancelled);
+    let folded = feeds::fold(input);
+    let work = folded.as_ref().map_or(input, |f| &f.bytes[..]);
     let Original {
         before,
         before_segments,
         sources,
         path,
         path_metrics,
-    } = read_original(input, options)?;
+    } = read_original(input, (work, folded.as_ref()), options)?;
     if !progress(0.3) {
         return Err(cancelled());
     }
@@ -250,13 +256,15 @@ fn rewrite_file(
         arcs: options.arcs.resolved(input, &before, &options.analyze),
         ..options.clone()
     };
+    let folded_lines = folded.as_ref().map_or(0, |f| f.lines);
     let run = Run {
-        input,
+        input: work,
         path: &path,
         path_metrics,
         sources: &sources,
         options,
         limits: rewrite::limits_for(&path, options),
+        allowed_lines: search::allowed_lines(work, options, folded_lines),
         known: std::sync::Mutex::new(None),
         smoothings: std::sync::Mutex::new(smoothings::Smoothings::new(smoothings_bound(
             input, options,
@@ -270,7 +278,7 @@ fn rewrite_file(
         || {
             options
                 .dynamics
-                .then(|| closed_loop::printing_deviation(input, expected_s, options))
+                .then(|| closed_loop::printing_deviation(work, expected_s, options))
         },
         || run.report((first, &[]), before, &mut |f| progress(0.3 + 0.4 * f)),
     );
@@ -284,11 +292,9 @@ fn rewrite_file(
             progress,
         };
         report =
-            closed_loop::with_simulated_deviation(input, original, report, options, &mut again)?;
+            closed_loop::with_simulated_deviation(work, original, report, options, &mut again)?;
     }
-    if report.message.is_none() {
-        report.message = report.paths.nothing_rewritten(options.critical_angle_deg);
-    }
+    let report = unfolded_if_unchanged(report, (input, work), (folded_lines, options));
     // The move lists and the offers kept are done with (the estimates and the firmware's
     // figures stream): on the 34 MB file the lists are 450 MB of the peak, freed beside the
     // finish where there are threads (90 ms on one).
@@ -297,7 +303,7 @@ fn rewrite_file(
     let Run {
         known, smoothings, ..
     } = run;
-    let done_with = (known, smoothings, path, sources);
+    let done_with = (known, smoothings, path, sources, folded);
     let ((), report) = crate::parallel::join(
         move || drop(done_with),
         || finish(input, report, options, (budget, before_segments)),
@@ -305,6 +311,26 @@ fn rewrite_file(
     let report = report?;
     progress(1.0);
     Ok(report)
+}
+
+/// `report` as handed back: where nothing was rewritten, with the original `input` as it
+/// came (not `work`, its feed lines folded, [`rewrite_file`]), else with the `folded` lines
+/// counted. A report without a message, nothing rewritten, says why.
+fn unfolded_if_unchanged(
+    mut report: VtgReport,
+    (input, work): (&[u8], &[u8]),
+    (folded, options): (u64, &VtgOptions),
+) -> VtgReport {
+    if report.message.is_none() {
+        report.message = report.paths.nothing_rewritten(options.critical_angle_deg);
+    }
+    if report.output == work {
+        report.output = input.to_vec();
+        report.after.file = report.before.file.clone();
+    } else {
+        report.feed_lines_folded = folded;
+    }
+    report
 }
 
 /// The original as every rewrite reads it: its analysis (with the firmware's segment figures
@@ -323,7 +349,14 @@ struct Original {
 /// moves' sources and its metrics. The path takes its timing from the analysis: the same
 /// planner fed the same moves, so the same timing to the bit as planning it again, which took
 /// a sixth of the reading's CPU time on one thread while the analysis' threads were done.
-fn read_original(input: &[u8], options: &VtgOptions) -> Result<Original, Error> {
+/// The analysis is the original `input`'s (its lines and bytes are the report's), the path and
+/// sources those of `work`, the file every rewrite starts from ([`rewrite_file`]), which moves
+/// as it does, move for move.
+fn read_original(
+    input: &[u8],
+    (work, folded): (&[u8], Option<&feeds::Folded>),
+    options: &VtgOptions,
+) -> Result<Original, Error> {
     let (read, path) = crate::parallel::join(
         || {
             let min_segment_s = firmware::min_segment_time_s(input, options.min_segment_time_ms);
@@ -336,14 +369,20 @@ fn read_original(input: &[u8], options: &VtgOptions) -> Result<Original, Error> 
             crate::analyze::analyze_keeping(input, &options.analyze, keep)
         },
         || {
-            let (path, sources) = source::path_and_sources(input, &options.analyze, false)?;
+            let (path, sources) = source::path_and_sources(work, &options.analyze, false)?;
             let metrics = metrics::from_path(&path, options.critical_angle_deg);
             Ok::<_, Error>((path, sources, metrics))
         },
     );
     let ((before, kept), (mut path, sources, path_metrics)) = (read?, path?);
-    if let Some(timed) = &kept.timed_moves {
-        path.set_timing(timed, before.time_s);
+    if let Some(mut timed) = kept.timed_moves {
+        // Matched by line: the analysis numbers the original's lines.
+        if let Some(folded) = folded {
+            timed
+                .iter_mut()
+                .for_each(|t| t.line = folded.line_in_folded(t.line));
+        }
+        path.set_timing(&timed, before.time_s);
     }
     Ok(Original {
         before,
@@ -369,6 +408,7 @@ fn smoothings_bound(input: &[u8], options: &VtgOptions) -> usize {
 
 /// One file being rewritten: what every whole-file attempt shares.
 struct Run<'a> {
+    /// The original with its feed-only lines folded ([`feeds`]).
     input: &'a [u8],
     path: &'a crate::path::PrintPath,
     /// The original's trajectory metrics, file and layers ([`metrics::from_path`]).
@@ -376,6 +416,8 @@ struct Run<'a> {
     sources: &'a source::Sources,
     options: &'a VtgOptions,
     limits: KinematicLimits,
+    /// Lines a rewrite may add to `input` ([`search::allowed_lines`]).
+    allowed_lines: i64,
     /// The offers of the last rewrite and the layers it kept: a later rewrite of the same
     /// variant that keeps those layers and more (the closed loop's rounds) drops the offers of
     /// the others ([`rewrite::Offers::keep_layers`]) instead of making every path's again.
@@ -478,7 +520,7 @@ impl Run<'_> {
                     self.input,
                     self.path,
                     self.sources,
-                    (self.options, &self.limits),
+                    (self.options, &self.limits, self.allowed_lines),
                     (variant, kept),
                     (smoothings, &mut |f: f64| progress(0.8 * f)),
                 )?

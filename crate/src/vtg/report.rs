@@ -237,6 +237,10 @@ pub struct VtgReport {
     /// Layers (0-based) kept as they were because, rewritten, they rang above the original's
     /// peak deviation in the dynamics model (empty: none).
     pub peak_layers_kept: Vec<usize>,
+    /// Feed-only lines of the original (`G1 F6000` alone) folded into the moves that read
+    /// them, or dropped where the next move sets its own feed: the same motion in fewer lines,
+    /// spent on rounded corners (0 where the original is handed back).
+    pub feed_lines_folded: u64,
     /// The rewritten G-code.
     #[serde(skip)]
     pub output: Vec<u8>,
@@ -349,5 +353,6 @@ pub(crate) fn build(
         output_kept: None,
         message: None,
         peak_layers_kept: Vec::new(),
+        feed_lines_folded: 0,
     }
 }

@@ -23,6 +23,11 @@ pub struct MoveSource {
     pub plain: bool,
     /// Mode its `E` word is read in.
     pub mode: ExtrusionMode,
+    /// The modal `F` after the line is never read: the next move sets its own (a `G1`, `G2` or
+    /// `G3` with an `F` word) with only lines between that read no feed (those
+    /// [`crate::vtg::feeds`] folds across). A rewritten block ending here need not leave the
+    /// modal feed as the original did.
+    pub feed_overridden: bool,
     /// Its `E` word.
     pub e_word: f64,
     /// Logical (G-code) E before the line.
@@ -134,6 +139,8 @@ struct Read {
     line_notes: Notes,
     /// The modal `F` word.
     f_modal: Option<f64>,
+    /// Since the last move, every line read no feed ([`crate::vtg::feeds::crosses`]).
+    feed_unread: bool,
     /// What the line's move needs of the state before it: mode, logical E, modal `F`.
     before: (ExtrusionMode, f64, Option<f64>),
 }
@@ -149,6 +156,7 @@ impl Read {
             notes: Notes::default(),
             line_notes: Notes::default(),
             f_modal: None,
+            feed_unread: true,
             before: (ExtrusionMode::Absolute, 0.0, None),
         }
     }
@@ -158,8 +166,13 @@ impl Fold for Read {
     fn line(&mut self, raw: &RawLine<'_>, line: Option<&Line<'_>>) -> Result<Flow, Error> {
         let Some(line) = line else {
             self.notes = Notes::default();
+            self.feed_unread = false;
             return Ok(Flow::Read);
         };
+        // Moves are told in `event`; a motion line that makes none moves nothing.
+        if !crate::vtg::feeds::crosses(line) && !line.code().is_some_and(|c| c.is_motion()) {
+            self.feed_unread = false;
+        }
         let end = raw.offset + raw.text.len();
         let joined = is_annotation(line)
             .then(|| self.notes.with(raw.offset, end, u32::MAX as usize))
@@ -194,11 +207,17 @@ impl Fold for Read {
 
     fn event(&mut self, line: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
         if let Event::Move(m) = event {
+            let overrides = self.feed_unread && crate::vtg::feeds::sets_feed(line);
+            if let Some(last) = self.sources.moves.last_mut() {
+                last.feed_overridden = overrides;
+            }
+            self.feed_unread = true;
             let (mode, e_before, f_before) = self.before;
             self.sources.moves.push(MoveSource {
                 line: at.line,
                 plain: is_plain(line, &m.to),
                 mode,
+                feed_overridden: false,
                 e_word: line.params.get(b'E').unwrap_or(0.0),
                 e_before,
                 f_before: f_before.unwrap_or(f64::NAN),
@@ -284,6 +303,28 @@ mod tests {
         let first = s.moves.first().unwrap();
         assert_eq!((first.f_before(), first.notes.lines), (None, 0));
         assert_eq!(first.f_after(), Some(600.0));
+    }
+
+    /// A move's modal feed is overridden where the next move is a `G1`–`G3` with its own `F`
+    /// and only lines that read no feed lie between; a macro, a `G0` (Marlin may keep its feed
+    /// apart) or a move without `F` reads or may read it.
+    #[test]
+    fn a_feed_the_next_move_sets_again_is_overridden() {
+        let overridden = |between: &str, next: &str| {
+            let g = format!("G90\nM83\nG1 X1 Y1 E1 F600\n{between}{next}\n");
+            let s = move_sources(g.as_bytes(), &AnalyzeOptions::default()).unwrap();
+            s.moves[0].feed_overridden
+        };
+        assert!(overridden("", "G1 X5 Y5 F9000"));
+        assert!(overridden(
+            ";TYPE:Skirt\nM204 S800\nG92 E0\n",
+            "G1 E-.8 F2100"
+        ));
+        assert!(overridden("", "G2 X3 Y3 I1 J1 E1 F1200"));
+        assert!(!overridden("", "G1 X5 Y5 E1"));
+        assert!(!overridden("", "G0 X5 Y5 F9000"));
+        assert!(!overridden("M600\n", "G1 X5 Y5 F9000"));
+        assert!(!overridden("PAUSE\n", "G1 X5 Y5 F9000"));
     }
 
     #[test]

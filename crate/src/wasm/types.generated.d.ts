@@ -3076,6 +3076,12 @@ export type VtgReport = {
    * peak deviation in the dynamics model (empty: none).
    */
   peak_layers_kept: Array<number>,
+  /**
+   * Feed-only lines of the original (`G1 F6000` alone) folded into the moves that read
+   * them, or dropped where the next move sets its own feed: the same motion in fewer lines,
+   * spent on rounded corners (0 where the original is handed back).
+   */
+  feed_lines_folded: number,
 };
 
 /**

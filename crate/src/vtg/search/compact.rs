@@ -61,6 +61,7 @@ pub(super) fn compact_path(
         total_e: *e.last()?,
         f_before: first.f_before(),
         f_after: last.f_after(),
+        f_after_read: !last.feed_overridden,
         notes: notes(input, src, e)?,
     };
     let text = block::write(&frame, &pts[1..], &e[1..], &pieces);

@@ -138,22 +138,25 @@ pub(crate) struct Offers {
     paths: Vec<(u32, bool)>,
     candidate_paths: u64,
     variant: Variant,
+    /// Lines the file may add ([`super::allowed_lines`]).
+    allowed_lines: i64,
 }
 
 /// Rewrites every eligible path of `input` in every way worth offering: the free rewrite, and
 /// the dearer ones (see [`budget`]); [`Offers::write`] then writes the file with the choice.
 /// Paths smoothed the same way before are taken from `smoothings`, and those smoothed now kept
-/// there (within its bound).
+/// there (within its bound). The file may add `allowed_lines` lines ([`super::allowed_lines`]).
 pub(crate) fn offers(
     input: &[u8],
     path: &PrintPath,
     all: &Sources,
-    (options, limits): (&VtgOptions, &KinematicLimits),
+    (options, limits, allowed_lines): (&VtgOptions, &KinematicLimits, i64),
     (variant, kept_layers): (Variant, &[bool]),
     (smoothings, progress): (&mut Smoothings, crate::progress::Progress<'_>),
 ) -> Result<Offers, Error> {
     let mut out = Offers {
         variant,
+        allowed_lines,
         ..Offers::default()
     };
     let moves = &path.moves;
@@ -208,11 +211,7 @@ pub(crate) fn offers(
     };
     let (mut offers, pending) = offering.offer_all(&candidates, progress)?;
     if settings.arcs {
-        offering.add_leans(
-            &mut offers,
-            &candidates,
-            super::allowed_lines(input, options),
-        );
+        offering.add_leans(&mut offers, &candidates, allowed_lines);
     }
     smoothings.keep_all(pending);
     out.offers = offers;
@@ -503,6 +502,11 @@ impl Offers {
         self.offers.iter().any(|o| !o.dearer.is_empty())
     }
 
+    /// Lines the file may add, as the offers were made for.
+    pub(crate) fn allowed_lines(&self) -> i64 {
+        self.allowed_lines
+    }
+
     /// The file with the free rewrites `allowed_lines` more lines allow ([`budget::free_within_lines`])
     /// and the dearer ones bought with half of what those saved plus `allowed_s` of time,
     /// energy weighed at the print's `mean_power_w` where time is allowed ([`budget::choose`]).
@@ -538,6 +542,9 @@ impl Offers {
             }
         }
         out.output = apply_edits(input, edits);
+        // The lines that leave the modal feed as the original did, where the next move sets
+        // its own or reads it first: folded into it (`crate::vtg::feeds`).
+        crate::vtg::feeds::fold_in_place(&mut out.output);
         out
     }
 
@@ -1076,6 +1083,7 @@ impl Draft<'_> {
             total_e: sum,
             f_before: first_src.f_before(),
             f_after: last_src.f_after(),
+            f_after_read: !last_src.feed_overridden,
             notes,
         };
         let text = block::write(&frame, &written.points, &written.e, &pieces);
@@ -1329,7 +1337,11 @@ mod tests {
         let path = crate::path::extract(input, &options.analyze, true).expect("path");
         let sources = crate::vtg::source::move_sources(input, &options.analyze).expect("sources");
         let limits = super::limits_for(&path, &options);
-        let at = (&options, &limits);
+        let at = (
+            &options,
+            &limits,
+            super::super::allowed_lines(input, &options, 0),
+        );
         super::offers(
             input,
             &path,
