@@ -340,9 +340,10 @@ test('the URL hash restores the view on load', async () => {
 
 const cli = process.env.QUIETPATH_CLI ?? path.join(repoRoot, 'target', 'release', 'quietpath');
 const MULTIAXIS = 'multiaxis-xyzbc_zhang-ral2021_model1.gcode';
-/** A small file VTG keeps as it was: rounding any of its corners would add lines (a spiral
- * vase has no other paths to save them on). */
-const KEPT_BY_VTG = 'prusaslicer-2.7.4_spiral-vase.gcode';
+/** A small file VTG keeps as it was: rounding any of its corners would add lines (FullControl
+ * writes no feed-only lines to fold, and its vase has no other paths to save them on; the
+ * PrusaSlicer spiral vase's feed-only lines now pay for a few corners). */
+const KEPT_BY_VTG = 'fullcontrol_ripple-vase.gcode';
 const JOB_TIMEOUT = 180_000;
 
 // Runs the CLI; returns { ok, json, output (Buffer | null), ms, stderr }.
