@@ -28,7 +28,7 @@ fn folded_files_plan_as_the_originals_do() {
             analyze(bytes, &options).expect("original"),
             analyze(&f.bytes, &options).expect("folded"),
         );
-        assert_eq!(b.file.lines + f.lines, a.file.lines, "{name}: lines");
+        assert_eq!(b.file.lines + f.lines(), a.file.lines, "{name}: lines");
         assert!(b.file.bytes < a.file.bytes, "{name}: bytes");
         assert_eq!(a.time_s, b.time_s, "{name}: time");
         assert_eq!(a.moves, b.moves, "{name}: moves");

@@ -183,7 +183,7 @@ fn klipper_plans_a_file_with_its_feed_lines_folded_as_the_original() {
     let file = corpus_dir().join("crealityprint-5_k1c_benchy_klipper_exclude-object.gcode");
     let original = std::fs::read(&file).expect("K1C benchy");
     let folded = quietpath::vtg::feeds::fold(&original).expect("feed lines to fold");
-    assert_eq!(folded.lines, 18_368);
+    assert_eq!(folded.lines(), 18_368);
     let path = std::env::temp_dir().join(format!("qp-folded-{}.gcode", std::process::id()));
     std::fs::write(&path, &folded.bytes).expect("write the folded file");
     let (before, after) = (

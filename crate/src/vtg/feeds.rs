@@ -25,14 +25,18 @@ use crate::gcode::{parse_line, Code, Command, Line, Lines, RawLine};
 pub struct Folded {
     /// The file as folded.
     pub bytes: Vec<u8>,
-    /// Lines removed: every feed line folded or dropped.
-    pub lines: u64,
-    /// Their numbers in the original (1-based, ascending): a line `n` of the original is line
-    /// `n` less those before it in the folded file ([`Folded::line_in_folded`]).
+    /// The lines removed, every feed line folded or dropped: their numbers in the original
+    /// (1-based, ascending). A line `n` of the original is line `n` less those before it in the
+    /// folded file ([`Folded::line_in_folded`]).
     pub removed: Vec<u32>,
 }
 
 impl Folded {
+    /// Lines removed.
+    pub fn lines(&self) -> u64 {
+        self.removed.len() as u64
+    }
+
     /// The number in the folded file of the original's line `line` (one that is kept).
     pub fn line_in_folded(&self, line: u32) -> u32 {
         line - self.removed.partition_point(|&r| r < line) as u32
@@ -43,52 +47,76 @@ impl Folded {
 /// none does; `None` where there is none to fold. One pass over the file that parses only the
 /// lines starting `G0 F`/`G1 F` and the few after each.
 pub fn fold(input: &[u8]) -> Option<Folded> {
-    let mut splices = splices(input);
-    if splices.is_empty() {
+    let plan = Plan::of(input);
+    if plan.edits.is_empty() {
         return None;
     }
-    let mut removed: Vec<u32> = splices.iter().filter_map(|s| s.deletes).collect();
-    removed.sort_unstable();
+    let mut bytes = input.to_vec();
+    plan.apply(&mut bytes);
     Some(Folded {
-        lines: removed.len() as u64,
-        bytes: spliced(input, &mut splices),
-        removed,
+        bytes,
+        removed: plan.removed,
     })
 }
 
 /// [`fold`] in place: `bytes` folded without a second copy of them (a rewrite of the 34 MB
 /// corpus file is folded so at every write), and the lines removed.
 pub(crate) fn fold_in_place(bytes: &mut Vec<u8>) -> u64 {
-    let mut splices = splices(bytes);
-    splices.sort_by_key(|s| s.at);
-    // The words inserted come from feed lines the compaction writes over: kept aside first.
-    let mut words = Vec::new();
-    let moves: Vec<(usize, usize, std::ops::Range<usize>)> = splices
-        .iter()
-        .map(|s| {
-            let from = words.len();
-            if !s.insert.is_empty() {
-                words.extend_from_slice(b" F");
-                words.extend_from_slice(s.insert);
-            }
-            (s.at, s.remove, from..words.len())
-        })
-        .collect();
-    let removed = splices.iter().filter(|s| s.deletes.is_some()).count() as u64;
-    // Each word goes in after the feed line it came from was taken out, and is shorter than
-    // that line: what is written never overtakes what is still to be read.
-    let (mut write, mut read) = (0, 0);
-    for (at, remove, word) in moves {
-        bytes.copy_within(read..at, write);
-        write += at - read;
-        bytes[write..write + word.len()].copy_from_slice(&words[word.clone()]);
-        write += word.len();
-        read = at + remove;
+    let plan = Plan::of(bytes);
+    plan.apply(bytes);
+    plan.removed.len() as u64
+}
+
+/// The edits that fold a file ([`fold`]), owned, so that they can be made in the file itself.
+struct Plan {
+    /// In order along the file: remove `.1` bytes at `.0`, then write the bytes `.2` of `words`.
+    edits: Vec<(usize, usize, std::ops::Range<usize>)>,
+    /// The words written (` F6000`): taken from feed lines the edits remove.
+    words: Vec<u8>,
+    /// The lines removed, ascending ([`Folded::removed`]).
+    removed: Vec<u32>,
+}
+
+impl Plan {
+    fn of(input: &[u8]) -> Self {
+        let mut splices = splices(input);
+        splices.sort_by_key(|s| s.at);
+        let mut words = Vec::new();
+        let edits = splices
+            .iter()
+            .map(|s| {
+                let from = words.len();
+                if !s.insert.is_empty() {
+                    words.extend_from_slice(b" F");
+                    words.extend_from_slice(s.insert);
+                }
+                (s.at, s.remove, from..words.len())
+            })
+            .collect();
+        let removed = splices.iter().filter_map(|s| s.deletes).collect();
+        Plan {
+            edits,
+            words,
+            removed,
+        }
     }
-    let end = bytes.len();
-    bytes.copy_within(read..end, write);
-    bytes.truncate(write + end - read);
-    removed
+
+    /// The edits made in `bytes`, the file they were planned on. Each word goes in after the
+    /// feed line it came from was taken out, and is shorter than that line: what is written
+    /// never overtakes what is still to be read.
+    fn apply(&self, bytes: &mut Vec<u8>) {
+        let (mut write, mut read) = (0, 0);
+        for (at, remove, word) in &self.edits {
+            bytes.copy_within(read..*at, write);
+            write += at - read;
+            bytes[write..write + word.len()].copy_from_slice(&self.words[word.clone()]);
+            write += word.len();
+            read = at + remove;
+        }
+        let end = bytes.len();
+        bytes.copy_within(read..end, write);
+        bytes.truncate(write + end - read);
+    }
 }
 
 /// The splices that fold `input`'s feed-only lines ([`fold`]), in the order found.
@@ -242,23 +270,6 @@ struct Splice<'a> {
     insert: &'a [u8],
     /// The line it deletes, if it deletes one.
     deletes: Option<u32>,
-}
-
-/// `input` with `splices` made (sorted here by where they are made).
-fn spliced(input: &[u8], splices: &mut [Splice<'_>]) -> Vec<u8> {
-    splices.sort_by_key(|s| s.at);
-    let mut out = Vec::with_capacity(input.len());
-    let mut copied = 0;
-    for s in splices.iter() {
-        out.extend_from_slice(&input[copied..s.at]);
-        if !s.insert.is_empty() {
-            out.extend_from_slice(b" F");
-            out.extend_from_slice(s.insert);
-        }
-        copied = s.at + s.remove;
-    }
-    out.extend_from_slice(&input[copied..]);
-    out
 }
 
 #[cfg(test)]

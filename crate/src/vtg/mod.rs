@@ -256,7 +256,7 @@ fn rewrite_file(
         arcs: options.arcs.resolved(input, &before, &options.analyze),
         ..options.clone()
     };
-    let folded_lines = folded.as_ref().map_or(0, |f| f.lines);
+    let folded_lines = folded.as_ref().map_or(0, |f| f.lines());
     let run = Run {
         input: work,
         path: &path,
@@ -264,7 +264,8 @@ fn rewrite_file(
         sources: &sources,
         options,
         limits: rewrite::limits_for(&path, options),
-        allowed_lines: search::allowed_lines(work, options, folded_lines),
+        // The original's lines, and those its folded lines free.
+        allowed_lines: search::allowed_lines(input, options) + folded_lines as i64,
         known: std::sync::Mutex::new(None),
         smoothings: std::sync::Mutex::new(smoothings::Smoothings::new(smoothings_bound(
             input, options,

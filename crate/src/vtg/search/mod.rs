@@ -322,21 +322,18 @@ pub(crate) fn analysed(
 /// What [`within_allowed_time`] measures of each output beside its analysis.
 pub(crate) type Beside<'f, T> = &'f dyn Fn(&[u8]) -> T;
 
-/// Lines the rewrite may add to `input`: `allow_more_lines_pct` of the original's lines, less
-/// the header the refreshed time estimates will add where it has estimates
-/// (`crate::vtg::ESTIMATE_HEADER_LINES`), so the file as written keeps to it. `input` is the
-/// original with `folded` feed-only lines folded into its moves (`crate::vtg::feeds`): those
-/// lines are the original's, and the rewrite may spend them.
-pub(crate) fn allowed_lines(input: &[u8], options: &VtgOptions, folded: u64) -> i64 {
+/// Lines the rewrite may add to `input`: `allow_more_lines_pct` of its lines, less the header
+/// the refreshed time estimates will add where it has estimates (`crate::vtg::ESTIMATE_HEADER_LINES`), so the file as
+/// written keeps to it.
+pub(crate) fn allowed_lines(input: &[u8], options: &VtgOptions) -> i64 {
     let ends = memchr::memchr_iter(b'\n', input).count();
     let lines = ends + usize::from(input.last().is_some_and(|&b| b != b'\n'));
-    let original = lines as u64 + folded;
     let header = if options.estimates && crate::estimate::has_estimates(input) {
         super::ESTIMATE_HEADER_LINES
     } else {
         0
     };
-    (original as f64 * options.allow_more_lines_pct / 100.0).floor() as i64 - header + folded as i64
+    (lines as f64 * options.allow_more_lines_pct / 100.0).floor() as i64 - header
 }
 
 #[cfg(test)]

@@ -1340,7 +1340,7 @@ mod tests {
         let at = (
             &options,
             &limits,
-            super::super::allowed_lines(input, &options, 0),
+            super::super::allowed_lines(input, &options),
         );
         super::offers(
             input,
