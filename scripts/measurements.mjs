@@ -181,7 +181,9 @@ function heldBy(v) {
   if (p.kept_for_time > 0) why.push(`time: ${p.kept_for_time} paths`);
   const layers = (v.peak_layers_kept ?? []).length;
   if (layers > 0) why.push(`ringing: ${layers} layers`);
-  return why.join('; ') || 'corners rounded where a fillet fits';
+  // Nothing kept: the corners left have no replacement that fits the tolerance and costs no
+  // time (a fillet the machine would run slower than the sharp corner).
+  return why.join('; ') || 'no path kept: no fillet fits the rest';
 }
 
 async function vtg() {
