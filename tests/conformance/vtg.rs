@@ -61,6 +61,9 @@ struct Outcome {
     peak_layers_kept: usize,
     lines_in: usize,
     lines: usize,
+    /// The report's warning that the rewrite's peak segment rate is over the firmware's budget
+    /// (and over the original's).
+    over_segment_budget: Option<String>,
 }
 
 fn check(bytes: &[u8], name: &str, options: &VtgOptions) -> Outcome {
@@ -154,6 +157,7 @@ fn check(bytes: &[u8], name: &str, options: &VtgOptions) -> Outcome {
         peak_layers_kept: r.peak_layers_kept.len(),
         lines_in: bytes.split(|&b| b == b'\n').count(),
         lines: r.output.split(|&b| b == b'\n').count(),
+        over_segment_budget: r.firmware.as_ref().and_then(|f| f.warning.clone()),
     }
 }
 
@@ -240,12 +244,14 @@ struct Bars {
     corners_pct: f64,
     /// Energy and simulated mean deviation must fall (not only not rise).
     must_fall: bool,
-    /// Lines may not grow; something must be rewritten.
+    /// Lines may not grow, nor the peak segment rate past the firmware's budget; otherwise
+    /// something must be rewritten.
     lines_kept: bool,
 }
 
 /// What the defaults promise on every file: not more lines, sharp corners, energy or
-/// simulated mean deviation than the original, and at most 1 % more time.
+/// simulated mean deviation than the original, at most 1 % more time, and a peak segment rate
+/// within the firmware's budget wherever the original's was.
 const DEFAULT_BARS: Bars = Bars {
     corners_pct: 0.0,
     must_fall: false,
@@ -267,6 +273,9 @@ fn fails(o: &Outcome, bars: &Bars) -> Vec<String> {
     let mut fail = Vec::new();
     if bars.lines_kept && o.lines > o.lines_in {
         fail.push(format!("{} lines from {}", o.lines, o.lines_in));
+    }
+    if let Some(warning) = o.over_segment_budget.as_ref().filter(|_| bars.lines_kept) {
+        fail.push(warning.clone());
     }
     if !bars.lines_kept && o.rewritten == 0 {
         fail.push("nothing rewritten".to_string());
