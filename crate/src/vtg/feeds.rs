@@ -179,8 +179,13 @@ pub(crate) fn crosses(line: &Line<'_>) -> bool {
 
 /// Whether the line sets the modal feed a `G1` reads: a `G1`, `G2` or `G3` with an `F` word.
 pub(crate) fn sets_feed(line: &Line<'_>) -> bool {
-    let feed_move = line.code().is_some_and(|c| c.is_motion() && !c.is(b'G', 0));
-    feed_move && line.params.get(b'F').is_some()
+    line.code().is_some_and(reads_g1_feed) && line.params.get(b'F').is_some()
+}
+
+/// Whether a move of `code` reads the modal feed a `G1` sets: a `G1`, `G2` or `G3` (not a
+/// `G0`: Marlin built with `VARIABLE_G0_FEEDRATE` keeps its feed apart).
+fn reads_g1_feed(code: Code) -> bool {
+    code.is_motion() && !code.is(b'G', 0)
 }
 
 /// A feed-only line waiting for the move that reads it.
@@ -237,7 +242,7 @@ impl<'a> Feed<'a> {
         let code = line.code()?;
         let same = match self.code.number {
             0 => code.is(b'G', 0),
-            _ => code.is_motion() && !code.is(b'G', 0),
+            _ => reads_g1_feed(code),
         };
         let plain = line.comment.is_none() && line.line_number.is_none();
         if !same || !plain || line.checksum.is_some() {
