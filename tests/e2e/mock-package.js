@@ -89,7 +89,7 @@ export function vtg(input, options = {}, progress) {
     paths: {
       candidates: 12, rewritten: 10, replaced_moves: 400, written_moves: 900, above_k_cr_segments: 30, lowered_feed_segments: 5,
       raised_caps: 2, uncapped: 1, paid_from_savings: 1, kept_for_time: 2, kept_for_lines: 3, compacted: 4, mean_speed_fluctuation_pct: 3.5, feed_cap_scale: 1,
-      steps_joined: true, arcs_written: 0, keyholes: 0,
+      steps_joined: true, stretch_caps: false, arcs_written: 0, keyholes: 0,
     },
     table1: {
       l_total_mm: cmp(tb.l_total_mm, ta.l_total_mm), n_total: cmp(tb.n_total, ta.n_total), l_infill_mm: cmp(tb.l_infill_mm, ta.l_infill_mm),

@@ -286,38 +286,39 @@ fn quietest(
     }
 }
 
-/// `best`, or its rival ([`search::Variant::rival`]) where `best` keeps the no-dearer rule,
-/// the rival leaves fewer sharp corners and keeps the rule too. The rival is written first and
-/// its output simulated only where it is rounder: by default it seldom is, and its simulation
-/// would cost as much again.
+/// `best`, or the roundest of its rivals ([`search::Variant::rivals`]) where `best` keeps the
+/// no-dearer rule: each rival that leaves fewer sharp corners than the best so far and keeps
+/// the rule too takes its place. A rival is written first and its output simulated only where
+/// it is rounder: by default it seldom is, and its simulation would cost as much again.
 fn rounder_rival(
-    best: Tried,
+    mut best: Tried,
     (orig, options): (&Simulated, &VtgOptions),
     again: &mut dyn Again,
 ) -> Result<Tried, Error> {
     let b = &orig.deviation;
-    let Some(rival) = best.variant.rival() else {
-        return Ok(best);
-    };
     if quietness(b, &best.sim.deviation).0 != 0 {
         return Ok(best);
     }
-    let before = best.report.before.clone();
-    let corners = best.report.table1.n_turning.after;
-    let report = again.report(rival, &[], before, (0.94, 0.01))?;
-    if report.paths.rewrote_nothing() || report.table1.n_turning.after >= corners {
-        return Ok(best);
+    let rivals = best.variant.rivals();
+    let step = 0.01 / rivals.len().max(1) as f64;
+    for (k, rival) in rivals.into_iter().enumerate() {
+        let before = best.report.before.clone();
+        let corners = best.report.table1.n_turning.after;
+        let report = again.report(rival, &[], before, (0.94 + step * k as f64, step))?;
+        if report.paths.rewrote_nothing() || report.table1.n_turning.after >= corners {
+            continue;
+        }
+        // Split where the original's run is, as every rewrite's ([`Again::simulated`]).
+        let sim = printing_deviation(&report.output, report.before.time_s, options);
+        if let Some(sim) = sim.filter(|s| quietness(b, &s.deviation).0 == 0) {
+            best = Tried {
+                report,
+                sim,
+                variant: rival,
+            };
+        }
     }
-    // Split where the original's run is, as every rewrite's ([`Again::simulated`]).
-    let sim = printing_deviation(&report.output, report.before.time_s, options);
-    Ok(match sim {
-        Some(sim) if quietness(b, &sim.deviation).0 == 0 => Tried {
-            report,
-            sim,
-            variant: rival,
-        },
-        _ => best,
-    })
+    Ok(best)
 }
 
 /// Each of `variants` written whole and simulated in turn, until one keeps the no-dearer rule;

@@ -135,6 +135,11 @@ pub struct PathCounts {
     /// found the joined rewrite ringing more than the original and the steps as walked
     /// quieter (see [`crate::vtg::VtgOptions::dynamics`]).
     pub steps_joined: bool,
+    /// Whether a segment that joins walked steps was also offered the VTG eq. 29 speed of the
+    /// stretch it stands for (its mean curvature), not only that of the tightest of its steps:
+    /// `true` where, with the dynamics model, that rewrite kept the no-dearer rule and left
+    /// fewer sharp corners (see [`crate::vtg::VtgOptions::dynamics`]).
+    pub stretch_caps: bool,
     /// Arcs (`G2`/`G3`) written (with the `arcs` option), each in place of several steps.
     pub arcs_written: u64,
     /// Single corners too tight to fillet that were turned round a keyhole loop instead
@@ -340,6 +345,7 @@ pub(crate) fn build(
             },
             feed_cap_scale: rewritten.feed_cap_scale,
             steps_joined: rewritten.steps_joined,
+            stretch_caps: rewritten.stretch_caps,
             arcs_written: rewritten.arcs_written,
             keyholes: rewritten.keyholes,
         },

@@ -2032,6 +2032,13 @@ export type PathCounts = {
    */
   steps_joined: boolean,
   /**
+   * Whether a segment that joins walked steps was also offered the VTG eq. 29 speed of the
+   * stretch it stands for (its mean curvature), not only that of the tightest of its steps:
+   * `true` where, with the dynamics model, that rewrite kept the no-dearer rule and left
+   * fewer sharp corners (see [`crate::vtg::VtgOptions::dynamics`]).
+   */
+  stretch_caps: boolean,
+  /**
    * Arcs (`G2`/`G3`) written (with the `arcs` option), each in place of several steps.
    */
   arcs_written: number,

@@ -21,6 +21,7 @@ use super::tuning::TUNING;
 use super::VtgOptions;
 use crate::analyze::Report;
 use crate::error::Error;
+use crate::vtg::feed::Way;
 use crate::vtg::report::OutputKept;
 use smooth::{Settings, SmoothPath, Smoothed};
 
@@ -43,6 +44,9 @@ pub(crate) struct Variant {
     pub(crate) thin: bool,
     /// Rewrite nothing: the original, reported as a rewrite would be ([`Variant::original`]).
     pub(crate) keep_original: bool,
+    /// At each scale of the VTG eq. 29 speeds, joined segments capped for their stretch's
+    /// mean curvature too, before the next scale ([`Settings::stretch`]).
+    pub(crate) stretch: bool,
 }
 
 impl Variant {
@@ -69,6 +73,30 @@ impl Variant {
     }
 }
 
+impl Variant {
+    /// The variants tried, in turn, for more rounded corners where this one keeps the
+    /// no-dearer rule: [`Variant::rival`], then the stretch twins (`stretch`) of this one, of
+    /// the first rewrite and of the first without keyholes. Joined segments capped for their
+    /// stretch run their long straights faster, so a path more often costs no time at the
+    /// speeds as they are: on the thesis teardrop and oval and the Simplify3D file the twins
+    /// keep the rule with more corners rounded, while on the L bracket the first rewrite's
+    /// twin rounds fewer (its slower fillets need ramps, and so lines; docs/measurements/vtg.md).
+    pub(crate) fn rivals(self) -> Vec<Variant> {
+        let twin = |v: Variant| Variant { stretch: true, ..v };
+        let mut out: Vec<Variant> = self.rival().into_iter().collect();
+        if self.keep_original {
+            return out;
+        }
+        let joined = quieter_variants().next().unwrap_or_default();
+        for v in [twin(self), twin(Variant::default()), twin(joined)] {
+            if v != self && !out.contains(&v) {
+                out.push(v);
+            }
+        }
+        out
+    }
+}
+
 impl Default for Variant {
     fn default() -> Self {
         Variant {
@@ -76,6 +104,7 @@ impl Default for Variant {
             keyholes: true,
             thin: true,
             keep_original: false,
+            stretch: false,
         }
     }
 }
@@ -101,14 +130,16 @@ pub(crate) fn quieter_variants() -> impl Iterator<Item = Variant> {
             keyholes,
             thin: false,
             keep_original: false,
+            stretch: false,
         })
     }))
 }
 
 /// The ways a smoothed path is written, in turn: the VTG eq. 29 speeds at each of
 /// `Tuning::cap_scales` times the settings' first scale (`None`: no caps; only that without
-/// `limit_feed`), each first without a ceiling, then no faster than the original.
-pub(crate) fn writings(settings: &Settings) -> Vec<(Option<f64>, bool)> {
+/// `limit_feed`), each first without a ceiling, then no faster than the original; with
+/// [`Settings::stretch`], each then again with joined segments capped for their stretch.
+pub(crate) fn writings(settings: &Settings) -> Vec<Way> {
     let base = settings.feed_cap_scale;
     let capped = TUNING.cap_scales.map(|k| k.map(|k| k * base));
     let scales: &[Option<f64>] = if settings.limit_feed {
@@ -116,10 +147,24 @@ pub(crate) fn writings(settings: &Settings) -> Vec<(Option<f64>, bool)> {
     } else {
         &[None]
     };
-    scales
-        .iter()
-        .flat_map(|&k| [(k, false), (k, true)])
-        .collect()
+    let stretches: &[bool] = if settings.stretch {
+        &[false, true]
+    } else {
+        &[false]
+    };
+    let mut ways = Vec::with_capacity(scales.len() * 2 * stretches.len());
+    for &scale in scales {
+        for &stretch in stretches {
+            for ceiling in [false, true] {
+                ways.push(Way {
+                    scale,
+                    ceiling,
+                    stretch,
+                });
+            }
+        }
+    }
+    ways
 }
 
 /// The shares of the tolerance a piece's blends are tried with, in turn: `Tuning::blend_share`,
@@ -371,6 +416,54 @@ mod tests {
         assert!(variants[1..].iter().all(|v| v.rival().is_none()));
         assert_eq!(Variant::default().rival(), None);
         assert_eq!(Variant::original().rival(), None);
+    }
+
+    /// A variant's rivals: its own rival first, then the stretch twins of itself, of the first
+    /// rewrite and of the first without keyholes, none twice and none the variant itself.
+    #[test]
+    fn the_rivals_are_the_rival_then_the_stretch_twins() {
+        let twin = |v: Variant| Variant { stretch: true, ..v };
+        let joined = quieter_variants().next().expect("a variant");
+        let walked = joined.rival().expect("a rival");
+        assert_eq!(
+            joined.rivals(),
+            [walked, twin(joined), twin(Variant::default())]
+        );
+        assert_eq!(
+            walked.rivals(),
+            [twin(walked), twin(Variant::default()), twin(joined)]
+        );
+        // A twin's rival is the rival's twin, and its own twin is itself.
+        assert_eq!(
+            twin(joined).rivals(),
+            [twin(walked), twin(Variant::default())]
+        );
+        assert_eq!(Variant::original().rivals(), []);
+        assert!(quieter_variants().all(|v| !v.stretch) && !Variant::default().stretch);
+    }
+
+    /// With `stretch`, each scale is offered as it is, then with joined segments capped for
+    /// their stretch, each first without a ceiling; without it, only as it is.
+    #[test]
+    fn stretch_offers_each_scale_again_for_the_stretch() {
+        let mut s = smooth::tests::settings();
+        let plain = writings(&s);
+        assert!(plain.iter().all(|w| !w.stretch));
+        assert_eq!(plain.len(), 2 * TUNING.cap_scales.len());
+        s.stretch = true;
+        let ways = writings(&s);
+        assert_eq!(ways.len(), 2 * plain.len());
+        for (k, four) in ways.chunks(4).enumerate() {
+            let scale = TUNING.cap_scales[k];
+            let got: Vec<(bool, bool)> = four.iter().map(|w| (w.stretch, w.ceiling)).collect();
+            assert_eq!(
+                got,
+                [(false, false), (false, true), (true, false), (true, true)]
+            );
+            assert!(four
+                .iter()
+                .all(|w| w.scale == scale.map(|x| x * s.feed_cap_scale)));
+        }
     }
 
     /// Within both limits nothing is cut; over the time, the allowance loses the excess and the

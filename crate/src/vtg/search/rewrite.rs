@@ -23,6 +23,7 @@ use crate::vtg::arcs::{self, Piece};
 use crate::vtg::block::{self, Frame};
 use crate::vtg::budget::{self, Budget, Offer, Outcome};
 use crate::vtg::deviation::both_ways;
+use crate::vtg::feed::Way;
 use crate::vtg::feed::Written;
 use crate::vtg::kinematics::KinematicLimits;
 use crate::vtg::resample::WalkStats;
@@ -72,6 +73,8 @@ pub(crate) struct Rewritten {
     pub(crate) feed_cap_scale: f64,
     /// Whether the walked steps were joined up to the segment budget ([`Variant::thin`]).
     pub(crate) steps_joined: bool,
+    /// Whether joined segments were offered speeds for their stretch ([`Variant::stretch`]).
+    pub(crate) stretch_caps: bool,
     /// Arcs (`G2`/`G3`) written.
     pub(crate) arcs_written: u64,
     /// Corners turned round keyhole loops.
@@ -246,6 +249,7 @@ fn file_settings(
         classic_jerk_mm_s: (path.junction_model == JunctionModel::ClassicJerk)
             .then(|| xy_jerk(&path.print_limits)),
         feed_cap_scale: variant.feed_cap_scale,
+        stretch: variant.stretch,
         // `vtg` has resolved `auto` by now.
         arcs: options.arcs == crate::vtg::ArcsMode::On,
         min_speed_share: 1.0,
@@ -520,6 +524,7 @@ impl Offers {
             candidate_paths: self.candidate_paths,
             feed_cap_scale: self.variant.feed_cap_scale,
             steps_joined: self.variant.thin,
+            stretch_caps: self.variant.stretch,
             ..Rewritten::default()
         };
         let (lines, choice) = self.choice((allowed_s, allowed_lines), mean_power_w);
@@ -842,8 +847,8 @@ fn rewrite_path(
     let added = costs.added_by(written_cost);
     let mut out =
         vec![draft.outcome(scale, &written, written_cost, added, costs.dearer(&added))?];
-    if let Some((k, ceiling, total)) = fastest.filter(|f| f.2 .0 < written_cost.0) {
-        let w = smoothed.written(k, ceiling, pts[0], settings);
+    if let Some((k, way, total)) = fastest.filter(|f| f.2 .0 < written_cost.0) {
+        let w = smoothed.written(way, pts[0], settings);
         out.extend(draft.outcome(k, &w, total, costs.added_by(total), true));
     }
     Some(out)
@@ -920,7 +925,7 @@ impl Costs {
 }
 
 /// A writing of a smoothed path: the VTG eq. 29 speeds' scale (`None`: no caps), and the path
-/// written with it (or whether it had a ceiling), with its time (s) and energy (J).
+/// written with it (or the way it was written), with its time (s) and energy (J).
 type Writing<W> = (Option<f64>, W, (f64, f64));
 
 /// The VTG eq. 29 speeds as they are, then raised step by step, then no caps at all, each first
@@ -933,17 +938,18 @@ fn cheapest_and_fastest(
     settings: &Settings,
     machine: &PlanContext<'_>,
     costs: Costs,
-) -> (Option<Writing<Written>>, Option<Writing<bool>>) {
+) -> (Option<Writing<Written>>, Option<Writing<Way>>) {
     let cost = |w: &Written| machine.cost(start, &w.points, &w.e, &w.feed_mm_s);
     let mut cheapest: Option<Writing<Written>> = None;
-    let mut fastest: Option<Writing<bool>> = None;
+    let mut fastest: Option<Writing<Way>> = None;
     // The feeds of the writings costed so far. Two writings with the same feeds are one path
     // at one cost, and every test below takes a later writing only where it is strictly
     // better, so a writing met before is skipped unplanned (on the 34 MB corpus file 22 669
     // of 146 472 writings, a sixth of the planning).
     let mut tried: Vec<Vec<f64>> = Vec::new();
-    for (k, ceiling) in super::writings(settings) {
-        let feeds = smoothed.feeds(k, ceiling);
+    for way in super::writings(settings) {
+        let k = way.scale;
+        let feeds = smoothed.feeds(way);
         if tried.contains(&feeds.feed_mm_s) {
             continue;
         }
@@ -969,7 +975,7 @@ fn cheapest_and_fastest(
             (a[0], a[1]) < (b[0], b[1])
         });
         if quicker {
-            fastest = Some((k, ceiling, total));
+            fastest = Some((k, way, total));
         }
         if better {
             cheapest = Some((k, w, total));

@@ -52,6 +52,9 @@ pub(crate) struct Settings {
     /// are); [`crate::vtg::vtg`] raises it where the dynamics model finds the rewrite at 1
     /// rings more than the original.
     pub(crate) feed_cap_scale: f64,
+    /// Offer each scale of the VTG eq. 29 speeds a second time with joined segments capped for
+    /// the mean curvature of their stretch ([`crate::vtg::feed::Way::stretch`]).
+    pub(crate) stretch: bool,
     /// Write runs of new points that lie on a circle as arcs (`G2`/`G3`, [`crate::vtg::arcs`]).
     pub(crate) arcs: bool,
     /// How the firmware cuts arcs into chords, under the limits in force where the path starts,
@@ -487,6 +490,7 @@ impl Smoothed {
                 StepSpeed {
                     programmed: f,
                     limit: f64::INFINITY,
+                    stretch_limit: f64::INFINITY,
                     floor: 0.0,
                     ceiling: planned.map_or(f64::INFINITY, |p| p.peak),
                     accel: planned.map_or(0.0, |p| p.acceleration),
@@ -672,6 +676,7 @@ fn attempt(
         let mut step = StepSpeed {
             programmed: feed.get(seg).copied()?,
             limit: f64::INFINITY,
+            stretch_limit: f64::INFINITY,
             floor: 0.0,
             ceiling: o.top(u_prev, x.u),
             accel: local.normal_accel_mm_s2,
@@ -680,6 +685,9 @@ fn attempt(
             out.above_k_cr += 1;
             if s.limit_feed {
                 step.limit = local.feed_limit(x.mean_kappa);
+                if x.stretch_kappa > k_cr {
+                    step.stretch_limit = local.feed_limit(x.stretch_kappa);
+                }
                 step.floor = o.speed(u_prev).min(o.speed(x.u));
             }
         }
@@ -808,11 +816,31 @@ fn thinned(
             x.kappa = x.kappa.max(y.kappa);
             x.mean_kappa = x.mean_kappa.max(y.mean_kappa);
         }
+        x.stretch_kappa = stretch_curvature(&walked, &points, from, k);
         samples.push(x);
         kept.push(*p);
         from = k;
     }
     (samples, kept)
+}
+
+/// The mean curvature of the walked steps `from + 1 ..= to` joined as one segment: their
+/// tangent's turn (each step's mean curvature times its chord) over their length, 1/mm.
+fn stretch_curvature(walked: &[Sample], points: &[[f64; 3]], from: usize, to: usize) -> f64 {
+    let (mut turn, mut length) = (0.0, 0.0);
+    for j in from + 1..=to {
+        let (Some(y), Some(a), Some(b)) = (walked.get(j), points.get(j - 1), points.get(j)) else {
+            continue;
+        };
+        let l = norm(sub(*b, *a));
+        turn += y.mean_kappa * l;
+        length += l;
+    }
+    if length > 0.0 {
+        turn / length
+    } else {
+        walked.get(to).map_or(0.0, |y| y.mean_kappa)
+    }
 }
 
 /// What [`walk_within`] gives: the walk's samples, their points with the ends pinned, the
@@ -874,8 +902,28 @@ impl Original<'_, '_> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// A joined segment's stretch curvature is its steps' turn over their length: a 9 mm
+    /// straight step and a 1 mm step turning 0.5 rad (mean curvature 0.5/mm) give 0.05/mm,
+    /// a tenth of the curved step's; a segment of one step keeps that step's.
+    #[test]
+    fn a_joined_segments_stretch_curvature_is_its_turn_over_its_length() {
+        let sample = |mean_kappa: f64| Sample {
+            u: 0.0,
+            p: [0.0; 3],
+            kappa: mean_kappa,
+            mean_kappa,
+            stretch_kappa: mean_kappa,
+            step_mm: 0.0,
+        };
+        let walked = [sample(0.0), sample(0.0), sample(0.5)];
+        let points = [[0.0, 0.0, 0.2], [9.0, 0.0, 0.2], [10.0, 0.0, 0.2]];
+        assert!((stretch_curvature(&walked, &points, 0, 2) - 0.05).abs() < 1e-12);
+        assert_eq!(stretch_curvature(&walked, &points, 1, 2), 0.5);
+        assert_eq!(stretch_curvature(&walked, &points, 0, 1), 0.0);
+    }
 
     /// Turns over the critical angle of `settings()` (30°) along `start` then `points`.
     fn sharp_turns_from(start: [f64; 3], points: &[[f64; 3]]) -> usize {
@@ -883,7 +931,8 @@ mod tests {
         crate::vtg::rewrite::sharp_turns(std::iter::once(&start).chain(points), cos)
     }
 
-    fn settings() -> Settings {
+    /// The settings the tests rewrite with: 0.1 mm, 30°, VTG eq. 29 speeds from scale 1.
+    pub(crate) fn settings() -> Settings {
         Settings {
             tolerance_mm: 0.1,
             critical_rad: 30f64.to_radians(),
@@ -901,6 +950,7 @@ mod tests {
             min_step_mm: TUNING.klipper_min_step_mm,
             classic_jerk_mm_s: None,
             feed_cap_scale: 1.0,
+            stretch: false,
             arcs: false,
             min_speed_share: 1.0,
             keyholes: true,

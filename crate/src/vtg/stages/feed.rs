@@ -13,6 +13,9 @@ pub(crate) struct StepSpeed {
     pub(crate) programmed: f64,
     /// The speed VTG eq. 29 allows for the segment's curvature, mm/s (infinite below `K_cr`).
     pub(crate) limit: f64,
+    /// The speed VTG eq. 29 allows for the mean curvature of the stretch the segment stands
+    /// for, mm/s: `limit`, but for a segment that joins walked steps (`Way::stretch`).
+    pub(crate) stretch_limit: f64,
     /// The original's planned speed over the stretch the segment replaces, mm/s: the feed is
     /// never lowered below it.
     pub(crate) floor: f64,
@@ -20,6 +23,21 @@ pub(crate) struct StepSpeed {
     pub(crate) ceiling: f64,
     /// The acceleration the firmware used there, mm/s² (0: unknown).
     pub(crate) accel: f64,
+}
+
+/// One way of writing a smoothed path's feeds ([`Smoothed::feeds`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Way {
+    /// The VTG eq. 29 speeds' scale (`None`: no caps).
+    pub(crate) scale: Option<f64>,
+    /// No faster than the original went over the same stretch.
+    pub(crate) ceiling: bool,
+    /// A segment that joins walked steps capped for the mean curvature of the stretch it
+    /// stands for, not for the tightest of its steps ([`StepSpeed::stretch_limit`]): the
+    /// firmware runs it as one straight block that turns only at its ends, and a long
+    /// straight joined to the first step of a fillet otherwise runs at the fillet's speed
+    /// all its length (the thesis teardrop's 27 mm side at its tip's 12 mm/s).
+    pub(crate) stretch: bool,
 }
 
 /// A rewritten path as it is written: points, filament and feed of each segment.
@@ -36,36 +54,35 @@ pub(crate) struct Written {
 }
 
 impl Smoothed {
-    /// The path as written with the VTG eq. 29 speeds scaled by `scale` (`None`: no caps, the
-    /// firmware's own cornering sets the speed), from `start` on; with `ceiling`, no faster
-    /// than the original went over the same stretch either (rounded corners let the machine
+    /// The path as written `way`: the VTG eq. 29 speeds scaled by its scale (`None`: no caps,
+    /// the firmware's own cornering sets the speed), from `start` on; with its ceiling, no
+    /// faster than the original went over the same stretch either (rounded corners let the machine
     /// carry more speed into each leg, so it peaks higher on it: faster, but dearer in motor
     /// energy). On a classic-jerk firmware rising feeds are ramped: such a planner counts a
     /// rise of the feed from one block to the next as jerk against the new block's full speed,
     /// so the segment where it rises is cut into pieces that each rise by a share of the jerk.
-    pub(crate) fn written(
-        &self,
-        scale: Option<f64>,
-        ceiling: bool,
-        start: [f64; 3],
-        s: &Settings,
-    ) -> Written {
-        self.written_at(self.feeds(scale, ceiling), start, s)
+    pub(crate) fn written(&self, way: Way, start: [f64; 3], s: &Settings) -> Written {
+        self.written_at(self.feeds(way), start, s)
     }
 
     /// The feed of each step as [`Smoothed::written`] sets it, before any ramp, and how many
     /// are lowered: all that sets one writing apart from another of the same path.
-    pub(crate) fn feeds(&self, scale: Option<f64>, ceiling: bool) -> Feeds {
+    pub(crate) fn feeds(&self, way: Way) -> Feeds {
         let mut feeds = Feeds {
             feed_mm_s: Vec::with_capacity(self.steps.len()),
             lowered: 0,
         };
         for st in &self.steps {
             let mut cap = f64::INFINITY;
-            if let Some(k) = scale {
-                cap = (st.limit * k).max(st.floor);
+            if let Some(k) = way.scale {
+                let limit = if way.stretch {
+                    st.stretch_limit
+                } else {
+                    st.limit
+                };
+                cap = (limit * k).max(st.floor);
             }
-            if ceiling {
+            if way.ceiling {
                 cap = cap.min(st.ceiling);
             }
             let v = if cap < st.programmed * 0.99 {
@@ -218,6 +235,35 @@ fn ramp_up(out: &mut Written, start: [f64; 3], start_feed: f64, jerk: f64, accel
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A joined segment's feed: its tightest step's VTG eq. 29 speed as it is, its stretch's
+    /// with `stretch`; either scaled, and neither below the original's speed there.
+    #[test]
+    fn stretch_caps_a_joined_segment_for_its_stretch() {
+        let step = StepSpeed {
+            programmed: 50.0,
+            limit: 10.0,
+            stretch_limit: 30.0,
+            floor: 12.0,
+            ceiling: f64::INFINITY,
+            accel: 1000.0,
+        };
+        let smoothed = Smoothed {
+            steps: vec![step],
+            ..Smoothed::default()
+        };
+        let way = |scale, stretch| Way {
+            scale,
+            ceiling: false,
+            stretch,
+        };
+        let feed = |w| smoothed.feeds(w).feed_mm_s[0];
+        assert_eq!(feed(way(Some(1.0), false)), 12.0);
+        assert_eq!(feed(way(Some(1.0), true)), 30.0);
+        assert_eq!(feed(way(Some(1.5), true)), 45.0);
+        assert_eq!(feed(way(None, true)), 50.0);
+        assert_eq!(smoothed.feeds(way(Some(1.0), true)).lowered, 1);
+    }
 
     #[test]
     fn ramp_rises_within_the_jerk_and_keeps_geometry_and_filament() {

@@ -47,6 +47,9 @@ pub(crate) struct Sample {
     /// Mean curvature over that step (turn of the tangent over the chord), 1/mm: what the
     /// feed rate of the written segment must respect.
     pub(crate) mean_kappa: f64,
+    /// Mean curvature over the stretch of the curve the written segment stands for (the
+    /// tangent's turn over its length), 1/mm: `mean_kappa` until steps are joined.
+    pub(crate) stretch_kappa: f64,
     /// The step `L_i` asked for (0 for the first point and the shortened last step).
     pub(crate) step_mm: f64,
 }
@@ -73,6 +76,7 @@ pub(crate) fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Opti
         p: first.p,
         kappa: first.curvature(),
         mean_kappa: 0.0,
+        stretch_kappa: 0.0,
         step_mm: 0.0,
     }];
     let end = curve.eval(u_end);
@@ -99,11 +103,13 @@ pub(crate) fn walk_curve(curve: &Curve, w: &Walk, stats: &mut WalkStats) -> Opti
         stats.steps += 1;
         let next = next.unwrap_or_else(|| curve.eval(un));
         let t1 = next.d1;
+        let mean_kappa = mean_curvature(&e.d1, &t1, norm(sub(pn, p)));
         out.push(Sample {
             u: un,
             p: pn,
             kappa: k,
-            mean_kappa: mean_curvature(&e.d1, &t1, norm(sub(pn, p))),
+            mean_kappa,
+            stretch_kappa: mean_kappa,
             step_mm: step,
         });
         if un >= u_end {
