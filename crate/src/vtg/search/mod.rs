@@ -68,6 +68,7 @@ impl Variant {
         (self.thin && !self.keyholes && !self.keep_original).then_some(Variant {
             keyholes: true,
             thin: false,
+            stretch: false,
             ..self
         })
     }
@@ -76,7 +77,8 @@ impl Variant {
 impl Variant {
     /// The variants tried, in turn, for more rounded corners where this one keeps the
     /// no-dearer rule: [`Variant::rival`], then the stretch twins (`stretch`) of this one, of
-    /// the first rewrite and of the first without keyholes. Joined segments capped for their
+    /// the first rewrite and of the first without keyholes (a variant whose steps are not
+    /// joined has no twin of its own: its feeds would be its own). Joined segments capped for their
     /// stretch run their long straights faster, so a path more often costs no time at the
     /// speeds as they are: on the thesis teardrop and oval and the Simplify3D file the twins
     /// keep the rule with more corners rounded, while on the L bracket the first rewrite's
@@ -89,7 +91,7 @@ impl Variant {
         }
         let joined = quieter_variants().next().unwrap_or_default();
         for v in [twin(self), twin(Variant::default()), twin(joined)] {
-            if v != self && !out.contains(&v) {
+            if v.thin && v != self && !out.contains(&v) {
                 out.push(v);
             }
         }
@@ -429,15 +431,10 @@ mod tests {
             joined.rivals(),
             [walked, twin(joined), twin(Variant::default())]
         );
-        assert_eq!(
-            walked.rivals(),
-            [twin(walked), twin(Variant::default()), twin(joined)]
-        );
-        // A twin's rival is the rival's twin, and its own twin is itself.
-        assert_eq!(
-            twin(joined).rivals(),
-            [twin(walked), twin(Variant::default())]
-        );
+        // Steps as walked have no twin of their own: their feeds would be the same.
+        assert_eq!(walked.rivals(), [twin(Variant::default()), twin(joined)]);
+        // A twin's rival is the plain rival (walked steps have no twin), its own twin itself.
+        assert_eq!(twin(joined).rivals(), [walked, twin(Variant::default())]);
         assert_eq!(Variant::original().rivals(), []);
         assert!(quieter_variants().all(|v| !v.stretch) && !Variant::default().stretch);
     }
