@@ -72,9 +72,7 @@ impl Variant {
             ..self
         })
     }
-}
 
-impl Variant {
     /// The variants tried, in turn, for more rounded corners where this one keeps the
     /// no-dearer rule: [`Variant::rival`], then the stretch twins (`stretch`) of this one, of
     /// the first rewrite and of the first without keyholes (a variant whose steps are not

@@ -685,6 +685,8 @@ fn attempt(
             out.above_k_cr += 1;
             if s.limit_feed {
                 step.limit = local.feed_limit(x.mean_kappa);
+                // Set whatever the settings' `stretch`: the smoothing cache hands a path
+                // smoothed for one variant to its stretch twin.
                 if x.stretch_kappa > k_cr {
                     step.stretch_limit = local.feed_limit(x.stretch_kappa);
                 }
