@@ -509,6 +509,38 @@ fn a_stretch_twin_rounds_more_corners_where_a_variant_keeps_the_rule() {
     }
 }
 
+/// Where a rewrite raises the mean deviation, the closed loop's first round keeps the layers
+/// that raised it most until the mean is back at the original's, not under it by a margin: a
+/// layer kept quiet leaves less ringing in the rewritten layer after it, which the per-layer
+/// figures miss, so the margin kept layers the file did not need kept (2026-12-07: the
+/// fabtotum 322 → 299 layers kept, −14.3 → −19.5 %; the Marlin 2 benchy 19 → 14 layers,
+/// −49.8 → −51.6 %). The rule still holds on both.
+#[test]
+fn the_first_mean_round_keeps_only_the_layers_the_mean_needs() {
+    for (name, most_layers, bar) in [
+        (
+            "cura-legacy-15.x_fabtotum_socket-screwdriver.gcode",
+            310,
+            -18.0,
+        ),
+        ("prusaslicer-2.6.1_benchy_marlin2.gcode", 16, -51.0),
+    ] {
+        let bytes = std::fs::read(corpus_dir().join(name)).unwrap();
+        let r = vtg(&bytes, &VtgOptions::default()).unwrap();
+        let d = r.table2.deviation.as_ref().unwrap();
+        assert!(d.mean_mm.after <= d.mean_mm.before, "{name}: {d:?}");
+        assert!(d.max_mm.after <= d.max_mm.before, "{name}: {d:?}");
+        let kept = r.peak_layers_kept.len();
+        assert!(
+            (1..=most_layers).contains(&kept),
+            "{name}: {kept} layers kept"
+        );
+        let corners = r.table1.n_turning.change_pct;
+        assert!(corners <= bar, "{name}: {corners} %");
+        assert!(r.after.file.lines <= r.before.file.lines, "{name}");
+    }
+}
+
 /// The progress `vtg` reports never goes back, and ends at 1: on a file whose closed loop
 /// keeps layers as they were over its rounds (the K1 SE accessory) and on one where it tries
 /// its variants and hands the original back (the star). Each attempt of the loop used to
