@@ -580,17 +580,18 @@ impl closed_loop::Again for Retry<'_, '_> {
         kept: &[bool],
         before: &Report,
         ((from, width), measure): (closed_loop::Span, closed_loop::Measure<'_>),
-    ) -> Result<closed_loop::Sampled, Error> {
+    ) -> Result<(closed_loop::Sampled, u64), Error> {
         let progress = &mut *self.progress;
         let (rewritten, measured) =
             self.run
                 .rewrite((variant, kept), before, Some(measure), &mut |g| {
                     progress(from + width * g)
                 })?;
-        Ok(match measured {
+        let sampled = match measured {
             Some((_, _, Some(sampled))) => sampled,
             _ => measure(&rewritten.output),
-        })
+        };
+        Ok((sampled, rewritten.corners_removed))
     }
 }
 

@@ -46,6 +46,9 @@ pub(crate) struct Rewritten {
     pub(crate) replaced_moves: u64,
     /// Moves written in their place.
     pub(crate) written_moves: u64,
+    /// Sharp corners the rewrites written remove, by their own count (set by
+    /// [`Offers::write`]; a race's trial is not analysed, [`crate::vtg::closed_loop`]).
+    pub(crate) corners_removed: u64,
     /// Segments whose feed was lowered (VTG eq. 29).
     pub(crate) lowered_segments: u64,
     /// Segments whose curvature stays above `K_cr`.
@@ -543,6 +546,7 @@ impl Offers {
             }
             if let Some(o) = written(&self.offers, k, chosen, &lines) {
                 out.add(&o.part);
+                out.corners_removed += o.corners_removed;
                 edits.extend(&o.edits);
             }
         }
