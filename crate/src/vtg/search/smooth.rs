@@ -84,6 +84,10 @@ pub(crate) struct Settings {
     /// walked steps are joined up to `v · t_min` where the tolerance allows
     /// ([`crate::vtg::thin`]); `None`: written as walked.
     pub(crate) min_segment_s: Option<f64>,
+    /// Planned blocks a second the firmware reads ([`crate::vtg::firmware::SegmentBudget`]):
+    /// a path written with fewer lines must not have its arcs cut into more than this, or
+    /// than its original lines made ([`crate::vtg::search::compact`]).
+    pub(crate) max_blocks_per_s: f64,
 }
 
 /// A rewritten path: the new geometry, and what the feed of each new segment is made of.
@@ -961,6 +965,7 @@ pub(crate) mod tests {
             arc_cutting: None,
             lean: false,
             min_segment_s: Some(0.0),
+            max_blocks_per_s: f64::INFINITY,
         }
     }
 
