@@ -260,6 +260,5 @@ mod tests {
         // Some arcs are written still, and the file has fewer lines than before.
         assert!(with.paths.arcs_written > 0, "{:?}", with.paths);
         assert!(firmware.after.lines < firmware.before.lines, "{firmware:?}");
-        eprintln!("{:?} {:?}", with.paths, firmware);
     }
 }
