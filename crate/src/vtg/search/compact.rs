@@ -104,8 +104,9 @@ const BLOCK_BURST_S: f64 = 0.1;
 /// reads 350 or so. The blocks are metered as a token bucket, each piece over its time at
 /// its feed (a lower bound, which the acceleration only lengthens): the bucket fills at the
 /// rate allowed while each piece runs, carries at most [`BLOCK_BURST_S`] of it from one piece
-/// to the next, and an arc it cannot pay for is written as its lines. So the path asks at most that rate over any second, plus the burst, and its arcs
-/// are spread along it instead of bunched at one end.
+/// to the next, and an arc it cannot pay for is written as its lines. So the path asks at
+/// most that rate over any second, plus the burst, and its arcs are spread along it instead
+/// of bunched at one end.
 fn within_block_rate(
     (pts, feed): (&[[f64; 3]], &[f64]),
     pieces: Vec<Piece>,
