@@ -158,7 +158,17 @@ fn within_block_rate(
 
 #[cfg(test)]
 mod tests {
-    use crate::vtg::{vtg, ArcsMode, VtgOptions};
+    use crate::vtg::{vtg, ArcsMode, VtgOptions, VtgReport};
+
+    /// `src` rewritten by default, but with `arcs` and without the dynamics model.
+    fn without_dynamics(src: &str, arcs: ArcsMode) -> VtgReport {
+        let options = VtgOptions {
+            dynamics: false,
+            arcs,
+            ..VtgOptions::default()
+        };
+        vtg(src.as_bytes(), &options).expect("vtg")
+    }
 
     /// A 72-chord circle (5° turns: no sharp corner) and a square: with arcs, the circle
     /// written as arcs pays for the square's rounded corners, and the file has fewer lines
@@ -177,15 +187,7 @@ mod tests {
             src.push_str(&format!("G1 X{x} Y{y} E0.7 F1800\n"));
         }
         let lines = |b: &[u8]| b.iter().filter(|&&c| c == b'\n').count();
-        let run = |arcs| {
-            let options = VtgOptions {
-                dynamics: false,
-                arcs,
-                ..VtgOptions::default()
-            };
-            vtg(src.as_bytes(), &options).expect("vtg")
-        };
-        let with = run(ArcsMode::On);
+        let with = without_dynamics(&src, ArcsMode::On);
         assert_eq!(with.paths.compacted, 1);
         assert!(with.paths.arcs_written >= 1);
         assert_eq!(with.paths.rewritten, 1);
@@ -204,7 +206,7 @@ mod tests {
                 .sum::<f64>()
         };
         assert!((e(&with.output) - e(src.as_bytes())).abs() < 1e-3);
-        let without = run(ArcsMode::Off);
+        let without = without_dynamics(&src, ArcsMode::Off);
         assert_eq!((without.paths.compacted, without.paths.rewritten), (0, 0));
         assert_eq!(without.output, src.as_bytes());
     }
@@ -243,15 +245,7 @@ mod tests {
                 src.push_str(&format!("G1 X{} Y{} E0.07\n", x + dx, y + dy));
             }
         }
-        let run = |arcs| {
-            let options = VtgOptions {
-                dynamics: false,
-                arcs,
-                ..VtgOptions::default()
-            };
-            vtg(src.as_bytes(), &options).expect("vtg")
-        };
-        let with = run(ArcsMode::On);
+        let with = without_dynamics(&src, ArcsMode::On);
         let firmware = with.firmware.as_ref().expect("firmware figures");
         assert!(firmware.warning.is_none(), "{:?}", firmware.warning);
         assert!(
