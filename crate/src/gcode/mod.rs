@@ -68,6 +68,12 @@ where
     Ok(())
 }
 
+/// Lines of `input`: its newlines, and one more where its last line has none.
+pub fn file_lines(input: &[u8]) -> u64 {
+    let newlines = memchr::memchr_iter(b'\n', input).count() as u64;
+    newlines + u64::from(input.last().is_some_and(|&b| b != b'\n'))
+}
+
 /// Lines of `input` that start with a `G` command: about as many as the moves a reader will
 /// find, for sizing a list of them up front. A list grown by doubling as it goes ends up with
 /// up to twice the room it needs (a 34 MB file's 1.09 million moves took 704 MB of list for

@@ -473,21 +473,13 @@ fn to_write_whole(mut ranked: Vec<Trial>, first: Quietness) -> Vec<search::Varia
     ranked.sort_by(|x, y| {
         (figures(x).cmp(&figures(y))).then(x.quietness.2.total_cmp(&y.quietness.2))
     });
-    let mut start = 0;
-    while start < ranked.len() {
-        let lowest = ranked[start].quietness.2;
-        let tied = ranked[start..]
-            .iter()
-            .take_while(|t| figures(t) == figures(&ranked[start]))
+    for group in ranked.chunk_by_mut(|x, y| figures(x) == figures(y)) {
+        let lowest = group[0].quietness.2;
+        let tied = (group.iter())
             .take_while(|t| t.quietness.2 <= lowest * (1.0 + RACE_MEAN_TIE))
             .count();
-        let group = ranked[start..]
-            .iter()
-            .take_while(|t| figures(t) == figures(&ranked[start]))
-            .count();
         // Stable: equal corners keep their order by the mean.
-        ranked[start..start + tied].sort_by_key(|t| std::cmp::Reverse(t.corners));
-        start += group;
+        group[..tied].sort_by_key(|t| std::cmp::Reverse(t.corners));
     }
     let passing: Vec<_> = (ranked.iter())
         .filter(|t| t.quietness.0 == 0)

@@ -248,8 +248,7 @@ pub fn analysed_figures(
 impl FirmwareFigures {
     /// The figures of `input`, whose segments `counts` counted, against `budget`.
     pub fn of(input: &[u8], counts: SegmentCounts, budget: &SegmentBudget) -> Self {
-        let newlines = memchr::memchr_iter(b'\n', input).count() as u64;
-        let lines = newlines + u64::from(input.last().is_some_and(|&b| b != b'\n'));
+        let lines = crate::gcode::file_lines(input);
         let bytes = input.len() as u64;
         Self {
             lines,

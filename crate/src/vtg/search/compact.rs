@@ -115,9 +115,9 @@ fn within_block_rate(
     let Some(cutting) = settings.arc_cutting else {
         return pieces;
     };
-    let seconds = |a: &[f64; 3], b: &[f64; 3], v: f64| norm(sub(b, a)) / v.max(f64::MIN_POSITIVE);
+    let seconds = |length: f64, v: f64| length / v.max(f64::MIN_POSITIVE);
     let original_s: f64 = (pts.windows(2).zip(feed))
-        .map(|(w, &v)| seconds(&w[0], &w[1], v))
+        .map(|(w, &v)| seconds(norm(sub(w[1], w[0])), v))
         .sum();
     let rate = settings
         .max_blocks_per_s
@@ -134,7 +134,7 @@ fn within_block_rate(
             feed: feed[k - 1],
         });
         let Some(shape) = piece.arc else {
-            tokens = (tokens + rate * seconds(&a, &b, piece.feed) - 1.0).min(capacity);
+            tokens = (tokens + rate * seconds(norm(sub(b, a)), piece.feed) - 1.0).min(capacity);
             out.push(piece);
             from = end;
             continue;
@@ -142,8 +142,7 @@ fn within_block_rate(
         let arc = shape.resolve(&a, &b);
         let planar = arc.radius * arc.sweep.abs();
         let chords = cutting.segments(arc.radius, (planar, b[2] - a[2]), piece.feed) as f64;
-        let arc_s = planar.hypot(b[2] - a[2]) / piece.feed.max(f64::MIN_POSITIVE);
-        let filled = tokens + rate * arc_s;
+        let filled = tokens + rate * seconds(planar.hypot(b[2] - a[2]), piece.feed);
         if filled >= chords {
             tokens = (filled - chords).min(capacity);
             out.push(piece);

@@ -371,8 +371,7 @@ pub(crate) type Beside<'f, T> = &'f dyn Fn(&[u8]) -> T;
 /// the refreshed time estimates will add where it has estimates (`crate::vtg::ESTIMATE_HEADER_LINES`), so the file as
 /// written keeps to it.
 pub(crate) fn allowed_lines(input: &[u8], options: &VtgOptions) -> i64 {
-    let ends = memchr::memchr_iter(b'\n', input).count();
-    let lines = ends + usize::from(input.last().is_some_and(|&b| b != b'\n'));
+    let lines = crate::gcode::file_lines(input);
     let header = if options.estimates && crate::estimate::has_estimates(input) {
         super::ESTIMATE_HEADER_LINES
     } else {

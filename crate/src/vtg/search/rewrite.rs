@@ -177,7 +177,7 @@ pub(crate) fn offers(
         path.junction_model,
         options.min_segment_time_ms,
     );
-    let lines = memchr::memchr_iter(b'\n', input).count().max(1);
+    let lines = crate::gcode::file_lines(input).max(1);
     let settings = Settings {
         min_segment_s: variant.thin.then_some(budget.min_segment_time_s),
         // A fifth under what the original's lines allow: the rewrite's own are longer (an
