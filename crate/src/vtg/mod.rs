@@ -262,6 +262,7 @@ fn rewrite_file(
         path: &path,
         path_metrics,
         sources: &sources,
+        paths: rewrite::FilePaths::of(work, &path, &sources, options),
         options,
         limits: rewrite::limits_for(&path, options),
         // The original's lines, and those its folded lines free.
@@ -415,6 +416,8 @@ struct Run<'a> {
     /// The original's trajectory metrics, file and layers ([`metrics::from_path`]).
     path_metrics: (ToolpathMetrics, Vec<ToolpathMetrics>),
     sources: &'a source::Sources,
+    /// What every rewrite's offers take from the file alone ([`rewrite::FilePaths`]).
+    paths: rewrite::FilePaths,
     options: &'a VtgOptions,
     limits: KinematicLimits,
     /// Lines a rewrite may add to `input` ([`search::allowed_lines`]).
@@ -519,8 +522,7 @@ impl Run<'_> {
                 let smoothings = kept_smoothings.as_deref_mut().unwrap_or(&mut none);
                 rewrite::offers(
                     self.input,
-                    self.path,
-                    self.sources,
+                    (self.path, self.sources, &self.paths),
                     (self.options, &self.limits, self.allowed_lines),
                     (variant, kept),
                     (smoothings, &mut |f: f64| progress(0.8 * f)),

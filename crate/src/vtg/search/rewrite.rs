@@ -148,14 +148,56 @@ pub(crate) struct Offers {
     allowed_lines: i64,
 }
 
+/// What the offers of every variant take from the file alone: its candidate paths and the
+/// firmware's segment figures. Made once a run ([`FilePaths::of`]): on the 34 MB corpus file
+/// they took 80 ms, on one thread, of each of the closed loop's whole-file rewrites and race
+/// trials (ten of them).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct FilePaths {
+    /// The paths worth rewriting ([`candidates`]); `None` where the path's moves and their
+    /// sources do not line up, and nothing is rewritten.
+    candidates: Option<Vec<(usize, usize, bool)>>,
+    /// The firmware's minimum segment time, s ([`crate::vtg::firmware::SegmentBudget`]).
+    min_segment_time_s: f64,
+    /// The compaction's block rate ([`Settings::max_blocks_per_s`]).
+    max_blocks_per_s: f64,
+}
+
+impl FilePaths {
+    /// The candidate paths of `input` (read as `path`, its moves' sources `all`) and its
+    /// firmware's figures, as `options` read them.
+    pub(crate) fn of(input: &[u8], path: &PrintPath, all: &Sources, options: &VtgOptions) -> Self {
+        let moves = &path.moves;
+        let sources = &all.moves[..];
+        let aligned = sources.len() == moves.len()
+            && sources.iter().zip(moves).all(|(s, m)| s.line == m.line);
+        let budget = crate::vtg::firmware::SegmentBudget::for_file(
+            input,
+            path.junction_model,
+            options.min_segment_time_ms,
+        );
+        let lines = crate::gcode::file_lines(input).max(1);
+        let cos_critical = crate::math::cos(options.critical_angle_deg.to_radians());
+        FilePaths {
+            candidates: aligned.then(|| candidates(moves, sources, cos_critical)),
+            min_segment_time_s: budget.min_segment_time_s,
+            // A fifth under what the original's lines allow: the rewrite's own are longer (an
+            // arc's `I` and `J`), so the stream reads fewer of them (374 → 330 a second on the
+            // 34 MB corpus file), and the compaction's bursts add a tenth
+            // (`compact::BLOCK_BURST_S`).
+            max_blocks_per_s: 0.8 * budget.segment_rate_hz(input.len() as f64 / lines as f64),
+        }
+    }
+}
+
 /// Rewrites every eligible path of `input` in every way worth offering: the free rewrite, and
 /// the dearer ones (see [`budget`]); [`Offers::write`] then writes the file with the choice.
-/// Paths smoothed the same way before are taken from `smoothings`, and those smoothed now kept
-/// there (within its bound). The file may add `allowed_lines` lines ([`super::allowed_lines`]).
+/// The paths are `file`'s candidates ([`FilePaths::of`]). Paths smoothed the same way before
+/// are taken from `smoothings`, and those smoothed now kept there (within its bound). The file
+/// may add `allowed_lines` lines ([`super::allowed_lines`]).
 pub(crate) fn offers(
     input: &[u8],
-    path: &PrintPath,
-    all: &Sources,
+    (path, all, file): (&PrintPath, &Sources, &FilePaths),
     (options, limits, allowed_lines): (&VtgOptions, &KinematicLimits, i64),
     (variant, kept_layers): (Variant, &[bool]),
     (smoothings, progress): (&mut Smoothings, crate::progress::Progress<'_>),
@@ -166,41 +208,25 @@ pub(crate) fn offers(
         ..Offers::default()
     };
     let moves = &path.moves;
-    let sources = &all.moves[..];
-    let aligned =
-        sources.len() == moves.len() && sources.iter().zip(moves).all(|(s, m)| s.line == m.line);
-    if !aligned || variant.keep_original {
+    let Some(candidates) = file.candidates.as_ref().filter(|_| !variant.keep_original) else {
         return Ok(out);
-    }
-    let budget = crate::vtg::firmware::SegmentBudget::for_file(
-        input,
-        path.junction_model,
-        options.min_segment_time_ms,
-    );
-    let lines = crate::gcode::file_lines(input).max(1);
+    };
     let settings = Settings {
-        min_segment_s: variant.thin.then_some(budget.min_segment_time_s),
-        // A fifth under what the original's lines allow: the rewrite's own are longer (an
-        // arc's `I` and `J`), so the stream reads fewer of them (374 → 330 a second on the
-        // 34 MB corpus file), and the compaction's bursts add a tenth
-        // (`compact::BLOCK_BURST_S`).
-        max_blocks_per_s: 0.8 * budget.segment_rate_hz(input.len() as f64 / lines as f64),
+        min_segment_s: variant.thin.then_some(file.min_segment_time_s),
+        max_blocks_per_s: file.max_blocks_per_s,
         ..file_settings(path, options, limits, variant)
     };
     let energy = Accumulator::new(
         &options.analyze.energy.clone().unwrap_or_default(),
         &path.profile.name,
     );
-    let cos_critical = crate::math::cos(settings.critical_rad);
-    // The candidates first (cheap), then the paths rewritten ([`Offering::offer_all`]).
-    // The paths without sharp corners too: written with arcs, or their nearly collinear lines
-    // joined, they can save lines.
-    let mut candidates = candidates(moves, sources, cos_critical);
     // Layers kept as they are (where a rewrite rang above the original's peak).
-    candidates.retain(|&(i, _, _)| {
-        let layer = moves.get(i).map_or(u32::MAX, |m| m.layer) as usize;
-        !kept_layers.get(layer).copied().unwrap_or(false)
-    });
+    let candidates: Vec<(usize, usize, bool)> = (candidates.iter().copied())
+        .filter(|&(i, _, _)| {
+            let layer = moves.get(i).map_or(u32::MAX, |m| m.layer) as usize;
+            !kept_layers.get(layer).copied().unwrap_or(false)
+        })
+        .collect();
     out.candidate_paths = candidates.iter().filter(|c| c.2).count() as u64;
     out.paths = candidates
         .iter()
@@ -1359,10 +1385,10 @@ mod tests {
             &limits,
             super::super::allowed_lines(input, &options),
         );
+        let file = super::FilePaths::of(input, &path, &sources, &options);
         super::offers(
             input,
-            &path,
-            &sources,
+            (&path, &sources, &file),
             at,
             (variant, kept),
             (smoothings, &mut |_| true),
