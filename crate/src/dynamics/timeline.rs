@@ -90,7 +90,9 @@ pub(super) fn kept_of_file(
     keep: impl Fn(u32) -> bool,
     capacity: usize,
 ) -> Result<(Option<Vec<Segment>>, Walked), Error> {
-    let (kept, timed, walked) = of_file(input, options, Kept::new(keep, capacity))?;
+    let (kept, timed, walked) = walked_into(Kept::new(keep, capacity), |sink| {
+        crate::path::walk_piped(input, options, sink)
+    })?;
     let by_markers = matches!(walked.layer_source, crate::read::LayerSource::Markers(_));
     Ok((timed.then(|| kept.finish(by_markers)), walked))
 }
@@ -102,6 +104,14 @@ pub(super) fn of_file<E: Emit>(
     options: &crate::analyze::AnalyzeOptions,
     emit: E,
 ) -> Result<(E, bool, Walked), Error> {
+    walked_into(emit, |sink| crate::path::walk(input, options, true, sink))
+}
+
+/// [`of_file`] with the file's moves walked by `walk` (on one thread or two).
+fn walked_into<E: Emit>(
+    emit: E,
+    walk: impl FnOnce(&mut Streamed<E>) -> Result<Walked, Error>,
+) -> Result<(E, bool, Walked), Error> {
     let mut sink = Streamed {
         timeline: Timeline::new(emit),
         limits: None,
@@ -110,7 +120,7 @@ pub(super) fn of_file<E: Emit>(
         early: Vec::new(),
         untimed: false,
     };
-    let walked = crate::path::walk(input, options, true, &mut sink)?;
+    let walked = walk(&mut sink)?;
     while let Some(w) = sink.waiting.pop_front() {
         sink.done(w);
     }

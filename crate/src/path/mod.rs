@@ -16,8 +16,10 @@
 //! ```
 
 mod geometry;
+mod piped;
 
 pub use geometry::{DrawPoint, LayerGeometry, SegmentKind, ARC_CHORD_DEG, TOOL_FLOATS};
+pub(crate) use piped::walk_piped;
 
 use serde::Serialize;
 
@@ -216,18 +218,7 @@ impl<S: MoveSink> Fold for Walk<'_, S> {
     }
 
     fn feature(&mut self, name: &str, _: &Machine) {
-        let features = &mut self.features;
-        self.current_feature = match features.iter().position(|f| f.name == name) {
-            Some(i) => i as u16,
-            None if features.len() < NO_FEATURE as usize => {
-                features.push(PathFeature {
-                    name: name.to_string(),
-                    kind: feature_kind(name),
-                });
-                (features.len() - 1) as u16
-            }
-            None => NO_FEATURE,
-        };
+        self.current_feature = feature_index(&mut self.features, name);
     }
 
     fn limits(&mut self, limits: &Limits, _: &Machine) {
@@ -243,17 +234,7 @@ impl<S: MoveSink> Fold for Walk<'_, S> {
             (Event::Move(m), planner) => {
                 let index = self.count;
                 self.count += 1;
-                let moved = PathMove {
-                    line: m.line,
-                    kind: m.kind,
-                    from: m.from,
-                    to: m.to,
-                    feed_mm_s: m.feed_mm_s,
-                    length_mm: m.length_mm,
-                    feature: self.current_feature,
-                    layer: NO_LAYER,
-                    timing: None,
-                };
+                let moved = path_move(m, self.current_feature);
                 sink.moved(index, moved, at.layers, &self.features);
                 match planner {
                     Some(planner) if at.untimed_homing(m) => {
@@ -274,6 +255,38 @@ impl<S: MoveSink> Fold for Walk<'_, S> {
             _ => {}
         }
         Ok(())
+    }
+}
+
+/// The index of the feature named `name` in `features`, added where it is new (at most
+/// [`NO_FEATURE`] of them: past that, [`NO_FEATURE`]).
+fn feature_index(features: &mut Vec<PathFeature>, name: &str) -> u16 {
+    match features.iter().position(|f| f.name == name) {
+        Some(i) => i as u16,
+        None if features.len() < NO_FEATURE as usize => {
+            features.push(PathFeature {
+                name: name.to_string(),
+                kind: feature_kind(name),
+            });
+            (features.len() - 1) as u16
+        }
+        None => NO_FEATURE,
+    }
+}
+
+/// A move as [`MoveSink::moved`] is told of it: its feature `feature`, its layer and timing
+/// not known yet.
+fn path_move(m: &crate::machine::Move, feature: u16) -> PathMove {
+    PathMove {
+        line: m.line,
+        kind: m.kind,
+        from: m.from,
+        to: m.to,
+        feed_mm_s: m.feed_mm_s,
+        length_mm: m.length_mm,
+        feature,
+        layer: NO_LAYER,
+        timing: None,
     }
 }
 
@@ -324,6 +337,13 @@ pub(crate) fn walk_also<F: Fold>(
         planner.flush(&mut |pm| sink.timed(pm));
         time_s = planner.elapsed_s();
     }
+    let walked = walked_of(reader, features, count, time_s);
+    Ok((walked, also))
+}
+
+/// What a walk learnt: the `reader`'s layers, machine and warnings once it has read the file,
+/// with the `features` named, the `count` of moves and the planned time `time_s`.
+fn walked_of(reader: Reader, features: Vec<PathFeature>, count: usize, time_s: f64) -> Walked {
     let print_limits = reader.limits_in_force().clone();
     let Reader { setup, layers, .. } = reader;
     let (summaries, layer_source) = layers.finish();
@@ -337,7 +357,7 @@ pub(crate) fn walk_also<F: Fold>(
         })
         .collect();
     let (warnings, _) = setup.warnings.into_parts();
-    let walked = Walked {
+    Walked {
         layers,
         layer_source,
         features,
@@ -348,8 +368,7 @@ pub(crate) fn walk_also<F: Fold>(
         time_s,
         warnings,
         moves: count,
-    };
-    Ok((walked, also))
+    }
 }
 
 impl PrintPath {
