@@ -257,6 +257,7 @@ fn rewrite_file(
         ..options.clone()
     };
     let folded_lines = folded.as_ref().map_or(0, |f| f.lines());
+    let bound = smoothings_bound(input, options);
     let run = Run {
         input: work,
         path: &path,
@@ -268,9 +269,7 @@ fn rewrite_file(
         // The original's lines, and those its folded lines free.
         allowed_lines: search::allowed_lines(input, options) + folded_lines as i64,
         known: std::sync::Mutex::new(None),
-        smoothings: std::sync::Mutex::new(smoothings::Smoothings::new(smoothings_bound(
-            input, options,
-        ))),
+        smoothings: std::sync::Mutex::new(smoothings::Smoothings::new(bound)),
     };
     let first = search::Variant::default();
     // The original's simulated deviation does not depend on the rewrite: where there are
