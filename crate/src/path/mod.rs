@@ -17,18 +17,20 @@
 
 mod geometry;
 mod piped;
+mod steps;
 
 pub use geometry::{DrawPoint, LayerGeometry, SegmentKind, ARC_CHORD_DEG, TOOL_FLOATS};
 pub(crate) use piped::walk_piped;
+use steps::{Planning, Reading};
 
 use serde::Serialize;
 
 use crate::error::{Error, Warning};
-use crate::gcode::{feature_kind, FeatureKind, Line, RawLine};
-use crate::machine::{Event, ExtrusionMode, Machine, MoveKind, Pos};
-use crate::plan::{JunctionModel, Limits, MachineProfile, Motion, PlannedMove, Planner, Profile};
+use crate::gcode::FeatureKind;
+use crate::machine::{ExtrusionMode, MoveKind, Pos};
+use crate::plan::{JunctionModel, Limits, MachineProfile, PlannedMove, Planner, Profile};
 use crate::read::{AnalyzeOptions, LayerSource};
-use crate::read::{At, Both, Flow, Fold, Reader};
+use crate::read::{Both, Fold, Reader};
 
 /// Feature index of moves before the file names any feature.
 pub const NO_FEATURE: u16 = u16::MAX;
@@ -199,97 +201,6 @@ impl Walked {
     }
 }
 
-/// The fold of [`walk`]: names features, numbers moves, plans them when asked.
-struct Walk<'s, S> {
-    sink: &'s mut S,
-    planner: Option<Planner>,
-    features: Vec<PathFeature>,
-    current_feature: u16,
-    count: usize,
-}
-
-impl<S: MoveSink> Fold for Walk<'_, S> {
-    fn line(&mut self, _: &RawLine<'_>, _: Option<&Line<'_>>) -> Result<Flow, Error> {
-        Ok(if self.sink.finished() {
-            Flow::Skip
-        } else {
-            Flow::Read
-        })
-    }
-
-    fn feature(&mut self, name: &str, _: &Machine) {
-        self.current_feature = feature_index(&mut self.features, name);
-    }
-
-    fn limits(&mut self, limits: &Limits, _: &Machine) {
-        if let Some(planner) = &mut self.planner {
-            *planner.limits_mut() = limits.clone();
-        }
-        self.sink.limits(limits);
-    }
-
-    fn event(&mut self, _: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
-        let sink = &mut *self.sink;
-        match (event, &mut self.planner) {
-            (Event::Move(m), planner) => {
-                let index = self.count;
-                self.count += 1;
-                let moved = path_move(m, self.current_feature);
-                sink.moved(index, moved, at.layers, &self.features);
-                match planner {
-                    Some(planner) if at.untimed_homing(m) => {
-                        planner.flush(&mut |pm| sink.timed(pm))
-                    }
-                    Some(planner) => {
-                        planner.push(&Motion::from(m), index as u64, &mut |pm| sink.timed(pm));
-                    }
-                    None => {}
-                }
-            }
-            (&Event::Dwell(secs), Some(planner)) => {
-                planner.dwell(secs, &mut |pm| sink.timed(pm));
-            }
-            (Event::Temperature { wait: true, .. }, Some(planner)) => {
-                planner.flush(&mut |pm| sink.timed(pm));
-            }
-            _ => {}
-        }
-        Ok(())
-    }
-}
-
-/// The index of the feature named `name` in `features`, added where it is new (at most
-/// [`NO_FEATURE`] of them: past that, [`NO_FEATURE`]).
-fn feature_index(features: &mut Vec<PathFeature>, name: &str) -> u16 {
-    match features.iter().position(|f| f.name == name) {
-        Some(i) => i as u16,
-        None if features.len() < NO_FEATURE as usize => {
-            features.push(PathFeature {
-                name: name.to_string(),
-                kind: feature_kind(name),
-            });
-            (features.len() - 1) as u16
-        }
-        None => NO_FEATURE,
-    }
-}
-
-/// A move as [`MoveSink::moved`] is told of it: its feature `feature`, its layer and timing
-/// not known yet.
-fn path_move(m: &crate::machine::Move, feature: u16) -> PathMove {
-    PathMove {
-        line: m.line,
-        kind: m.kind,
-        from: m.from,
-        to: m.to,
-        feed_mm_s: m.feed_mm_s,
-        length_mm: m.length_mm,
-        feature,
-        layer: NO_LAYER,
-        timing: None,
-    }
-}
-
 /// Reads every move of `input` the way [`crate::analyze::analyze`] does and hands each to
 /// `sink`, keeping nothing itself: memory stays bounded whatever the file's size (what a sink
 /// keeps is its own business). With `plan`, the planner's timing follows through
@@ -317,26 +228,10 @@ pub(crate) fn walk_also<F: Fold>(
     let mut also = also(&reader);
     sink.machine(&reader.setup.profile);
     sink.limits(&reader.setup.limits);
-    let mut fold = Walk {
-        sink,
-        planner: plan.then(|| Planner::new(reader.setup.limits.clone(), reader.setup.model)),
-        features: Vec::new(),
-        current_feature: NO_FEATURE,
-        count: 0,
-    };
+    let planner = plan.then(|| Planner::new(reader.setup.limits.clone(), reader.setup.model));
+    let mut fold = Reading::new(Planning::new(sink, planner), plan);
     reader.read(input, &mut Both(&mut fold, &mut also))?;
-    let Walk {
-        sink,
-        planner,
-        features,
-        count,
-        ..
-    } = fold;
-    let mut time_s = 0.0;
-    if let Some(mut planner) = planner {
-        planner.flush(&mut |pm| sink.timed(pm));
-        time_s = planner.elapsed_s();
-    }
+    let (features, count, time_s) = fold.to.finish();
     let walked = walked_of(reader, features, count, time_s);
     Ok((walked, also))
 }

@@ -1,7 +1,8 @@
 //! [`super::walk`] with planning, its reading (parser and machine) on a thread of its own
 //! beside the planner and the sink on the caller's, as [`crate::analyze`] runs its timing side
-//! beside its read side. The sink is told of the same moves, limits and timings in the same
-//! order as the walk on one thread tells it, so what it makes is the same bit for bit.
+//! beside its read side: the two sides of [`super::steps`], the steps handed over in batches.
+//! The sink is told of the same moves, limits and timings in the same order as the walk on one
+//! thread tells it, so what it makes is the same bit for bit.
 //!
 //! Only for a sink that takes every move ([`super::MoveSink::finished`] never true): a reader a
 //! batch ahead cannot stop on the line the sink stopped at. The race's trials of the closed
@@ -10,12 +11,11 @@
 //! 0.25 s on one thread of each trial's 0.33 s. The wasm build walks on one thread.
 #![cfg_attr(target_arch = "wasm32", allow(dead_code, unused_imports))]
 
-use super::{feature_index, path_move, MoveSink, PathFeature, PathMove, Walked, NO_FEATURE};
+use super::steps::{Planning, Reading, Step, TakeSteps};
+use super::{MoveSink, Walked};
 use crate::error::Error;
-use crate::gcode::Line;
-use crate::machine::{Event, Machine};
-use crate::plan::{Limits, Motion, Planner};
-use crate::read::{AnalyzeOptions, At, Fold, Reader};
+use crate::plan::Planner;
+use crate::read::{AnalyzeOptions, Reader};
 
 /// Steps handed over at a time.
 const BATCH: usize = 1024;
@@ -25,25 +25,6 @@ const QUEUED_BATCHES: usize = 8;
 
 /// Files smaller than this are walked on one thread (a thread costs more than it saves).
 const THREAD_MIN_BYTES: usize = 1 << 20;
-
-/// What the reading side tells the planning side, in file order.
-enum Step {
-    /// A feature named for the first time.
-    Feature(PathFeature),
-    /// New limits in force.
-    Limits(Limits),
-    /// A move, its layers by marker and by counting, and its motion for the planner (`None`:
-    /// homing that takes no planned time, which empties the look-ahead).
-    Move {
-        moved: PathMove,
-        layers: (u32, u32),
-        motion: Option<Motion>,
-    },
-    /// A dwell, s.
-    Dwell(f64),
-    /// A wait that empties the look-ahead (a temperature waited for).
-    Flush,
-}
 
 /// [`super::walk`] with planning, for a sink that takes every move, the reading on a thread of
 /// its own where there are threads and the file is large enough to pay for one.
@@ -70,29 +51,18 @@ fn threaded(
     let mut reader = Reader::new(input, options)?;
     sink.machine(&reader.setup.profile);
     sink.limits(&reader.setup.limits);
-    let mut planning = Planning {
-        planner: Planner::new(reader.setup.limits.clone(), reader.setup.model),
-        sink,
-        features: Vec::new(),
-        count: 0,
-    };
+    let planner = Planner::new(reader.setup.limits.clone(), reader.setup.model);
+    let mut planning = Planning::new(sink, Some(planner));
     let (read, reader) = std::thread::scope(|scope| {
         let (tx, rx) = sync_channel::<Vec<Step>>(QUEUED_BATCHES);
         let reading = scope.spawn(move || {
-            let mut batch = Vec::with_capacity(BATCH);
-            let mut fold = Reading {
-                send: &mut |step| {
-                    batch.push(step);
-                    if batch.len() >= BATCH {
-                        // Fails only where the planning side is gone (it panicked).
-                        let _ = tx.send(std::mem::replace(&mut batch, Vec::with_capacity(BATCH)));
-                    }
-                },
-                features: Vec::new(),
-                current_feature: NO_FEATURE,
+            let batches = Batches {
+                batch: Vec::with_capacity(BATCH),
+                tx,
             };
+            let mut fold = Reading::new(batches, true);
             let read = reader.read(input, &mut fold);
-            drop(fold);
+            let Batches { batch, tx } = fold.to;
             let _ = tx.send(batch);
             (read, reader)
         });
@@ -105,95 +75,25 @@ fn threaded(
         }
     });
     read?;
-    let Planning {
-        mut planner,
-        sink,
-        features,
-        count,
-    } = planning;
-    planner.flush(&mut |pm| sink.timed(pm));
-    Ok(super::walked_of(
-        reader,
-        features,
-        count,
-        planner.elapsed_s(),
-    ))
+    let (features, count, time_s) = planning.finish();
+    Ok(super::walked_of(reader, features, count, time_s))
 }
 
-/// The reading side's fold: each move, limit and wait as a [`Step`], features named as
-/// [`super::walk`]'s fold names them.
-struct Reading<'s> {
-    send: &'s mut dyn FnMut(Step),
-    features: Vec<PathFeature>,
-    current_feature: u16,
+/// The reading side's steps gathered into batches for the planning side's thread.
+#[cfg(not(target_arch = "wasm32"))]
+struct Batches {
+    batch: Vec<Step>,
+    tx: std::sync::mpsc::SyncSender<Vec<Step>>,
 }
 
-impl Fold for Reading<'_> {
-    fn feature(&mut self, name: &str, _: &Machine) {
-        let known = self.features.len();
-        self.current_feature = feature_index(&mut self.features, name);
-        if let Some(new) = self.features.get(known) {
-            (self.send)(Step::Feature(new.clone()));
-        }
-    }
-
-    fn limits(&mut self, limits: &Limits, _: &Machine) {
-        (self.send)(Step::Limits(limits.clone()));
-    }
-
-    fn event(&mut self, _: &Line<'_>, event: &Event, at: At<'_>) -> Result<(), Error> {
-        match event {
-            Event::Move(m) => (self.send)(Step::Move {
-                moved: path_move(m, self.current_feature),
-                layers: at.layers,
-                motion: (!at.untimed_homing(m)).then(|| Motion::from(m)),
-            }),
-            &Event::Dwell(secs) => (self.send)(Step::Dwell(secs)),
-            Event::Temperature { wait: true, .. } => (self.send)(Step::Flush),
-            _ => {}
-        }
-        Ok(())
-    }
-}
-
-/// The planning side: the planner, the sink, and the features and moves told so far.
-struct Planning<'s, S> {
-    planner: Planner,
-    sink: &'s mut S,
-    features: Vec<PathFeature>,
-    count: usize,
-}
-
-impl<S: MoveSink> Planning<'_, S> {
-    /// `step` taken as [`super::walk`]'s fold takes the line it came from.
+#[cfg(not(target_arch = "wasm32"))]
+impl TakeSteps for Batches {
     fn take(&mut self, step: Step) {
-        let Planning {
-            planner,
-            sink,
-            features,
-            count,
-        } = self;
-        match step {
-            Step::Feature(f) => features.push(f),
-            Step::Limits(limits) => {
-                *planner.limits_mut() = limits.clone();
-                sink.limits(&limits);
-            }
-            Step::Move {
-                moved,
-                layers,
-                motion,
-            } => {
-                let index = *count;
-                *count += 1;
-                sink.moved(index, moved, layers, features);
-                match motion {
-                    None => planner.flush(&mut |pm| sink.timed(pm)),
-                    Some(motion) => planner.push(&motion, index as u64, &mut |pm| sink.timed(pm)),
-                }
-            }
-            Step::Dwell(secs) => planner.dwell(secs, &mut |pm| sink.timed(pm)),
-            Step::Flush => planner.flush(&mut |pm| sink.timed(pm)),
+        self.batch.push(step);
+        if self.batch.len() >= BATCH {
+            let full = std::mem::replace(&mut self.batch, Vec::with_capacity(BATCH));
+            // Fails only where the planning side is gone (it panicked).
+            let _ = self.tx.send(full);
         }
     }
 }
@@ -201,6 +101,8 @@ impl<S: MoveSink> Planning<'_, S> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::path::{PathFeature, PathMove};
+    use crate::plan::Limits;
 
     /// Everything a sink is told, in order.
     #[derive(Debug, Default, PartialEq)]
