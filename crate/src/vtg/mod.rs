@@ -50,6 +50,7 @@ use serde::{Deserialize, Serialize};
 use crate::analyze::toolpath::ToolpathMetrics;
 use crate::analyze::{AnalyzeOptions, Report};
 use crate::error::{Error, ErrorKind};
+use crate::path::PrintPath;
 use crate::progress::Progress;
 pub use arc_support::ArcsMode;
 pub use report::{
@@ -257,20 +258,11 @@ fn rewrite_file(
         ..options.clone()
     };
     let folded_lines = folded.as_ref().map_or(0, |f| f.lines());
-    let bound = smoothings_bound(input, options);
-    let run = Run {
-        input: work,
-        path: &path,
-        path_metrics,
-        sources: &sources,
-        paths: rewrite::FilePaths::of(work, &path, &sources, options),
+    let run = Run::new(
+        (input, work, folded_lines),
+        (&path, &sources, path_metrics),
         options,
-        limits: rewrite::limits_for(&path, options),
-        // The original's lines, and those its folded lines free.
-        allowed_lines: search::allowed_lines(input, options) + folded_lines as i64,
-        known: std::sync::Mutex::new(None),
-        smoothings: std::sync::Mutex::new(smoothings::Smoothings::new(bound)),
-    };
+    );
     let first = search::Variant::default();
     // The original's simulated deviation does not depend on the rewrite: where there are
     // threads, it runs beside the first one (on a long print it takes as long).
@@ -341,9 +333,12 @@ struct Original {
     before: Report,
     before_segments: Option<SegmentCounts>,
     sources: source::Sources,
-    path: crate::path::PrintPath,
-    path_metrics: (ToolpathMetrics, Vec<ToolpathMetrics>),
+    path: PrintPath,
+    path_metrics: PathMetrics,
 }
+
+/// A file's trajectory metrics and its layers' ([`metrics::from_path`]).
+type PathMetrics = (ToolpathMetrics, Vec<ToolpathMetrics>);
 
 /// Reads [`Original`] in two passes side by side where there are threads: the analysis, which
 /// plans the file and keeps each move's timing, and one pass for the path (unplanned), its
@@ -411,9 +406,9 @@ fn smoothings_bound(input: &[u8], options: &VtgOptions) -> usize {
 struct Run<'a> {
     /// The original with its feed-only lines folded ([`feeds`]).
     input: &'a [u8],
-    path: &'a crate::path::PrintPath,
+    path: &'a PrintPath,
     /// The original's trajectory metrics, file and layers ([`metrics::from_path`]).
-    path_metrics: (ToolpathMetrics, Vec<ToolpathMetrics>),
+    path_metrics: PathMetrics,
     sources: &'a source::Sources,
     /// What every rewrite's offers take from the file alone ([`rewrite::FilePaths`]).
     paths: rewrite::FilePaths,
@@ -432,7 +427,31 @@ struct Run<'a> {
 /// What a rewrite's attempt measures of its output beside its analysis ([`Run::attempt`]).
 type Also<'a, X> = &'a (dyn Fn(&[u8]) -> X + Sync);
 
-impl Run<'_> {
+impl<'a> Run<'a> {
+    /// The run of `work`, the original `input` with its `folded` feed-only lines folded
+    /// ([`feeds`]), read as `path`, `sources` and `metrics` ([`read_original`]).
+    fn new(
+        (input, work, folded): (&[u8], &'a [u8], u64),
+        (path, sources, metrics): (&'a PrintPath, &'a source::Sources, PathMetrics),
+        options: &'a VtgOptions,
+    ) -> Self {
+        Run {
+            input: work,
+            path,
+            path_metrics: metrics,
+            sources,
+            paths: rewrite::FilePaths::of(work, path, sources, options),
+            options,
+            limits: rewrite::limits_for(path, options),
+            // The original's lines, and those its folded lines free.
+            allowed_lines: search::allowed_lines(input, options) + folded as i64,
+            known: std::sync::Mutex::new(None),
+            smoothings: std::sync::Mutex::new(smoothings::Smoothings::new(smoothings_bound(
+                input, options,
+            ))),
+        }
+    }
+
     /// One rewrite tried as `variant`, the layers `kept` marks left as they are, analysed and
     /// reported (`before`: the original's analysis), and what `also` measures of its output,
     /// beside its analysis.
@@ -513,7 +532,35 @@ impl Run<'_> {
         beside: Option<search::Beside<'_, T>>,
         progress: Progress<'_>,
     ) -> Result<(rewrite::Rewritten, Option<search::Measured<T>>), Error> {
-        let mut offers = match self.known_offers(variant, kept) {
+        let offers = self.offers((variant, kept), progress)?;
+        let written =
+            search::within_allowed_time(self.input, &offers, (self.options, before), beside);
+        self.remember(offers, kept);
+        written
+    }
+
+    /// [`Run::rewrite`] as a race's trial needs it: the first choice within the time allowed
+    /// written as its own forecast keeps it, not analysed ([`search::within_forecast_time`]).
+    fn rewrite_for_trial(
+        &self,
+        (variant, kept): (search::Variant, &[bool]),
+        before: &Report,
+        progress: Progress<'_>,
+    ) -> Result<rewrite::Rewritten, Error> {
+        let offers = self.offers((variant, kept), progress)?;
+        let written = search::within_forecast_time(self.input, &offers, (self.options, before));
+        self.remember(offers, kept);
+        Ok(written)
+    }
+
+    /// The offers of a rewrite as `variant`, the layers `kept` marks left as they are: the last
+    /// rewrite's where they serve ([`Run::known_offers`]), else made; progress to 0.8.
+    fn offers(
+        &self,
+        (variant, kept): (search::Variant, &[bool]),
+        progress: Progress<'_>,
+    ) -> Result<rewrite::Offers, Error> {
+        let offers = match self.known_offers(variant, kept) {
             Some(offers) => offers,
             None => {
                 let mut kept_smoothings = self.smoothings.lock().ok();
@@ -531,12 +578,14 @@ impl Run<'_> {
         if !progress(0.8) {
             return Err(Error::new(0, 0, ErrorKind::Cancelled));
         }
-        let written =
-            search::within_allowed_time(self.input, &offers, (self.options, before), beside);
+        Ok(offers)
+    }
+
+    /// `offers`, made for the layers `kept` marks left as they are, kept for the next rewrite.
+    fn remember(&self, offers: rewrite::Offers, kept: &[bool]) {
         if let Ok(mut known) = self.known.lock() {
-            *known = Some((std::mem::take(&mut offers), kept.to_vec()));
+            *known = Some((offers, kept.to_vec()));
         }
-        written
     }
 }
 
@@ -583,16 +632,9 @@ impl closed_loop::Again for Retry<'_, '_> {
         ((from, width), measure): (closed_loop::Span, closed_loop::Measure<'_>),
     ) -> Result<(closed_loop::Sampled, u64), Error> {
         let progress = &mut *self.progress;
-        let (rewritten, measured) =
-            self.run
-                .rewrite((variant, kept), before, Some(measure), &mut |g| {
-                    progress(from + width * g)
-                })?;
-        let sampled = match measured {
-            Some((_, _, Some(sampled))) => sampled,
-            _ => measure(&rewritten.output),
-        };
-        Ok((sampled, rewritten.corners_removed))
+        let rewritten = (self.run)
+            .rewrite_for_trial((variant, kept), before, &mut |g| progress(from + width * g))?;
+        Ok((measure(&rewritten.output), rewritten.corners_removed))
     }
 }
 
@@ -675,6 +717,52 @@ mod tests {
         let f = r.firmware.expect("figures");
         let walked = |bytes: &[u8]| firmware::figures(bytes, &options.analyze, &f.budget).unwrap();
         assert_eq!((f.before, f.after), (walked(demo), walked(&r.output)));
+    }
+
+    /// A race's trial writes what the whole-file rewrite writes where the analysis confirms
+    /// the time allowance's first choice, without that analysis: on a Klipper square whose
+    /// corners are bought with time, with the allowance spent (2 %) and none allowed.
+    #[test]
+    fn a_trial_writes_the_confirmed_choice_without_analysing_it() {
+        let mut src =
+            String::from("SET_VELOCITY_LIMIT ACCEL=5000 SQUARE_CORNER_VELOCITY=50\nM83\n");
+        src.push_str("G1 X60 Y50 F30000\nG1 Z0.2\nG1 F12000\n");
+        for _ in 0..10 {
+            for (x, y) in [(70, 50), (70, 70), (50, 70), (50, 50)] {
+                src.push_str(&format!("G1 X{x} Y{y} E0.6\n"));
+            }
+        }
+        for (allow, bought) in [(2.0, true), (0.0, false)] {
+            let options = VtgOptions {
+                dynamics: false,
+                allow_slower_pct: allow,
+                allow_more_energy_pct: 10.0,
+                allow_more_lines_pct: 1000.0,
+                ..Default::default()
+            };
+            let input = src.as_bytes();
+            let o = read_original(input, (input, None), &options).unwrap();
+            let run = Run::new(
+                (input, input, 0),
+                (&o.path, &o.sources, o.path_metrics),
+                &options,
+            );
+            let tried = (search::Variant::default(), &[][..]);
+            let (whole, measured) = run
+                .rewrite::<()>(tried, &o.before, None, &mut |_| true)
+                .unwrap();
+            let trial = run
+                .rewrite_for_trial(tried, &o.before, &mut |_| true)
+                .unwrap();
+            assert_eq!(trial.output, whole.output);
+            assert_eq!(trial.corners_removed, whole.corners_removed);
+            // Analysed where time was allowed, and bought within it; else written free.
+            assert_eq!(measured.is_some(), bought);
+            if let Some((after, _, _)) = measured {
+                assert!(after.time_s > o.before.time_s);
+                assert!(after.time_s <= o.before.time_s * (1.0 + allow / 100.0));
+            }
+        }
     }
 
     /// A file that comes back as it was, nothing rewritten, says why: here no corner is sharp.

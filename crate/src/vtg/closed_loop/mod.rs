@@ -378,10 +378,11 @@ pub(super) trait Again {
         span: Span,
     ) -> Result<(VtgReport, Option<Simulated>), Error>;
 
-    /// The same rewrite measured by `measure` alone, not analysed for a report (on the 34 MB
-    /// file the report's analysis and metrics cost 0.3–0.5 s a trial natively, more in a
-    /// single-threaded worker): all a race's trial simulates. Where the time allowance analyses
-    /// the rewrite, `measure` runs beside that analysis, on the output it keeps. With it, the
+    /// The same rewrite measured by `measure` alone, not analysed (on the 34 MB file the
+    /// report's analysis and metrics cost 0.3–0.5 s a trial natively, more in a
+    /// single-threaded worker): all a race's trial simulates. The time allowance's first
+    /// choice is written as its own forecast keeps it, without the analysis that confirms it
+    /// for a whole-file rewrite ([`crate::vtg::search::within_forecast_time`]). With it, the
     /// sharp corners the rewrite removes, by the rewrites' own count.
     fn measured(
         &mut self,
