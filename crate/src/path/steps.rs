@@ -98,10 +98,10 @@ impl<T: TakeSteps> Fold for Reading<T> {
 /// The planning side: the planner (`None`: a walk without planning), the sink, and the
 /// features and moves told so far.
 pub(super) struct Planning<'s, S> {
-    pub(super) planner: Option<Planner>,
-    pub(super) sink: &'s mut S,
-    pub(super) features: Vec<PathFeature>,
-    pub(super) count: usize,
+    planner: Option<Planner>,
+    sink: &'s mut S,
+    features: Vec<PathFeature>,
+    count: usize,
 }
 
 impl<'s, S: MoveSink> Planning<'s, S> {
@@ -117,17 +117,12 @@ impl<'s, S: MoveSink> Planning<'s, S> {
     /// The planner emptied into the sink, and what the side learnt: the features named, the
     /// moves told and the planned time, s (0 without planning).
     pub(super) fn finish(self) -> (Vec<PathFeature>, usize, f64) {
-        let Planning {
-            planner,
-            sink,
-            features,
-            count,
-        } = self;
-        let time_s = planner.map_or(0.0, |mut planner| {
+        let sink = self.sink;
+        let time_s = self.planner.map_or(0.0, |mut planner| {
             planner.flush(&mut |pm| sink.timed(pm));
             planner.elapsed_s()
         });
-        (features, count, time_s)
+        (self.features, self.count, time_s)
     }
 }
 
@@ -139,36 +134,38 @@ impl<S: MoveSink> TakeSteps for Planning<'_, S> {
             features,
             count,
         } = self;
-        match (step, planner) {
-            (Step::Feature(f), _) => features.push(f),
-            (Step::Limits(limits), planner) => {
+        match step {
+            Step::Feature(f) => features.push(f),
+            Step::Limits(limits) => {
                 if let Some(planner) = planner {
                     *planner.limits_mut() = limits.clone();
                 }
                 sink.limits(&limits);
             }
-            (
-                Step::Move {
-                    moved,
-                    layers,
-                    motion,
-                },
-                planner,
-            ) => {
+            Step::Move {
+                moved,
+                layers,
+                motion,
+            } => {
                 let index = *count;
                 *count += 1;
                 sink.moved(index, moved, layers, features);
-                match (planner, motion) {
-                    (Some(planner), None) => planner.flush(&mut |pm| sink.timed(pm)),
-                    (Some(planner), Some(motion)) => {
-                        planner.push(&motion, index as u64, &mut |pm| sink.timed(pm))
-                    }
-                    (None, _) => {}
+                let Some(planner) = planner else { return };
+                match motion {
+                    Some(motion) => planner.push(&motion, index as u64, &mut |pm| sink.timed(pm)),
+                    None => planner.flush(&mut |pm| sink.timed(pm)),
                 }
             }
-            (Step::Dwell(secs), Some(planner)) => planner.dwell(secs, &mut |pm| sink.timed(pm)),
-            (Step::Flush, Some(planner)) => planner.flush(&mut |pm| sink.timed(pm)),
-            (Step::Dwell(_) | Step::Flush, None) => {}
+            Step::Dwell(secs) => {
+                if let Some(planner) = planner {
+                    planner.dwell(secs, &mut |pm| sink.timed(pm));
+                }
+            }
+            Step::Flush => {
+                if let Some(planner) = planner {
+                    planner.flush(&mut |pm| sink.timed(pm));
+                }
+            }
         }
     }
 
