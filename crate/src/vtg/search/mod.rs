@@ -245,10 +245,10 @@ pub(crate) fn within_allowed_time<T>(
     let mut allowed_s = limits.time_s;
     let lines = offers.allowed_lines();
     for _ in 0..TUNING.time_rounds {
-        allowed_s = within_forecast(offers, (allowed_s, lines), &limits, before);
-        if allowed_s <= 0.0 || !allowed_s.is_finite() {
+        let Some(kept) = within_forecast(offers, (allowed_s, lines), &limits, before) else {
             break;
-        }
+        };
+        allowed_s = kept;
         let rewritten = offers.write(input, (allowed_s, lines), limits.mean_power_w);
         let (analysed, alongside) = crate::parallel::join(
             || analysed(&rewritten.output, input, options),
@@ -280,12 +280,9 @@ pub(crate) fn within_forecast_time(
 ) -> rewrite::Rewritten {
     let limits = Allowance::of(offers, (options, before));
     let lines = offers.allowed_lines();
-    let allowed_s = within_forecast(offers, (limits.time_s, lines), &limits, before);
-    let allowed_s = if allowed_s > 0.0 && allowed_s.is_finite() && TUNING.time_rounds > 0 {
-        allowed_s
-    } else {
-        0.0
-    };
+    let allowed_s = within_forecast(offers, (limits.time_s, lines), &limits, before)
+        .filter(|_| TUNING.time_rounds > 0)
+        .unwrap_or(0.0);
     offers.write(input, (allowed_s, lines), limits.mean_power_w)
 }
 
@@ -336,12 +333,13 @@ impl Allowance {
 /// (`before`'s `aux_j` over its time). The forecast tracks the whole file's analysis: on the
 /// 34 MB corpus file, whose first choice bought 102 s and went over by 3.3 kJ, the forecast
 /// was 110 s and 3.8 kJ, and within 0.2 kJ on the other files that buy time (not over on any).
+/// `None` where no time is left to spend (none allowed, or cut to none).
 fn within_forecast(
     offers: &rewrite::Offers,
     (mut allowed_s, lines): (f64, i64),
     limits: &Allowance,
     before: &Report,
-) -> f64 {
+) -> Option<f64> {
     let aux_power_w = before.energy.aux_j / before.time_s;
     for _ in 0..TUNING.time_rounds {
         if allowed_s <= 0.0 || !allowed_s.is_finite() || !aux_power_w.is_finite() {
@@ -353,7 +351,7 @@ fn within_forecast(
             Some(cut) => allowed_s = cut,
         }
     }
-    allowed_s
+    Some(allowed_s).filter(|&s| s > 0.0 && s.is_finite())
 }
 
 /// A rewrite's analysis and what it kept of its pass, as the time allowance measured it, and
